@@ -1,0 +1,226 @@
+"""The rule catalog: one TOML file per rule in ``rules/``, documented the way ruff documents rules.
+
+A rule file holds ``code``, ``name``, ``severity``, ``profiles``, ``source`` (seed document and
+section), ``summary`` (what it does), ``why`` (why it is bad), ``docs_vs_code`` (where PX4's code
+behaves differently), ``options`` (thresholds with defaults) and ``example.bad`` /
+``example.good`` as tiny event streams that the tests replay through the rule.
+"""
+
+from __future__ import annotations
+
+import functools
+import tomllib
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from fuzzoff.findings import Severity
+from fuzzoff.profiles import PX4_PROFILES, VEHICLE_TYPES
+
+SOURCE_DOCS = {
+    "000": "000_f9f2ad20eb5ad951.txt (PX4 User Guide, Offboard Mode, main / v1.16+)",
+    "002": "002_6cfbef319bb21c3e.txt (PX4 User Guide, Offboard mode, v1.13-v1.14, Chinese)",
+    "003": "003_87de8cdeab70eae1.txt (uORB-era offboard internals blog, legacy)",
+    "code": "px4-offboard-gate.md (what PX4's code does)",
+    "tool": "fuzzoff itself (input handling)",
+}
+
+RULE_URL = "https://fuzzoff.dev/rules/{code}"
+"""Where a rule's page is published; every machine-readable output links to it."""
+
+
+class CatalogError(ValueError):
+    """A rule file is malformed (a bug in the catalog, caught by the tests)."""
+
+
+@dataclass(frozen=True, slots=True)
+class RuleOption:
+    name: str
+    default: float | int | str | bool
+    doc: str
+
+
+@dataclass(frozen=True, slots=True)
+class Rule:
+    code: str
+    name: str
+    severity: Severity
+    summary: str
+    why: str
+    px4: tuple[str, ...]
+    vehicles: tuple[str, ...]
+    source_doc: str
+    source_section: str
+    docs_vs_code: str = ""
+    heuristic: bool = False
+    options: tuple[RuleOption, ...] = ()
+    example_bad: tuple[dict[str, Any], ...] = ()
+    example_good: tuple[dict[str, Any], ...] = ()
+    example_profile: dict[str, str] = field(default_factory=dict)
+    formats: tuple[str, ...] = ()
+    """Recording formats whose data can show this rule (empty = all)."""
+
+    @property
+    def url(self) -> str:
+        return RULE_URL.format(code=self.code)
+
+    def applies_to(self, px4: str, vehicle: str) -> bool:
+        return px4 in self.px4 and vehicle in self.vehicles
+
+    def option(self, name: str) -> RuleOption:
+        for opt in self.options:
+            if opt.name == name:
+                return opt
+        raise KeyError(f"{self.code} has no option {name!r}")
+
+    def profiles_text(self) -> str:
+        px4 = "all" if self.px4 == PX4_PROFILES else ", ".join(self.px4)
+        veh = "all" if self.vehicles == VEHICLE_TYPES else ", ".join(self.vehicles)
+        return f"PX4 {px4}; vehicles {veh}"
+
+
+def _catalog_dir() -> Path:
+    """``rules/`` beside the package in a checkout, or ``fuzzoff/_catalog`` in a wheel."""
+    packaged = Path(str(resources.files("fuzzoff"))) / "_catalog"
+    if packaged.is_dir():
+        return packaged
+    return Path(__file__).resolve().parent.parent / "rules"
+
+
+def _expand(
+    values: Iterable[str], universe: tuple[str, ...], what: str, path: Path
+) -> tuple[str, ...]:
+    chosen: set[str] = set()
+    for value in values:
+        if value == "all":
+            chosen.update(universe)
+        elif value.endswith("+") and value[:-1] in universe:
+            chosen.update(universe[universe.index(value[:-1]) :])
+        elif value in universe:
+            chosen.add(value)
+        elif value == "rover":
+            chosen.update(v for v in universe if v.startswith("rover"))
+        else:
+            raise CatalogError(f"{path.name}: unknown {what} {value!r}")
+    return tuple(v for v in universe if v in chosen)
+
+
+def _load_rule(path: Path) -> Rule:
+    with path.open("rb") as fh:
+        data = tomllib.load(fh)
+    try:
+        profiles = data.get("profiles", {})
+        source = data["source"]
+        options = tuple(
+            RuleOption(name=name, default=opt["default"], doc=opt["doc"])
+            for name, opt in data.get("options", {}).items()
+        )
+        example = data.get("example", {})
+        rule = Rule(
+            code=data["code"],
+            name=data["name"],
+            severity=Severity.parse(data["severity"]),
+            summary=data["summary"].strip(),
+            why=data["why"].strip(),
+            px4=_expand(profiles.get("px4", ["all"]), PX4_PROFILES, "PX4 profile", path),
+            vehicles=_expand(profiles.get("vehicles", ["all"]), VEHICLE_TYPES, "vehicle", path),
+            source_doc=source["doc"],
+            source_section=source["section"],
+            docs_vs_code=data.get("docs_vs_code", "").strip(),
+            heuristic=bool(data.get("heuristic", False)),
+            options=options,
+            example_bad=tuple(example.get("bad", ())),
+            example_good=tuple(example.get("good", ())),
+            example_profile=dict(example.get("profile", {})),
+            formats=tuple(data.get("formats", ())),
+        )
+    except KeyError as exc:
+        raise CatalogError(f"{path.name}: missing key {exc}") from None
+    if rule.code != path.stem:
+        raise CatalogError(f"{path.name}: code {rule.code} does not match the file name")
+    if rule.source_doc not in SOURCE_DOCS:
+        raise CatalogError(f"{path.name}: unknown source document {rule.source_doc!r}")
+    return rule
+
+
+@functools.cache
+def load_catalog() -> dict[str, Rule]:
+    """All rules by code, sorted by code."""
+    rules = [_load_rule(p) for p in sorted(_catalog_dir().glob("OFB*.toml"))]
+    return {r.code: r for r in rules}
+
+
+def get_rule(code: str) -> Rule:
+    catalog = load_catalog()
+    try:
+        return catalog[code.upper()]
+    except KeyError:
+        raise KeyError(f"unknown rule {code!r}") from None
+
+
+def expand_selectors(selectors: Iterable[str]) -> set[str]:
+    """Codes matching the selectors (a code, a prefix such as ``OFB1``, or ``ALL``).
+
+    Raises ``ValueError`` naming a selector that matches no rule.
+    """
+    codes = list(load_catalog())
+    chosen: set[str] = set()
+    for raw in selectors:
+        selector = raw.strip().upper()
+        if not selector:
+            continue
+        if selector == "ALL":
+            chosen.update(codes)
+            continue
+        matched = [c for c in codes if c.startswith(selector)]
+        if not matched:
+            raise ValueError(f"unknown rule selector {raw!r}: no rule code starts with it")
+        chosen.update(matched)
+    return chosen
+
+
+def render_page(rule: Rule) -> str:
+    """The rule's page in Markdown, with ruff's headings plus Profiles and Docs vs code."""
+    lines = [f"# {rule.name} ({rule.code})", ""]
+    lines += [f"Default severity: {rule.severity.label}. Profiles: {rule.profiles_text()}."]
+    if rule.heuristic:
+        lines += ["", "This rule is a heuristic: its thresholds are listed under Options."]
+    lines += ["", "## What it does", "", rule.summary, "", "## Why is this bad?", "", rule.why]
+    if rule.docs_vs_code:
+        lines += ["", "## Docs vs code", "", rule.docs_vs_code]
+    if rule.example_bad:
+        lines += ["", "## Example", "", "```toml", *_example_lines(rule.example_bad), "```"]
+    if rule.example_good:
+        lines += ["", "## Use instead", "", "```toml", *_example_lines(rule.example_good), "```"]
+    if rule.options:
+        lines += ["", "## Options", ""]
+        for opt in rule.options:
+            lines.append(f"- `{rule.code}.{opt.name}` (default `{opt.default}`): {opt.doc}")
+    lines += ["", "## Profiles", "", rule.profiles_text()]
+    lines += [
+        "",
+        "## References",
+        "",
+        f"- {SOURCE_DOCS[rule.source_doc]}, section \u201c{rule.source_section}\u201d",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def _example_lines(stream: tuple[dict[str, Any], ...]) -> list[str]:
+    out = []
+    for event in stream:
+        items = ", ".join(f"{k} = {_toml_value(v)}" for k, v in event.items())
+        out.append(f"{{ {items} }},")
+    return out
+
+
+def _toml_value(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return f'"{value}"'
+    if isinstance(value, list):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    return str(value)

@@ -1,0 +1,1 @@
+"""One module per ``fuzzoff`` subcommand (``add_parser`` + ``run``), discovered by ``cli``."""

@@ -1,0 +1,42 @@
+"""``fuzzoff profiles``: the PX4 versions and vehicle types the gate model and rules know."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from typing import Any
+
+from rich.console import Console
+from rich.table import Table
+
+from fuzzoff.profiles import PX4_PROFILE_NOTES, PX4_PROFILES, VEHICLE_NOTES, VEHICLE_TYPES
+
+
+def add_parser(sub: Any) -> None:
+    parser = sub.add_parser("profiles", help="list the modelled PX4 versions and vehicle types")
+    parser.add_argument("--format", choices=("terminal", "json"), default="terminal")
+    parser.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.format == "json":
+        data = {
+            "px4": [{"profile": p, "covers": PX4_PROFILE_NOTES[p]} for p in PX4_PROFILES],
+            "vehicles": [{"type": v, "name": VEHICLE_NOTES[v]} for v in VEHICLE_TYPES],
+        }
+        print(json.dumps(data, indent=2))
+        return 0
+    console = Console(highlight=False)
+    table = Table(title="PX4 profiles", show_edge=False)
+    table.add_column("profile")
+    table.add_column("covers")
+    for p in PX4_PROFILES:
+        table.add_row(p, PX4_PROFILE_NOTES[p])
+    console.print(table)
+    vehicles = Table(title="vehicle types", show_edge=False)
+    vehicles.add_column("type")
+    vehicles.add_column("vehicle")
+    for v in VEHICLE_TYPES:
+        vehicles.add_row(v, VEHICLE_NOTES[v])
+    console.print(vehicles)
+    return 0

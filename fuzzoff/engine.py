@@ -1,0 +1,317 @@
+"""One pass over a recording: source events -> shared state -> gate model -> checks -> findings."""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from collections.abc import Callable, Iterable, Sequence
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from fuzzoff.catalog import get_rule
+from fuzzoff.checks import CheckContext, load_all
+from fuzzoff.config import Settings
+from fuzzoff.events import Event, VehicleStatus, is_keepalive
+from fuzzoff.findings import FileReport, Finding, Report, Severity
+from fuzzoff.gate import GateModel, GateTransition
+from fuzzoff.profiles import (
+    DEFAULT_PX4,
+    DEFAULT_VEHICLE,
+    Profile,
+    ProfileError,
+    px4_profile_for,
+)
+from fuzzoff.sources import SourceError, find_recordings, open_source
+from fuzzoff.sources.base import RecordingInfo
+from fuzzoff.state import VehicleState
+
+Progress = Callable[[float], None]
+
+
+def resolve_profile(info: RecordingInfo, settings: Settings) -> Profile:
+    """The user's choice wins; else what the recording says; else the defaults (OFB003)."""
+    release = info.px4_version
+    detected_px4: str | None = None
+    if release:
+        try:
+            detected_px4 = px4_profile_for(release)
+        except ProfileError:
+            detected_px4 = None
+    px4 = settings.px4 or detected_px4 or DEFAULT_PX4
+    vehicle = settings.vehicle or info.vehicle_type or DEFAULT_VEHICLE
+    return Profile(
+        px4=px4,
+        vehicle=vehicle,
+        px4_detected=settings.px4 is not None or detected_px4 is not None,
+        vehicle_detected=settings.vehicle is not None or info.vehicle_type is not None,
+        px4_release=release,
+    )
+
+
+@dataclass(slots=True)
+class Timeline:
+    """Optional per-vehicle series for the gate command and the HTML report."""
+
+    keepalive: list[float] = field(default_factory=list)
+    recorded_modes: list[tuple[float, int | None, bool | None]] = field(default_factory=list)
+    transitions: list[GateTransition] = field(default_factory=list)
+    setpoint_kinds: dict[str, list[float]] = field(default_factory=dict)
+
+
+class VehicleRun:
+    """Shared state, gate model and checks for one vehicle of one recording."""
+
+    def __init__(
+        self,
+        vehicle: str,
+        profile: Profile,
+        settings: Settings,
+        info: RecordingInfo,
+        timeline: Timeline | None,
+    ) -> None:
+        self.state = VehicleState(mode_recorded="vehicle_status" in info.kinds)
+        self.gate = GateModel(profile, settings.params, vehicle)
+        self.ctx = CheckContext(
+            profile=profile,
+            settings=settings,
+            info=info,
+            vehicle=vehicle,
+            state=self.state,
+            gate=self.gate,
+        )
+        self.checks = [cls(self.ctx) for cls in load_all() if cls.wanted(self.ctx)]
+        self.handlers: dict[type, list[Callable[[Event], None]]] = {}
+        self._wants = [(check.wants, check.on_event) for check in self.checks]
+        self.timeline = timeline
+        self.last_t = 0.0
+
+    def _handlers_for(self, cls: type) -> list[Callable[[Event], None]]:
+        handlers = self.handlers.get(cls)
+        if handlers is None:
+            handlers = [h for wants, h in self._wants if issubclass(cls, wants)]
+            self.handlers[cls] = handlers
+        return handlers
+
+    def _dispatch(self, event: Event) -> None:
+        for handler in self._handlers_for(type(event)):
+            handler(event)
+
+    def _transitions(self, transitions: list[GateTransition]) -> None:
+        for tr in transitions:
+            self.state.predicted_offboard = self.gate.in_offboard
+            if self.timeline is not None:
+                self.timeline.transitions.append(tr)
+            self._dispatch(tr)
+
+    def feed(self, event: Event) -> None:
+        self.last_t = event.t
+        self.state.update(event)
+        self._transitions(self.gate.feed(event))
+        self.state.predicted_offboard = self.gate.in_offboard
+        if self.timeline is not None:
+            self._record(event)
+        self._dispatch(event)
+
+    def _record(self, event: Event) -> None:
+        assert self.timeline is not None
+        if is_keepalive(event):
+            self.timeline.keepalive.append(event.t)
+        if isinstance(event, VehicleStatus):
+            last = self.timeline.recorded_modes[-1] if self.timeline.recorded_modes else None
+            entry = (event.t, event.nav_state, event.armed)
+            if last is None or last[1:] != entry[1:]:
+                self.timeline.recorded_modes.append(entry)
+        if (event.origin == "sent" and not is_keepalive(event)) or event.kind.startswith("set_"):
+            series = self.timeline.setpoint_kinds.setdefault(event.kind, [])
+            if not series or event.t - series[-1] >= 0.05:
+                series.append(event.t)
+
+    def finish(self, t_end: float) -> list[Finding]:
+        self._transitions(self.gate.finish(t_end))
+        for check in self.checks:
+            check.finish(t_end)
+        return self.ctx.findings
+
+
+def run_events(
+    events: Iterable[Event],
+    info: RecordingInfo,
+    profile: Profile,
+    settings: Settings,
+    *,
+    timelines: dict[str, Timeline] | None = None,
+    on_event: Callable[[int], None] | None = None,
+) -> tuple[list[Finding], dict[str, Any]]:
+    """Run the gate and every enabled check over ``events`` (one recording, any vehicles)."""
+    runs: dict[str, VehicleRun] = {}
+    kinds: Counter[str] = Counter()
+    count = 0
+    t_end = 0.0
+    for event in events:
+        run = runs.get(event.vehicle)
+        if run is None:
+            timeline = None
+            if timelines is not None:
+                timeline = timelines.setdefault(event.vehicle, Timeline())
+            run = runs[event.vehicle] = VehicleRun(event.vehicle, profile, settings, info, timeline)
+        run.feed(event)
+        kinds[event.kind] += 1
+        t_end = max(t_end, event.t)
+        count += 1
+        if on_event is not None and count % 4096 == 0:
+            on_event(count)
+    findings: list[Finding] = []
+    not_checkable: dict[str, str] = {}
+    for run in runs.values():
+        findings.extend(run.finish(t_end))
+        for code, needs in run.ctx.not_checkable.items():
+            not_checkable.setdefault(code, needs)
+    if not runs:
+        # No event at all: every rule that needs a stream is not checkable.
+        empty = VehicleRun("", profile, settings, info, None)
+        findings.extend(empty.finish(0.0))
+        not_checkable.update(empty.ctx.not_checkable)
+    for code, needs in sorted(not_checkable.items()):
+        rule = get_rule(code)
+        if settings.enabled("OFB002"):
+            findings.append(
+                Finding(
+                    code="OFB002",
+                    name=get_rule("OFB002").name,
+                    severity=settings.severity_of("OFB002", Severity.INFO),
+                    message=f"{code} ({rule.name}) cannot be checked on this recording: {needs}",
+                )
+            )
+    stats = {
+        "events": count,
+        "duration_s": round(t_end, 6),
+        "vehicles": sorted(runs),
+        "kinds": dict(sorted(kinds.items())),
+    }
+    return findings, stats
+
+
+def _sort_key(finding: Finding) -> tuple[float, str, str]:
+    t = -math.inf if finding.time_s is None else finding.time_s
+    return (t, finding.vehicle, finding.code)
+
+
+def lint_file(
+    path: str | Path,
+    settings: Settings | None = None,
+    *,
+    progress: Progress | None = None,
+    timelines: dict[str, Timeline] | None = None,
+) -> FileReport:
+    """Lint one recording. Never raises for a bad file: it becomes OFB001 and ``complete=False``."""
+    settings = settings or Settings()
+    path = Path(path)
+    unreadable = get_rule("OFB001")
+    try:
+        source = open_source(path)
+        source.open()
+    except SourceError as exc:
+        report = FileReport(
+            str(path), "unknown", resolve_profile(RecordingInfo(str(path), "?"), settings)
+        )
+        report.complete = False
+        report.problems.append(exc.line())
+        report.findings.append(Finding("OFB001", unreadable.name, Severity.ERROR, exc.line()))
+        return report
+    try:
+        try:
+            info = source.probe()
+        except SourceError as exc:
+            info = RecordingInfo(str(path), source.format)
+            source.problems.append(_problem(exc))
+        profile = resolve_profile(info, settings)
+        report = FileReport(str(path), source.format, profile)
+
+        def tick(_: int) -> None:
+            if progress is not None:
+                fraction = source.progress()
+                if fraction is not None:
+                    progress(fraction)
+
+        try:
+            findings, stats = run_events(
+                source.events(), info, profile, settings, timelines=timelines, on_event=tick
+            )
+        except SourceError as exc:  # a reader that gives up mid-way keeps what it yielded
+            source.problems.append(_problem(exc))
+            findings, stats = [], {}
+    finally:
+        source.close()
+    for problem in source.problems:
+        line = problem.line(str(path))
+        report.problems.append(line)
+        findings.append(
+            Finding("OFB001", unreadable.name, Severity.ERROR, line, time_s=problem.time_s)
+        )
+    report.complete = not source.problems
+    if not (profile.px4_detected and profile.vehicle_detected) and settings.enabled("OFB003"):
+        findings.append(_assumed(profile))
+    findings = [f for f in findings if settings.enabled(f.code)]
+    findings.sort(key=_sort_key)
+    report.findings = findings
+    report.stats = {**stats, **source.stats}
+    if info.notes:
+        report.stats["notes"] = info.notes
+    if progress is not None:
+        progress(1.0)
+    return report
+
+
+def _problem(exc: SourceError) -> Any:
+    from fuzzoff.sources.base import SourceProblem
+
+    return SourceProblem(exc.what, exc.where)
+
+
+def _assumed(profile: Profile) -> Finding:
+    missing = []
+    if not profile.px4_detected:
+        missing.append(f"PX4 version (assumed {profile.px4}; set --px4)")
+    if not profile.vehicle_detected:
+        missing.append(f"vehicle type (assumed {profile.vehicle}; set --vehicle)")
+    rule = get_rule("OFB003")
+    return Finding(
+        "OFB003",
+        rule.name,
+        Severity.INFO,
+        "the recording does not say its " + " or its ".join(missing),
+    )
+
+
+def _lint_one(args: tuple[str, Settings]) -> FileReport:
+    return lint_file(args[0], args[1])
+
+
+def lint_paths(
+    paths: Sequence[str | Path],
+    settings: Settings | None = None,
+    *,
+    jobs: int = 1,
+    on_file: Callable[[FileReport], None] | None = None,
+) -> Report:
+    """Lint files and folders (searched recursively). ``jobs`` > 1 uses worker processes."""
+    settings = settings or Settings()
+    files: list[Path] = []
+    for raw in paths:
+        files.extend(find_recordings(Path(raw)))
+    report = Report()
+    if jobs > 1 and len(files) > 1:
+        with ProcessPoolExecutor(max_workers=jobs) as pool:
+            for file_report in pool.map(_lint_one, [(str(f), settings) for f in files]):
+                report.files.append(file_report)
+                if on_file is not None:
+                    on_file(file_report)
+    else:
+        for f in files:
+            file_report = lint_file(f, settings)
+            report.files.append(file_report)
+            if on_file is not None:
+                on_file(file_report)
+    return report

@@ -1,0 +1,623 @@
+"""The normalised event stream: one small frozen dataclass per thing a recording can say.
+
+Every reader (tlog, ULog, MCAP, ROS 2 bag, ROS 1 bag) turns its library's messages into these
+events, in recording-time order. The gate model and the checks see only these, never a
+library object. Field names follow px4_msgs / MAVLink where one exists; units are SI (metres,
+radians, seconds), frames as the message defines them (NED/FRD for PX4, MAVROS is converted to
+what MAVROS sends PX4 before it becomes an event).
+
+Common header of every event:
+
+* ``t``: recording time in seconds from the recording's first message (any topic);
+* ``vehicle``: which vehicle it belongs to, as text: the MAVLink system id (``"1"``) or the ROS
+  namespace (``""`` for none, ``"/px4_1"``);
+* ``where``: topic or MAVLink message type, and index / byte offset in the file where known;
+* ``sender_time_us``: the sender's own clock where the message carries one (PX4 ``timestamp``,
+  MAVLink ``time_boot_ms`` x 1000), else ``None``;
+* ``origin``: ``"sent"`` for a message on its way to the vehicle as recorded on the wire or the
+  bus (ROS 2 ``/fmu/in``, MAVLink to the autopilot), ``"vehicle"`` for what the vehicle itself
+  reports or logged internally (ULog topics, ``/fmu/out``, HEARTBEAT, MAVROS state), ``"model"``
+  for what fuzzoff's gate model predicts (``fuzzoff.gate.GateTransition``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+from typing import Any, ClassVar, Literal
+
+Origin = Literal["sent", "vehicle", "model"]
+Transport = Literal["ros2", "mavlink", "mavros", "uorb"]
+
+Vec2 = tuple[float, float]
+Vec3 = tuple[float, float, float]
+Quat = tuple[float, float, float, float]
+
+NAN = math.nan
+NAN3: Vec3 = (NAN, NAN, NAN)
+
+
+@dataclass(frozen=True, slots=True)
+class Where:
+    """Where an event sits in its file: topic or message type, and index / byte offset."""
+
+    topic: str
+    index: int | None = None
+    offset: int | None = None
+
+    def __str__(self) -> str:
+        parts = [self.topic]
+        if self.index is not None:
+            parts.append(f"#{self.index}")
+        if self.offset is not None:
+            parts.append(f"@{self.offset}")
+        return " ".join(parts)
+
+
+NOWHERE = Where("")
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Event:
+    """Common header; never instantiated directly."""
+
+    kind: ClassVar[str] = "event"
+
+    t: float
+    vehicle: str = ""
+    where: Where = NOWHERE
+    sender_time_us: int | None = None
+    origin: Origin = "sent"
+
+
+# ---------------------------------------------------------------------------------------------
+# Keep-alive / control-mode declarations (ROS 2 OffboardControlMode, uORB offboard_control_mode)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ControlMode(Event):
+    """``OffboardControlMode`` (1.13+ boolean layout). Field order is PX4's priority order.
+
+    ``actuator`` is the single flag of 1.13/1.14; ``thrust_and_torque`` and ``direct_actuator``
+    replace it from 1.15. ``layout`` says which one the message had.
+    """
+
+    kind: ClassVar[str] = "control_mode"
+
+    position: bool = False
+    velocity: bool = False
+    acceleration: bool = False
+    attitude: bool = False
+    body_rate: bool = False
+    thrust_and_torque: bool = False
+    direct_actuator: bool = False
+    actuator: bool = False
+    layout: Literal["actuator", "thrust_and_torque"] = "thrust_and_torque"
+
+    FLAG_ORDER: ClassVar[tuple[str, ...]] = (
+        "position",
+        "velocity",
+        "acceleration",
+        "attitude",
+        "body_rate",
+        "thrust_and_torque",
+        "direct_actuator",
+        "actuator",
+    )
+
+    def flags(self) -> tuple[str, ...]:
+        """The true flags, in priority order."""
+        return tuple(name for name in self.FLAG_ORDER if getattr(self, name))
+
+    def first_flag(self) -> str | None:
+        """The first true flag: the one that selects the controller chain (None if empty)."""
+        for name in self.FLAG_ORDER:
+            if getattr(self, name):
+                return name
+        return None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class LegacyControlMode(Event):
+    """Legacy (v1.5-v1.11) ``offboard_control_mode`` with ``ignore_*`` flags (seed 003)."""
+
+    kind: ClassVar[str] = "legacy_control_mode"
+
+    ignore_thrust: bool = False
+    ignore_attitude: bool = False
+    ignore_bodyrate: bool = False
+    ignore_position: bool = False
+    ignore_velocity: bool = False
+    ignore_acceleration_force: bool = False
+    ignore_alt_hold: bool = False
+
+
+# ---------------------------------------------------------------------------------------------
+# PX4 setpoint topics (ROS 2 /fmu/in/..., or their uORB copies in a ULog)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TrajectorySetpoint(Event):
+    """``TrajectorySetpoint``; the 1.13 ``x, y, z, vx...`` layout is normalised. NaN = unset."""
+
+    kind: ClassVar[str] = "trajectory"
+
+    position: Vec3 = NAN3
+    velocity: Vec3 = NAN3
+    acceleration: Vec3 = NAN3
+    jerk: Vec3 = NAN3
+    yaw: float = NAN
+    yawspeed: float = NAN
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class AttitudeSetpoint(Event):
+    """``VehicleAttitudeSetpoint``: ``q_d`` (w, x, y, z) and normalised ``thrust_body``."""
+
+    kind: ClassVar[str] = "attitude"
+
+    q_d: Quat = (NAN, NAN, NAN, NAN)
+    thrust_body: Vec3 = NAN3
+    yaw_sp_move_rate: float = NAN
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class RatesSetpoint(Event):
+    """``VehicleRatesSetpoint``: body rates (rad/s) and normalised ``thrust_body``."""
+
+    kind: ClassVar[str] = "rates"
+
+    roll: float = NAN
+    pitch: float = NAN
+    yaw: float = NAN
+    thrust_body: Vec3 = NAN3
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ThrustSetpoint(Event):
+    """``VehicleThrustSetpoint``: normalised FRD thrust."""
+
+    kind: ClassVar[str] = "thrust"
+
+    xyz: Vec3 = NAN3
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TorqueSetpoint(Event):
+    """``VehicleTorqueSetpoint``: normalised FRD torque."""
+
+    kind: ClassVar[str] = "torque"
+
+    xyz: Vec3 = NAN3
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ActuatorMotors(Event):
+    """``ActuatorMotors``: normalised motor commands; NaN = that motor is off (disarmed)."""
+
+    kind: ClassVar[str] = "actuator_motors"
+
+    control: tuple[float, ...] = ()
+    reversible_flags: int = 0
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ActuatorServos(Event):
+    """``ActuatorServos``: normalised servo commands."""
+
+    kind: ClassVar[str] = "actuator_servos"
+
+    control: tuple[float, ...] = ()
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class RoverPositionSetpoint(Event):
+    kind: ClassVar[str] = "rover_position"
+
+    position_ned: Vec2 = (NAN, NAN)
+    start_ned: Vec2 = (NAN, NAN)
+    cruising_speed: float = NAN
+    arrival_speed: float = NAN
+    yaw: float = NAN
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class RoverSpeedSetpoint(Event):
+    kind: ClassVar[str] = "rover_speed"
+
+    speed_body_x: float = NAN
+    speed_body_y: float = NAN
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class RoverAttitudeSetpoint(Event):
+    kind: ClassVar[str] = "rover_attitude"
+
+    yaw_setpoint: float = NAN
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class RoverRateSetpoint(Event):
+    kind: ClassVar[str] = "rover_rate"
+
+    yaw_rate_setpoint: float = NAN
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class RoverThrottleSetpoint(Event):
+    kind: ClassVar[str] = "rover_throttle"
+
+    throttle_body_x: float = NAN
+    throttle_body_y: float = NAN
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class RoverSteeringSetpoint(Event):
+    """``RoverSteeringSetpoint``: 1.16 ``normalized_steering_angle`` / ``normalized_speed_diff``,
+    1.17+ ``normalized_steering_setpoint`` (stored in ``normalized_steering_angle``)."""
+
+    kind: ClassVar[str] = "rover_steering"
+
+    normalized_steering_angle: float = NAN
+    normalized_speed_diff: float = NAN
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class PositionSetpointTriplet(Event):
+    """Legacy ``position_setpoint_triplet`` (only what the legacy rules need)."""
+
+    kind: ClassVar[str] = "position_setpoint_triplet"
+
+    previous_valid: bool = False
+    current_valid: bool = False
+    next_valid: bool = False
+    current_type: int = 0
+    current_position_valid: bool = False
+    current_velocity_valid: bool = False
+    current_yaw_valid: bool = False
+
+
+# ---------------------------------------------------------------------------------------------
+# MAVLink setpoints (from a tlog, or what MAVROS sends for a ROS setpoint topic)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class MavlinkTarget(Event):
+    """Fields every MAVLink setpoint carries: addressing, sender and the raw ``type_mask``."""
+
+    kind: ClassVar[str] = "mavlink_target"
+
+    target_system: int = 0
+    target_component: int = 0
+    source_system: int | None = None
+    source_component: int | None = None
+    type_mask: int = 0
+    transport: Transport = "mavlink"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class SetPositionTargetLocal(MavlinkTarget):
+    """``SET_POSITION_TARGET_LOCAL_NED`` (#84), values as sent (NED or body frame)."""
+
+    kind: ClassVar[str] = "set_position_target_local_ned"
+
+    coordinate_frame: int = 1
+    position: Vec3 = (0.0, 0.0, 0.0)
+    velocity: Vec3 = (0.0, 0.0, 0.0)
+    acceleration: Vec3 = (0.0, 0.0, 0.0)
+    yaw: float = 0.0
+    yaw_rate: float = 0.0
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class SetPositionTargetGlobal(MavlinkTarget):
+    """``SET_POSITION_TARGET_GLOBAL_INT`` (#86): ``lat_int``/``lon_int`` in 1e-7 degrees."""
+
+    kind: ClassVar[str] = "set_position_target_global_int"
+
+    coordinate_frame: int = 5
+    lat_int: int = 0
+    lon_int: int = 0
+    alt: float = 0.0
+    velocity: Vec3 = (0.0, 0.0, 0.0)
+    acceleration: Vec3 = (0.0, 0.0, 0.0)
+    yaw: float = 0.0
+    yaw_rate: float = 0.0
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class SetAttitudeTarget(MavlinkTarget):
+    """``SET_ATTITUDE_TARGET`` (#82): quaternion (w, x, y, z), body rates, thrust."""
+
+    kind: ClassVar[str] = "set_attitude_target"
+
+    q: Quat = (1.0, 0.0, 0.0, 0.0)
+    body_roll_rate: float = 0.0
+    body_pitch_rate: float = 0.0
+    body_yaw_rate: float = 0.0
+    thrust: float = 0.0
+    thrust_body: Vec3 | None = None
+
+
+MAVLINK_SETPOINTS: tuple[type[MavlinkTarget], ...] = (
+    SetPositionTargetLocal,
+    SetPositionTargetGlobal,
+    SetAttitudeTarget,
+)
+
+PX4_SETPOINTS: tuple[type[Event], ...] = (
+    TrajectorySetpoint,
+    AttitudeSetpoint,
+    RatesSetpoint,
+    ThrustSetpoint,
+    TorqueSetpoint,
+    ActuatorMotors,
+    ActuatorServos,
+    RoverPositionSetpoint,
+    RoverSpeedSetpoint,
+    RoverAttitudeSetpoint,
+    RoverRateSetpoint,
+    RoverThrottleSetpoint,
+    RoverSteeringSetpoint,
+)
+
+
+# ---------------------------------------------------------------------------------------------
+# Vehicle state as the vehicle reports it
+
+NAV_STATE_OFFBOARD = 14
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class VehicleStatus(Event):
+    """Mode and arming as reported (``vehicle_status``, HEARTBEAT, ``/mavros/state``).
+
+    ``nav_state`` uses PX4's ``vehicle_status.nav_state`` numbering whatever the source
+    (HEARTBEAT custom modes and MAVROS mode strings are mapped); ``mode`` is its name.
+    ``user_intention`` is ``nav_state_user_intention`` (v1.14+) or the v1.13 main state
+    mapped to a nav state, where recorded.
+    """
+
+    kind: ClassVar[str] = "vehicle_status"
+
+    nav_state: int | None = None
+    mode: str = ""
+    armed: bool | None = None
+    user_intention: int | None = None
+    failsafe: bool | None = None
+    vehicle_type: int | None = None
+    is_vtol: bool | None = None
+    origin: Origin = "vehicle"
+
+    @property
+    def in_offboard(self) -> bool:
+        return self.nav_state == NAV_STATE_OFFBOARD
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class VehicleControlModeStatus(Event):
+    """``vehicle_control_mode``: which controllers PX4 has enabled (``flag_control_*``)."""
+
+    kind: ClassVar[str] = "vehicle_control_mode"
+
+    offboard_enabled: bool = False
+    enabled: frozenset[str] = frozenset()
+    origin: Origin = "vehicle"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class FailsafeFlags(Event):
+    """Estimate and link validity (``failsafe_flags`` v1.14+, ``vehicle_status_flags`` before).
+
+    ``None`` = not recorded. ``*_valid`` are the negations of PX4's ``*_invalid`` flags.
+    """
+
+    kind: ClassVar[str] = "failsafe_flags"
+
+    offboard_control_signal_lost: bool | None = None
+    manual_control_signal_lost: bool | None = None
+    local_position_valid: bool | None = None
+    local_velocity_valid: bool | None = None
+    local_altitude_valid: bool | None = None
+    global_position_valid: bool | None = None
+    attitude_valid: bool | None = None
+    angular_velocity_valid: bool | None = None
+    home_position_valid: bool | None = None
+    origin: Origin = "vehicle"
+
+
+# ---------------------------------------------------------------------------------------------
+# Commands, acks, parameters, vehicle identity
+
+MAV_CMD_DO_SET_MODE = 176
+MAV_CMD_COMPONENT_ARM_DISARM = 400
+VEHICLE_CMD_SET_NAV_STATE = 100001
+PX4_MAIN_MODE_OFFBOARD = 6
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Command(Event):
+    """A command: ``COMMAND_LONG``/``COMMAND_INT``/``SET_MODE`` or ``VehicleCommand``.
+
+    ``SET_MODE`` (#11, what MAVROS ``set_mode`` sends) is normalised to ``DO_SET_MODE`` with
+    ``param1`` = base mode and ``param2`` = custom main mode, as PX4 itself does.
+    """
+
+    kind: ClassVar[str] = "command"
+
+    command: int
+    params: tuple[float, float, float, float, float, float, float] = (0.0,) * 7
+    target_system: int = 0
+    target_component: int = 0
+    source_system: int | None = None
+    source_component: int | None = None
+    from_external: bool | None = None
+    transport: Transport = "mavlink"
+
+    @property
+    def is_offboard_switch(self) -> bool:
+        """A switch to OFFBOARD (DO_SET_MODE custom main mode 6, or SET_NAV_STATE 14)."""
+        if self.command == MAV_CMD_DO_SET_MODE:
+            return int(self.params[0]) & 1 == 1 and int(self.params[1]) == PX4_MAIN_MODE_OFFBOARD
+        if self.command == VEHICLE_CMD_SET_NAV_STATE:
+            return int(self.params[0]) == NAV_STATE_OFFBOARD
+        return False
+
+    @property
+    def is_mode_switch(self) -> bool:
+        return self.command in (MAV_CMD_DO_SET_MODE, VEHICLE_CMD_SET_NAV_STATE)
+
+    @property
+    def is_arm(self) -> bool:
+        return self.command == MAV_CMD_COMPONENT_ARM_DISARM and round(self.params[0]) == 1
+
+    @property
+    def is_disarm(self) -> bool:
+        return self.command == MAV_CMD_COMPONENT_ARM_DISARM and round(self.params[0]) == 0
+
+
+ACK_RESULT_NAMES = {
+    0: "ACCEPTED",
+    1: "TEMPORARILY_REJECTED",
+    2: "DENIED",
+    3: "UNSUPPORTED",
+    4: "FAILED",
+    5: "IN_PROGRESS",
+    6: "CANCELLED",
+}
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class CommandAck(Event):
+    """``COMMAND_ACK`` / ``VehicleCommandAck``. 1.16/1.17 ack a mode switch twice: last wins."""
+
+    kind: ClassVar[str] = "command_ack"
+
+    command: int
+    result: int
+    target_system: int = 0
+    target_component: int = 0
+    origin: Origin = "vehicle"
+
+    @property
+    def accepted(self) -> bool:
+        return self.result == 0
+
+    @property
+    def result_name(self) -> str:
+        return ACK_RESULT_NAMES.get(self.result, str(self.result))
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Parameter(Event):
+    """A parameter value the recording shows (``PARAM_VALUE``, ULog parameters)."""
+
+    kind: ClassVar[str] = "parameter"
+
+    name: str
+    value: float
+    origin: Origin = "vehicle"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class VehicleInfo(Event):
+    """What the recording says about the vehicle's identity (firmware, airframe).
+
+    ``px4_version``: the release as ``"1.15.4"`` where known; ``vehicle_type``: one of the
+    profile names (``mc``, ``fw``, ``vtol``, ``rover-ackermann``...) where it can be told;
+    ``mav_type``: MAVLink ``MAV_TYPE`` where known.
+    """
+
+    kind: ClassVar[str] = "vehicle_info"
+
+    px4_version: str | None = None
+    vehicle_type: str | None = None
+    mav_type: int | None = None
+    origin: Origin = "vehicle"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class StatusText(Event):
+    """A human-readable message from the vehicle (STATUSTEXT, ULog logged message). Untrusted."""
+
+    kind: ClassVar[str] = "status_text"
+
+    severity: int = 6
+    text: str = ""
+    origin: Origin = "vehicle"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Dropout(Event):
+    """The logger itself lost data here (ULog dropout record) for ``duration_s``."""
+
+    kind: ClassVar[str] = "dropout"
+
+    duration_s: float = 0.0
+    origin: Origin = "vehicle"
+
+
+KEEPALIVE_ROS: tuple[type[Event], ...] = (ControlMode, LegacyControlMode)
+KEEPALIVE_TYPES: tuple[type[Event], ...] = (*KEEPALIVE_ROS, *MAVLINK_SETPOINTS)
+
+ALL_EVENT_TYPES: tuple[type[Event], ...] = (
+    ControlMode,
+    LegacyControlMode,
+    *PX4_SETPOINTS,
+    PositionSetpointTriplet,
+    *MAVLINK_SETPOINTS,
+    VehicleStatus,
+    VehicleControlModeStatus,
+    FailsafeFlags,
+    Command,
+    CommandAck,
+    Parameter,
+    VehicleInfo,
+    StatusText,
+    Dropout,
+)
+
+EVENT_BY_KIND: dict[str, type[Event]] = {cls.kind: cls for cls in ALL_EVENT_TYPES}
+
+
+def is_keepalive(event: Event) -> bool:
+    """Is this a keep-alive message as the docs define it (OCM on ROS 2, a setpoint on MAVLink)?"""
+    return isinstance(event, KEEPALIVE_TYPES)
+
+
+def event_to_dict(event: Event) -> dict[str, Any]:
+    """A JSON-friendly dict of the event (``kind`` first); NaN stays NaN (``float``)."""
+    out: dict[str, Any] = {"kind": event.kind}
+    for f in fields(event):
+        value = getattr(event, f.name)
+        if isinstance(value, Where):
+            value = {"topic": value.topic, "index": value.index, "offset": value.offset}
+        elif isinstance(value, frozenset):
+            value = sorted(value)
+        elif isinstance(value, tuple):
+            value = list(value)
+        out[f.name] = value
+    return out
+
+
+def event_from_dict(data: dict[str, Any]) -> Event:
+    """Build an event from ``event_to_dict`` output or a hand-written example (rule pages)."""
+    data = dict(data)
+    cls = EVENT_BY_KIND[data.pop("kind")]
+    kwargs: dict[str, Any] = {}
+    names = {f.name for f in fields(cls)}
+    for key, value in data.items():
+        if key not in names:
+            raise ValueError(f"{cls.__name__} has no field {key!r}")
+        if key == "where" and isinstance(value, dict):
+            value = Where(**value)
+        elif key == "where" and isinstance(value, str):
+            value = Where(value)
+        elif key == "enabled":
+            value = frozenset(value)
+        elif isinstance(value, list):
+            value = tuple(float("nan") if v == "nan" else v for v in value)
+        elif value == "nan":
+            value = math.nan
+        kwargs[key] = value
+    return cls(**kwargs)

@@ -1,0 +1,47 @@
+"""The gate model's output: a timeline of transitions, each an event the checks also see."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar, Literal
+
+from fuzzoff.events import Event, Origin
+
+TransitionKind = Literal[
+    "signal_available",
+    "signal_lost",
+    "request_accepted",
+    "request_rejected",
+    "arm_accepted",
+    "arm_rejected",
+    "failsafe",
+    "offboard_resumed",
+    "mode",
+    "controller",
+    "setpoint_dropped",
+    "disarmed",
+]
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class GateTransition(Event):
+    """One change the gate model predicts, at ``t``, caused by ``cause`` (None for a timeout).
+
+    ``spec`` names the section of px4-offboard-gate.md the transition implements;
+    ``unverified`` marks behaviour the spec lists as unverified (section 15).
+    """
+
+    kind: ClassVar[str] = "gate"
+
+    what: TransitionKind
+    message: str
+    spec: str
+    cause: Event | None = None
+    nav_state: int | None = None
+    """The effective nav_state after the transition, where it changed or is known."""
+    action: str | None = None
+    """Failsafe action name (e.g. ``POSCTL``, ``AUTO_RTL``) for ``failsafe`` transitions."""
+    reason: str | None = None
+    """Why a request was rejected or a setpoint dropped, in PX4's terms."""
+    unverified: bool = False
+    origin: Origin = "model"

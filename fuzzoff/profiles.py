@@ -1,0 +1,158 @@
+"""PX4 version profiles and vehicle types (gate spec section 0, rules.md "Profile").
+
+A profile is the pair (PX4 profile, vehicle type). ``--px4`` takes a release such as ``1.15.4``
+and maps it to the modelled profile; the report always says whether it was detected.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+PX4_PROFILES: tuple[str, ...] = ("legacy", "1.11", "1.13", "1.14", "1.15", "1.16", "1.17", "main")
+"""Ordered oldest to newest; ``1.11`` is the transition release of gate spec section 2.2."""
+
+PX4_PROFILE_NOTES: dict[str, str] = {
+    "legacy": "v1.5-v1.10: ignore_* control mode, fixed 500 ms loss timeout",
+    "1.11": "v1.11: legacy receiver, timestamp-age gate with COM_OF_LOSS_T (0.5 s)",
+    "1.13": "v1.12-v1.13: boolean OffboardControlMode, hysteresis gate, COM_OBL_ACT/COM_OBL_RC_ACT",
+    "1.14": "v1.14: new Commander, failsafe framework, disarmed switch always accepted",
+    "1.15": "v1.15: thrust_and_torque/direct_actuator flags, SET_NAV_STATE",
+    "1.16": "v1.16: acceleration needs attitude, 200 ms last-valid fallback, double mode ack",
+    "1.17": "v1.17: offboard loss without RC uses NAV_RCL_ACT, double mode ack",
+    "main": "v1.18 / main: accepts_offboard_setpoints, thrust required for SET_ATTITUDE_TARGET",
+}
+
+VEHICLE_TYPES: tuple[str, ...] = (
+    "mc",
+    "fw",
+    "vtol",
+    "rover-ackermann",
+    "rover-differential",
+    "rover-mecanum",
+)
+
+VEHICLE_NOTES: dict[str, str] = {
+    "mc": "multicopter",
+    "fw": "fixed-wing",
+    "vtol": "VTOL",
+    "rover-ackermann": "Ackermann rover",
+    "rover-differential": "differential rover",
+    "rover-mecanum": "mecanum rover",
+}
+
+DEFAULT_PX4 = "1.15"
+DEFAULT_VEHICLE = "mc"
+
+_RELEASE = re.compile(r"^v?(\d+)\.(\d+)(?:\.(\d+))?")
+
+
+class ProfileError(ValueError):
+    """An unknown PX4 version or vehicle type (a usage error)."""
+
+
+def px4_profile_for(version: str) -> str:
+    """Map a release (``1.15.4``, ``v1.17.0-beta1``) or a profile name to the modelled profile."""
+    text = version.strip()
+    if text in PX4_PROFILES:
+        return text
+    match = _RELEASE.match(text)
+    if match is None:
+        raise ProfileError(
+            f"unknown PX4 version {version!r}: give a release such as 1.15.4, "
+            f"or one of {', '.join(PX4_PROFILES)}"
+        )
+    major, minor = int(match.group(1)), int(match.group(2))
+    if major != 1:
+        return "main" if major > 1 else "legacy"
+    if minor <= 10:
+        return "legacy"
+    if minor == 11:
+        return "1.11"
+    if minor in (12, 13):
+        return "1.13"
+    if minor >= 18:
+        return "main"
+    return f"1.{minor}"
+
+
+def vehicle_type_for(name: str) -> str:
+    """Validate and normalise a vehicle type name (``rover`` alone means differential)."""
+    text = name.strip().lower()
+    aliases = {
+        "multicopter": "mc",
+        "copter": "mc",
+        "quad": "mc",
+        "fixedwing": "fw",
+        "fixed-wing": "fw",
+        "plane": "fw",
+        "rover": "rover-differential",
+    }
+    text = aliases.get(text, text)
+    if text not in VEHICLE_TYPES:
+        raise ProfileError(f"unknown vehicle type {name!r}: one of {', '.join(VEHICLE_TYPES)}")
+    return text
+
+
+def at_least(profile: str, oldest: str) -> bool:
+    """True when ``profile`` is ``oldest`` or newer."""
+    return PX4_PROFILES.index(profile) >= PX4_PROFILES.index(oldest)
+
+
+def is_rover(vehicle: str) -> bool:
+    return vehicle.startswith("rover")
+
+
+@dataclass(frozen=True, slots=True)
+class Profile:
+    """The profile a recording is judged against, and where each half came from."""
+
+    px4: str = DEFAULT_PX4
+    vehicle: str = DEFAULT_VEHICLE
+    px4_detected: bool = False
+    vehicle_detected: bool = False
+    px4_release: str | None = None
+    """The exact release the recording names, where it names one."""
+
+    @property
+    def detected(self) -> bool:
+        return self.px4_detected and self.vehicle_detected
+
+    def at_least(self, oldest: str) -> bool:
+        return at_least(self.px4, oldest)
+
+    @property
+    def is_rover(self) -> bool:
+        return is_rover(self.vehicle)
+
+    def describe(self) -> str:
+        px4 = f"PX4 {self.px4}"
+        if self.px4_release and px4_profile_for(self.px4_release) == self.px4:
+            px4 += f" ({self.px4_release})"
+        px4 += " detected" if self.px4_detected else " assumed"
+        vehicle = f"{self.vehicle} " + ("detected" if self.vehicle_detected else "assumed")
+        return f"{px4}, {vehicle}"
+
+
+# MAVLink MAV_TYPE -> vehicle type (rovers cannot be told apart from MAV_TYPE alone).
+MAV_TYPE_VEHICLE: dict[int, str] = {
+    1: "fw",
+    2: "mc",
+    3: "mc",
+    4: "mc",
+    10: "rover-differential",
+    13: "mc",
+    14: "mc",
+    15: "mc",
+    19: "vtol",
+    20: "vtol",
+    21: "vtol",
+    22: "vtol",
+    23: "vtol",
+    24: "vtol",
+    25: "vtol",
+    29: "mc",
+}
+
+# vehicle_status.vehicle_type -> vehicle type (is_vtol checked first by callers).
+PX4_VEHICLE_TYPE: dict[int, str] = {1: "mc", 2: "fw", 3: "rover-differential"}

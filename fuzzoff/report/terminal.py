@@ -1,0 +1,108 @@
+"""Terminal output with rich: findings grouped per file, then a summary.
+
+Colour only on a terminal and without ``NO_COLOR`` (rich decides); every string that comes from a
+recording goes through ``printable`` and into ``Text`` objects, never into markup.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+
+from rich.console import Console
+from rich.table import Table
+from rich.text import Text
+
+from fuzzoff.catalog import get_rule
+from fuzzoff.findings import FileReport, Finding, Report, Severity
+from fuzzoff.report.sanitize import printable
+
+STYLE = {Severity.ERROR: "bold red", Severity.WARNING: "yellow", Severity.INFO: "cyan"}
+
+
+def finding_line(finding: Finding) -> Text:
+    when = "   whole file" if finding.time_s is None else f"{finding.time_s:11.3f}s"
+    line = Text()
+    line.append(when, style="dim")
+    line.append("  ")
+    line.append(finding.code, style="bold")
+    line.append(" ")
+    line.append(f"{finding.severity.label:<7}", style=STYLE[finding.severity])
+    line.append(" ")
+    if finding.vehicle:
+        line.append(f"[{printable(finding.vehicle, 40)}] ", style="magenta")
+    line.append(printable(finding.message))
+    if finding.where is not None and finding.where.topic:
+        line.append(f"  ({printable(str(finding.where), 120)})", style="dim")
+    return line
+
+
+def print_file(console: Console, file: FileReport, fail_on: Severity, quiet: bool) -> None:
+    shown = [f for f in file.findings if not quiet or f.severity >= fail_on]
+    header = Text()
+    header.append(printable(file.path), style="bold underline")
+    header.append(f"  {file.format}, {file.profile.describe()}", style="dim")
+    if not file.complete:
+        header.append("  (incomplete)", style="bold red")
+    if quiet and not shown:
+        return
+    console.print(header)
+    for finding in shown:
+        console.print(finding_line(finding), soft_wrap=True)
+    if not shown:
+        console.print(Text("  no findings", style="green"))
+    console.print()
+
+
+def print_summary(console: Console, report: Report, fail_on: Severity) -> None:
+    counts = Counter(f.severity for f in report.findings)
+    table = Table(title="fuzzoff summary", show_edge=False)
+    table.add_column("files", justify="right")
+    table.add_column("errors", justify="right", style=STYLE[Severity.ERROR])
+    table.add_column("warnings", justify="right", style=STYLE[Severity.WARNING])
+    table.add_column("info", justify="right", style=STYLE[Severity.INFO])
+    table.add_column("unreadable", justify="right")
+    table.add_row(
+        str(len(report.files)),
+        str(counts[Severity.ERROR]),
+        str(counts[Severity.WARNING]),
+        str(counts[Severity.INFO]),
+        str(sum(1 for f in report.files if not f.complete)),
+    )
+    console.print(table)
+    status = report.exit_status(fail_on)
+    verdict = {
+        0: "passed",
+        1: f"failed (findings at or above {fail_on.label})",
+        2: "incomplete input",
+    }
+    console.print(Text(f"result: {verdict[status]}", style="bold"))
+
+
+def print_statistics(console: Console, report: Report) -> None:
+    counts = Counter(f.code for f in report.findings)
+    table = Table(show_edge=False)
+    table.add_column("count", justify="right")
+    table.add_column("code")
+    table.add_column("name")
+    table.add_column("severity")
+    for code, count in sorted(counts.items(), key=lambda kv: (-kv[1], kv[0])):
+        rule = get_rule(code)
+        table.add_row(str(count), code, rule.name, rule.severity.label)
+    console.print(table)
+
+
+def print_report(
+    console: Console,
+    report: Report,
+    fail_on: Severity,
+    *,
+    quiet: bool = False,
+    statistics: bool = False,
+) -> None:
+    if statistics:
+        print_statistics(console, report)
+        return
+    for file in report.files:
+        print_file(console, file, fail_on, quiet)
+    if not quiet:
+        print_summary(console, report, fail_on)

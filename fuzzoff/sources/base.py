@@ -1,0 +1,109 @@
+"""What every reader provides: a probe of the recording, then its events in time order.
+
+A reader never judges. It raises ``SourceError`` when the file cannot be read at all (empty,
+foreign, no header) and records a ``SourceProblem`` when part of it cannot be read (truncated,
+corrupt), after yielding every event it could read before that point.
+"""
+
+from __future__ import annotations
+
+import abc
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import TracebackType
+from typing import Any
+
+from fuzzoff.events import Event
+
+
+class SourceError(Exception):
+    """The recording cannot be read at all. ``str()`` is the one line the user sees."""
+
+    def __init__(self, path: Path | str, what: str, where: str | None = None) -> None:
+        self.path = str(path)
+        self.what = what
+        self.where = where
+        super().__init__(self.line())
+
+    def line(self) -> str:
+        at = f" at {self.where}" if self.where else ""
+        return f"{self.path}: {self.what}{at}"
+
+
+@dataclass(frozen=True, slots=True)
+class SourceProblem:
+    """Part of a recording that could not be read; everything before it was."""
+
+    what: str
+    where: str | None = None
+    time_s: float | None = None
+
+    def line(self, path: str) -> str:
+        at = f" at {self.where}" if self.where else ""
+        return f"{path}: {self.what}{at}"
+
+
+@dataclass(slots=True)
+class RecordingInfo:
+    """What a reader learns before (or without) decoding messages.
+
+    ``kinds`` is the set of event kinds the recording can produce (``Event.kind`` values), so a
+    rule can say it is not checkable before seeing the stream. ``sampled_intervals`` is set for
+    recordings that subsample topics (ULog): event kind -> the logger's interval in seconds.
+    """
+
+    path: str
+    format: str
+    kinds: set[str] = field(default_factory=set)
+    px4_version: str | None = None
+    vehicle_type: str | None = None
+    vehicles: list[str] = field(default_factory=list)
+    message_count: int | None = None
+    sampled_intervals: dict[str, float] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def sampled(self) -> bool:
+        return bool(self.sampled_intervals)
+
+
+class Source(abc.ABC):
+    """One recording of one format. Use as a context manager."""
+
+    format: str = "?"
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+        self.problems: list[SourceProblem] = []
+        self.stats: dict[str, Any] = {}
+
+    def __enter__(self) -> Source:
+        self.open()
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.close()
+
+    def open(self) -> None:  # noqa: B027 - optional hook
+        """Open the file; raise ``SourceError`` if it cannot be read at all."""
+
+    def close(self) -> None:  # noqa: B027 - optional hook
+        """Release the file."""
+
+    @abc.abstractmethod
+    def probe(self) -> RecordingInfo:
+        """What the recording holds, read cheaply (header, index, summary)."""
+
+    @abc.abstractmethod
+    def events(self) -> Iterator[Event]:
+        """The normalised events in recording-time order; streaming where the library can."""
+
+    def progress(self) -> float | None:
+        """Fraction of the file consumed so far, where the reader can tell."""
+        return None
