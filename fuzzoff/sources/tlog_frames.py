@@ -1,0 +1,292 @@
+"""Split a .tlog into records and hand the packets that matter to pymavlink (formats.md 7).
+
+A tlog is ``[8-byte big-endian µs timestamp][one MAVLink packet]`` repeated, with no header or
+index. pymavlink decodes the packets; this module only finds where each record starts and ends
+(the packet length is in its header) and decides which packets to decode.
+
+Why not ``mavutil.mavlink_connection`` (which gives a ``mavmmaplog``)? Measured against the
+targets of issue 3 part 10 (see bench/bench_tlog.py):
+
+* its type filter needs its index, built by a pure-Python pre-scan that keeps one list entry
+  per message: memory grows with the file (about 40 MB per million messages), and every page of
+  the mmapped file it touches counts in the process's RSS, so peak RSS grows with the file too;
+* the pre-scan silently steps over bytes it cannot frame and over message ids the dialect does
+  not know, so a corrupt region is never reported, and with a type filter the skipped messages
+  are never CRC-checked at all;
+* without a filter it decodes everything (about 90 000 messages/s), which is what we must beat
+  on logs where offboard messages are a small share.
+
+So the file is read sequentially in fixed-size chunks (flat memory, no mmap), each record is
+framed here, the wanted message types go to pymavlink's ``MAVLink.decode`` (header, CRC with
+CRC_EXTRA, payload unpacking) and every other known packet only has its CRC checked with
+pymavlink's ``x25crc``, so corruption anywhere is still found. After a bad record the reader
+resynchronises on the next record whose timestamp is plausible and whose CRC is good, and
+reports the skipped bytes as one corrupt region.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import struct
+from collections import Counter
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from typing import Any, BinaryIO
+
+os.environ.setdefault("MAVLINK20", "1")  # formats.md 7.2: before any pymavlink import
+
+from pymavlink.dialects.v20 import common as mavlink
+
+CHUNK = 1 << 20
+"""Bytes read at a time; memory stays at a few chunks whatever the file size."""
+
+MAX_RECORD = 8 + 10 + 255 + 2 + 13
+"""Largest record: timestamp, MAVLink 2 header, payload, CRC, signature."""
+
+BACKWARD_US = 5_000_000
+"""A timestamp this far before the previous one is not plausible."""
+
+FORWARD_US = 3_600_000_000
+"""Nor one this far after it (unless the following record confirms the jump)."""
+
+MAX_UNKNOWN_IDS = 256
+"""Distinct unknown message ids tracked one by one; beyond that they are only counted."""
+
+_MAGIC = re.compile(b"[\xfd\xfe]")
+_TS = struct.Struct(">Q")
+_CRC = struct.Struct("<H")
+_CRC_EXTRA: dict[int, int] = {mid: cls.crc_extra for mid, cls in mavlink.mavlink_map.items()}
+_NAMES: dict[int, str] = {mid: cls.msgname for mid, cls in mavlink.mavlink_map.items()}
+
+
+def message_name(msgid: int) -> str:
+    return _NAMES.get(msgid, f"UNKNOWN_{msgid}")
+
+
+@dataclass(slots=True)
+class Region:
+    """Bytes skipped as unreadable: [start, end) in the file, after the record at ``t_us``."""
+
+    start: int
+    end: int
+    why: str
+    ts_us: int | None
+
+
+@dataclass(slots=True)
+class FrameStats:
+    packets: int = 0
+    by_id: Counter[int] = field(default_factory=Counter)
+    unknown: Counter[int] = field(default_factory=Counter)
+    unknown_first: dict[int, tuple[int, int]] = field(default_factory=dict)
+    """Unknown id -> (offset, timestamp) of its first packet."""
+    unknown_other: int = 0
+    regions: list[Region] = field(default_factory=list)
+    truncated_at: int | None = None
+    """Offset of an incomplete last record, if the file ends inside one."""
+    first_ts: int | None = None
+    last_ts: int | None = None
+    size: int = 0
+
+
+class Framer:
+    """Iterate over the records of one tlog; decode only ``wanted`` message ids.
+
+    ``verify`` CRC-checks the packets that are not decoded too (the lint pass); the probe
+    leaves it off to stay cheap, so its counts may include a packet that later proves corrupt.
+    """
+
+    def __init__(self, fh: BinaryIO, size: int, wanted: frozenset[int], verify: bool) -> None:
+        self.fh = fh
+        self.wanted = wanted
+        self.verify = verify
+        self.stats = FrameStats(size=size)
+        self.mav = mavlink.MAVLink(None)
+        self.mav.robust_parsing = True
+        self.buf = b""
+        self.base = 0
+        self.eof = False
+        self.consumed = 0
+
+    # -- buffer ---------------------------------------------------------------------------
+
+    def _fill(self, pos: int) -> int:
+        """Drop bytes before ``pos`` and read one more chunk; returns the new ``pos``."""
+        chunk = self.fh.read(CHUNK)
+        if not chunk:
+            self.eof = True
+        self.base += pos
+        self.buf = self.buf[pos:] + chunk
+        return 0
+
+    # -- checks ---------------------------------------------------------------------------
+
+    def _record_end(self, buf: bytes, pos: int) -> int | None:
+        """End of the record at ``pos`` from its header, or None if its start byte is wrong."""
+        magic = buf[pos + 8]
+        if magic == 0xFD:
+            return pos + 20 + buf[pos + 9] + (13 if buf[pos + 10] & 1 else 0)
+        if magic == 0xFE:
+            return pos + 16 + buf[pos + 9]
+        return None
+
+    @staticmethod
+    def _msgid(buf: bytes, pos: int) -> int:
+        if buf[pos + 8] == 0xFD:
+            return buf[pos + 15] | (buf[pos + 16] << 8) | (buf[pos + 17] << 16)
+        return buf[pos + 13]
+
+    @staticmethod
+    def _crc_ok(buf: bytes, pos: int, end: int, msgid: int) -> bool:
+        """pymavlink's CRC (x25 with the message's CRC_EXTRA); False for unknown ids."""
+        extra = _CRC_EXTRA.get(msgid)
+        if extra is None:
+            return False
+        crc_at = end - (13 if buf[pos + 8] == 0xFD and buf[pos + 10] & 1 else 0) - 2
+        crc = mavlink.x25crc(buf[pos + 9 : crc_at])
+        crc.accumulate(bytes((extra,)))
+        expected: int = _CRC.unpack_from(buf, crc_at)[0]
+        return bool(crc.crc == expected)
+
+    def _plausible(self, ts: int, slack: int = 1) -> bool:
+        last = self.stats.last_ts
+        return last is None or last - BACKWARD_US * slack <= ts <= last + FORWARD_US * slack
+
+    # -- main loop ------------------------------------------------------------------------
+
+    def records(self) -> Iterator[tuple[int, int, int, Any]]:
+        """(offset, timestamp µs, msgid, decoded message) for every wanted, valid packet."""
+        stats = self.stats
+        by_id = stats.by_id
+        wanted = self.wanted
+        verify = self.verify
+        decode = self.mav.decode
+        crc_ok = self._crc_ok
+        unpack_ts = _TS.unpack_from
+        buf = self.buf
+        pos = 0
+        n = 0
+        first = True
+        while True:
+            if pos + 18 > n or (pos + MAX_RECORD > n and not self.eof):
+                if not self.eof:
+                    pos = self._fill(pos)
+                    buf = self.buf
+                    n = len(buf)
+                    continue
+                if pos >= n:
+                    break
+            if pos + 11 > n:
+                self._tail(pos)
+                break
+            end = self._record_end(buf, pos)
+            if end is None:
+                pos, buf, n = self._resync(pos, "no MAVLink start byte")
+                continue
+            if end > n:
+                self._tail(pos)
+                break
+            ts = unpack_ts(buf, pos)[0]
+            msgid = self._msgid(buf, pos)
+            last = stats.last_ts
+            if (
+                last is not None
+                and not last - BACKWARD_US <= ts <= last + FORWARD_US
+                and not self._jump_confirmed(buf, pos, end, ts, n)
+            ):
+                pos, buf, n = self._resync(pos, "implausible timestamp")
+                continue
+            msg: Any = None
+            if msgid in wanted:
+                try:
+                    msg = decode(bytearray(buf[pos + 8 : end]))
+                except mavlink.MAVError:
+                    pos, buf, n = self._resync(pos, "bad CRC or length")
+                    continue
+            elif verify or first:
+                if msgid not in _CRC_EXTRA:
+                    if first:
+                        pos, buf, n = self._resync(pos, "no MAVLink packet")
+                        continue
+                    self._unknown(msgid, pos, ts)
+                elif not crc_ok(buf, pos, end, msgid):
+                    pos, buf, n = self._resync(pos, "bad CRC")
+                    continue
+            elif msgid not in _CRC_EXTRA:
+                self._unknown(msgid, pos, ts)
+            first = False
+            if stats.first_ts is None:
+                stats.first_ts = ts
+            stats.last_ts = ts
+            by_id[msgid] += 1
+            stats.packets += 1
+            if msg is not None:
+                yield self.base + pos, ts, msgid, msg
+            pos = end
+            self.consumed = self.base + pos
+        self.consumed = stats.size
+
+    def _unknown(self, msgid: int, pos: int, ts: int) -> None:
+        stats = self.stats
+        if msgid in stats.unknown or len(stats.unknown) < MAX_UNKNOWN_IDS:
+            stats.unknown[msgid] += 1
+            stats.unknown_first.setdefault(msgid, (self.base + pos, ts))
+        else:
+            stats.unknown_other += 1
+
+    def _tail(self, pos: int) -> None:
+        """The file ends inside a record at ``pos``."""
+        if pos + 9 <= len(self.buf) and self.buf[pos + 8] not in (0xFD, 0xFE):
+            size = len(self.buf) - pos
+            self.stats.regions.append(
+                Region(self.base + pos, self.base + pos + size, "garbage", self.stats.last_ts)
+            )
+        else:
+            self.stats.truncated_at = self.base + pos
+
+    def _jump_confirmed(self, buf: bytes, pos: int, end: int, ts: int, n: int) -> bool:
+        """A large time jump is real if the next record frames and agrees with it."""
+        if end + 11 > n:
+            return True  # nothing (yet) contradicts it
+        nxt = self._record_end(buf, end)
+        if nxt is None:
+            return False
+        ts2: int = _TS.unpack_from(buf, end)[0]
+        return ts - BACKWARD_US <= ts2 <= ts + FORWARD_US
+
+    def _resync(self, bad: int, why: str) -> tuple[int, bytes, int]:
+        """Find the next good record after ``bad``; record the skipped bytes as a region.
+
+        A candidate is a start byte 8 bytes into a record whose timestamp is plausible, whose
+        message id is known and whose CRC is good (unknown ids cannot be checked).
+        """
+        start_abs = self.base + bad
+        qmin = bad + 9  # smallest index of a candidate's start byte
+        while True:
+            buf = self.buf
+            n = len(buf)
+            m = _MAGIC.search(buf, qmin)
+            qmin = n
+            while m is not None:
+                q = m.start()
+                cand = q - 8
+                if cand + 11 > n or (cand + MAX_RECORD > n and not self.eof):
+                    qmin = q  # judge this one after the next read
+                    break
+                end = self._record_end(buf, cand)
+                if end is not None and end <= n:
+                    ts = _TS.unpack_from(buf, cand)[0]
+                    msgid = self._msgid(buf, cand)
+                    if self._plausible(ts, slack=24) and self._crc_ok(buf, cand, end, msgid):
+                        self.stats.regions.append(
+                            Region(start_abs, self.base + cand, why, self.stats.last_ts)
+                        )
+                        return cand, buf, n
+                m = _MAGIC.search(buf, q + 1)
+            if self.eof:
+                self.stats.regions.append(Region(start_abs, self.base + n, why, self.stats.last_ts))
+                return n, buf, n
+            keep = max(0, qmin - 8)
+            self._fill(keep)
+            qmin -= keep
