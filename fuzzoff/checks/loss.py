@@ -1,0 +1,121 @@
+"""OFB103: the keep-alive stopped in offboard for longer than the loss timeout.
+
+Driven by the gate model's ``failsafe`` transitions (gate spec 5); where the gate did not see the
+vehicle in offboard but the recording does (a MAVROS bag has no mode commands to model), the same
+timeout is applied to the recorded mode so the loss is still reported. Where the recording shows
+what the vehicle did next, the finding compares it with the model's action.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from fuzzoff.checks._keepalive import (
+    KEEPALIVE_EVENTS,
+    counts_as_keepalive,
+    loss_timeout,
+    offboard_and_flying,
+    px4_label,
+)
+from fuzzoff.checks.base import Check, CheckContext
+from fuzzoff.events import NAV_STATE_OFFBOARD, Event, VehicleStatus, Where
+from fuzzoff.gate import GateTransition
+from fuzzoff.modes import nav_state_name
+
+RECORDED_ANSWER_WINDOW_S = 2.5
+"""How long after the predicted failsafe a recorded mode change still counts as its answer
+(PX4's HEARTBEAT is 1 Hz and the loss is evaluated at 10 Hz)."""
+
+
+@dataclass(slots=True)
+class _Pending:
+    t: float
+    message: str
+    where: Where
+    last_keepalive: float | None
+
+
+class OffboardLoss(Check):
+    codes = ("OFB103",)
+    wants = (*KEEPALIVE_EVENTS, VehicleStatus, GateTransition)
+
+    def __init__(self, ctx: CheckContext) -> None:
+        super().__init__(ctx)
+        self.last: float | None = None
+        self.last_where = Where("keep-alive")
+        self.last_flying = False
+        self.pending: _Pending | None = None
+        self.reported_until: float = -1.0
+        """Keep-alive time up to which a loss has been reported (one finding per gap)."""
+
+    def on_event(self, event: Event) -> None:
+        if self.pending is not None and event.t - self.pending.t > RECORDED_ANSWER_WINDOW_S:
+            self._flush(None)
+        if isinstance(event, GateTransition):
+            if event.what == "failsafe":
+                self._from_gate(event)
+        elif isinstance(event, VehicleStatus):
+            if self.pending is not None and event.nav_state is not None and not event.in_offboard:
+                self._flush(event)
+        elif counts_as_keepalive(self.ctx, event):
+            self._gap_from_recording(event.t)
+            self.last, self.last_where = event.t, event.where
+            gate = self.ctx.gate
+            gate_models_it = gate.armed and gate.user_intention == NAV_STATE_OFFBOARD
+            # The gate is the authority where it models offboard; the recorded mode otherwise.
+            self.last_flying = offboard_and_flying(self.ctx) and not gate_models_it
+
+    def _from_gate(self, tr: GateTransition) -> None:
+        timeout = loss_timeout(self.ctx)
+        stopped = (
+            f"the keep-alive stopped at {self.last:.2f} s"
+            if self.last is not None
+            else ("no keep-alive")
+        )
+        action = tr.action or "its failsafe"
+        message = (
+            f"{stopped} while in OFFBOARD; {px4_label(self.ctx)} declares the offboard signal lost "
+            f"at {tr.t:.2f} s (loss timeout {timeout:.2f} s) and runs {action}"
+        )
+        if tr.reason:
+            message += f" ({tr.reason})"
+        self.reported_until = self.last if self.last is not None else tr.t
+        self.pending = _Pending(tr.t, message, self.last_where, self.last)
+        if not self.ctx.state.mode_recorded:
+            self._flush(None)
+
+    def _gap_from_recording(self, now: float) -> None:
+        """A loss the gate did not model, judged on the recorded mode with the same timeout."""
+        if self.last is None or not self.last_flying or self.last <= self.reported_until:
+            return
+        timeout = loss_timeout(self.ctx)
+        if now - self.last < timeout:
+            return
+        self.reported_until = self.last
+        act = self.ctx.gate.params.get("COM_OBL_RC_ACT", 0.0)
+        message = (
+            f"the keep-alive stopped at {self.last:.2f} s for {now - self.last:.2f} s while the "
+            f"recording shows OFFBOARD; {px4_label(self.ctx)} loses the offboard signal after "
+            f"{timeout:.2f} s and runs the COM_OBL_RC_ACT = {act:g} failsafe"
+        )
+        self.ctx.report("OFB103", message, self.last + timeout, self.last_where, end=now)
+
+    def _flush(self, answer: VehicleStatus | None) -> None:
+        pending, self.pending = self.pending, None
+        if pending is None:
+            return
+        message = pending.message
+        if answer is not None:
+            message += f"; recorded: {nav_state_name(answer.nav_state)} at {answer.t:.2f} s"
+        elif self.ctx.state.mode_recorded:
+            message += f"; recorded: still {nav_state_name(self.ctx.state.nav_state)}"
+        else:
+            message += " (the recording has no mode to compare)"
+        self.ctx.report("OFB103", message, pending.t, pending.where)
+
+    def finish(self, t_end: float) -> None:
+        self._flush(None)
+        if self.last is not None and self.last_flying and self.last > self.reported_until:
+            timeout = loss_timeout(self.ctx)
+            if t_end - self.last >= timeout:
+                self._gap_from_recording(t_end)

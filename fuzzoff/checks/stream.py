@@ -1,0 +1,291 @@
+"""OFB101, OFB102, OFB105: the keep-alive stream's rate and its run-up to an offboard request.
+
+Seed 000 "Опис": a > 2 Hz proof of life, running for a second before an offboard request. The
+messages say both what the docs require and what the profile's PX4 does (gate spec 2, 3, D1/D2).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from fuzzoff.checks._keepalive import (
+    KEEPALIVE_EVENTS,
+    counts_as_keepalive,
+    loss_timeout,
+    mode_note,
+    offboard_and_flying,
+    proven_gap,
+    px4_label,
+)
+from fuzzoff.checks.base import Check, CheckContext
+from fuzzoff.events import (
+    NAV_STATE_OFFBOARD,
+    Command,
+    Dropout,
+    Event,
+    VehicleStatus,
+    Where,
+)
+from fuzzoff.findings import Severity
+from fuzzoff.gate import GateTransition
+
+
+@dataclass(slots=True)
+class _Gap:
+    start: float
+    end: float
+    proven: float
+    where: Where
+
+
+class KeepaliveRate(Check):
+    """OFB101: gaps of 500 ms or more in offboard, or in the second before an offboard request."""
+
+    codes = ("OFB101",)
+    wants = (*KEEPALIVE_EVENTS, Command, VehicleStatus)
+
+    def __init__(self, ctx: CheckContext) -> None:
+        super().__init__(ctx)
+        self.max_gap = float(ctx.option("OFB101", "max_gap_s"))
+        self.window = float(ctx.option("OFB101", "pre_request_window_s"))
+        self.last: float | None = None
+        self.last_in_offboard = False
+        self.dropout_since_last = False
+        self.was_offboard: bool | None = None
+        """Recorded mode at the previous status (None before the first: a recording may start
+        in OFFBOARD, which is not a switch)."""
+        self.recent: list[_Gap] = []
+        """Gaps outside offboard, kept for ``window`` seconds in case a request follows."""
+
+    def on_event(self, event: Event) -> None:
+        if isinstance(event, Dropout):
+            self.dropout_since_last = True
+        elif isinstance(event, Command):
+            if event.is_offboard_switch or (event.is_arm and self.ctx.state.in_offboard):
+                self._request(event.t)
+        elif isinstance(event, VehicleStatus):
+            no_commands = "command" not in self.ctx.info.kinds
+            switched = event.in_offboard and self.was_offboard is False
+            if switched and no_commands:
+                self._request(event.t)  # no commands recorded (MAVROS): the switch itself
+            if event.nav_state is not None:
+                self.was_offboard = event.in_offboard
+        elif counts_as_keepalive(self.ctx, event):
+            if self.last is not None and not self.dropout_since_last:
+                gap = event.t - self.last
+                proven = proven_gap(self.ctx, event, gap)
+                if proven >= self.max_gap:
+                    found = _Gap(self.last, event.t, proven, event.where)
+                    if self.last_in_offboard:
+                        self._report(found, "in OFFBOARD")
+                    else:
+                        self.recent.append(found)
+            self.last = event.t
+            self.last_in_offboard = offboard_and_flying(self.ctx)
+            self.dropout_since_last = False
+        if self.recent:
+            self.recent = [g for g in self.recent if event.t - g.end <= self.window]
+
+    def _request(self, t: float) -> None:
+        for found in self.recent:
+            if t - found.end <= self.window:
+                self._report(found, "in the second before an offboard request")
+        self.recent.clear()
+
+    def _report(self, gap: _Gap, context: str) -> None:
+        ctx = self.ctx
+        timeout = loss_timeout(ctx)
+        sampled = " (logged gap minus the logger's interval)" if ctx.info.sampled else ""
+        docs = f"docs: keep-alive at > 2 Hz, gaps under {self.max_gap:.1f} s"
+        if ctx.profile.px4 != "legacy" and gap.proven < timeout:
+            message = (
+                f"keep-alive gap of {gap.proven:.2f} s{sampled} {context}{mode_note(ctx)}; "
+                f"{docs}; {px4_label(ctx)} would: keep the offboard signal, it is lost only after "
+                f"a gap of COM_OF_LOSS_T = {timeout:.2f} s"
+            )
+            severity = Severity.WARNING
+        else:
+            message = (
+                f"keep-alive gap of {gap.proven:.2f} s{sampled} {context}{mode_note(ctx)}; "
+                f"{docs}; {px4_label(ctx)} loses the offboard signal after {timeout:.2f} s"
+            )
+            severity = Severity.ERROR
+        ctx.report("OFB101", message, gap.start, gap.where, severity=severity, end=gap.end)
+
+    def finish(self, t_end: float) -> None:
+        if self.last is not None and self.last_in_offboard and t_end - self.last >= self.max_gap:
+            self._report(
+                _Gap(self.last, t_end, t_end - self.last, self._where()),
+                "in OFFBOARD (stream stopped, recording ends)",
+            )
+
+    def _where(self) -> Where:
+        return Where("keep-alive")
+
+
+class StreamBeforeRequest(Check):
+    """OFB102: an offboard request without one second of unbroken keep-alive before it."""
+
+    codes = ("OFB102",)
+    wants = (*KEEPALIVE_EVENTS, Command, VehicleStatus, GateTransition)
+
+    def __init__(self, ctx: CheckContext) -> None:
+        super().__init__(ctx)
+        self.min_stream = float(ctx.option("OFB102", "min_stream_s"))
+        self.max_gap = float(ctx.option("OFB101", "max_gap_s"))
+        self.run_start: float | None = None
+        self.last: float | None = None
+        self.gate_verdict: dict[int, GateTransition] = {}
+        self.was_offboard: bool | None = None
+
+    def on_event(self, event: Event) -> None:
+        if isinstance(event, GateTransition):
+            if event.cause is not None and event.what in (
+                "request_accepted",
+                "request_rejected",
+                "arm_accepted",
+                "arm_rejected",
+            ):
+                self.gate_verdict[id(event.cause)] = event
+        elif isinstance(event, Command):
+            if event.is_offboard_switch:
+                self._judge(event, "switch to OFFBOARD")
+            elif event.is_arm and self.ctx.state.nav_state == NAV_STATE_OFFBOARD:
+                self._judge(event, "arm in OFFBOARD")
+            self.gate_verdict.clear()
+        elif isinstance(event, VehicleStatus):
+            if event.nav_state is None:
+                return
+            switched = event.in_offboard and self.was_offboard is False
+            if switched and "command" not in self.ctx.info.kinds:
+                self._judge(event, "switch to OFFBOARD (recorded mode)")
+            self.was_offboard = event.in_offboard
+        elif isinstance(event, Dropout):
+            pass
+        elif counts_as_keepalive(self.ctx, event):
+            if (
+                self.last is None
+                or proven_gap(self.ctx, event, event.t - self.last) >= self.max_gap
+            ):
+                self.run_start = event.t
+            self.last = event.t
+
+    def _judge(self, event: Event, what: str) -> None:
+        t = event.t
+        fresh = self.last is not None and t - self.last < self.max_gap
+        if fresh and self.run_start is not None and t - self.run_start >= self.min_stream:
+            return
+        if self.last is None:
+            had = "no keep-alive at all before it"
+        elif not fresh:
+            had = f"the last keep-alive {t - self.last:.2f} s before it"
+        else:
+            assert self.run_start is not None
+            had = f"only {t - self.run_start:.2f} s of unbroken keep-alive before it"
+        verdict = self.gate_verdict.get(id(event))
+        if verdict is None:
+            would = (
+                "the recording shows the vehicle's answer"
+                if isinstance(event, VehicleStatus)
+                else "see the gate timeline"
+            )
+        elif verdict.what.endswith("accepted"):
+            would = "accept it"
+        else:
+            would = f"reject it ({verdict.reason or verdict.message})"
+        message = (
+            f"{what} with {had}; docs: stream for at least {self.min_stream:.0f} s first; "
+            f"{px4_label(self.ctx)} would: {would}"
+        )
+        self.ctx.report("OFB102", message, t, event.where, severity=Severity.WARNING)
+
+
+class _Histogram:
+    """Gap counts in 1 ms bins up to the budget: bounded memory however long the stretch."""
+
+    def __init__(self, budget: float) -> None:
+        self.bins = [0] * (int(budget * 1000) + 2)
+        self.count = 0
+        self.worst = 0.0
+
+    def add(self, gap: float) -> None:
+        self.bins[min(len(self.bins) - 1, int(gap * 1000))] += 1
+        self.count += 1
+        self.worst = max(self.worst, gap)
+
+    def quantile(self, q: float) -> float:
+        target = q * self.count
+        seen = 0
+        for ms, n in enumerate(self.bins):
+            seen += n
+            if seen >= target:
+                return ms / 1000
+        return self.worst
+
+
+class KeepaliveMargin(Check):
+    """OFB105: above 2 Hz but with little margin, per offboard stretch (heuristic)."""
+
+    codes = ("OFB105",)
+    wants = KEEPALIVE_EVENTS
+
+    def __init__(self, ctx: CheckContext) -> None:
+        super().__init__(ctx)
+        self.budget = float(ctx.option("OFB105", "budget_s"))
+        self.worst_limit = self.budget * float(ctx.option("OFB105", "worst_fraction"))
+        self.p99_limit = self.budget * float(ctx.option("OFB105", "p99_fraction"))
+        self.min_intervals = int(ctx.option("OFB105", "min_intervals"))
+        self.last: float | None = None
+        self.stretch_start: float | None = None
+        self.hist = _Histogram(self.budget)
+        self.broken = False
+        if ctx.info.sampled:
+            ctx.cannot_check(
+                "OFB105",
+                "needs the keep-alive as sent (a ULog subsamples offboard_control_mode, "
+                "hiding the sender's jitter)",
+            )
+
+    def on_event(self, event: Event) -> None:
+        if self.ctx.info.sampled or not counts_as_keepalive(self.ctx, event):
+            return
+        flying = offboard_and_flying(self.ctx)
+        if flying and self.stretch_start is None:
+            self.stretch_start = event.t
+        elif not flying and self.stretch_start is not None:
+            self._close(event.t)
+        if flying and self.last is not None and self.last >= (self.stretch_start or 0.0):
+            gap = event.t - self.last
+            if gap >= self.budget:
+                self.broken = True  # OFB101 territory, not a margin problem
+            else:
+                self.hist.add(gap)
+        self.last = event.t
+
+    def _close(self, t: float) -> None:
+        start = self.stretch_start
+        hist = self.hist
+        self.stretch_start, self.hist = None, _Histogram(self.budget)
+        broken, self.broken = self.broken, False
+        if start is None or broken or hist.count == 0:
+            return
+        reasons = []
+        if hist.worst > self.worst_limit:
+            reasons.append(
+                f"worst gap {hist.worst * 1000:.0f} ms ({hist.worst / self.budget:.0%} of the "
+                f"{self.budget * 1000:.0f} ms budget)"
+            )
+        if hist.count >= self.min_intervals:
+            p99 = hist.quantile(0.99)
+            if p99 > self.p99_limit:
+                reasons.append(f"99th-percentile gap {p99 * 1000:.0f} ms")
+        if reasons:
+            message = (
+                f"keep-alive above 2 Hz but marginal over {hist.count} intervals in OFFBOARD"
+                f"{mode_note(self.ctx)}: " + "; ".join(reasons)
+            )
+            self.ctx.report("OFB105", message, start, Where("keep-alive"), end=t)
+
+    def finish(self, t_end: float) -> None:
+        if self.stretch_start is not None:
+            self._close(t_end)

@@ -1,0 +1,106 @@
+"""The command line as users and scripts see it: exit status, usage errors, JSON shape, config."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from tests.helpers import run_cli, run_cli_process
+
+
+def test_unknown_rule_selector_is_a_usage_error(tmp_path: Path) -> None:
+    junk = tmp_path / "x.tlog"
+    junk.write_bytes(b"\x00" * 64)
+    result = run_cli(["lint", str(junk), "--select", "OFB9"])
+    assert result.returncode == 2
+    assert "OFB9" in result.stderr and "Traceback" not in result.stderr
+
+
+def test_unknown_px4_version_is_a_usage_error(tmp_path: Path) -> None:
+    result = run_cli(["lint", str(tmp_path), "--px4", "banana"])
+    assert result.returncode == 2
+    assert "unknown PX4 version" in result.stderr
+
+
+def test_missing_path_is_a_usage_error() -> None:
+    result = run_cli(["lint", "/no/such/flight.tlog"])
+    assert result.returncode == 2
+    assert "/no/such/flight.tlog" in result.stderr
+
+
+@pytest.mark.parametrize(
+    ("name", "content"),
+    [("empty.tlog", b""), ("foreign.ulg", b"PK\x03\x04 this is a zip file, not a log" * 4)],
+)
+def test_unreadable_file_one_line_exit_2_and_json_still_written(
+    tmp_path: Path, name: str, content: bytes
+) -> None:
+    path = tmp_path / name
+    path.write_bytes(content)
+    result = run_cli(["lint", str(path), "--format", "json"])
+    assert result.returncode == 2
+    lines = [line for line in result.stderr.splitlines() if line.strip()]
+    assert len(lines) == 1 and str(path) in lines[0]
+    data = json.loads(result.stdout)
+    assert data["tool"] == "fuzzoff"
+    (file_report,) = data["files"]
+    assert file_report["complete"] is False
+    assert [f["code"] for f in file_report["findings"]] == ["OFB001"]
+
+
+def test_json_shape_follows_the_interface(tmp_path: Path) -> None:
+    path = tmp_path / "empty.mcap"
+    path.write_bytes(b"")
+    data = json.loads(run_cli(["lint", str(path), "--format", "json"]).stdout)
+    assert set(data) >= {"tool", "version", "files"}
+    file_report = data["files"][0]
+    assert set(file_report) >= {"path", "format", "profile", "complete", "findings"}
+    assert set(file_report["profile"]) >= {"px4", "vehicle", "detected"}
+    finding = file_report["findings"][0]
+    assert set(finding) >= {"code", "name", "severity", "message", "time_s", "location"}
+
+
+def test_config_unknown_key_is_a_usage_error(tmp_path: Path) -> None:
+    (tmp_path / "pyproject.toml").write_text('[tool.fuzzoff]\npx4 = "1.15"\nselct = ["OFB1"]\n')
+    (tmp_path / "a.tlog").write_bytes(b"")
+    result = run_cli(["lint", "a.tlog"], cwd=tmp_path)
+    assert result.returncode == 2
+    assert "selct" in result.stderr
+
+
+def test_config_from_pyproject_sets_the_profile(tmp_path: Path) -> None:
+    (tmp_path / "pyproject.toml").write_text('[tool.fuzzoff]\npx4 = "1.16.2"\nvehicle = "fw"\n')
+    (tmp_path / "a.tlog").write_bytes(b"")
+    data = json.loads(run_cli(["lint", "a.tlog", "--format", "json"], cwd=tmp_path).stdout)
+    assert data["files"][0]["profile"]["px4"] == "1.16"
+    assert data["files"][0]["profile"]["vehicle"] == "fw"
+    # the command line wins over the file
+    data = json.loads(
+        run_cli(["lint", "a.tlog", "--format", "json", "--px4", "1.13"], cwd=tmp_path).stdout
+    )
+    assert data["files"][0]["profile"]["px4"] == "1.13"
+
+
+def test_rule_page_and_list() -> None:
+    page = run_cli(["rule", "OFB101"])
+    assert page.returncode == 0
+    assert "keepalive-below-2hz" in page.stdout and "Why is this bad?" in page.stdout
+    listing = json.loads(run_cli(["rule", "--format", "json"]).stdout)
+    assert {"OFB001", "OFB101", "OFB201"} <= {r["code"] for r in listing}
+    assert run_cli(["rule", "OFB999"]).returncode == 2
+
+
+def test_profiles_lists_versions_and_vehicles() -> None:
+    data = json.loads(run_cli(["profiles", "--format", "json"]).stdout)
+    assert [p["profile"] for p in data["px4"]][:1] == ["legacy"]
+    assert "rover-ackermann" in [v["type"] for v in data["vehicles"]]
+
+
+def test_the_installed_command_runs_as_a_process(tmp_path: Path) -> None:
+    path = tmp_path / "zero.ulg"
+    path.write_bytes(b"")
+    result = run_cli_process(["lint", str(path)])
+    assert result.returncode == 2
+    assert "Traceback" not in result.stderr

@@ -1,0 +1,160 @@
+"""OFB101-OFB105 and OFB201 on minimal streams: edges of their thresholds, per profile."""
+
+from __future__ import annotations
+
+import pytest
+
+from fuzzoff.events import Dropout, SetPositionTargetLocal, TrajectorySetpoint, VehicleStatus
+from fuzzoff.findings import Severity
+from tests.streams import OFFBOARD, POSCTL, ack, codes, every, lint_events, ocm, status, switch
+
+
+def flying(*gaps_at: tuple[float, float]) -> list:
+    """Armed in OFFBOARD from t=0, a 10 Hz keep-alive to t=10 with the given (start, end) holes."""
+    times = [t for t in every(0.0, 10.0, 0.1) if not any(a < t < b for a, b in gaps_at)]
+    return [status(0.0, OFFBOARD), *ocm(times)]
+
+
+@pytest.mark.parametrize(
+    ("gap", "expected"),
+    [(0.49, None), (0.5, Severity.WARNING), (0.95, Severity.WARNING), (1.2, Severity.ERROR)],
+)
+def test_ofb101_gap_edges_on_1_15(gap: float, expected: Severity | None) -> None:
+    events = [status(0.0, OFFBOARD), *ocm([0.0, 0.1, 0.2, 0.2 + gap, 0.3 + gap])]
+    found = codes(lint_events(events), "OFB101")
+    if expected is None:
+        assert found == []
+    else:
+        assert [f.severity for f in found] == [expected]
+        assert found[0].time_s == pytest.approx(0.2)
+        assert "docs:" in found[0].message
+
+
+def test_ofb101_is_an_error_on_legacy_where_500ms_is_the_timeout() -> None:
+    events = [status(0.0, OFFBOARD), *ocm([0.0, 0.1, 0.7, 0.8])]
+    (found,) = codes(lint_events(events, px4="legacy"), "OFB101")
+    assert found.severity is Severity.ERROR
+
+
+def test_ofb101_ignores_gaps_outside_offboard() -> None:
+    events = [status(0.0, POSCTL), *ocm([0.0, 0.1, 2.0, 2.1])]
+    assert codes(lint_events(events), "OFB101") == []
+
+
+def test_ofb101_counts_a_gap_in_the_second_before_a_request() -> None:
+    events = [status(0.0, POSCTL), *ocm([0.0, 0.1, 0.8, 0.9, 1.0]), switch(1.05)]
+    (found,) = codes(lint_events(events), "OFB101")
+    assert "before an offboard request" in found.message
+
+
+def test_ofb101_judges_ulog_gaps_against_the_logging_interval() -> None:
+    sampled = {"control_mode": 0.1}
+    near_miss = [status(0.0, OFFBOARD), *ocm([0.0, 0.1, 0.65, 0.75])]  # proves only 0.45 s
+    assert codes(lint_events(near_miss, fmt="ulog", sampled=sampled), "OFB101") == []
+    real = [status(0.0, OFFBOARD), *ocm([0.0, 0.1, 0.75, 0.85])]  # proves 0.55 s
+    assert len(codes(lint_events(real, fmt="ulog", sampled=sampled), "OFB101")) == 1
+
+
+def test_ofb101_does_not_count_a_gap_across_a_logger_dropout() -> None:
+    events = [status(0.0, OFFBOARD), *ocm([0.0, 0.1, 0.9]), Dropout(t=0.3, duration_s=0.5)]
+    assert codes(lint_events(events, fmt="ulog", sampled={"control_mode": 0.1}), "OFB101") == []
+
+
+def test_ofb101_mavlink_setpoints_for_another_system_are_not_keepalive() -> None:
+    own = [SetPositionTargetLocal(t=t, vehicle="1", target_system=1) for t in every(0, 2, 0.1)]
+    other = [SetPositionTargetLocal(t=t, vehicle="1", target_system=7) for t in every(0.05, 2, 0.1)]
+    base = [VehicleStatus(t=0.0, vehicle="1", nav_state=OFFBOARD, armed=True)]
+    assert codes(lint_events(base + own + other, fmt="tlog"), "OFB101") == []
+    only_other = base + other + [own[0], own[-1]]
+    assert len(codes(lint_events(only_other, fmt="tlog"), "OFB101")) == 1
+
+
+def test_ofb102_switch_on_first_setpoint_is_a_warning_with_what_px4_does() -> None:
+    events = [status(0.0, POSCTL), *ocm([1.0, 1.02, 1.04]), switch(1.048)]
+    (found,) = codes(lint_events(events), "OFB102")
+    assert found.severity is Severity.WARNING
+    assert "0.05 s of unbroken keep-alive" in found.message
+    assert "PX4 1.15 would: accept it" in found.message
+
+
+def test_ofb102_no_stream_at_all_and_disarmed_on_1_14_is_accepted_by_px4() -> None:
+    events = [status(0.0, POSCTL, armed=False), switch(1.0)]
+    (found,) = codes(lint_events(events, px4="1.14"), "OFB102")
+    assert "no keep-alive at all" in found.message
+    assert "accept it" in found.message
+
+
+def test_ofb102_clean_after_one_second_of_stream() -> None:
+    events = [status(0.0, POSCTL), *ocm(every(0.0, 1.2, 0.1)), switch(1.21)]
+    assert codes(lint_events(events), "OFB102") == []
+
+
+def test_ofb102_recorded_switch_counts_when_no_commands_are_recorded() -> None:
+    events = [status(0.0, POSCTL), *ocm(every(0.5, 1.0, 0.05)), status(1.0, OFFBOARD)]
+    (found,) = codes(lint_events(events), "OFB102")
+    assert "recorded mode" in found.message
+    started_in_offboard = [status(0.0, OFFBOARD), *ocm(every(0.0, 1.0, 0.1))]
+    assert codes(lint_events(started_in_offboard), "OFB102") == []
+
+
+def test_ofb103_failsafe_with_action_and_recorded_answer() -> None:
+    events = [*flying((2.0, 9.0)), status(3.2, POSCTL)]
+    (found,) = codes(lint_events(events), "OFB103")
+    assert found.severity is Severity.ERROR
+    assert 2.9 <= (found.time_s or 0) <= 3.15
+    assert "POSCTL" in found.message and "recorded: POSCTL" in found.message
+
+
+def test_ofb103_not_for_a_gap_under_the_timeout() -> None:
+    assert codes(lint_events(flying((2.0, 2.8))), "OFB103") == []
+
+
+def test_ofb103_respects_a_recorded_loss_timeout_parameter() -> None:
+    from fuzzoff.events import Parameter
+
+    events = [Parameter(t=0.0, name="COM_OF_LOSS_T", value=0.5), *flying((2.0, 2.8))]
+    assert len(codes(lint_events(events), "OFB103")) == 1
+
+
+def test_ofb104_stale_trajectory_under_live_keepalive_ros2_only() -> None:
+    sp = [TrajectorySetpoint(t=t, position=(0.0, 0.0, -2.0)) for t in every(0.0, 1.0, 0.1)]
+    events = [*flying(), *sp]
+    (found,) = codes(lint_events(events, fmt="mcap"), "OFB104")
+    assert "TrajectorySetpoint" in found.message
+    assert found.time_s == pytest.approx(1.5)
+    assert codes(lint_events(events, fmt="tlog"), "OFB104") == []
+
+
+def test_ofb105_marginal_rate_and_p99() -> None:
+    times = every(0.0, 20.0, 0.2)
+    shifted = [t + (0.25 if i % 10 == 5 else 0) for i, t in enumerate(times)]  # one 450 ms gap
+    marginal = [status(0.0, OFFBOARD), *ocm(shifted)]
+    (found,) = codes(lint_events(marginal), "OFB105")
+    assert "worst gap" in found.message
+    healthy = [status(0.0, OFFBOARD), *ocm(every(0.0, 20.0, 0.05))]
+    assert codes(lint_events(healthy), "OFB105") == []
+    # 2.5 Hz: every gap 400 ms, so p99 and worst are both over their limits
+    slow = [status(0.0, OFFBOARD), *ocm(every(0.0, 30.0, 0.4))]
+    (found,) = codes(lint_events(slow), "OFB105")
+    assert "99th-percentile" in found.message
+
+
+def test_ofb201_double_ack_last_one_decides() -> None:
+    base = [status(0.0, POSCTL), switch(1.0)]
+    rejected = lint_events([*base, ack(1.004, 0), ack(1.010, 1), status(2.0, POSCTL)], px4="1.16")
+    (found,) = codes(rejected, "OFB201")
+    assert "TEMPORARILY_REJECTED" in found.message
+    assert "no offboard signal" in found.message
+    accepted = lint_events([*base, *ocm(every(0.0, 1.0, 0.1)), ack(1.004, 0), ack(1.01, 0)])
+    assert codes(accepted, "OFB201") == []
+
+
+def test_ofb201_a_late_second_ack_is_a_new_answer_not_a_double_ack() -> None:
+    events = [
+        status(0.0, POSCTL),
+        *ocm(every(0.0, 1.0, 0.1)),
+        switch(1.0),
+        ack(1.01, 0),
+        ack(1.5, 1),
+    ]
+    assert codes(lint_events(events), "OFB201") == []
