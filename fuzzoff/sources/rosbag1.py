@@ -1,0 +1,220 @@
+"""ROS 1 bags (``#ROSBAG V2.0``) with MAVROS topics, read by ``rosbags.rosbag1`` (formats.md 6).
+
+Only the connections that matter are decoded: the MAVROS topics ``fuzzoff.sources.mavros``
+converts (setpoints and ``state``). Every other connection (images, IMU, ...) is filtered out
+before its messages are read, using the bag's index. Message definitions come from the bag
+itself (every ROS 1 connection record embeds them, formats.md section 3); the shipped
+mavros_msgs definitions are the fallback for a connection whose embedded text does not parse.
+
+Damaged bags: rosbags needs the index at the end of the file and has no reindex mode (formats.md
+section 9 item 2), so an unindexed bag (``.bag.active`` from a killed ``rosbag record``) or a
+truncated one yields nothing through it. ``rosbag1_salvage`` then reads the chunks in file
+order with the library's own record primitives, the way ``rosbag reindex`` would; the events
+read are kept and the file is reported incomplete, with one line saying why.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+from rosbags.interfaces import Connection
+from rosbags.rosbag1 import Reader, ReaderError
+from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
+from fuzzoff.events import Event
+from fuzzoff.sources.base import RecordingInfo, Source, SourceError, SourceProblem
+from fuzzoff.sources.mavros import TOPIC_KINDS, MavrosConverter, mavros_topic
+from fuzzoff.sources.mavros_msgs import mavros_typedefs
+from fuzzoff.sources.rosbag1_salvage import SalvageReader, bag_header_index_pos
+
+REINDEX_HINT = "run `rosbag reindex` on it for a complete read"
+
+
+class Rosbag1Source(Source):
+    """A ROS 1 bag; MAVROS topics become MAVLink setpoint and vehicle-status events."""
+
+    format = "rosbag1"
+
+    def __init__(self, path: Path) -> None:
+        super().__init__(path)
+        self._reader: Reader | None = None
+        self._salvage: SalvageReader | None = None
+        self._salvage_reason = ""
+        self._typestore: Any = None
+        self._wanted: list[Connection] = []
+        self._done = 0
+        self._total = 0
+
+    # -- opening -------------------------------------------------------------------------------
+
+    def open(self) -> None:
+        reader = Reader(self.path)
+        try:
+            reader.open()
+        except ReaderError as exc:
+            self._open_damaged(str(exc))
+            return
+        except PermissionError as exc:
+            raise SourceError(self.path, f"cannot open: {exc.strerror or exc}") from None
+        except Exception as exc:  # rosbags asserts and struct errors on corrupt index records
+            self._open_damaged(f"{type(exc).__name__}: {exc}")
+            return
+        self._reader = reader
+        self._check_chunks(reader)
+        self._wanted = [c for c in reader.connections if mavros_topic(c.topic, c.msgtype)]
+        self._total = sum(c.msgcount for c in self._wanted)
+        self._typestore = self._build_typestore(self._wanted)
+
+    def _open_damaged(self, why: str) -> None:
+        """The index could not be read: say why in one line, then fall back to the salvage."""
+        size = self.path.stat().st_size
+        if why.startswith("File magic is invalid") or "seems to be empty" in why:
+            raise SourceError(self.path, "not a ROS 1 bag (no `#ROSBAG V2.0` header)")
+        if "version" in why and "not supported" in why:
+            raise SourceError(self.path, why.rstrip("."))
+        index_pos = bag_header_index_pos(self.path)
+        if index_pos is None:
+            raise SourceError(self.path, "bag header unreadable", "byte 13")
+        if index_pos == 0:
+            self._salvage_reason = f"bag is not indexed ({REINDEX_HINT})"
+        elif index_pos >= size:
+            self._salvage_reason = (
+                f"truncated at byte {size} (its index was to start at byte {index_pos}); "
+                "events before the cut were read"
+            )
+        else:
+            self._salvage_reason = f"index damaged at byte {index_pos} ({REINDEX_HINT})"
+        self._salvage = SalvageReader(self.path)
+        try:
+            self._salvage.open()
+        except ReaderError as exc:
+            raise SourceError(self.path, f"unreadable bag: {exc}") from None
+
+    def _check_chunks(self, reader: Reader) -> None:
+        """A chunk whose size field points past the end is corruption, not a read request."""
+        size = self.path.stat().st_size
+        for pos, chunk in reader.chunks.items():
+            if chunk.datapos + chunk.datasize > size:
+                raise SourceError(
+                    self.path,
+                    f"chunk size field points past the end of the file ({size} bytes)",
+                    f"byte {pos}",
+                )
+
+    def _build_typestore(self, connections: list[Connection]) -> Any:
+        """Embedded definitions first, per connection; the shipped mavros_msgs as fallback."""
+        store = get_typestore(Stores.ROS1_NOETIC)
+        store.register(mavros_typedefs())
+        for conn in connections:
+            try:
+                typedefs = get_types_from_msg(conn.msgdef.data, conn.msgtype)
+                fresh = {k: v for k, v in typedefs.items() if k not in store.fielddefs}
+                store.register(fresh)
+            except Exception:
+                continue
+        return store
+
+    def close(self) -> None:
+        if self._reader is not None:
+            self._reader.close()
+            self._reader = None
+        if self._salvage is not None:
+            self._salvage.close()
+            self._salvage = None
+
+    # -- probing -------------------------------------------------------------------------------
+
+    def probe(self) -> RecordingInfo:
+        info = RecordingInfo(str(self.path), self.format)
+        if self._salvage is not None:
+            info.notes.append(self._salvage_reason)
+            conns = [c for c in self._salvage.connections if mavros_topic(c.topic, c.msgtype)]
+        else:
+            conns = self._wanted
+            info.message_count = self._total
+        for conn in conns:
+            split = mavros_topic(conn.topic, conn.msgtype)
+            assert split is not None
+            info.kinds.add(TOPIC_KINDS[split.name])
+            if split.namespace not in info.vehicles:
+                info.vehicles.append(split.namespace)
+        if self._salvage is None and self._reader is not None:
+            px4 = sorted({c.topic for c in self._reader.connections if "px4_msgs" in c.msgtype})
+            if px4:
+                info.notes.append(f"px4_msgs topics are not read from ROS 1 bags: {px4[0]} ...")
+        return info
+
+    def progress(self) -> float | None:
+        if self._salvage is not None:
+            return self._salvage.progress()
+        return self._done / self._total if self._total else None
+
+    # -- events --------------------------------------------------------------------------------
+
+    def events(self) -> Iterator[Event]:
+        if self._salvage is not None:
+            yield from self._salvaged_events()
+            return
+        reader = self._reader
+        if reader is None or not self._wanted:
+            return
+        start = reader.start_time
+        yield from self._convert(reader.messages(connections=self._wanted), lambda: start)
+
+    def _salvaged_events(self) -> Iterator[Event]:
+        """File order, as recorded; the first message of any topic is time zero."""
+        salvage = self._salvage
+        assert salvage is not None
+        first: list[int] = []
+
+        def wanted() -> Iterator[tuple[Connection, int, bytes]]:
+            for conn, timestamp, raw in salvage.messages():
+                if not first:
+                    first.append(timestamp)
+                if mavros_topic(conn.topic, conn.msgtype):
+                    if conn.msgtype not in self._typestore.fielddefs:
+                        self._typestore = self._build_typestore(salvage.connections)
+                    yield conn, timestamp, raw
+
+        self._typestore = self._build_typestore(salvage.connections)
+        yield from self._convert(wanted(), lambda: first[0])
+        what, at = self._salvage_reason, None
+        if salvage.stopped is not None:
+            at = f"byte {salvage.stopped[1]}"
+            if "truncated" not in what:
+                what = f"{what}; reading stopped: {salvage.stopped[0]}"
+        self.problems.append(SourceProblem(what, at))
+
+    def _convert(
+        self, messages: Iterator[tuple[Connection, int, bytes]], start_ns: Callable[[], int]
+    ) -> Iterator[Event]:
+        """Decode, convert and yield; corrupt messages are skipped and reported once."""
+        converter = MavrosConverter()
+        counts: dict[int, int] = {}
+        first_bad: SourceProblem | None = None
+        bad = 0
+        try:
+            for conn, timestamp, raw in messages:
+                self._done += 1
+                index = counts.get(conn.id, 0)
+                counts[conn.id] = index + 1
+                t = (timestamp - start_ns()) / 1e9
+                try:
+                    msg = self._typestore.deserialize_ros1(raw, conn.msgtype)
+                except Exception as exc:  # corrupt message bytes: skip it, say so once
+                    what = f"message does not decode as {conn.msgtype} ({type(exc).__name__})"
+                    bad += 1
+                    first_bad = first_bad or SourceProblem(what, f"{conn.topic} #{index}", t)
+                    continue
+                yield from converter.convert(conn.topic, msg, t, index)
+        except Exception as exc:  # rosbags ReaderError, asserts, codec errors on corrupt chunks
+            detail = str(exc) if isinstance(exc, ReaderError) else type(exc).__name__
+            self.problems.append(SourceProblem(f"bag data unreadable: {detail}"))
+        if first_bad is not None:
+            more = f" (and {bad - 1} more)" if bad > 1 else ""
+            self.problems.append(
+                SourceProblem(first_bad.what + more, first_bad.where, first_bad.time_s)
+            )
+        self.stats["messages_decoded"] = self._done
