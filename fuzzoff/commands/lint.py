@@ -23,6 +23,7 @@ from fuzzoff.findings import Report
 from fuzzoff.report import renderer
 from fuzzoff.report.sanitize import printable
 from fuzzoff.report.terminal import print_report
+from fuzzoff.report.timelines import lint_with_timelines
 from fuzzoff.sources import find_recordings
 
 
@@ -70,6 +71,8 @@ def run(args: argparse.Namespace) -> int:
     show_progress = terminal and console.is_terminal and not args.no_progress and args.jobs == 1
     if show_progress:
         report = _lint_with_progress(args.paths, settings, console)
+    elif args.format == "html":  # the HTML report plots each vehicle's timeline
+        report = lint_with_timelines(args.paths, settings, jobs=args.jobs)
     else:
         report = lint_paths(args.paths, settings, jobs=args.jobs)
     if terminal:

@@ -1,0 +1,61 @@
+"""Lint with the per-vehicle timelines the HTML report plots (``--format html``).
+
+The timelines go into ``FileReport.extras``: ``timelines`` (vehicle -> ``Timeline``) and
+``loss_timeouts`` (vehicle -> (seconds, where the value came from)).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+from fuzzoff.config import Settings
+from fuzzoff.engine import Timeline, lint_file
+from fuzzoff.findings import FileReport, Report
+from fuzzoff.gate import GateModel
+from fuzzoff.profiles import Profile
+from fuzzoff.sources import find_recordings
+
+
+def loss_timeout(timeline: Timeline, profile: Profile, settings: Settings) -> tuple[float, str]:
+    """COM_OF_LOSS_T as the gate used it: the engine's value where the timeline carries one.
+
+    An engine that records the gate's final ``loss_timeout`` on the timeline (the value read from
+    the recording's parameters) wins; else ``--param`` / config, else the profile's default.
+    """
+    recorded = getattr(timeline, "loss_timeout", None)
+    if isinstance(recorded, int | float):
+        return float(recorded), "gate model (recording, --param or default)"
+    value = GateModel(profile, settings.params).loss_timeout
+    if "COM_OF_LOSS_T" in settings.params:
+        return value, "--param / configuration"
+    return value, f"PX4 {profile.px4} default"
+
+
+def lint_one(path: str | Path, settings: Settings) -> FileReport:
+    timelines: dict[str, Timeline] = {}
+    report = lint_file(path, settings, timelines=timelines)
+    report.extras["timelines"] = timelines
+    report.extras["loss_timeouts"] = {
+        vehicle: loss_timeout(tl, report.profile, settings) for vehicle, tl in timelines.items()
+    }
+    return report
+
+
+def _lint_one(args: tuple[str, Settings]) -> FileReport:
+    return lint_one(args[0], args[1])
+
+
+def lint_with_timelines(
+    paths: Sequence[str | Path], settings: Settings, *, jobs: int = 1
+) -> Report:
+    """Like ``engine.lint_paths`` but every file report carries its timelines."""
+    files = [str(f) for raw in paths for f in find_recordings(Path(raw))]
+    report = Report()
+    if jobs > 1 and len(files) > 1:
+        with ProcessPoolExecutor(max_workers=jobs) as pool:
+            report.files.extend(pool.map(_lint_one, [(f, settings) for f in files]))
+    else:
+        report.files.extend(lint_one(f, settings) for f in files)
+    return report
