@@ -1,0 +1,79 @@
+"""Bundled px4_msgs definitions, one ``.msg`` file per message per release (formats.md 2.2, 3).
+
+Each folder (``1.13`` ... ``1.17``, ``main`` = release/1.18) holds the wire fields of the messages
+fuzzoff decodes, in the order of that release's ``px4_msgs`` branch, with comments and constants
+dropped except ``MESSAGE_VERSION`` (which names the ``_vN`` topic suffix; it is not on the wire).
+They are used for recordings without embedded definitions (Humble-and-older ``.db3`` bags) and by
+the writers. See ``docs/ros2.md`` for what is exact and what is not.
+"""
+
+from __future__ import annotations
+
+import re
+from functools import cache
+from importlib import resources
+
+from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+from rosbags.typesys.store import Typestore
+
+from fuzzoff.profiles import ProfileError, px4_profile_for
+
+RELEASES: tuple[str, ...] = ("1.13", "1.14", "1.15", "1.16", "1.17", "main")
+"""Oldest to newest; ``main`` is release/1.18 (identical to main for these messages)."""
+
+PACKAGE = "px4_msgs"
+_VERSION = re.compile(r"^\s*uint32\s+MESSAGE_VERSION\s*=\s*(\d+)", re.MULTILINE)
+
+
+def type_name(message: str) -> str:
+    """``TrajectorySetpoint`` -> ``px4_msgs/msg/TrajectorySetpoint``."""
+    return f"{PACKAGE}/msg/{message}"
+
+
+def release_for(px4: str | None) -> str | None:
+    """The bundled release for a ``--px4`` value (``1.15.4``, ``main``); None if none applies."""
+    if not px4:
+        return None
+    try:
+        profile = px4_profile_for(px4)
+    except ProfileError:
+        return None
+    return profile if profile in RELEASES else None
+
+
+@cache
+def definition(release: str, message: str) -> str | None:
+    """The ``.msg`` text of ``message`` in ``release``, or None where that release lacks it."""
+    node = resources.files(__name__).joinpath(release, f"{message}.msg")
+    if not node.is_file():
+        return None
+    return node.read_text(encoding="utf-8")
+
+
+def releases_with(message: str) -> list[str]:
+    """The releases (oldest first) that define ``message``."""
+    return [r for r in RELEASES if definition(r, message) is not None]
+
+
+def message_version(text: str) -> int:
+    """``MESSAGE_VERSION`` of a definition (0 when it has none)."""
+    match = _VERSION.search(text)
+    return int(match.group(1)) if match else 0
+
+
+@cache
+def typestore_for(typename: str, text: str) -> Typestore:
+    """A rosbags type store holding ``typename`` as ``text`` defines it (one per definition).
+
+    One store per definition text, because two connections may carry the same type name with
+    different definitions (formats.md 3: the per-connection choice AnyReader does not make).
+    """
+    store = get_typestore(Stores.EMPTY)
+    store.register(get_types_from_msg(text, typename))
+    return store
+
+
+def field_names(typename: str, text: str) -> frozenset[str]:
+    """The wire field names of ``typename`` under ``text``."""
+    store = typestore_for(typename, text)
+    return frozenset(name for name, _ in store.fielddefs[typename][1])

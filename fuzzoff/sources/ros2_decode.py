@@ -1,0 +1,282 @@
+"""Which px4_msgs definition decodes which connection, and the decode itself (formats.md 2.3, 3).
+
+Per connection: the definition embedded in the recording first; else a bundled release chosen by
+the ``--px4`` release, the topic's ``_vN`` suffix (or the v1.13 naming) and the first payload's
+length. Every payload must decode to exactly its length (CDR may pad the end with up to three zero
+bytes): a payload that does not is never passed on half-understood; the topic becomes a problem
+(OFB001) naming the definition used.
+"""
+
+from __future__ import annotations
+
+import struct
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from rosbags.typesys import get_types_from_idl
+from rosbags.typesys.store import Typestore
+
+from fuzzoff.events import Event, Origin, Where
+from fuzzoff.sources import px4_msgs
+from fuzzoff.sources.base import SourceProblem
+from fuzzoff.sources.ros2_convert import BUILDERS, KIND_OF, Builder
+from fuzzoff.sources.ros2_topics import MESSAGE_FOR_NAME, OUTPUT_MESSAGES, TopicRef, parse_topic
+
+_DECODE_ERRORS = (struct.error, IndexError, ValueError, TypeError, UnicodeDecodeError)
+
+
+@dataclass(frozen=True, slots=True)
+class Definition:
+    """One message definition ready to decode with (a rosbags type store holding it)."""
+
+    typename: str
+    source: str
+    """``embedded`` or ``bundled <release>``: said in every problem about it."""
+    store: Typestore
+    fields: frozenset[str]
+    layout: tuple[Any, ...]
+
+    @classmethod
+    def make(cls, typename: str, text: str, source: str, fmt: str = "msg") -> Definition:
+        if fmt == "idl":
+            store = _idl_store(typename, text)
+        else:
+            store = px4_msgs.typestore_for(typename, text)
+        layout = tuple(store.fielddefs[typename][1])
+        fields = frozenset(name for name, _ in layout)
+        return cls(typename, source, store, fields, layout)
+
+    def decode(self, raw: bytes | memoryview) -> tuple[Any, str | None]:
+        """(message, None) when ``raw`` decodes to exactly its length, else (None, why)."""
+        size = len(raw)
+        if size < 4 or raw[0] != 0 or raw[1] not in (0, 1):
+            return None, "not a CDR payload (bad encapsulation header)"
+        msgdef = self.store.get_msgdef(self.typename)
+        func = msgdef.deserialize_cdr_le if raw[1] else msgdef.deserialize_cdr_be
+        try:
+            message, pos = func(memoryview(raw)[4:], 0, msgdef.cls, self.store)
+        except _DECODE_ERRORS:
+            return None, f"payload of {size} bytes is shorter than {self.describe()} needs"
+        # rosbags' own check tolerates any 3 stray bytes, which hides a newer release's extra
+        # trailing field (formats.md 2.3): only zero padding up to a 4-byte boundary is slack.
+        extra = size - 4 - pos
+        if extra and not (extra < 4 and size % 4 == 0 and not any(raw[size - extra :])):
+            return None, f"payload of {size} bytes, {4 + pos} decoded by {self.describe()}"
+        return message, None
+
+    def describe(self) -> str:
+        return f"{self.typename} ({self.source} definition)"
+
+
+def _idl_store(typename: str, text: str) -> Typestore:
+    from rosbags.typesys import Stores, get_typestore
+
+    store = get_typestore(Stores.EMPTY)
+    store.register(get_types_from_idl(text))
+    return store
+
+
+def bundled(message: str, release: str) -> Definition | None:
+    text = px4_msgs.definition(release, message)
+    if text is None:
+        return None
+    return Definition.make(px4_msgs.type_name(message), text, f"bundled {release}")
+
+
+def message_of(topic: str, msgtype: str) -> tuple[str | None, TopicRef | None]:
+    """The px4_msgs message a connection carries (by type, else by PX4 topic name)."""
+    ref = parse_topic(topic)
+    pkg, _, name = msgtype.replace("/msg/", "/").partition("/")
+    if pkg == px4_msgs.PACKAGE and name in BUILDERS:
+        return name, ref
+    if ref is not None and ref.name in MESSAGE_FOR_NAME and not msgtype:
+        return MESSAGE_FOR_NAME[ref.name], ref
+    return None, ref
+
+
+@dataclass(slots=True)
+class TopicDecoder:
+    """Decodes one connection's payloads into events; counts what it could not decode."""
+
+    topic: str
+    message: str
+    vehicle: str
+    origin: Origin
+    ref: TopicRef | None
+    owner: Ros2Decoding
+    definition: Definition | None = None
+    builder: Builder | None = None
+    index: int = 0
+    failed: int = 0
+    first_failure: tuple[float, str] | None = None
+
+    def event(self, raw: bytes | memoryview, t: float) -> Event | None:
+        """The event for one payload, or None (not decodable: counted as a problem)."""
+        index = self.index
+        self.index = index + 1
+        if self.builder is None:
+            if self.failed:
+                self._fail(t, "")
+                return None
+            self._resolve(raw, t)
+            if self.builder is None:
+                return None
+        assert self.definition is not None
+        message, why = self.definition.decode(raw)
+        if why is not None:
+            self._fail(t, why)
+            return None
+        return self.builder(message, t, Where(self.topic, index), message.timestamp)
+
+    def _resolve(self, sample: bytes | memoryview, t: float) -> None:
+        definition, why = self.owner.choose(self, sample)
+        if definition is None:
+            self._fail(t, why)
+            return
+        self.use(definition)
+
+    def use(self, definition: Definition) -> None:
+        self.definition = definition
+        self.builder = BUILDERS[self.message](definition.fields, self.vehicle, self.origin)
+
+    def _fail(self, t: float, why: str) -> None:
+        self.failed += 1
+        if self.first_failure is None:
+            self.first_failure = (t, why)
+
+
+@dataclass(slots=True)
+class Ros2Decoding:
+    """The per-recording choice of definitions, and the problems it found.
+
+    ``release`` is the ``--px4`` release (bundled folder name) when the user gave one.
+    """
+
+    release: str | None = None
+    decoders: list[TopicDecoder] = field(default_factory=list)
+    unknown: list[tuple[str, str]] = field(default_factory=list)
+    evidence: set[str] | None = None
+    """Releases every definition seen so far fits (for profile detection)."""
+    notes: list[str] = field(default_factory=list)
+
+    def connection(
+        self, topic: str, msgtype: str, embedded: str | None, fmt: str = "msg"
+    ) -> TopicDecoder | None:
+        """A decoder for a connection, or None when it is not a PX4 topic fuzzoff decodes."""
+        message, ref = message_of(topic, msgtype)
+        if message is None:
+            if ref is not None and ref.name in MESSAGE_FOR_NAME:
+                self.unknown.append((topic, msgtype))
+            return None
+        if ref is not None:
+            vehicle = ref.namespace
+            origin: Origin = "vehicle" if ref.direction == "out" else "sent"
+        else:
+            head, sep, _ = topic.partition("/fmu/")
+            vehicle = head if sep else ""
+            origin = "vehicle" if message in OUTPUT_MESSAGES else "sent"
+        decoder = TopicDecoder(topic, message, vehicle, origin, ref, self)
+        self.decoders.append(decoder)
+        if embedded and embedded.strip():
+            try:
+                definition = Definition.make(px4_msgs.type_name(message), embedded, "embedded", fmt)
+            except Exception as exc:
+                decoder._fail(0.0, f"its embedded definition cannot be parsed ({exc})")
+                return decoder
+            self._note_evidence(message, definition)
+            decoder.use(definition)
+        return decoder
+
+    def _note_evidence(self, message: str, definition: Definition) -> None:
+        fits = {
+            r
+            for r in px4_msgs.releases_with(message)
+            if (b := bundled(message, r)) is not None and b.layout == definition.layout
+        }
+        self.evidence = fits if self.evidence is None else self.evidence & fits
+
+    def candidates(self, decoder: TopicDecoder) -> list[str]:
+        """Bundled releases that can carry this topic (suffix / naming), newest first."""
+        out = []
+        ref = decoder.ref
+        for release in reversed(px4_msgs.releases_with(decoder.message)):
+            text = px4_msgs.definition(release, decoder.message)
+            assert text is not None
+            version = px4_msgs.message_version(text)
+            if ref is not None and ref.legacy and release != "1.13":
+                continue
+            if ref is not None and not ref.legacy and (ref.version or 0) != version:
+                continue
+            out.append(release)
+        return out
+
+    def choose(
+        self, decoder: TopicDecoder, sample: bytes | memoryview
+    ) -> tuple[Definition | None, str]:
+        """A bundled definition for a connection without one (formats.md 2.3 rule 2)."""
+        candidates = self.candidates(decoder)
+        if self.release is not None and self.release in candidates:
+            chosen = bundled(decoder.message, self.release)
+            assert chosen is not None
+            _, why = chosen.decode(sample)
+            if why is not None:
+                return None, f"no embedded definition and {why} (--px4 {self.release})"
+            return chosen, ""
+        fitting: list[Definition] = []
+        for release in candidates:
+            definition = bundled(decoder.message, release)
+            if definition is not None and definition.decode(sample)[1] is None:
+                fitting.append(definition)
+        if not fitting:
+            tried = ", ".join(candidates) or "none for this topic name"
+            return None, (
+                f"no embedded definition, and the {len(sample)}-byte payload fits no bundled "
+                f"px4_msgs release (tried {tried}); give --px4 or record with definitions"
+            )
+        if self.evidence:
+            preferred = [d for d in fitting if d.source.split()[-1] in self.evidence]
+            fitting = preferred or fitting
+        chosen = fitting[0]
+        release = chosen.source.split()[-1]
+        others = {d.source.split()[-1] for d in fitting if d.layout != chosen.layout}
+        if others:
+            self.notes.append(
+                f"{decoder.topic}: no embedded definition; decoded as px4_msgs {release} "
+                f"(the payload also fits {', '.join(sorted(others))}; --px4 decides)"
+            )
+        self._note_evidence(decoder.message, chosen)
+        return chosen, ""
+
+    def detected_release(self) -> str | None:
+        """The one release every embedded or chosen definition fits, if exactly one."""
+        if self.evidence and len(self.evidence) == 1:
+            return next(iter(self.evidence))
+        return None
+
+    def kinds(self) -> set[str]:
+        return {KIND_OF[d.message] for d in self.decoders}
+
+    def vehicles(self) -> list[str]:
+        return sorted({d.vehicle for d in self.decoders})
+
+    def problems(self) -> list[SourceProblem]:
+        out = []
+        for topic, msgtype in self.unknown:
+            out.append(
+                SourceProblem(
+                    f"topic {topic} has message type {msgtype or '(none)'}, which fuzzoff "
+                    "cannot decode as a PX4 topic; not read",
+                    topic,
+                )
+            )
+        for d in self.decoders:
+            if d.first_failure is None:
+                continue
+            t, why = d.first_failure
+            count = f"{d.failed} of {d.index} messages" if d.index else "messages"
+            out.append(SourceProblem(f"{d.message}: {why}; {count} not decoded", d.topic, t))
+        return out
+
+
+DecoderFactory = Callable[[str, str, str | None], TopicDecoder | None]
