@@ -170,6 +170,10 @@ class TlogSource(Source):
         stats = framer.stats
         if stats.packets == 0:
             self._fatal = True
+            if stats.truncated_at == 0:
+                raise SourceError(
+                    self.path, f"truncated at byte {stats.size}: no complete packet", "byte 0"
+                )
             raise SourceError(self.path, "no MAVLink packet found: not a tlog", "byte 0")
         info.vehicles = sorted({str(s) for s, _ in self._autopilots}, key=_vehicle_sort)
         info.message_count = stats.packets
@@ -182,14 +186,9 @@ class TlogSource(Source):
         return info
 
     def events(self) -> Iterator[Event]:
-        if self._info is None:
-            try:
-                self.probe()
-            except SourceError:
-                if self._fatal:
-                    raise
         if self._fatal:
-            return
+            return  # the probe already raised the one SourceError for this file
+        self.probe()
         framer = self._framer = Framer(self._file(), self._size, WANTED, verify=True)
         decoder = _Decoder(self._autopilots, self._vehicles())
         first_ts: int | None = None
