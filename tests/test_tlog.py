@@ -311,6 +311,7 @@ def test_flipped_bytes_are_reported_and_reading_resumes(good: Path) -> None:
     assert events[-1].t == pytest.approx(5.9)
     (problem,) = source.problems
     assert problem.what.startswith("corrupt data")
+    assert problem.where is not None
     start, end = (int(x) for x in problem.where.removeprefix("bytes ").split("-"))
     assert start <= middle and end >= middle + 40
     assert source.stats["bad_data"] == 1
