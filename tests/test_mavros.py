@@ -276,6 +276,7 @@ def test_setpoint_attitude_cmd_vel_rates_take_the_enu_ned_swap() -> None:
     )
     conv.convert("/mavros/setpoint_attitude/thrust", thrust(0.5), 1.0)
     (e,) = conv.convert("/mavros/setpoint_attitude/cmd_vel", msg, 1.0)
+    assert isinstance(e, SetAttitudeTarget)
     assert e.type_mask == 128 and e.q == (1.0, 0.0, 0.0, 0.0)
     assert (e.body_roll_rate, e.body_pitch_rate, e.body_yaw_rate) == (0.2, 0.1, -0.3)
 
