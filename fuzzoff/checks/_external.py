@@ -1,0 +1,104 @@
+"""What the ROS 2 / uORB content rules share: whose setpoint it is, the mode note, episodes.
+
+A ULog logs PX4's own setpoints next to the external controller's, so a logged (origin
+``vehicle``) setpoint counts as external only in offboard and only when the declared first
+true field selects its topic (fuzzoff/tables/control_mode.py). Messages recorded on their way
+to the vehicle (origin ``sent``: ROS 2 ``/fmu/in``, MAVLink) are always external.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from fuzzoff.checks.base import CheckContext
+from fuzzoff.events import ControlMode, Event, Where
+from fuzzoff.findings import Severity
+from fuzzoff.tables.control_mode import row_for
+
+
+def mode_note(ctx: CheckContext) -> str:
+    """Appended to messages that depend on the mode when the recording has none."""
+    return "" if ctx.state.mode_recorded else " (mode predicted by the gate model)"
+
+
+def declared_flag(ctx: CheckContext) -> str | None:
+    """The first true field of the latest ``OffboardControlMode`` (None: none seen, or empty)."""
+    mode = ctx.state.control_mode
+    if isinstance(mode, ControlMode):
+        return mode.first_flag()
+    return None
+
+
+def from_external(ctx: CheckContext, event: Event) -> bool:
+    """Was this setpoint written by the external controller (see the module docstring)?"""
+    if event.origin == "sent":
+        return True
+    if event.origin != "vehicle" or not ctx.state.in_offboard:
+        return False
+    row = row_for(ctx.profile, declared_flag(ctx))
+    return row is not None and event.kind in row.allowed
+
+
+def is_armed(ctx: CheckContext) -> bool:
+    """Armed as recorded, else as the gate model predicts from the recorded commands."""
+    if ctx.state.armed is not None:
+        return ctx.state.armed
+    return bool(ctx.gate.armed)
+
+
+@dataclass(slots=True)
+class Episode:
+    """A run of consecutive bad messages, reported once when it ends (or at ``finish``)."""
+
+    start: float
+    where: Where
+    message: str
+    last: float
+    count: int = 1
+    severity: Severity | None = None
+
+
+class Episodes:
+    """Open/extend/close runs of one condition per key, reporting each run as one finding."""
+
+    def __init__(self, ctx: CheckContext, code: str) -> None:
+        self.ctx = ctx
+        self.code = code
+        self.open: dict[str, Episode] = {}
+
+    def bad(
+        self,
+        key: str,
+        t: float,
+        where: Where,
+        message: str,
+        severity: Severity | None = None,
+    ) -> None:
+        episode = self.open.get(key)
+        if episode is None:
+            self.open[key] = Episode(t, where, message, t, severity=severity)
+        else:
+            episode.last = t
+            episode.count += 1
+
+    def good(self, key: str) -> None:
+        episode = self.open.pop(key, None)
+        if episode is not None:
+            self._report(episode)
+
+    def close_all(self) -> None:
+        for key in list(self.open):
+            self.good(key)
+
+    def _report(self, episode: Episode) -> None:
+        message = episode.message
+        if episode.count > 1:
+            message += f" ({episode.count} messages until {episode.last:.3f} s)"
+        self.ctx.report(
+            self.code,
+            message,
+            episode.start,
+            episode.where,
+            severity=episode.severity,
+            end=episode.last if episode.count > 1 else None,
+        )

@@ -1,0 +1,318 @@
+"""OFB401-OFB403, OFB405-OFB408: what the setpoint messages carry.
+
+Seed 000 "Мультикоптери" and "Універсальний апарат" (002 "旋翼机", "Generic Vehicle"); the
+per-axis validity of OFB403 is the code's rule (gate spec section 8, D13). OFB405/OFB406 also
+judge MAVLink ``SET_ATTITUDE_TARGET`` where its ``type_mask`` uses the field.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+
+from fuzzoff.checks._external import Episodes, declared_flag, from_external, is_armed
+from fuzzoff.checks.base import Check, CheckContext
+from fuzzoff.events import (
+    ActuatorMotors,
+    ActuatorServos,
+    AttitudeSetpoint,
+    Event,
+    RatesSetpoint,
+    SetAttitudeTarget,
+    ThrustSetpoint,
+    TorqueSetpoint,
+    TrajectorySetpoint,
+    Vec3,
+    VehicleStatus,
+)
+from fuzzoff.tables.control_mode import SETPOINT_NAMES
+
+TRAJECTORY_CONTROLS = ("position", "velocity", "acceleration")
+
+# SET_ATTITUDE_TARGET type_mask bits (gate spec 6.4).
+ATTITUDE_IGNORE = 128
+THROTTLE_IGNORE = 64
+THRUST_BODY_SET = 32
+
+MAVLINK_THRUST_RANGE: dict[str, tuple[float, float]] = {"mc": (0.0, 1.0), "vtol": (0.0, 1.0)}
+"""SET_ATTITUDE_TARGET ``thrust``: 0..1, -1..1 where the vehicle can reverse (fw, rovers)."""
+
+
+def _finite(values: Iterable[float]) -> bool:
+    return any(math.isfinite(v) for v in values)
+
+
+def content_controller(sp: TrajectorySetpoint) -> str | None:
+    """The controller the docs say the content selects (seed 000 "Мультикоптери")."""
+    for name in TRAJECTORY_CONTROLS:
+        vec: Vec3 = getattr(sp, name)
+        if _finite(vec):
+            return name
+    return None
+
+
+def axis_problems(sp: TrajectorySetpoint) -> list[str]:
+    """What PX4's position controller rejects (gate spec section 8, ``_inputValid``)."""
+    problems = []
+    for i, axis in enumerate("xyz"):
+        if not any(math.isfinite(getattr(sp, name)[i]) for name in TRAJECTORY_CONTROLS):
+            problems.append(f"axis {axis} has no finite position, velocity or acceleration")
+    for name in TRAJECTORY_CONTROLS:
+        vec = getattr(sp, name)
+        if math.isfinite(vec[0]) != math.isfinite(vec[1]):
+            problems.append(f"{name} x and y are not both finite or both NaN")
+    return problems
+
+
+class TrajectoryContent(Check):
+    """OFB401 (controller mismatch), OFB402 (all NaN), OFB403 (axis invalid)."""
+
+    codes = ("OFB401", "OFB402", "OFB403")
+    wants = (TrajectorySetpoint,)
+
+    def __init__(self, ctx: CheckContext) -> None:
+        super().__init__(ctx)
+        self.mismatch = Episodes(ctx, "OFB401")
+        self.all_nan = Episodes(ctx, "OFB402")
+        self.axis = Episodes(ctx, "OFB403")
+
+    def on_event(self, event: Event) -> None:
+        assert isinstance(event, TrajectorySetpoint)
+        flag = declared_flag(self.ctx)
+        if not from_external(self.ctx, event) or flag not in TRAJECTORY_CONTROLS:
+            return
+        selected = content_controller(event)
+        if selected is None:
+            self.all_nan.bad(
+                "nan",
+                event.t,
+                event.where,
+                f"TrajectorySetpoint with position, velocity and acceleration all NaN while "
+                f"OffboardControlMode declares '{flag}': it sets no target",
+            )
+            return
+        self.all_nan.good("nan")
+        if selected != flag:
+            self.mismatch.bad(
+                f"{flag}/{selected}",
+                event.t,
+                event.where,
+                f"OffboardControlMode declares '{flag}' but the TrajectorySetpoint content "
+                f"selects the {selected} controller; PX4 follows the content",
+            )
+        else:
+            self.mismatch.close_all()
+        problems = axis_problems(event) if self.ctx.profile.vehicle in ("mc", "vtol") else []
+        if problems:
+            self.axis.bad(
+                "axis",
+                event.t,
+                event.where,
+                f"TrajectorySetpoint PX4's position controller rejects: {'; '.join(problems)}; "
+                f"{_invalid_effect(self.ctx)}",
+            )
+        else:
+            self.axis.good("axis")
+
+    def finish(self, t_end: float) -> None:
+        for episodes in (self.mismatch, self.all_nan, self.axis):
+            episodes.close_all()
+
+
+def _invalid_effect(ctx: CheckContext) -> str:
+    """What mc_pos_control does with invalid input (gate spec section 8)."""
+    if ctx.profile.at_least("1.16"):
+        return (
+            f"PX4 {ctx.profile.px4} reuses the last valid setpoint for 200 ms, then flies a "
+            "failsafe setpoint (hold, or descend without a velocity estimate)"
+        )
+    return (
+        f"PX4 {ctx.profile.px4} flies a failsafe setpoint at once (hold, or descend without "
+        "a velocity estimate)"
+    )
+
+
+class QuaternionNotUnit(Check):
+    """OFB405: ``q_d`` / ``SET_ATTITUDE_TARGET.q`` NaN or off unit norm, where it is used."""
+
+    codes = ("OFB405",)
+    wants = (AttitudeSetpoint, SetAttitudeTarget)
+
+    def __init__(self, ctx: CheckContext) -> None:
+        super().__init__(ctx)
+        self.tolerance = float(ctx.option("OFB405", "tolerance"))
+        self.episodes = Episodes(ctx, "OFB405")
+
+    def on_event(self, event: Event) -> None:
+        if isinstance(event, AttitudeSetpoint):
+            if not from_external(self.ctx, event):
+                return
+            q, name = event.q_d, "VehicleAttitudeSetpoint.q_d"
+        elif isinstance(event, SetAttitudeTarget):
+            if event.type_mask & ATTITUDE_IGNORE:
+                self.episodes.good(event.kind)
+                return
+            q, name = event.q, "SET_ATTITUDE_TARGET.q"
+        else:
+            return
+        norm = math.sqrt(sum(v * v for v in q))
+        if math.isfinite(norm) and abs(norm - 1.0) <= self.tolerance:
+            self.episodes.good(event.kind)
+            return
+        what = "contains NaN" if not math.isfinite(norm) else f"has norm {norm:.4f}"
+        self.episodes.bad(
+            event.kind,
+            event.t,
+            event.where,
+            f"{name} {what}: not a unit quaternion (tolerance {self.tolerance:g}); PX4 uses "
+            f"it as is",
+        )
+
+    def finish(self, t_end: float) -> None:
+        self.episodes.close_all()
+
+
+class NormalizedOutOfRange(Check):
+    """OFB406: a value the docs normalise to [-1, 1] outside it."""
+
+    codes = ("OFB406",)
+    wants = (
+        AttitudeSetpoint,
+        RatesSetpoint,
+        ThrustSetpoint,
+        TorqueSetpoint,
+        ActuatorMotors,
+        ActuatorServos,
+        SetAttitudeTarget,
+    )
+
+    def __init__(self, ctx: CheckContext) -> None:
+        super().__init__(ctx)
+        self.episodes = Episodes(ctx, "OFB406")
+
+    def _values(self, event: Event) -> tuple[str, tuple[float, ...], tuple[float, float]] | None:
+        unit = (-1.0, 1.0)
+        if isinstance(event, SetAttitudeTarget):
+            if event.type_mask & THRUST_BODY_SET and event.thrust_body is not None:
+                return "SET_ATTITUDE_TARGET.thrust_body", event.thrust_body, unit
+            if event.type_mask & THROTTLE_IGNORE:
+                return None
+            span = MAVLINK_THRUST_RANGE.get(self.ctx.profile.vehicle, unit)
+            return "SET_ATTITUDE_TARGET.thrust", (event.thrust,), span
+        if not from_external(self.ctx, event):
+            return None
+        name = SETPOINT_NAMES[event.kind]
+        if isinstance(event, (AttitudeSetpoint, RatesSetpoint)):
+            return f"{name}.thrust_body", event.thrust_body, unit
+        if isinstance(event, (ThrustSetpoint, TorqueSetpoint)):
+            return f"{name}.xyz", event.xyz, unit
+        if isinstance(event, (ActuatorMotors, ActuatorServos)):
+            return f"{name}.control", event.control, unit
+        return None
+
+    def on_event(self, event: Event) -> None:
+        found = self._values(event)
+        if found is None:
+            return
+        name, values, (low, high) = found
+        bad = [(i, v) for i, v in enumerate(values) if math.isfinite(v) and not low <= v <= high]
+        if not bad:
+            self.episodes.good(event.kind)
+            return
+        shown = ", ".join(f"[{i}] = {v:g}" for i, v in bad)
+        self.episodes.bad(
+            event.kind,
+            event.t,
+            event.where,
+            f"{name} outside [{low:g}, {high:g}]: {shown}",
+        )
+
+    def finish(self, t_end: float) -> None:
+        self.episodes.close_all()
+
+
+class ActuatorNanDisarms(Check):
+    """OFB407: NaN in an ``ActuatorMotors`` control while armed disarms that motor.
+
+    Trailing NaNs after the last finite motor are unused outputs and stay clean, unless that
+    motor was commanded earlier while armed.
+    """
+
+    codes = ("OFB407",)
+    wants = (ActuatorMotors, VehicleStatus)
+
+    def __init__(self, ctx: CheckContext) -> None:
+        super().__init__(ctx)
+        self.episodes = Episodes(ctx, "OFB407")
+        self.active: set[int] = set()
+        self.saw_motors = False
+
+    def on_event(self, event: Event) -> None:
+        self.saw_motors = self.saw_motors or isinstance(event, ActuatorMotors)
+        if not is_armed(self.ctx):
+            self.active.clear()
+            self.episodes.close_all()
+            return
+        if not isinstance(event, ActuatorMotors) or not from_external(self.ctx, event):
+            return
+        finite = [i for i, v in enumerate(event.control) if math.isfinite(v)]
+        last = max(finite, default=-1)
+        nan = [
+            i
+            for i, v in enumerate(event.control)
+            if math.isnan(v) and (i < last or i in self.active)
+        ]
+        self.active.update(finite)
+        if not nan:
+            self.episodes.good("nan")
+            return
+        self.episodes.bad(
+            "nan",
+            event.t,
+            event.where,
+            f"ActuatorMotors.control NaN at {', '.join(f'[{i}]' for i in nan)} while armed: "
+            "PX4 disarms that motor output",
+        )
+
+    def finish(self, t_end: float) -> None:
+        self.episodes.close_all()
+        if self.saw_motors and not self.ctx.has("vehicle_status", "command"):
+            self.ctx.cannot_check(
+                "OFB407", "needs the arming state (vehicle_status, or the arm commands)"
+            )
+
+
+class RatesIncomplete(Check):
+    """OFB408: ``VehicleRatesSetpoint`` needs roll, pitch, yaw and thrust_body."""
+
+    codes = ("OFB408",)
+    wants = (RatesSetpoint,)
+
+    def __init__(self, ctx: CheckContext) -> None:
+        super().__init__(ctx)
+        self.episodes = Episodes(ctx, "OFB408")
+
+    def on_event(self, event: Event) -> None:
+        assert isinstance(event, RatesSetpoint)
+        if not from_external(self.ctx, event):
+            return
+        values = {
+            "roll": event.roll,
+            "pitch": event.pitch,
+            "yaw": event.yaw,
+            **{f"thrust_body[{i}]": v for i, v in enumerate(event.thrust_body)},
+        }
+        missing = [name for name, v in values.items() if math.isnan(v)]
+        if not missing:
+            self.episodes.good("nan")
+            return
+        self.episodes.bad(
+            "nan",
+            event.t,
+            event.where,
+            f"VehicleRatesSetpoint with NaN in {', '.join(missing)}: the docs require roll, "
+            "pitch, yaw and thrust_body",
+        )
+
+    def finish(self, t_end: float) -> None:
+        self.episodes.close_all()

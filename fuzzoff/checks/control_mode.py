@@ -1,0 +1,238 @@
+"""OFB301-OFB305: what ``OffboardControlMode`` declares, against what is published and valid.
+
+Seed 000 "The OffboardControlMode PX4 message" (1.15+; rover table in "Ровер"), seed 002
+"ROS 2 消息" (1.13-1.14). The table lives in fuzzoff/tables/control_mode.py.
+"""
+
+from __future__ import annotations
+
+from fuzzoff.checks._external import Episodes, declared_flag, mode_note
+from fuzzoff.checks.base import Check, CheckContext
+from fuzzoff.events import (
+    PX4_SETPOINTS,
+    Command,
+    ControlMode,
+    Event,
+    FailsafeFlags,
+    VehicleStatus,
+    Where,
+)
+from fuzzoff.gate import GateTransition
+from fuzzoff.tables.control_mode import (
+    SETPOINT_NAMES,
+    FlagRow,
+    describe_required,
+    estimate_valid,
+    row_for,
+)
+
+
+class ControlModeEmpty(Check):
+    """OFB301: an ``OffboardControlMode`` with every field false declares nothing."""
+
+    codes = ("OFB301",)
+    wants = (ControlMode,)
+
+    def __init__(self, ctx: CheckContext) -> None:
+        super().__init__(ctx)
+        self.episodes = Episodes(ctx, "OFB301")
+
+    def on_event(self, event: Event) -> None:
+        assert isinstance(event, ControlMode)
+        if event.flags():
+            self.episodes.good("empty")
+            return
+        self.episodes.bad(
+            "empty",
+            event.t,
+            event.where,
+            "OffboardControlMode with no field true: it declares no setpoint, and PX4 takes "
+            "it for no offboard signal at all",
+        )
+
+    def finish(self, t_end: float) -> None:
+        self.episodes.close_all()
+
+
+class SetpointNotDeclared(Check):
+    """OFB302: in offboard, a setpoint topic the first true field does not select."""
+
+    codes = ("OFB302",)
+    wants = PX4_SETPOINTS
+
+    def __init__(self, ctx: CheckContext) -> None:
+        super().__init__(ctx)
+        self.episodes = Episodes(ctx, "OFB302")
+        self.logged = False
+        self.sent = False
+
+    def on_event(self, event: Event) -> None:
+        if event.origin != "sent":
+            # A ULog copy cannot tell the external writer from PX4's own controllers.
+            self.logged = True
+            return
+        self.sent = True
+        flag = declared_flag(self.ctx)
+        row = row_for(self.ctx.profile, flag)
+        if not self.ctx.state.in_offboard or row is None:
+            self.episodes.close_all()
+            return
+        key = f"{event.kind}/{flag}"
+        if event.kind in row.allowed:
+            self.episodes.good(key)
+            return
+        self.episodes.bad(
+            key,
+            event.t,
+            event.where,
+            f"{SETPOINT_NAMES[event.kind]} published in offboard while OffboardControlMode's "
+            f"first true field is '{flag}', which does not select it: PX4's own controller "
+            f"still writes this topic{mode_note(self.ctx)}",
+        )
+
+    def finish(self, t_end: float) -> None:
+        self.episodes.close_all()
+        if self.logged and not self.sent:
+            self.ctx.cannot_check(
+                "OFB302",
+                "needs the setpoints as sent (ROS 2 /fmu/in topics); a ULog logs PX4's own "
+                "setpoints on the same topics",
+            )
+
+
+class DeclaredSetpointMissing(Check):
+    """OFB303: in offboard, the declared setpoint message has not been published."""
+
+    codes = ("OFB303",)
+    wants = (*PX4_SETPOINTS, ControlMode, VehicleStatus, GateTransition, Command)
+
+    def __init__(self, ctx: CheckContext) -> None:
+        super().__init__(ctx)
+        self.grace = float(ctx.option("OFB303", "grace_s"))
+        self.first_seen: dict[str, float] = {}
+        self.since: float | None = None
+        """When the current (offboard, first flag) period began."""
+        self.flag: str | None = None
+        self.checked = False
+
+    def on_event(self, event: Event) -> None:
+        self._due(event.t)
+        if event.kind in SETPOINT_NAMES and event.origin != "model":
+            self.first_seen.setdefault(event.kind, event.t)
+        flag = declared_flag(self.ctx) if self.ctx.state.in_offboard else None
+        if flag != self.flag or (flag is not None and self.since is None):
+            self.flag = flag
+            self.since = event.t if flag is not None else None
+            self.checked = False
+
+    def _due(self, t: float) -> None:
+        if self.since is None or self.checked or self.flag is None:
+            return
+        deadline = self.since + self.grace
+        if t < deadline:
+            return
+        self.checked = True
+        row = row_for(self.ctx.profile, self.flag)
+        if row is None or self._served(row, deadline):
+            return
+        self.ctx.report(
+            "OFB303",
+            f"in offboard with first true field '{self.flag}' since {self.since:.3f} s, but no "
+            f"{describe_required(row)} has been published by {deadline:.3f} s: PX4 has no "
+            f"setpoint for the controllers it enabled{mode_note(self.ctx)}",
+            deadline,
+            self.ctx.state.control_mode.where if self.ctx.state.control_mode else None,
+        )
+
+    def _served(self, row: FlagRow, by: float) -> bool:
+        return any(
+            all(kind in self.first_seen and self.first_seen[kind] <= by for kind in alt)
+            for alt in row.required
+        )
+
+    def finish(self, t_end: float) -> None:
+        self._due(t_end)
+
+
+class ControlModeChanged(Check):
+    """OFB304: the first true field changes while in offboard (info)."""
+
+    codes = ("OFB304",)
+    wants = (ControlMode, VehicleStatus, GateTransition)
+
+    def __init__(self, ctx: CheckContext) -> None:
+        super().__init__(ctx)
+        self.flag: str | None = None
+
+    def on_event(self, event: Event) -> None:
+        if not self.ctx.state.in_offboard:
+            self.flag = None
+            return
+        if not isinstance(event, ControlMode):
+            return
+        flag = event.first_flag()
+        if flag is None:
+            return  # OFB301's case
+        if self.flag is not None and flag != self.flag:
+            self.ctx.report(
+                "OFB304",
+                f"OffboardControlMode's first true field changed from '{self.flag}' to "
+                f"'{flag}' in offboard: PX4 switches its controller chain mid-flight"
+                f"{mode_note(self.ctx)}",
+                event.t,
+                event.where,
+            )
+        self.flag = flag
+
+
+class RequiredEstimateMissing(Check):
+    """OFB305: the estimate the first true field requires is invalid at the request or in
+    offboard (needs the estimator validity the recording rarely has outside a ULog)."""
+
+    codes = ("OFB305",)
+    wants = (ControlMode, FailsafeFlags, VehicleStatus, GateTransition, Command)
+
+    def __init__(self, ctx: CheckContext) -> None:
+        super().__init__(ctx)
+        self.bad_key: str | None = None
+        self.saw_mode = False
+
+    def on_event(self, event: Event) -> None:
+        if isinstance(event, ControlMode):
+            self.saw_mode = True
+        request = isinstance(event, Command) and event.is_offboard_switch
+        if not (self.ctx.state.in_offboard or request):
+            self.bad_key = None
+            return
+        flags = self.ctx.state.failsafe_flags
+        flag = declared_flag(self.ctx)
+        row = row_for(self.ctx.profile, flag)
+        if flags is None or row is None or row.estimate is None:
+            self.bad_key = None
+            return
+        if estimate_valid(flags, row.estimate) is not False:
+            self.bad_key = None
+            return
+        key = f"{flag}/{row.estimate}"
+        if key == self.bad_key and not request:
+            return
+        self.bad_key = key
+        at = "at the offboard request" if request else f"in offboard{mode_note(self.ctx)}"
+        self.ctx.report(
+            "OFB305",
+            f"first true field '{flag}' requires a valid {row.estimate} estimate, but the "
+            f"recording shows it invalid {at}",
+            event.t,
+            _where(event),
+        )
+
+    def finish(self, t_end: float) -> None:
+        if self.saw_mode and not self.ctx.has("failsafe_flags"):
+            self.ctx.cannot_check(
+                "OFB305",
+                "needs the estimator validity flags (ULog failsafe_flags or vehicle_status_flags)",
+            )
+
+
+def _where(event: Event) -> Where | None:
+    return None if isinstance(event, GateTransition) else event.where

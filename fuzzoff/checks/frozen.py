@@ -1,0 +1,87 @@
+"""OFB107: identical setpoint content for longer than a threshold while the stream keeps coming.
+
+A heuristic for a dead controller behind a library that re-sends the last setpoint (MAVSDK
+does, at 20 Hz): the keep-alive stays healthy, so PX4 never fails safe. Judged per topic, in
+offboard, on the external controller's messages; a gap longer than ``max_gap_s`` or any change
+in content restarts the count.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+
+from fuzzoff.checks._external import from_external, mode_note
+from fuzzoff.checks.base import Check, CheckContext
+from fuzzoff.events import MAVLINK_SETPOINTS, PX4_SETPOINTS, Event, VehicleStatus, Where
+from fuzzoff.gate import GateTransition
+
+HEADER_FIELDS = frozenset({"t", "vehicle", "where", "sender_time_us", "origin"})
+"""Fields that change with every message and say nothing about the setpoint."""
+
+_CONTENT_FIELDS: dict[type[Event], tuple[str, ...]] = {}
+
+
+def content_of(event: Event) -> tuple[str, ...]:
+    """The setpoint's content as comparable text (``repr`` keeps NaN equal to NaN)."""
+    names = _CONTENT_FIELDS.get(type(event))
+    if names is None:
+        names = tuple(f.name for f in fields(event) if f.name not in HEADER_FIELDS)
+        _CONTENT_FIELDS[type(event)] = names
+    return tuple(repr(getattr(event, name)) for name in names)
+
+
+@dataclass(slots=True)
+class _Run:
+    content: tuple[str, ...]
+    start: float
+    last: float
+    where: Where
+    count: int = 1
+
+
+class SetpointFrozen(Check):
+    codes = ("OFB107",)
+    wants = (*PX4_SETPOINTS, *MAVLINK_SETPOINTS, VehicleStatus, GateTransition)
+
+    def __init__(self, ctx: CheckContext) -> None:
+        super().__init__(ctx)
+        self.freeze = float(ctx.option("OFB107", "freeze_s"))
+        self.max_gap = float(ctx.option("OFB107", "max_gap_s"))
+        self.runs: dict[str, _Run] = {}
+
+    def on_event(self, event: Event) -> None:
+        if not self.ctx.state.in_offboard:
+            for kind in list(self.runs):
+                self._close(kind)
+            return
+        if isinstance(event, (VehicleStatus, GateTransition)) or not from_external(self.ctx, event):
+            return
+        content = content_of(event)
+        run = self.runs.get(event.kind)
+        if run is not None and run.content == content and event.t - run.last <= self.max_gap:
+            run.last = event.t
+            run.count += 1
+            return
+        self._close(event.kind)
+        self.runs[event.kind] = _Run(content, event.t, event.t, event.where)
+
+    def _close(self, kind: str) -> None:
+        run = self.runs.pop(kind, None)
+        if run is None or run.last - run.start <= self.freeze:
+            return
+        duration = run.last - run.start
+        rate = (run.count - 1) / duration
+        self.ctx.report(
+            "OFB107",
+            f"{run.where.topic or kind}: identical setpoint content for {duration:.2f} s "
+            f"({run.count} messages, {rate:.1f} Hz) in offboard: a controller that stopped "
+            f"while its library re-sends the last setpoint looks alive to PX4"
+            f"{mode_note(self.ctx)}",
+            run.start,
+            run.where,
+            end=run.last,
+        )
+
+    def finish(self, t_end: float) -> None:
+        for kind in list(self.runs):
+            self._close(kind)

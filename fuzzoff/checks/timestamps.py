@@ -1,0 +1,117 @@
+"""OFB106: the ``OffboardControlMode.timestamp`` a ROS 2 sender writes: zero, backwards, lagging.
+
+From 1.14 PX4 judges the keep-alive's age by this field, rewritten on receipt (gate spec
+2.1.1): zero becomes the receive time, anything else ``min(value - time_offset, now)``. So a
+clock that lags by more than the loss timeout makes a fresh stream look lost; 1.13 ignores the
+field (gate spec 2.2). The recording clock is relative, so the lag is measured against the
+freshest sender-to-recording offset seen so far.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from fuzzoff.checks.base import Check, CheckContext
+from fuzzoff.events import ControlMode, Event, Where
+from fuzzoff.findings import Severity
+
+
+@dataclass(slots=True)
+class _Seen:
+    t: float
+    where: Where
+    count: int = 1
+    worst_lag: float = 0.0
+
+
+class KeepaliveTimestamp(Check):
+    codes = ("OFB106",)
+    wants = (ControlMode,)
+
+    def __init__(self, ctx: CheckContext) -> None:
+        super().__init__(ctx)
+        option = float(ctx.option("OFB106", "lag_s"))
+        self.timeout = float(ctx.gate.loss_timeout)
+        self.lag_limit = option if option > 0 else self.timeout
+        self.judged_by_timestamp = ctx.profile.at_least("1.14")
+        self.best_offset: float | None = None
+        self.previous: int | None = None
+        self.seen: dict[str, _Seen] = {}
+        self.logged = False
+        self.sent = False
+
+    def on_event(self, event: Event) -> None:
+        assert isinstance(event, ControlMode)
+        if event.origin != "sent" or event.sender_time_us is None:
+            self.logged = self.logged or event.origin == "vehicle"
+            return
+        self.sent = True
+        stamp = event.sender_time_us
+        if stamp == 0:
+            self._note("zero", event, 0.0)
+            return
+        lag = self._lag(event.t, stamp)
+        if self.previous is not None and stamp < self.previous:
+            self._note("backwards", event, lag)
+        self.previous = stamp
+        if lag > self.lag_limit:
+            self._note("lag", event, lag)
+
+    def _lag(self, t: float, stamp_us: int) -> float:
+        offset = t - stamp_us / 1e6
+        if self.best_offset is None or offset < self.best_offset:
+            self.best_offset = offset
+        return offset - self.best_offset
+
+    def _note(self, what: str, event: Event, lag: float) -> None:
+        seen = self.seen.get(what)
+        if seen is None:
+            self.seen[what] = _Seen(event.t, event.where, worst_lag=lag)
+        else:
+            seen.count += 1
+            seen.worst_lag = max(seen.worst_lag, lag)
+
+    def finish(self, t_end: float) -> None:
+        for what, seen in sorted(self.seen.items(), key=lambda item: item[1].t):
+            self._report(what, seen)
+        if self.logged and not self.sent:
+            self.ctx.cannot_check(
+                "OFB106",
+                "needs OffboardControlMode as sent (ROS 2 /fmu/in/offboard_control_mode); "
+                "a ULog holds PX4's rewritten timestamp",
+            )
+
+    def _report(self, what: str, seen: _Seen) -> None:
+        stale = self.judged_by_timestamp and seen.worst_lag >= self.timeout
+        px4 = f"PX4 {self.ctx.profile.px4}"
+        if what == "zero":
+            text = "OffboardControlMode.timestamp is 0"
+            effect = (
+                f"{px4} replaces it with the receive time"
+                if self.judged_by_timestamp
+                else f"{px4} does not use the field"
+            )
+        else:
+            head = (
+                "OffboardControlMode.timestamp goes backwards"
+                if what == "backwards"
+                else "OffboardControlMode.timestamp lags the recording clock"
+            )
+            text = f"{head} (by up to {seen.worst_lag:.3f} s)"
+            if stale:
+                effect = (
+                    f"{px4} judges the keep-alive's age by this field and takes a stamp older "
+                    f"than COM_OF_LOSS_T ({self.timeout:.2f} s) for a lost signal"
+                )
+            elif self.judged_by_timestamp:
+                effect = f"{px4} judges the keep-alive's age by it; still within the timeout"
+            else:
+                effect = f"{px4} does not use the field for the offboard gate"
+        count = f" in {seen.count} messages" if seen.count > 1 else ""
+        self.ctx.report(
+            "OFB106",
+            f"{text}{count}: {effect}",
+            seen.t,
+            seen.where,
+            severity=Severity.WARNING if stale else Severity.INFO,
+        )

@@ -1,0 +1,60 @@
+"""Every rule page's example replays through the engine: ``bad`` gives that rule, ``good`` not.
+
+This also enforces that every rule in ``rules/`` has both examples (the page's "Example" and
+"Use instead" sections). OFB001-OFB003 are about the input and the profile, not about a stream:
+they are exempt, and listed here so that the exemption is visible.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import pytest
+
+from fuzzoff.catalog import Rule, load_catalog
+from fuzzoff.config import Settings
+from fuzzoff.engine import run_events
+from fuzzoff.events import Event, event_from_dict
+from fuzzoff.findings import Finding
+from fuzzoff.profiles import DEFAULT_PX4, DEFAULT_VEHICLE, Profile
+from fuzzoff.sources.base import RecordingInfo
+
+NOT_STREAM_RULES = {"OFB001", "OFB002", "OFB003"}
+"""Rules about reading the file or choosing the profile: no event stream can show them."""
+
+RULES = [rule for code, rule in load_catalog().items() if code not in NOT_STREAM_RULES]
+
+
+def _replay(rule: Rule, stream: tuple[dict[str, Any], ...]) -> list[Finding]:
+    events: list[Event] = sorted((event_from_dict(e) for e in stream), key=lambda e: e.t)
+    fmt = rule.formats[0] if rule.formats else "mcap"
+    info = RecordingInfo("example", fmt, kinds={e.kind for e in events})
+    profile = Profile(
+        px4=rule.example_profile.get("px4", DEFAULT_PX4),
+        vehicle=rule.example_profile.get("vehicle", DEFAULT_VEHICLE),
+        px4_detected=True,
+        vehicle_detected=True,
+    )
+    findings, _ = run_events(events, info, profile, Settings())
+    return findings
+
+
+@pytest.mark.parametrize("rule", RULES, ids=[r.code for r in RULES])
+def test_bad_example_gives_the_rule(rule: Rule) -> None:
+    assert rule.example_bad, f"rules/{rule.code}.toml has no example.bad"
+    found = [f for f in _replay(rule, rule.example_bad) if f.code == rule.code]
+    assert found, f"{rule.code}: example.bad gives no {rule.code} finding"
+
+
+@pytest.mark.parametrize("rule", RULES, ids=[r.code for r in RULES])
+def test_good_example_stays_clean(rule: Rule) -> None:
+    assert rule.example_good, f"rules/{rule.code}.toml has no example.good"
+    found = [f for f in _replay(rule, rule.example_good) if f.code == rule.code]
+    assert not found, f"{rule.code}: example.good gives {[f.message for f in found]}"
+
+
+@pytest.mark.parametrize("rule", RULES, ids=[r.code for r in RULES])
+def test_example_profile_is_one_the_rule_applies_to(rule: Rule) -> None:
+    px4 = rule.example_profile.get("px4", DEFAULT_PX4)
+    vehicle = rule.example_profile.get("vehicle", DEFAULT_VEHICLE)
+    assert rule.applies_to(px4, vehicle), f"{rule.code}: example profile {px4}/{vehicle}"
