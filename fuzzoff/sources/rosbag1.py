@@ -81,8 +81,8 @@ class Rosbag1Source(Source):
             self._salvage_reason = f"bag is not indexed ({REINDEX_HINT})"
         elif index_pos >= size:
             self._salvage_reason = (
-                f"truncated at byte {size} (its index was to start at byte {index_pos}); "
-                "events before the cut were read"
+                f"truncated at byte {size} (the index was due at byte {index_pos}); "
+                "the events before the cut were read"
             )
         else:
             self._salvage_reason = f"index damaged at byte {index_pos} ({REINDEX_HINT})"
@@ -181,10 +181,9 @@ class Rosbag1Source(Source):
         self._typestore = self._build_typestore(salvage.connections)
         yield from self._convert(wanted(), lambda: first[0])
         what, at = self._salvage_reason, None
-        if salvage.stopped is not None:
+        if salvage.stopped is not None and "truncated" not in what:
+            what = f"{what}; reading stopped: {salvage.stopped[0]}"
             at = f"byte {salvage.stopped[1]}"
-            if "truncated" not in what:
-                what = f"{what}; reading stopped: {salvage.stopped[0]}"
         self.problems.append(SourceProblem(what, at))
 
     def _convert(
@@ -195,6 +194,7 @@ class Rosbag1Source(Source):
         counts: dict[int, int] = {}
         first_bad: SourceProblem | None = None
         bad = 0
+        last: tuple[str, float] | None = None
         try:
             for conn, timestamp, raw in messages:
                 self._done += 1
@@ -208,10 +208,13 @@ class Rosbag1Source(Source):
                     bad += 1
                     first_bad = first_bad or SourceProblem(what, f"{conn.topic} #{index}", t)
                     continue
+                last = (f"{conn.topic} #{index}", t)
                 yield from converter.convert(conn.topic, msg, t, index)
         except Exception as exc:  # rosbags ReaderError, asserts, codec errors on corrupt chunks
-            detail = str(exc) if isinstance(exc, ReaderError) else type(exc).__name__
-            self.problems.append(SourceProblem(f"bag data unreadable: {detail}"))
+            detail = str(exc).rstrip(".") if isinstance(exc, ReaderError) else type(exc).__name__
+            where, t_last = last if last is not None else (None, None)
+            what = f"bag data corrupt ({detail}); reading stopped after the message"
+            self.problems.append(SourceProblem(what, where, t_last))
         if first_bad is not None:
             more = f" (and {bad - 1} more)" if bad > 1 else ""
             self.problems.append(
