@@ -1,0 +1,156 @@
+"""tlog speed and memory: ``fuzzoff lint`` beside pymavlink alone on the same files (issue 3/10).
+
+Targets: lint at most 1.3x the bare library (pymavlink's ``mavlink_connection`` iterating every
+message); on a log where offboard messages are under 10 %, lint faster than that; peak RSS flat
+from 100k to 1M messages; ``--jobs 2`` at least 1.8x ``--jobs 1`` over twenty files.
+
+Every measurement is its own process (wall time from outside, peak RSS from ``os.wait4``), so
+imports and start-up count for both sides. The data (bench/data/, git-ignored) are generated on
+the first run; ``python -m bench tlog`` runs only this benchmark.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from bench.tlog_data import generate
+
+DATA = Path(__file__).resolve().parent / "data"
+ROOT = DATA.parent.parent
+
+WANTED_TYPES = (
+    "HEARTBEAT,SET_MODE,PARAM_VALUE,COMMAND_INT,COMMAND_LONG,COMMAND_ACK,SET_ATTITUDE_TARGET,"
+    "SET_POSITION_TARGET_LOCAL_NED,SET_POSITION_TARGET_GLOBAL_INT,AUTOPILOT_VERSION,STATUSTEXT"
+)
+
+BARE = """
+import os, sys
+os.environ["MAVLINK20"] = "1"
+from pymavlink import mavutil
+log = mavutil.mavlink_connection(sys.argv[1], dialect="common")
+types = sys.argv[2].split(",") if len(sys.argv) > 2 else None
+n = 0
+while log.recv_match(type=types, blocking=False) is not None:
+    n += 1
+print(n)
+"""
+
+
+@dataclass
+class Run:
+    wall_s: float
+    rss_mb: float
+    output: str
+
+
+def measure(args: list[str]) -> Run:
+    """Run ``args``; wall time and this child's own peak RSS (not the max over all children)."""
+    env = {**os.environ, "MAVLINK20": "1", "NO_COLOR": "1"}
+    with tempfile.TemporaryFile() as out:
+        start = time.perf_counter()
+        proc = subprocess.Popen(args, stdout=out, stderr=subprocess.DEVNULL, cwd=ROOT, env=env)
+        _, status, usage = os.wait4(proc.pid, 0)
+        wall = time.perf_counter() - start
+        proc.returncode = os.waitstatus_to_exitcode(status)
+        out.seek(0)
+        text = out.read().decode(errors="replace")
+    return Run(wall, usage.ru_maxrss / 1024, text)
+
+
+def lint(paths: list[Path], jobs: int = 1) -> Run:
+    return measure(
+        [
+            sys.executable,
+            "-m",
+            "fuzzoff.cli",
+            "lint",
+            *map(str, paths),
+            "--format",
+            "json",
+            "--no-progress",
+            "--jobs",
+            str(jobs),
+        ]
+    )
+
+
+def bare(path: Path, types: str | None = None) -> Run:
+    return measure([sys.executable, "-c", BARE, str(path), *([types] if types else [])])
+
+
+def _row(name: str, what: str, messages: int, run: Run) -> None:
+    rate = messages / run.wall_s if run.wall_s else 0.0
+    print(f"{name:<12} {what:<26} {run.wall_s:8.2f} s {rate:11,.0f} msg/s {run.rss_mb:8.1f} MB")
+
+
+def main() -> None:
+    files = {
+        "100k": (generate(DATA / "tlog_100k.tlog", 100_000), 100_000),
+        "1M": (generate(DATA / "tlog_1m.tlog", 1_000_000), 1_000_000),
+        "mixed-500k": (generate(DATA / "tlog_mixed_500k.tlog", 500_000, 11), 500_000),
+    }
+    print(f"{'file':<12} {'method':<26} {'wall':>10} {'rate':>17} {'peak RSS':>11}")
+    results: dict[str, dict[str, Run]] = {}
+    for name, (path, messages) in files.items():
+        runs = {
+            "pymavlink, every message": bare(path),
+            "pymavlink, type filter": bare(path, WANTED_TYPES),
+            "fuzzoff lint": lint([path]),
+        }
+        results[name] = runs
+        size_mb = path.stat().st_size / 1e6
+        for what, run in runs.items():
+            _row(name, what, messages, run)
+        print(f"{'':<12} ({messages:,} messages, {size_mb:.1f} MB)")
+
+    def ratio(name: str) -> float:
+        runs = results[name]
+        return runs["fuzzoff lint"].wall_s / runs["pymavlink, every message"].wall_s
+
+    print()
+    print("target                                             measured   ok")
+    for name in ("100k", "1M"):
+        r = ratio(name)
+        print(f"lint / bare library ({name:<4}) <= 1.3x                  {r:7.2f}x   {r <= 1.3}")
+    r = ratio("mixed-500k")
+    print(f"lint / bare library (offboard < 10 %) < 1.0x          {r:7.2f}x   {r < 1.0}")
+    rss_small = results["100k"]["fuzzoff lint"].rss_mb
+    rss_big = results["1M"]["fuzzoff lint"].rss_mb
+    growth = rss_big / rss_small
+    print(
+        f"lint peak RSS 1M / 100k flat (<= 1.1x)              {growth:7.2f}x   {growth <= 1.1}"
+        f"   ({rss_small:.0f} -> {rss_big:.0f} MB)"
+    )
+    bare_growth = (
+        results["1M"]["pymavlink, every message"].rss_mb
+        / results["100k"]["pymavlink, every message"].rss_mb
+    )
+    print(f"  (pymavlink alone: {bare_growth:.2f}x)")
+
+    one = generate(DATA / "tlog_25k.tlog", 25_000)
+    folder = DATA / "twenty"
+    folder.mkdir(exist_ok=True)
+    copies = []
+    for i in range(20):
+        copy = folder / f"flight_{i:02d}.tlog"
+        if not copy.exists():
+            shutil.copyfile(one, copy)
+        copies.append(copy)
+    j1 = lint(copies, jobs=1)
+    j2 = lint(copies, jobs=2)
+    speedup = j1.wall_s / j2.wall_s
+    print(
+        f"--jobs 2 vs --jobs 1, 20 files x 25k >= 1.8x          {speedup:7.2f}x   "
+        f"{speedup >= 1.8}   ({j1.wall_s:.1f} s -> {j2.wall_s:.1f} s, {os.cpu_count()} CPUs)"
+    )
+
+
+if __name__ == "__main__":
+    main()
