@@ -1,0 +1,405 @@
+"""PX4 ULog reader: pyulog loads the topics that matter, events come out merged by timestamp.
+
+pyulog cannot stream (formats.md 9.1): it reads the whole file once, keeping only the topics of
+``LOADED_TOPICS`` (``message_name_filter_list``), as numpy arrays. Events are then made lazily,
+per topic in chunks, and merged by timestamp with ``heapq.merge``; nothing builds the whole
+event list. ``t`` is seconds since the ULog header's start time, ``sender_time_us`` the topic's
+``timestamp``; every event's origin is "vehicle" (PX4's own copy, docs/ulog.md).
+
+The logger subsamples topics (formats.md 8.1, rules.md "Keep-alive"), so ``probe`` reports the
+logging interval of each offboard topic in ``RecordingInfo.sampled_intervals``.
+"""
+
+from __future__ import annotations
+
+import heapq
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from fuzzoff import events as ev
+from fuzzoff.profiles import MAV_TYPE_VEHICLE, PX4_VEHICLE_TYPE, ProfileError, px4_profile_for
+from fuzzoff.sources.base import RecordingInfo, Source
+from fuzzoff.sources.ulog_load import Loaded, load
+from fuzzoff.sources.ulog_topics import (
+    EXTRA_TOPICS,
+    MAIN_STATE_TO_NAV,
+    TOPICS,
+    Chunk,
+    Context,
+    failsafe_flags,
+)
+
+LOADED_TOPICS: tuple[str, ...] = (*TOPICS, *EXTRA_TOPICS)
+CHUNK_ROWS = 4096
+"""Rows turned into Python values at a time (bounds memory on long logs)."""
+
+CA_AIRFRAME_VEHICLE: dict[int, str] = {
+    0: "mc",
+    1: "fw",
+    2: "vtol",
+    3: "vtol",
+    4: "vtol",
+    5: "rover-ackermann",
+    6: "rover-differential",
+    8: "mc",
+    10: "mc",
+    11: "mc",
+    12: "mc",
+    13: "rover-mecanum",
+}
+"""``CA_AIRFRAME`` (v1.14+ control allocation) -> vehicle type; the only parameter that names
+the rover drive in every release that has it."""
+
+ROVER_PARAM_PREFIX: dict[str, str] = {
+    "RA_": "rover-ackermann",
+    "RD_": "rover-differential",
+    "RM_": "rover-mecanum",
+}
+"""v1.16+ rover modules' parameter prefixes; a firmware that builds in only one of them names
+the drive by that alone (SITL builds all three, so several prefixes tell nothing)."""
+
+_SORTED_FIRST = -1
+"""Merge key for what a ULog says before any message (initial parameters, identity)."""
+_RECORD_RANK = 1 << 20
+"""Records without a topic sort after the topics at the same microsecond (pyulog dates a
+parameter change at the data message just before it)."""
+
+
+def decode_release(word: int) -> str | None:
+    """``ver_sw_release`` ``0xAABBCCTT`` -> ``"1.15.4"`` (``-rc``, ``-beta``, ``-alpha``,
+    ``-dev`` for TT < 255); None for 0 (a build without a release tag)."""
+    if not word:
+        return None
+    major, minor, patch, kind = (
+        (word >> 24) & 0xFF,
+        (word >> 16) & 0xFF,
+        (word >> 8) & 0xFF,
+        word & 0xFF,
+    )
+    base = f"{major}.{minor}.{patch}"
+    if kind == 255:
+        return base
+    suffix = "rc" if kind >= 192 else "beta" if kind >= 128 else "alpha" if kind >= 64 else "dev"
+    return f"{base}-{suffix}"
+
+
+def vehicle_from_params(params: dict[str, Any]) -> tuple[str | None, str]:
+    """The vehicle type the parameters name, and which parameter said so."""
+    airframe = params.get("CA_AIRFRAME")
+    if airframe is not None and int(airframe) in CA_AIRFRAME_VEHICLE:
+        return CA_AIRFRAME_VEHICLE[int(airframe)], f"CA_AIRFRAME={int(airframe)}"
+    families = {
+        vehicle
+        for prefix, vehicle in ROVER_PARAM_PREFIX.items()
+        if any(name.startswith(prefix) for name in params)
+    }
+    mav_type = params.get("MAV_TYPE")
+    rover_mav = mav_type is not None and MAV_TYPE_VEHICLE.get(int(mav_type), "").startswith("rover")
+    if len(families) == 1 and (mav_type is None or rover_mav):
+        (vehicle,) = families
+        return vehicle, "only the " + vehicle.split("-")[1] + " rover parameters exist"
+    if mav_type is not None and int(mav_type) in MAV_TYPE_VEHICLE:
+        return MAV_TYPE_VEHICLE[int(mav_type)], f"MAV_TYPE={int(mav_type)}"
+    return None, ""
+
+
+class UlogSource(Source):
+    """A PX4 ULog (.ulg), read with pyulog 1.3."""
+
+    format = "ulog"
+
+    def __init__(self, path: Path) -> None:
+        super().__init__(path)
+        self._loaded: Loaded | None = None
+        self._info: RecordingInfo | None = None
+        self._yielded = 0
+        self._total = 0
+
+    # -- loading ---------------------------------------------------------------------------
+
+    def probe_header(self) -> RecordingInfo:
+        """Version, parameters and vehicle type from the definition section only (instant)."""
+        header = load(self.path, None, header_only=True)
+        info = RecordingInfo(str(self.path), self.format, vehicles=[""])
+        self._identity(header.ulog, info, None)
+        return info
+
+    def _load(self) -> Loaded:
+        if self._loaded is None:
+            self._loaded = load(self.path, LOADED_TOPICS)
+            self.problems.extend(self._loaded.problems)
+            if self._loaded.library_output:
+                self.stats["pyulog_messages"] = self._loaded.library_output[:20]
+        return self._loaded
+
+    def _datasets(self) -> list[Any]:
+        return [d for d in self._load().ulog.data_list if len(d.data["timestamp"])]
+
+    # -- probe -----------------------------------------------------------------------------
+
+    def probe(self) -> RecordingInfo:
+        """Header first (cheap: fails fast on a foreign file), then the filtered data load,
+        which the kinds present and the logging intervals need (ULog has no index)."""
+        if self._info is not None:
+            return self._info
+        self.probe_header()
+        ulog = self._load().ulog
+        info = RecordingInfo(str(self.path), self.format, vehicles=[""])
+        datasets = self._datasets()
+        status = next((d for d in datasets if d.name == "vehicle_status"), None)
+        self._identity(ulog, info, status)
+        info.message_count = sum(len(d.data["timestamp"]) for d in datasets)
+        for d in datasets:
+            spec = TOPICS.get(d.name)
+            if spec is None:
+                continue
+            kind = _kind(d)
+            info.kinds.add(kind)
+            if spec.setpoint:
+                interval = _interval(d.data["timestamp"], spec.default_interval_s)
+                if interval is not None:
+                    current = info.sampled_intervals.get(kind)
+                    info.sampled_intervals[kind] = min(interval, current or interval)
+        if _legacy_flags(datasets):
+            info.kinds.add(ev.FailsafeFlags.kind)
+        info.kinds.add(ev.VehicleInfo.kind)
+        if ulog.initial_parameters or ulog.changed_parameters:
+            info.kinds.add(ev.Parameter.kind)
+        if ulog.logged_messages or ulog.logged_messages_tagged:
+            info.kinds.add(ev.StatusText.kind)
+        if ulog.dropouts:
+            info.kinds.add(ev.Dropout.kind)
+            total_ms = sum(d.duration for d in ulog.dropouts)
+            info.notes.append(f"the logger dropped data {len(ulog.dropouts)} times ({total_ms} ms)")
+        if info.sampled_intervals:
+            info.notes.append(
+                "offboard topics are subsampled by PX4's logger: "
+                + ", ".join(
+                    f"{k} every {v:.3f} s" for k, v in sorted(info.sampled_intervals.items())
+                )
+            )
+        self._total = info.message_count
+        self._info = info
+        return info
+
+    def _identity(self, ulog: Any, info: RecordingInfo, status: Any) -> None:
+        release = ulog.msg_info_dict.get("ver_sw_release")
+        info.px4_version = decode_release(int(release)) if isinstance(release, int) else None
+        params = dict(ulog.initial_parameters)
+        from_params, why = vehicle_from_params(params)
+        from_status = _vehicle_from_status(status) if status is not None else None
+        vehicle = from_status
+        if from_status == "rover":
+            rover_param = from_params if from_params and from_params.startswith("rover") else None
+            vehicle = rover_param or "rover-differential"
+            if rover_param is None:
+                info.notes.append("rover drive not recorded (no CA_AIRFRAME): assumed differential")
+        elif vehicle is None:
+            vehicle = from_params
+            if vehicle is not None:
+                info.notes.append(f"vehicle type from parameters ({why})")
+        info.vehicle_type = vehicle
+
+    # -- events ----------------------------------------------------------------------------
+
+    def events(self) -> Iterator[ev.Event]:
+        info = self.probe()
+        ulog = self._load().ulog
+        t0 = int(ulog.start_timestamp)
+        context = self._context(info)
+        streams: list[Iterator[tuple[int, int, int, ev.Event]]] = [self._preamble(ulog, info)]
+        ranks = {name: rank for rank, name in enumerate(TOPICS, start=10)}
+        datasets = self._datasets()
+        for d in datasets:
+            spec = TOPICS.get(d.name)
+            if spec is None:
+                continue
+            rank = ranks[d.name] * 256 + d.multi_id
+            topic = d.name if d.multi_id == 0 else f"{d.name}_{d.multi_id}"
+            streams.append(_stream(d.data, topic, rank, t0, spec.decode, context))
+        legacy = _legacy_flags(datasets)
+        if legacy is not None:
+            rank = (len(ranks) + 10) * 256
+            streams.append(
+                _stream(legacy.data, "vehicle_status", rank, t0, failsafe_flags, context)
+            )
+        streams.append(self._records(ulog, t0))
+        for _key, _rank, _index, event in heapq.merge(*streams):
+            self._yielded += 1
+            yield event
+
+    def _context(self, info: RecordingInfo) -> Context:
+        context = Context()
+        profile = None
+        if info.px4_version:
+            try:
+                profile = px4_profile_for(info.px4_version)
+            except ProfileError:
+                profile = None
+        context.legacy_arming = profile == "legacy" or (
+            profile is None and ev.LegacyControlMode.kind in info.kinds
+        )
+        commander = next((d for d in self._datasets() if d.name == "commander_state"), None)
+        if commander is not None:
+            ts = commander.data["timestamp"]
+            order = np.argsort(ts, kind="stable")
+            context.intention_ts = ts[order]
+            context.intention_nav = [
+                MAIN_STATE_TO_NAV.get(m) for m in commander.data["main_state"][order].tolist()
+            ]
+        return context
+
+    def _preamble(self, ulog: Any, info: RecordingInfo) -> Iterator[tuple[int, int, int, ev.Event]]:
+        t0 = int(ulog.start_timestamp)
+        mav_type = ulog.initial_parameters.get("MAV_TYPE")
+        yield (
+            _SORTED_FIRST,
+            0,
+            0,
+            ev.VehicleInfo(
+                t=0.0,
+                where=ev.Where("info"),
+                sender_time_us=t0,
+                px4_version=info.px4_version,
+                vehicle_type=info.vehicle_type,
+                mav_type=int(mav_type) if mav_type is not None else None,
+            ),
+        )
+        for index, (name, value) in enumerate(sorted(ulog.initial_parameters.items())):
+            yield (
+                _SORTED_FIRST,
+                1,
+                index,
+                ev.Parameter(
+                    t=0.0,
+                    where=ev.Where("parameters", index),
+                    sender_time_us=t0,
+                    name=name,
+                    value=float(value),
+                ),
+            )
+
+    def _records(self, ulog: Any, t0: int) -> Iterator[tuple[int, int, int, ev.Event]]:
+        """Changed parameters, logged messages and dropouts: records with a time but no topic.
+        pyulog dates parameter changes and dropouts at the last data message before them."""
+        items: list[tuple[int, int, int, ev.Event]] = []
+        for index, (ts, name, value) in enumerate(ulog.changed_parameters):
+            event: ev.Event = ev.Parameter(
+                t=_seconds(ts, t0),
+                where=ev.Where("changed_parameters", index),
+                sender_time_us=int(ts),
+                name=name,
+                value=float(value),
+            )
+            items.append((int(ts), _RECORD_RANK + 1, index, event))
+        logged = list(ulog.logged_messages)
+        for tagged in ulog.logged_messages_tagged.values():
+            logged.extend(tagged)
+        for index, message in enumerate(sorted(logged, key=lambda m: m.timestamp)):
+            event = ev.StatusText(
+                t=_seconds(message.timestamp, t0),
+                where=ev.Where("logged_messages", index),
+                sender_time_us=int(message.timestamp),
+                severity=_severity(message.log_level),
+                text=message.message,
+            )
+            items.append((int(message.timestamp), _RECORD_RANK + 2, index, event))
+        for index, dropout in enumerate(ulog.dropouts):
+            event = ev.Dropout(
+                t=_seconds(dropout.timestamp, t0),
+                where=ev.Where("dropouts", index),
+                sender_time_us=int(dropout.timestamp),
+                duration_s=dropout.duration / 1000.0,
+            )
+            items.append((int(dropout.timestamp), _RECORD_RANK + 3, index, event))
+        items.sort(key=lambda item: item[:3])
+        yield from items
+
+    def progress(self) -> float | None:
+        if not self._total:
+            return None
+        return min(1.0, self._yielded / self._total)
+
+
+def _seconds(ts: int, t0: int) -> float:
+    return max(0.0, (int(ts) - t0) / 1e6)
+
+
+def _severity(level: int) -> int:
+    """ULog log levels are the ASCII digits '0'..'7' (syslog severities)."""
+    if ord("0") <= level <= ord("7"):
+        return level - ord("0")
+    return level if 0 <= level <= 7 else 6
+
+
+def _kind(d: Any) -> str:
+    if d.name == "offboard_control_mode" and "ignore_thrust" in d.data:
+        return ev.LegacyControlMode.kind
+    return TOPICS[d.name].kind
+
+
+def _interval(timestamps: Any, default: float | None) -> float | None:
+    """The logger's interval for a topic: the median gap between logged samples, but never
+    more than PX4's default logging interval (a slower stream is logged whole)."""
+    if len(timestamps) < 2:
+        return default
+    gaps = np.diff(np.sort(timestamps.astype(np.int64)))
+    gaps = gaps[gaps > 0]
+    if not len(gaps):
+        return default
+    median = float(np.median(gaps)) / 1e6
+    return round(min(median, default) if default is not None else median, 6)
+
+
+def _vehicle_from_status(status: Any) -> str | None:
+    """``vtol``, ``mc``, ``fw`` or ``rover`` (drive not known here) from ``vehicle_status``."""
+    data = status.data
+    if "is_vtol" in data and bool(np.any(data["is_vtol"] != 0)):
+        return "vtol"
+    if "vehicle_type" in data:
+        types = data["vehicle_type"]
+    elif "is_rotary_wing" in data:
+        system = data.get("system_type", np.zeros_like(data["is_rotary_wing"]))
+        types = np.where(data["is_rotary_wing"] != 0, 1, np.where(system == 10, 3, 2))
+    else:
+        return None
+    known = types[types != 0]
+    if not len(known):
+        return None
+    value = int(known[0])
+    if value == 3:
+        return "rover"
+    return PX4_VEHICLE_TYPE.get(value)
+
+
+def _legacy_flags(datasets: list[Any]) -> Any:
+    """Legacy ``vehicle_status`` carrying the link-loss flags itself, when no flags topic does."""
+    if any(d.name in ("failsafe_flags", "vehicle_status_flags") for d in datasets):
+        return None
+    status = next((d for d in datasets if d.name == "vehicle_status"), None)
+    if status is not None and "offboard_control_signal_lost" in status.data:
+        return status
+    return None
+
+
+def _stream(
+    cols: Any, topic: str, rank: int, t0: int, decode: Any, context: Context
+) -> Iterator[tuple[int, int, int, ev.Event]]:
+    """One topic instance's events in timestamp order, made a chunk at a time."""
+    ts = cols["timestamp"]
+    n = len(ts)
+    order: Any = None
+    if n > 1 and bool(np.any(ts[1:] < ts[:-1])):
+        order = np.argsort(ts, kind="stable")
+    for start in range(0, n, CHUNK_ROWS):
+        sel = (
+            slice(start, min(n, start + CHUNK_ROWS))
+            if order is None
+            else order[start : start + CHUNK_ROWS]
+        )
+        chunk = Chunk(cols, sel, topic, t0)
+        for ts_us, index, event in zip(chunk.ts, chunk.index, decode(chunk, context), strict=True):
+            yield (ts_us, rank, index, event)

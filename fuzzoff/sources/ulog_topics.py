@@ -1,0 +1,509 @@
+"""uORB topics in a ULog -> normalised events, one decoder per topic (formats.md 2.2, 8.1).
+
+A decoder sees a ``Chunk``: a slice of a topic's numpy columns (as pyulog returns them) turned
+into Python lists, and yields events. Field layouts differ between releases; decoders go by
+field names, so one decoder reads every release's layout (``ignore_*`` and boolean control
+modes, ``x, y, z`` and ``position[3]`` trajectories, ...). Every event has origin "vehicle":
+a ULog is PX4's own copy of what it received or computed.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import numpy as np
+
+from fuzzoff import events as ev
+from fuzzoff.modes import nav_state_name
+
+Columns = Mapping[str, Any]
+"""Field name -> numpy array (one topic instance, as in ``ULog.Data.data``)."""
+
+MAIN_STATE_TO_NAV: dict[int, int] = {
+    0: 0,
+    1: 1,
+    2: 2,
+    3: 3,
+    4: 4,
+    5: 5,
+    6: 10,
+    7: 14,
+    8: 15,
+    9: 16,
+    10: 17,
+    11: 18,
+    12: 19,
+    13: 20,
+    14: 21,
+    15: 22,
+}
+"""``commander_state.main_state`` (legacy - v1.13) -> the nav_state of the same mode (gate 11)."""
+
+NAV_TO_MAIN_STATE: dict[int, int] = {nav: main for main, nav in MAIN_STATE_TO_NAV.items()}
+
+
+@dataclass(slots=True)
+class Context:
+    """What decoders need beyond their own topic."""
+
+    legacy_arming: bool = False
+    """Legacy ``arming_state`` numbering: ARMED 2 and ARMED_ERROR 3 are both armed (gate 11)."""
+    intention_ts: Any = None
+    """``commander_state`` timestamps (sorted numpy array) for the <= v1.13 user intention."""
+    intention_nav: list[int | None] | None = None
+
+
+class Chunk:
+    """Rows ``sel`` of one topic instance, as Python values, with the common event header."""
+
+    def __init__(self, cols: Columns, sel: Any, topic: str, t0: int) -> None:
+        self.cols = cols
+        self.sel = sel
+        ts = cols["timestamp"][sel]
+        self.ts: list[int] = ts.tolist()
+        self.t: list[float] = np.maximum((ts.astype(np.float64) - t0) / 1e6, 0.0).tolist()
+        index = np.arange(len(cols["timestamp"]))[sel].tolist()
+        self.index: list[int] = index
+        self.where = [ev.Where(topic, i) for i in index]
+        self.n = len(self.ts)
+
+    def has(self, name: str) -> bool:
+        return name in self.cols
+
+    def f(self, name: str) -> list[float]:
+        """Float column; NaN where the layout has no such field."""
+        if name not in self.cols:
+            return [math.nan] * self.n
+        values: list[float] = self.cols[name][self.sel].astype(np.float64).tolist()
+        return values
+
+    def i(self, name: str, default: int = 0) -> list[int]:
+        if name not in self.cols:
+            return [default] * self.n
+        values: list[int] = self.cols[name][self.sel].tolist()
+        return values
+
+    def b(self, name: str) -> list[bool]:
+        if name not in self.cols:
+            return [False] * self.n
+        values: list[bool] = (self.cols[name][self.sel] != 0).tolist()
+        return values
+
+    def ob(self, name: str) -> list[bool | None]:
+        """Optional bool: None where the layout has no such field."""
+        if name not in self.cols:
+            return [None] * self.n
+        return list(self.b(name))
+
+    def vec(self, name: str, size: int) -> list[Any]:
+        """Array field ``name[0..size)`` as tuples (typed loosely: the size varies by field)."""
+        return list(zip(*(self.f(f"{name}[{k}]") for k in range(size)), strict=True))
+
+    def width(self, name: str) -> int:
+        """The length of array field ``name`` in this layout."""
+        size = 0
+        while f"{name}[{size}]" in self.cols:
+            size += 1
+        return size
+
+    def head(self) -> Iterator[dict[str, Any]]:
+        """The common header of each row's event."""
+        for t, where, ts in zip(self.t, self.where, self.ts, strict=True):
+            yield {"t": t, "where": where, "sender_time_us": ts, "origin": "vehicle"}
+
+
+Decoder = Callable[[Chunk, Context], Iterator[ev.Event]]
+
+
+def _legacy_thrust(c: Chunk) -> list[Any]:
+    """Legacy scalar ``thrust`` (0..1, up) as a body thrust vector (FRD: negative z)."""
+    if c.has("thrust_body[0]"):
+        return c.vec("thrust_body", 3)
+    return [(0.0, 0.0, -v) if not math.isnan(v) else ev.NAN3 for v in c.f("thrust")]
+
+
+def control_mode(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
+    if c.has("ignore_thrust"):
+        if c.has("ignore_bodyrate"):
+            bodyrate = c.b("ignore_bodyrate")
+        else:  # v1.7-v1.11 split it per axis; the rates are used if any axis is
+            x, y, z = c.b("ignore_bodyrate_x"), c.b("ignore_bodyrate_y"), c.b("ignore_bodyrate_z")
+            bodyrate = [a and b and d for a, b, d in zip(x, y, z, strict=True)]
+        for h, *row in zip(
+            c.head(),
+            c.b("ignore_thrust"),
+            c.b("ignore_attitude"),
+            bodyrate,
+            c.b("ignore_position"),
+            c.b("ignore_velocity"),
+            c.b("ignore_acceleration_force"),
+            c.b("ignore_alt_hold"),
+            strict=True,
+        ):
+            yield ev.LegacyControlMode(
+                **h,
+                ignore_thrust=row[0],
+                ignore_attitude=row[1],
+                ignore_bodyrate=row[2],
+                ignore_position=row[3],
+                ignore_velocity=row[4],
+                ignore_acceleration_force=row[5],
+                ignore_alt_hold=row[6],
+            )
+        return
+    new = c.has("thrust_and_torque")
+    layout: Literal["actuator", "thrust_and_torque"] = "thrust_and_torque" if new else "actuator"
+    for h, pos, vel, acc, att, rate, tt, direct, act in zip(
+        c.head(),
+        c.b("position"),
+        c.b("velocity"),
+        c.b("acceleration"),
+        c.b("attitude"),
+        c.b("body_rate"),
+        c.b("thrust_and_torque"),
+        c.b("direct_actuator"),
+        c.b("actuator"),
+        strict=True,
+    ):
+        yield ev.ControlMode(
+            **h,
+            position=pos,
+            velocity=vel,
+            acceleration=acc,
+            attitude=att,
+            body_rate=rate,
+            thrust_and_torque=tt,
+            direct_actuator=direct,
+            actuator=act,
+            layout=layout,
+        )
+
+
+def trajectory(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
+    if c.has("position[0]"):
+        position, velocity = c.vec("position", 3), c.vec("velocity", 3)
+    else:  # v1.13 layout
+        position = list(zip(c.f("x"), c.f("y"), c.f("z"), strict=True))
+        velocity = list(zip(c.f("vx"), c.f("vy"), c.f("vz"), strict=True))
+    for h, pos, vel, acc, jerk, yaw, yawspeed in zip(
+        c.head(),
+        position,
+        velocity,
+        c.vec("acceleration", 3),
+        c.vec("jerk", 3),
+        c.f("yaw"),
+        c.f("yawspeed"),
+        strict=True,
+    ):
+        yield ev.TrajectorySetpoint(
+            **h,
+            position=pos,
+            velocity=vel,
+            acceleration=acc,
+            jerk=jerk,
+            yaw=yaw,
+            yawspeed=yawspeed,
+        )
+
+
+def attitude(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
+    for h, q, thrust, move in zip(
+        c.head(), c.vec("q_d", 4), _legacy_thrust(c), c.f("yaw_sp_move_rate"), strict=True
+    ):
+        yield ev.AttitudeSetpoint(**h, q_d=q, thrust_body=thrust, yaw_sp_move_rate=move)
+
+
+def rates(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
+    for h, roll, pitch, yaw, thrust in zip(
+        c.head(), c.f("roll"), c.f("pitch"), c.f("yaw"), _legacy_thrust(c), strict=True
+    ):
+        yield ev.RatesSetpoint(**h, roll=roll, pitch=pitch, yaw=yaw, thrust_body=thrust)
+
+
+def thrust(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
+    for h, xyz in zip(c.head(), c.vec("xyz", 3), strict=True):
+        yield ev.ThrustSetpoint(**h, xyz=xyz)
+
+
+def torque(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
+    for h, xyz in zip(c.head(), c.vec("xyz", 3), strict=True):
+        yield ev.TorqueSetpoint(**h, xyz=xyz)
+
+
+def motors(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
+    control = c.vec("control", c.width("control"))
+    for h, values, flags in zip(c.head(), control, c.i("reversible_flags"), strict=True):
+        yield ev.ActuatorMotors(**h, control=values, reversible_flags=flags)
+
+
+def servos(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
+    for h, values in zip(c.head(), c.vec("control", c.width("control")), strict=True):
+        yield ev.ActuatorServos(**h, control=values)
+
+
+def rover_position(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
+    for h, pos, start, cruise, arrival, yaw in zip(
+        c.head(),
+        c.vec("position_ned", 2),
+        c.vec("start_ned", 2),
+        c.f("cruising_speed"),
+        c.f("arrival_speed"),
+        c.f("yaw"),
+        strict=True,
+    ):
+        yield ev.RoverPositionSetpoint(
+            **h,
+            position_ned=pos,
+            start_ned=start,
+            cruising_speed=cruise,
+            arrival_speed=arrival,
+            yaw=yaw,
+        )
+
+
+def _plain(cls: type[ev.Event], names: tuple[str, ...]) -> Decoder:
+    def decode(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
+        columns = [c.f(name) for name in names]
+        for h, *values in zip(c.head(), *columns, strict=True):
+            yield cls(**h, **dict(zip(names, values, strict=True)))
+
+    return decode
+
+
+def steering(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
+    name = (
+        "normalized_steering_setpoint"  # v1.17+
+        if c.has("normalized_steering_setpoint")
+        else "normalized_steering_angle"
+    )
+    for h, angle, diff in zip(c.head(), c.f(name), c.f("normalized_speed_diff"), strict=True):
+        yield ev.RoverSteeringSetpoint(
+            **h, normalized_steering_angle=angle, normalized_speed_diff=diff
+        )
+
+
+def triplet(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
+    for h, prev, cur, nxt, kind, pos, vel, yaw in zip(
+        c.head(),
+        c.b("previous.valid"),
+        c.b("current.valid"),
+        c.b("next.valid"),
+        c.i("current.type"),
+        c.b("current.position_valid"),
+        c.b("current.velocity_valid"),
+        c.b("current.yaw_valid"),
+        strict=True,
+    ):
+        yield ev.PositionSetpointTriplet(
+            **h,
+            previous_valid=prev,
+            current_valid=cur,
+            next_valid=nxt,
+            current_type=kind,
+            current_position_valid=pos,
+            current_velocity_valid=vel,
+            current_yaw_valid=yaw,
+        )
+
+
+def _vehicle_types(c: Chunk) -> list[int | None]:
+    if c.has("vehicle_type"):
+        return list(c.i("vehicle_type"))
+    if c.has("is_rotary_wing"):  # legacy: no vehicle_type; rovers report MAV_TYPE 10
+        system = c.i("system_type")
+        return [
+            1 if rotary else 3 if mav == 10 else 2
+            for rotary, mav in zip(c.b("is_rotary_wing"), system, strict=True)
+        ]
+    return [None] * c.n
+
+
+def _intentions(c: Chunk, ctx: Context) -> list[int | None]:
+    if c.has("nav_state_user_intention"):
+        return list(c.i("nav_state_user_intention"))
+    if ctx.intention_ts is None or ctx.intention_nav is None:
+        return [None] * c.n
+    ts = c.cols["timestamp"][c.sel]
+    at = np.searchsorted(ctx.intention_ts, ts, side="right") - 1
+    nav = ctx.intention_nav
+    return [nav[k] if k >= 0 else None for k in at.tolist()]
+
+
+def vehicle_status(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
+    arming = c.i("arming_state")
+    armed = [a in (2, 3) if ctx.legacy_arming else a == 2 for a in arming]
+    for h, nav, arm, intention, failsafe, vtype, vtol in zip(
+        c.head(),
+        c.i("nav_state"),
+        armed,
+        _intentions(c, ctx),
+        c.ob("failsafe"),
+        _vehicle_types(c),
+        c.ob("is_vtol"),
+        strict=True,
+    ):
+        yield ev.VehicleStatus(
+            **h,
+            nav_state=nav,
+            mode=nav_state_name(nav),
+            armed=arm,
+            user_intention=intention,
+            failsafe=failsafe,
+            vehicle_type=vtype,
+            is_vtol=vtol,
+        )
+
+
+_FLAG_PREFIX, _FLAG_SUFFIX = "flag_control_", "_enabled"
+
+
+def control_mode_status(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
+    names = [
+        name for name in c.cols if name.startswith(_FLAG_PREFIX) and name.endswith(_FLAG_SUFFIX)
+    ]
+    short = [name[len(_FLAG_PREFIX) : -len(_FLAG_SUFFIX)] for name in names]
+    columns = [c.b(name) for name in names]
+    for h, offboard, *flags in zip(
+        c.head(), c.b("flag_control_offboard_enabled"), *columns, strict=True
+    ):
+        enabled = frozenset(s for s, on in zip(short, flags, strict=True) if on)
+        yield ev.VehicleControlModeStatus(**h, offboard_enabled=offboard, enabled=enabled)
+
+
+_ESTIMATES = (
+    "local_position",
+    "local_velocity",
+    "local_altitude",
+    "global_position",
+    "attitude",
+    "angular_velocity",
+    "home_position",
+)
+
+
+def _valid(c: Chunk, estimate: str) -> list[bool | None]:
+    """``*_valid`` from whichever spelling the release logs (``*_invalid`` from v1.14)."""
+    if c.has(f"{estimate}_invalid"):
+        return [not v for v in c.b(f"{estimate}_invalid")]
+    for name in (f"condition_{estimate}_valid", f"{estimate}_valid"):
+        if c.has(name):
+            return list(c.b(name))
+    return [None] * c.n
+
+
+def failsafe_flags(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
+    manual = (
+        "manual_control_signal_lost" if c.has("manual_control_signal_lost") else "rc_signal_lost"
+    )
+    valid = [_valid(c, name) for name in _ESTIMATES]
+    for h, lost, manual_lost, *flags in zip(
+        c.head(), c.ob("offboard_control_signal_lost"), c.ob(manual), *valid, strict=True
+    ):
+        yield ev.FailsafeFlags(
+            **h,
+            offboard_control_signal_lost=lost,
+            manual_control_signal_lost=manual_lost,
+            **{f"{name}_valid": v for name, v in zip(_ESTIMATES, flags, strict=True)},
+        )
+
+
+def command(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
+    params = list(zip(*(c.f(f"param{k}") for k in range(1, 8)), strict=True))
+    for h, p, cmd, tsys, tcomp, ssys, scomp, external in zip(
+        c.head(),
+        params,
+        c.i("command"),
+        c.i("target_system"),
+        c.i("target_component"),
+        c.i("source_system"),
+        c.i("source_component"),
+        c.ob("from_external"),
+        strict=True,
+    ):
+        yield ev.Command(
+            **h,
+            command=cmd,
+            params=p,
+            target_system=tsys,
+            target_component=tcomp,
+            source_system=ssys,
+            source_component=scomp,
+            from_external=external,
+            transport="uorb",
+        )
+
+
+def ack(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
+    for h, cmd, result, tsys, tcomp in zip(
+        c.head(),
+        c.i("command"),
+        c.i("result"),
+        c.i("target_system"),
+        c.i("target_component"),
+        strict=True,
+    ):
+        yield ev.CommandAck(
+            **h, command=cmd, result=result, target_system=tsys, target_component=tcomp
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class TopicSpec:
+    kind: str
+    decode: Decoder
+    default_interval_s: float | None = None
+    """PX4's default logger interval for this topic (formats.md 8.1), where it is known."""
+    setpoint: bool = False
+    """An offboard keep-alive or setpoint topic: subsampled by the logger."""
+
+
+TOPICS: dict[str, TopicSpec] = {
+    "vehicle_command": TopicSpec(ev.Command.kind, command),
+    "offboard_control_mode": TopicSpec(ev.ControlMode.kind, control_mode, 0.1, True),
+    "trajectory_setpoint": TopicSpec(ev.TrajectorySetpoint.kind, trajectory, 0.2, True),
+    "vehicle_attitude_setpoint": TopicSpec(ev.AttitudeSetpoint.kind, attitude, 0.1, True),
+    "vehicle_rates_setpoint": TopicSpec(ev.RatesSetpoint.kind, rates, None, True),
+    "vehicle_thrust_setpoint": TopicSpec(ev.ThrustSetpoint.kind, thrust, None, True),
+    "vehicle_torque_setpoint": TopicSpec(ev.TorqueSetpoint.kind, torque, None, True),
+    "actuator_motors": TopicSpec(ev.ActuatorMotors.kind, motors, None, True),
+    "actuator_servos": TopicSpec(ev.ActuatorServos.kind, servos, None, True),
+    "rover_position_setpoint": TopicSpec(ev.RoverPositionSetpoint.kind, rover_position, None, True),
+    "rover_speed_setpoint": TopicSpec(
+        ev.RoverSpeedSetpoint.kind,
+        _plain(ev.RoverSpeedSetpoint, ("speed_body_x", "speed_body_y")),
+        None,
+        True,
+    ),
+    "rover_attitude_setpoint": TopicSpec(
+        ev.RoverAttitudeSetpoint.kind,
+        _plain(ev.RoverAttitudeSetpoint, ("yaw_setpoint",)),
+        None,
+        True,
+    ),
+    "rover_rate_setpoint": TopicSpec(
+        ev.RoverRateSetpoint.kind,
+        _plain(ev.RoverRateSetpoint, ("yaw_rate_setpoint",)),
+        None,
+        True,
+    ),
+    "rover_throttle_setpoint": TopicSpec(
+        ev.RoverThrottleSetpoint.kind,
+        _plain(ev.RoverThrottleSetpoint, ("throttle_body_x", "throttle_body_y")),
+        None,
+        True,
+    ),
+    "rover_steering_setpoint": TopicSpec(ev.RoverSteeringSetpoint.kind, steering, None, True),
+    "position_setpoint_triplet": TopicSpec(ev.PositionSetpointTriplet.kind, triplet, 0.2, True),
+    "vehicle_command_ack": TopicSpec(ev.CommandAck.kind, ack),
+    "vehicle_status": TopicSpec(ev.VehicleStatus.kind, vehicle_status),
+    "vehicle_control_mode": TopicSpec(ev.VehicleControlModeStatus.kind, control_mode_status),
+    "failsafe_flags": TopicSpec(ev.FailsafeFlags.kind, failsafe_flags),
+    "vehicle_status_flags": TopicSpec(ev.FailsafeFlags.kind, failsafe_flags),
+}
+"""uORB topic -> what it becomes. Dict order = the order of events at the same microsecond."""
+
+EXTRA_TOPICS = ("commander_state",)
+"""Loaded but not turned into events of their own (merged into ``vehicle_status``)."""

@@ -1,0 +1,612 @@
+"""uORB message formats as PX4 logs them, per release era (formats.md 2.2, 8.1; seed 003).
+
+Only the topics fuzzoff reads, and only the fields they need plus enough of the rest to look
+like PX4's; a field list starts at the era named and holds until the next entry. Trailing
+``_padding0`` fields are declared as PX4 declares them and, like PX4, never written in the data
+(formats.md 8.3).
+"""
+
+from __future__ import annotations
+
+from fuzzoff.profiles import px4_profile_for
+
+ERAS: tuple[str, ...] = ("legacy", "1.13", "1.14", "1.15", "1.16", "1.17")
+"""``legacy`` = v1.5-v1.11 (ignore_* control mode), ``1.13`` = v1.12-v1.13, ``1.17`` = 1.17+."""
+
+_PROFILE_ERA = {"legacy": "legacy", "1.11": "legacy", "main": "1.17"}
+
+
+def era_for(px4_version: str | None) -> str:
+    """The format era of a release (``1.15.4``) or profile name; 1.15 when unknown."""
+    if px4_version is None:
+        return "1.15"
+    profile = px4_profile_for(px4_version)
+    return _PROFILE_ERA.get(profile, profile)
+
+
+# Nested type used by position_setpoint_triplet (legacy and 1.13).
+POSITION_SETPOINT = [
+    "uint64_t timestamp",
+    "double lat",
+    "double lon",
+    "float x",
+    "float y",
+    "float z",
+    "float vx",
+    "float vy",
+    "float vz",
+    "float alt",
+    "float yaw",
+    "float yawspeed",
+    "float a_x",
+    "float a_y",
+    "float a_z",
+    "float acceptance_radius",
+    "float cruising_speed",
+    "bool valid",
+    "uint8_t type",
+    "bool position_valid",
+    "bool velocity_valid",
+    "bool alt_valid",
+    "bool yaw_valid",
+    "bool yawspeed_valid",
+    "bool acceleration_valid",
+    "bool acceleration_is_force",
+    "uint8_t[7] _padding0",
+]
+
+_VEHICLE_STATUS_1_13 = [
+    "uint64_t timestamp",
+    "uint64_t armed_time",
+    "uint64_t takeoff_time",
+    "uint64_t nav_state_timestamp",
+    "uint32_t onboard_control_sensors_present",
+    "uint16_t failure_detector_status",
+    "uint8_t arming_state",
+    "uint8_t latest_arming_reason",
+    "uint8_t latest_disarming_reason",
+    "uint8_t nav_state",
+    "uint8_t hil_state",
+    "uint8_t vehicle_type",
+    "bool failsafe",
+    "bool failsafe_and_user_took_over",
+    "uint8_t system_type",
+    "uint8_t system_id",
+    "uint8_t component_id",
+    "bool is_vtol",
+    "bool is_vtol_tailsitter",
+    "bool in_transition_mode",
+    "bool rc_signal_found_once",
+    "uint8_t[5] _padding0",
+]
+
+FORMATS: dict[str, list[tuple[str, list[str]]]] = {
+    "offboard_control_mode": [
+        (
+            "legacy",
+            [
+                "uint64_t timestamp",
+                "bool ignore_thrust",
+                "bool ignore_attitude",
+                "bool ignore_bodyrate_x",
+                "bool ignore_bodyrate_y",
+                "bool ignore_bodyrate_z",
+                "bool ignore_position",
+                "bool ignore_velocity",
+                "bool ignore_acceleration_force",
+                "bool ignore_alt_hold",
+                "uint8_t[7] _padding0",
+            ],
+        ),
+        (
+            "1.13",
+            [
+                "uint64_t timestamp",
+                "bool position",
+                "bool velocity",
+                "bool acceleration",
+                "bool attitude",
+                "bool body_rate",
+                "bool actuator",
+                "uint8_t[2] _padding0",
+            ],
+        ),
+        (
+            "1.15",
+            [
+                "uint64_t timestamp",
+                "bool position",
+                "bool velocity",
+                "bool acceleration",
+                "bool attitude",
+                "bool body_rate",
+                "bool thrust_and_torque",
+                "bool direct_actuator",
+                "uint8_t[1] _padding0",
+            ],
+        ),
+    ],
+    "trajectory_setpoint": [
+        (
+            "legacy",
+            [
+                "uint64_t timestamp",
+                "float x",
+                "float y",
+                "float z",
+                "float yaw",
+                "float yawspeed",
+                "float vx",
+                "float vy",
+                "float vz",
+                "float[3] acceleration",
+                "float[3] jerk",
+                "float[3] thrust",
+                "uint8_t[4] _padding0",
+            ],
+        ),
+        (
+            "1.14",
+            [
+                "uint64_t timestamp",
+                "float[3] position",
+                "float[3] velocity",
+                "float[3] acceleration",
+                "float[3] jerk",
+                "float yaw",
+                "float yawspeed",
+            ],
+        ),
+    ],
+    "vehicle_attitude_setpoint": [
+        (
+            "legacy",
+            [
+                "uint64_t timestamp",
+                "float roll_body",
+                "float pitch_body",
+                "float yaw_body",
+                "float yaw_sp_move_rate",
+                "float[4] q_d",
+                "float[3] thrust_body",
+                "bool roll_reset_integral",
+                "bool pitch_reset_integral",
+                "bool yaw_reset_integral",
+                "bool fw_control_yaw",
+                "uint8_t apply_flaps",
+                "uint8_t[7] _padding0",
+            ],
+        ),
+        (
+            "1.14",
+            [
+                "uint64_t timestamp",
+                "float roll_body",
+                "float pitch_body",
+                "float yaw_body",
+                "float yaw_sp_move_rate",
+                "float[4] q_d",
+                "float[3] thrust_body",
+                "bool reset_integral",
+                "bool fw_control_yaw_wheel",
+                "uint8_t[2] _padding0",
+            ],
+        ),
+        (
+            "1.16",
+            [
+                "uint64_t timestamp",
+                "float yaw_sp_move_rate",
+                "float[4] q_d",
+                "float[3] thrust_body",
+                "bool reset_integral",
+                "bool fw_control_yaw_wheel",
+                "uint8_t[2] _padding0",
+            ],
+        ),
+        (
+            "1.17",
+            [
+                "uint64_t timestamp",
+                "float yaw_sp_move_rate",
+                "float[4] q_d",
+                "float[3] thrust_body",
+            ],
+        ),
+    ],
+    "vehicle_rates_setpoint": [
+        (
+            "legacy",
+            [
+                "uint64_t timestamp",
+                "float roll",
+                "float pitch",
+                "float yaw",
+                "float[3] thrust_body",
+            ],
+        ),
+        (
+            "1.14",
+            [
+                "uint64_t timestamp",
+                "float roll",
+                "float pitch",
+                "float yaw",
+                "float[3] thrust_body",
+                "bool reset_integral",
+                "uint8_t[3] _padding0",
+            ],
+        ),
+    ],
+    "vehicle_thrust_setpoint": [
+        (
+            "legacy",
+            [
+                "uint64_t timestamp",
+                "uint64_t timestamp_sample",
+                "float[3] xyz",
+                "uint8_t[4] _padding0",
+            ],
+        )
+    ],
+    "vehicle_torque_setpoint": [
+        (
+            "legacy",
+            [
+                "uint64_t timestamp",
+                "uint64_t timestamp_sample",
+                "float[3] xyz",
+                "uint8_t[4] _padding0",
+            ],
+        )
+    ],
+    "actuator_motors": [
+        (
+            "legacy",
+            [
+                "uint64_t timestamp",
+                "uint64_t timestamp_sample",
+                "float[8] control",
+                "uint16_t reversible_flags",
+                "uint8_t[6] _padding0",
+            ],
+        ),
+        (
+            "1.14",
+            [
+                "uint64_t timestamp",
+                "uint64_t timestamp_sample",
+                "float[12] control",
+                "uint16_t reversible_flags",
+                "uint8_t[6] _padding0",
+            ],
+        ),
+    ],
+    "actuator_servos": [
+        ("legacy", ["uint64_t timestamp", "uint64_t timestamp_sample", "float[8] control"]),
+    ],
+    "rover_position_setpoint": [
+        (
+            "1.16",
+            [
+                "uint64_t timestamp",
+                "float[2] position_ned",
+                "float cruising_speed",
+                "float yaw",
+            ],
+        ),
+        (
+            "1.17",
+            [
+                "uint64_t timestamp",
+                "float[2] position_ned",
+                "float[2] start_ned",
+                "float cruising_speed",
+                "float arrival_speed",
+                "float yaw",
+                "uint8_t[4] _padding0",
+            ],
+        ),
+    ],
+    "rover_speed_setpoint": [
+        ("1.17", ["uint64_t timestamp", "float speed_body_x", "float speed_body_y"]),
+    ],
+    "rover_attitude_setpoint": [
+        ("1.16", ["uint64_t timestamp", "float yaw_setpoint", "uint8_t[4] _padding0"]),
+    ],
+    "rover_rate_setpoint": [
+        ("1.16", ["uint64_t timestamp", "float yaw_rate_setpoint", "uint8_t[4] _padding0"]),
+    ],
+    "rover_throttle_setpoint": [
+        ("1.16", ["uint64_t timestamp", "float throttle_body_x", "float throttle_body_y"]),
+    ],
+    "rover_steering_setpoint": [
+        (
+            "1.16",
+            [
+                "uint64_t timestamp",
+                "float normalized_steering_angle",
+                "float normalized_speed_diff",
+            ],
+        ),
+        (
+            "1.17",
+            ["uint64_t timestamp", "float normalized_steering_setpoint", "uint8_t[4] _padding0"],
+        ),
+    ],
+    "position_setpoint_triplet": [
+        (
+            "legacy",
+            [
+                "uint64_t timestamp",
+                "position_setpoint previous",
+                "position_setpoint current",
+                "position_setpoint next",
+            ],
+        ),
+    ],
+    "vehicle_status": [
+        (
+            "legacy",
+            [
+                "uint64_t timestamp",
+                "uint8_t nav_state",
+                "uint8_t arming_state",
+                "uint8_t hil_state",
+                "bool failsafe",
+                "uint8_t system_type",
+                "uint8_t system_id",
+                "uint8_t component_id",
+                "bool is_rotary_wing",
+                "bool is_vtol",
+                "bool vtol_fw_permanent_stab",
+                "bool in_transition_mode",
+                "bool rc_signal_lost",
+                "bool data_link_lost",
+                "bool offboard_control_signal_lost",
+                "uint8_t[2] _padding0",
+            ],
+        ),
+        ("1.13", _VEHICLE_STATUS_1_13),
+        (
+            "1.14",
+            [
+                *_VEHICLE_STATUS_1_13[:10],
+                "uint8_t nav_state_user_intention",
+                *_VEHICLE_STATUS_1_13[10:-1],
+                "uint8_t[4] _padding0",
+            ],
+        ),
+        (
+            "1.15",
+            [
+                *_VEHICLE_STATUS_1_13[:10],
+                "uint8_t nav_state_user_intention",
+                "uint8_t executor_in_charge",
+                "uint32_t valid_nav_states_mask",
+                "uint32_t can_set_nav_states_mask",
+                *_VEHICLE_STATUS_1_13[10:-1],
+                "uint8_t failsafe_defer_state",
+                "uint8_t[7] _padding0",
+            ],
+        ),
+    ],
+    "commander_state": [
+        (
+            "legacy",
+            [
+                "uint64_t timestamp",
+                "uint16_t main_state_changes",
+                "uint8_t main_state",
+                "uint8_t[5] _padding0",
+            ],
+        ),
+    ],
+    "vehicle_control_mode": [
+        (
+            "legacy",
+            [
+                "uint64_t timestamp",
+                "bool flag_armed",
+                "bool flag_multicopter_position_control_enabled",
+                "bool flag_control_manual_enabled",
+                "bool flag_control_auto_enabled",
+                "bool flag_control_offboard_enabled",
+                "bool flag_control_rates_enabled",
+                "bool flag_control_attitude_enabled",
+                "bool flag_control_acceleration_enabled",
+                "bool flag_control_velocity_enabled",
+                "bool flag_control_position_enabled",
+                "bool flag_control_altitude_enabled",
+                "bool flag_control_climb_rate_enabled",
+                "bool flag_control_termination_enabled",
+                "uint8_t[3] _padding0",
+            ],
+        ),
+        (
+            "1.14",
+            [
+                "uint64_t timestamp",
+                "bool flag_armed",
+                "bool flag_multicopter_position_control_enabled",
+                "bool flag_control_manual_enabled",
+                "bool flag_control_auto_enabled",
+                "bool flag_control_offboard_enabled",
+                "bool flag_control_position_enabled",
+                "bool flag_control_velocity_enabled",
+                "bool flag_control_altitude_enabled",
+                "bool flag_control_climb_rate_enabled",
+                "bool flag_control_acceleration_enabled",
+                "bool flag_control_attitude_enabled",
+                "bool flag_control_rates_enabled",
+                "bool flag_control_allocation_enabled",
+                "bool flag_control_termination_enabled",
+                "uint8_t source_id",
+                "uint8_t[1] _padding0",
+            ],
+        ),
+    ],
+    "vehicle_status_flags": [
+        (
+            "legacy",
+            [
+                "uint64_t timestamp",
+                "bool condition_home_position_valid",
+                "bool condition_local_altitude_valid",
+                "bool condition_local_position_valid",
+                "bool condition_local_velocity_valid",
+                "bool condition_global_position_valid",
+                "bool condition_attitude_valid",
+                "bool condition_angular_velocity_valid",
+                "bool rc_signal_lost",
+                "bool offboard_control_signal_lost",
+                "uint8_t[7] _padding0",
+            ],
+        ),
+    ],
+    "failsafe_flags": [
+        (
+            "1.14",
+            [
+                "uint64_t timestamp",
+                "uint32_t mode_req_angular_velocity",
+                "uint32_t mode_req_attitude",
+                "uint32_t mode_req_local_alt",
+                "uint32_t mode_req_local_position",
+                "uint32_t mode_req_global_position",
+                "uint32_t mode_req_offboard_signal",
+                "bool angular_velocity_invalid",
+                "bool attitude_invalid",
+                "bool local_altitude_invalid",
+                "bool local_position_invalid",
+                "bool local_position_invalid_relaxed",
+                "bool local_velocity_invalid",
+                "bool global_position_invalid",
+                "bool home_position_invalid",
+                "bool offboard_control_signal_lost",
+                "bool manual_control_signal_lost",
+                "uint8_t[6] _padding0",
+            ],
+        ),
+    ],
+    "vehicle_command": [
+        (
+            "legacy",
+            [
+                "uint64_t timestamp",
+                "double param5",
+                "double param6",
+                "float param1",
+                "float param2",
+                "float param3",
+                "float param4",
+                "float param7",
+                "uint32_t command",
+                "uint8_t target_system",
+                "uint8_t target_component",
+                "uint8_t source_system",
+                "uint8_t source_component",
+                "uint8_t confirmation",
+                "bool from_external",
+                "uint8_t[2] _padding0",
+            ],
+        ),
+        (
+            "1.15",
+            [
+                "uint64_t timestamp",
+                "double param5",
+                "double param6",
+                "float param1",
+                "float param2",
+                "float param3",
+                "float param4",
+                "float param7",
+                "uint32_t command",
+                "uint8_t target_system",
+                "uint8_t target_component",
+                "uint8_t source_system",
+                "uint16_t source_component",
+                "uint8_t confirmation",
+                "bool from_external",
+                "uint8_t[1] _padding0",
+            ],
+        ),
+    ],
+    "vehicle_command_ack": [
+        (
+            "legacy",
+            [
+                "uint64_t timestamp",
+                "uint32_t command",
+                "int32_t result_param2",
+                "uint8_t result",
+                "uint8_t result_param1",
+                "uint8_t target_system",
+                "uint8_t target_component",
+                "bool from_external",
+                "uint8_t[3] _padding0",
+            ],
+        ),
+        (
+            "1.15",
+            [
+                "uint64_t timestamp",
+                "uint32_t command",
+                "int32_t result_param2",
+                "uint16_t target_component",
+                "uint8_t result",
+                "uint8_t result_param1",
+                "uint8_t target_system",
+                "bool from_external",
+                "uint8_t[2] _padding0",
+            ],
+        ),
+    ],
+    # Busy topics that are not about offboard (the benchmark's mixed log).
+    "sensor_combined": [
+        (
+            "legacy",
+            [
+                "uint64_t timestamp",
+                "float[3] gyro_rad",
+                "uint32_t gyro_integral_dt",
+                "int32_t accelerometer_timestamp_relative",
+                "float[3] accelerometer_m_s2",
+                "uint32_t accelerometer_integral_dt",
+                "uint8_t accelerometer_clipping",
+                "uint8_t[3] _padding0",
+            ],
+        )
+    ],
+    "vehicle_imu": [
+        (
+            "legacy",
+            [
+                "uint64_t timestamp",
+                "uint64_t timestamp_sample",
+                "uint32_t accel_device_id",
+                "uint32_t gyro_device_id",
+                "float[3] delta_angle",
+                "float[3] delta_velocity",
+                "uint16_t delta_angle_dt",
+                "uint16_t delta_velocity_dt",
+                "uint8_t delta_angle_clipping",
+                "uint8_t delta_velocity_clipping",
+                "uint8_t calibration_count",
+                "uint8_t[1] _padding0",
+            ],
+        )
+    ],
+}
+
+NESTED: dict[str, list[str]] = {"position_setpoint": POSITION_SETPOINT}
+
+
+def fields_for(topic: str, era: str) -> list[str] | None:
+    """The field list of ``topic`` in ``era``, or None when that era has no such topic."""
+    chosen: list[str] | None = None
+    for first, fields in FORMATS[topic]:
+        if ERAS.index(first) <= ERAS.index(era):
+            chosen = fields
+    return chosen
