@@ -1,0 +1,425 @@
+"""OFB106, OFB107, OFB203, OFB3xx, OFB4xx, OFB8xx on minimal streams: threshold edges, near misses."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from fuzzoff.config import Settings
+from fuzzoff.events import (
+    ActuatorMotors,
+    AttitudeSetpoint,
+    ControlMode,
+    Event,
+    FailsafeFlags,
+    LegacyControlMode,
+    PositionSetpointTriplet,
+    RatesSetpoint,
+    RoverAttitudeSetpoint,
+    RoverRateSetpoint,
+    RoverSpeedSetpoint,
+    SetAttitudeTarget,
+    SetPositionTargetLocal,
+    TrajectorySetpoint,
+)
+from fuzzoff.findings import Severity
+from tests.streams import OFFBOARD, POSCTL, codes, every, ocm, status, switch
+from tests.streams import lint_events as _lint_events
+
+NAN = math.nan
+MINE = frozenset(
+    "OFB002 OFB106 OFB107 OFB203 OFB301 OFB302 OFB303 OFB304 OFB305 OFB401 OFB402 OFB403 "
+    "OFB404 OFB405 OFB406 OFB407 OFB408 OFB801 OFB802 OFB803".split()
+)
+
+
+def lint_events(events: list[Event], settings: Settings | None = None, **kw: object) -> list:
+    """These rules alone (plus OFB002), so that a test shows only what they do."""
+    chosen = settings or Settings()
+    chosen = Settings(select=MINE - chosen.ignore)
+    return _lint_events(events, settings=chosen, **kw)  # type: ignore[arg-type]
+
+
+def ocm_stamped(times: list[float], stamps_us: list[int], origin: str = "sent") -> list[Event]:
+    return [
+        ControlMode(t=t, position=True, sender_time_us=s, origin=origin)  # type: ignore[arg-type]
+        for t, s in zip(times, stamps_us, strict=True)
+    ]
+
+
+# --- OFB106 -------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(("lag", "flagged"), [(1.0, False), (1.1, True)])
+def test_ofb106_lag_edge_is_the_loss_timeout(lag: float, flagged: bool) -> None:
+    # The sender clock stops at t=0.5; by t=0.5+lag its stamp lags by ``lag``.
+    times = [0.0, 0.5, 0.5 + lag]
+    events = ocm_stamped(times, [10_000_000, 10_500_000, 10_500_000])
+    found = codes(lint_events(events), "OFB106")
+    assert bool(found) is flagged
+    if flagged:
+        assert found[0].severity is Severity.WARNING
+        assert found[0].time_s == pytest.approx(0.5 + lag)
+
+
+def test_ofb106_lag_is_info_on_1_13_which_ignores_the_field() -> None:
+    events = ocm_stamped([0.0, 1.0, 2.0], [10_000_000] * 3)
+    (found,) = codes(lint_events(events, px4="1.13"), "OFB106")
+    assert found.severity is Severity.INFO
+    assert "does not use" in found.message
+
+
+def test_ofb106_zero_is_info_because_px4_uses_the_receive_time() -> None:
+    events = ocm_stamped([0.0, 0.1, 0.2], [0, 0, 0])
+    (found,) = codes(lint_events(events), "OFB106")
+    assert found.severity is Severity.INFO
+    assert "receive time" in found.message and "3 messages" in found.message
+
+
+def test_ofb106_small_backwards_step_is_info() -> None:
+    events = ocm_stamped([0.0, 0.1, 0.2], [10_000_000, 10_100_000, 10_050_000])
+    (found,) = codes(lint_events(events), "OFB106")
+    assert found.severity is Severity.INFO and "backwards" in found.message
+
+
+def test_ofb106_ulog_copies_are_not_checkable() -> None:
+    events = ocm_stamped([0.0, 1.0, 2.0], [0, 0, 0], origin="vehicle")
+    findings = lint_events(events, fmt="ulog")
+    assert codes(findings, "OFB106") == []
+    assert any("OFB106" in f.message for f in codes(findings, "OFB002"))
+
+
+# --- OFB107 -------------------------------------------------------------------------------
+
+
+def _repeat(t0: float, t1: float, hz: float, **fields: object) -> list[Event]:
+    return [TrajectorySetpoint(t=round(t, 6), **fields) for t in every(t0, t1, 1 / hz)]  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(("duration", "flagged"), [(3.0, False), (3.05, True)])
+def test_ofb107_freeze_edge(duration: float, flagged: bool) -> None:
+    events = [
+        status(0.0, OFFBOARD),
+        *ocm(every(0.0, 4.0, 0.05), velocity=True),
+        *_repeat(0.0, duration, 20.0, velocity=(1.0, 0.0, 0.0)),
+        TrajectorySetpoint(t=duration + 0.05, velocity=(0.5, 0.0, 0.0)),
+    ]
+    found = codes(lint_events(events), "OFB107")
+    assert bool(found) is flagged
+    if flagged:
+        assert found[0].time_s == pytest.approx(0.0)
+        assert found[0].end_s == pytest.approx(duration)
+
+
+def test_ofb107_realistic_near_miss_with_estimator_noise_stays_clean() -> None:
+    # A live position hold: the controller's output jitters by micrometres at 20 Hz.
+    events: list[Event] = [status(0.0, OFFBOARD), *ocm(every(0.0, 10.0, 0.1))]
+    for i, t in enumerate(every(0.0, 10.0, 0.05)):
+        jitter = 1e-6 * ((i * 7919) % 13 - 6)
+        events.append(TrajectorySetpoint(t=round(t, 6), position=(1.0 + jitter, 2.0, -5.0)))
+    assert codes(lint_events(events), "OFB107") == []
+
+
+def test_ofb107_gap_restarts_and_outside_offboard_does_not_count() -> None:
+    gap = [
+        status(0.0, OFFBOARD),
+        *_repeat(0.0, 2.0, 20.0, position=(0.0, 0.0, -2.0)),
+        *_repeat(3.5, 5.5, 20.0, position=(0.0, 0.0, -2.0)),
+    ]
+    assert codes(lint_events(gap), "OFB107") == []
+    outside = [status(0.0, POSCTL), *_repeat(0.0, 5.0, 20.0, position=(0.0, 0.0, -2.0))]
+    assert codes(lint_events(outside), "OFB107") == []
+
+
+def test_ofb107_judges_mavlink_setpoints_too() -> None:
+    events: list[Event] = [status(0.0, OFFBOARD)]
+    events += [
+        SetPositionTargetLocal(t=round(t, 6), type_mask=0b110111111000, position=(0, 0, -3))
+        for t in every(0.0, 4.0, 0.05)
+    ]
+    assert len(codes(lint_events(events, fmt="tlog"), "OFB107")) == 1
+
+
+# --- OFB203 -------------------------------------------------------------------------------
+
+
+def test_ofb203_one_finding_per_stretch_with_count() -> None:
+    events = [
+        status(0.0, POSCTL),
+        *_repeat(0.0, 0.9, 10.0, position=(0.0, 0.0, -2.0)),
+        status(1.0, OFFBOARD),
+        *_repeat(1.0, 2.0, 10.0, position=(0.0, 0.0, -2.0)),
+    ]
+    (found,) = codes(lint_events(events), "OFB203")
+    assert found.time_s == 0.0 and "10 messages" in found.message
+    assert "POSCTL" in found.message or "Position" in found.message
+
+
+def test_ofb203_uses_the_gate_prediction_without_a_recorded_mode() -> None:
+    events = [
+        *ocm(every(0.0, 2.0, 0.1)),
+        *_repeat(0.0, 0.5, 10.0, position=(0.0, 0.0, -2.0)),
+        switch(1.0),
+        *_repeat(1.1, 2.0, 10.0, position=(0.0, 0.0, -2.0)),
+    ]
+    (found,) = codes(lint_events(events), "OFB203")
+    assert "predicted by the gate model" in found.message
+    assert found.end_s == pytest.approx(0.5)
+
+
+def test_ofb203_ulog_copies_are_not_checkable() -> None:
+    events = [status(0.0, POSCTL), TrajectorySetpoint(t=0.1, origin="vehicle", position=(0, 0, -1))]
+    findings = lint_events(events, fmt="ulog")
+    assert codes(findings, "OFB203") == []
+    assert any("OFB203" in f.message for f in codes(findings, "OFB002"))
+
+
+# --- OFB3xx -------------------------------------------------------------------------------
+
+
+def test_ofb302_rover_speed_rate_with_nan_attitude_is_declared() -> None:
+    events = [
+        status(0.0, OFFBOARD),
+        ControlMode(t=0.0, velocity=True),
+        RoverSpeedSetpoint(t=0.1, speed_body_x=1.0),
+        RoverAttitudeSetpoint(t=0.1),
+        RoverRateSetpoint(t=0.1, yaw_rate_setpoint=0.2),
+    ]
+    findings = lint_events(events, px4="1.16", vehicle="rover-differential")
+    assert codes(findings, "OFB302") == []
+    assert codes(findings, "OFB303") == []
+
+
+def test_ofb302_actuator_flag_of_1_14_selects_thrust_and_torque() -> None:
+    events = [
+        status(0.0, OFFBOARD),
+        ControlMode(t=0.0, actuator=True, layout="actuator"),
+        AttitudeSetpoint(t=0.1, q_d=(1, 0, 0, 0), thrust_body=(0, 0, -0.5)),
+    ]
+    (found,) = codes(lint_events(events, px4="1.14"), "OFB302")
+    assert "'actuator'" in found.message
+
+
+@pytest.mark.parametrize(("first_at", "flagged"), [(0.49, False), (None, True)])
+def test_ofb303_grace_edge(first_at: float | None, flagged: bool) -> None:
+    events: list[Event] = [status(0.0, OFFBOARD), *ocm(every(0.0, 1.0, 0.1), attitude=True)]
+    if first_at is not None:
+        events.append(AttitudeSetpoint(t=first_at, q_d=(1, 0, 0, 0), thrust_body=(0, 0, -0.5)))
+    found = codes(lint_events(events), "OFB303")
+    assert bool(found) is flagged
+    if flagged:
+        assert found[0].time_s == pytest.approx(0.5)
+        assert "VehicleAttitudeSetpoint" in found[0].message
+
+
+def test_ofb304_changes_outside_offboard_are_not_reported() -> None:
+    events = [
+        status(0.0, POSCTL),
+        ControlMode(t=0.0, position=True),
+        ControlMode(t=0.1, attitude=True),
+        status(0.2, OFFBOARD),
+        ControlMode(t=0.3, attitude=True),
+    ]
+    assert codes(lint_events(events), "OFB304") == []
+
+
+def test_ofb305_at_the_request_and_not_checkable_without_flags() -> None:
+    events = [
+        status(0.0, POSCTL),
+        ControlMode(t=0.0, velocity=True),
+        FailsafeFlags(t=0.0, local_velocity_valid=False),
+        switch(0.5),
+    ]
+    (found,) = codes(lint_events(events, fmt="ulog"), "OFB305")
+    assert "at the offboard request" in found.message and found.time_s == 0.5
+    bare = lint_events([status(0.0, OFFBOARD), ControlMode(t=0.0, velocity=True)])
+    assert any("OFB305" in f.message for f in codes(bare, "OFB002"))
+
+
+def test_ofb305_follows_the_profile_table() -> None:
+    # acceleration needs a velocity estimate on 1.14 (seed 002) but an attitude on 1.16 (000).
+    events = [
+        status(0.0, OFFBOARD),
+        ControlMode(t=0.0, acceleration=True),
+        FailsafeFlags(t=0.1, local_velocity_valid=False, attitude_valid=True),
+    ]
+    assert len(codes(lint_events(events, px4="1.14"), "OFB305")) == 1
+    assert codes(lint_events(events, px4="1.16"), "OFB305") == []
+
+
+# --- OFB4xx -------------------------------------------------------------------------------
+
+
+def _traj(**fields: object) -> list[Event]:
+    return [
+        status(0.0, OFFBOARD),
+        ControlMode(t=0.0, position=True),
+        TrajectorySetpoint(t=0.1, **fields),
+    ]  # type: ignore[arg-type]
+
+
+def test_ofb401_acceleration_only_under_acceleration_is_clean() -> None:
+    events = [
+        status(0.0, OFFBOARD),
+        ControlMode(t=0.0, acceleration=True),
+        TrajectorySetpoint(t=0.1, acceleration=(0.0, 0.0, -1.0)),
+    ]
+    findings = lint_events(events)
+    assert codes(findings, "OFB401") == [] and codes(findings, "OFB403") == []
+
+
+def test_ofb401_mixed_axes_follow_the_docs_per_message_reading() -> None:
+    events = [
+        status(0.0, OFFBOARD),
+        ControlMode(t=0.0, velocity=True),
+        TrajectorySetpoint(t=0.1, position=(NAN, NAN, -2.0), velocity=(1.0, 0.0, NAN)),
+    ]
+    findings = lint_events(events)
+    (found,) = codes(findings, "OFB401")
+    assert "position controller" in found.message
+    assert codes(findings, "OFB403") == []  # valid per axis for the code
+
+
+def test_ofb403_says_what_each_profile_does() -> None:
+    events = _traj(position=(1.0, 2.0, NAN))
+    (old,) = codes(lint_events(events, px4="1.15"), "OFB403")
+    (new,) = codes(lint_events(events, px4="1.16"), "OFB403")
+    assert "axis z" in old.message and "at once" in old.message
+    assert "200 ms" in new.message
+    assert codes(lint_events(events, vehicle="fw"), "OFB403") == []
+
+
+def test_ofb402_is_reported_instead_of_ofb403() -> None:
+    findings = lint_events(_traj(yaw=0.5))
+    assert len(codes(findings, "OFB402")) == 1 and codes(findings, "OFB403") == []
+
+
+def _on_ground_then(*events: Event, armed_at_start: bool = False) -> list[Event]:
+    head = [status(0.0, OFFBOARD, armed=armed_at_start), status(0.1, OFFBOARD, armed=True)]
+    return [*head, *events]
+
+
+def test_ofb404_small_first_commands_decide_nothing() -> None:
+    events = _on_ground_then(
+        TrajectorySetpoint(t=0.2, position=(0.0, 0.0, 0.3)),  # zero-ish setpoint before takeoff
+        TrajectorySetpoint(t=0.3, position=(0.0, 0.0, -5.0)),
+        TrajectorySetpoint(t=5.0, velocity=(0.0, 0.0, 1.0)),  # a later descent is fine
+    )
+    assert codes(lint_events(events), "OFB404") == []
+
+
+@pytest.mark.parametrize(("vz", "flagged"), [(0.3, False), (0.31, True)])
+def test_ofb404_vertical_velocity_edge(vz: float, flagged: bool) -> None:
+    events = _on_ground_then(TrajectorySetpoint(t=0.2, velocity=(0.0, 0.0, vz)))
+    assert bool(codes(lint_events(events), "OFB404")) is flagged
+
+
+def test_ofb404_recording_that_starts_in_flight_is_not_a_takeoff() -> None:
+    events = [
+        status(0.0, OFFBOARD, armed=True),
+        TrajectorySetpoint(t=0.2, velocity=(0.0, 0.0, 1.0)),
+    ]
+    assert codes(lint_events(events), "OFB404") == []
+
+
+def test_ofb404_thrust_pointing_down_on_a_multicopter() -> None:
+    events = [
+        status(0.0, OFFBOARD),
+        ControlMode(t=0.0, body_rate=True),
+        RatesSetpoint(t=0.1, roll=0, pitch=0, yaw=0, thrust_body=(0.0, 0.0, 0.6)),
+    ]
+    (found,) = codes(lint_events(events), "OFB404")
+    assert "FLU" in found.message
+    assert codes(lint_events(events, vehicle="fw"), "OFB404") == []
+
+
+@pytest.mark.parametrize(("w", "flagged"), [(1.0009, False), (1.0011, True), (NAN, True)])
+def test_ofb405_norm_edge(w: float, flagged: bool) -> None:
+    events = [AttitudeSetpoint(t=0.0, q_d=(w, 0.0, 0.0, 0.0), thrust_body=(0, 0, -0.5))]
+    assert bool(codes(lint_events(events), "OFB405")) is flagged
+
+
+def test_ofb405_ignores_the_quaternion_of_a_body_rate_attitude_target() -> None:
+    rates = SetAttitudeTarget(t=0.0, type_mask=128, q=(0.0, 0.0, 0.0, 0.0), thrust=0.5)
+    attitude = SetAttitudeTarget(t=0.1, type_mask=7, q=(0.0, 0.0, 0.0, 0.0), thrust=0.5)
+    (found,) = codes(lint_events([rates, attitude], fmt="tlog"), "OFB405")
+    assert found.time_s == 0.1 and "SET_ATTITUDE_TARGET.q" in found.message
+
+
+@pytest.mark.parametrize(("value", "flagged"), [(1.0, False), (-1.0, False), (-1.0001, True)])
+def test_ofb406_range_edge(value: float, flagged: bool) -> None:
+    events = [ActuatorMotors(t=0.0, control=(0.5, value))]
+    assert bool(codes(lint_events(events), "OFB406")) is flagged
+
+
+def test_ofb406_mavlink_thrust_range_depends_on_the_vehicle() -> None:
+    reverse = [SetAttitudeTarget(t=0.0, type_mask=7, thrust=-0.2)]
+    assert len(codes(lint_events(reverse, fmt="tlog"), "OFB406")) == 1
+    assert codes(lint_events(reverse, fmt="tlog", vehicle="fw"), "OFB406") == []
+    ignored = [SetAttitudeTarget(t=0.0, type_mask=7 | 64, thrust=7.0)]
+    assert codes(lint_events(ignored, fmt="tlog"), "OFB406") == []
+
+
+def test_ofb407_trailing_nans_are_unused_outputs_unless_they_ran() -> None:
+    unused = [status(0.0, OFFBOARD), ActuatorMotors(t=0.1, control=(0.5, 0.5, NAN, NAN))]
+    assert codes(lint_events(unused), "OFB407") == []
+    stopped = [
+        status(0.0, OFFBOARD),
+        ActuatorMotors(t=0.1, control=(0.5, 0.5, 0.5, 0.5)),
+        ActuatorMotors(t=0.2, control=(0.5, 0.5, 0.5, NAN)),
+    ]
+    (found,) = codes(lint_events(stopped), "OFB407")
+    assert found.time_s == 0.2 and "[3]" in found.message
+
+
+def test_ofb407_not_while_disarmed() -> None:
+    events = [
+        status(0.0, OFFBOARD, armed=False),
+        ActuatorMotors(t=0.1, control=(NAN, 0.5)),
+    ]
+    assert codes(lint_events(events), "OFB407") == []
+
+
+def test_ofb408_names_the_missing_component() -> None:
+    events = [RatesSetpoint(t=0.0, roll=0, pitch=0, yaw=0, thrust_body=(NAN, 0.0, -0.5))]
+    (found,) = codes(lint_events(events), "OFB408")
+    assert "thrust_body[0]" in found.message
+
+
+# --- OFB8xx -------------------------------------------------------------------------------
+
+
+def test_ofb801_acceleration_alone_is_deliberate() -> None:
+    events = [
+        LegacyControlMode(
+            t=0.0, ignore_position=True, ignore_velocity=True, ignore_acceleration_force=False
+        )
+    ]
+    assert codes(lint_events(events, px4="legacy", fmt="ulog"), "OFB801") == []
+
+
+def test_ofb802_only_in_offboard() -> None:
+    triplet = PositionSetpointTriplet(t=0.1, current_valid=True, previous_valid=True)
+    assert codes(lint_events([status(0.0, POSCTL), triplet], px4="legacy"), "OFB802") == []
+    assert len(codes(lint_events([status(0.0, OFFBOARD), triplet], px4="legacy"), "OFB802")) == 1
+
+
+def test_ofb803_current_invalid_and_velocity_validity() -> None:
+    invalid = [status(0.0, OFFBOARD), PositionSetpointTriplet(t=0.1, current_valid=False)]
+    (found,) = codes(lint_events(invalid, px4="legacy"), "OFB803")
+    assert "current.valid false" in found.message
+    velocity = [
+        status(0.0, OFFBOARD),
+        LegacyControlMode(t=0.0, ignore_position=True, ignore_acceleration_force=True),
+        PositionSetpointTriplet(t=0.1, current_valid=True, current_position_valid=True),
+    ]
+    (found,) = codes(lint_events(velocity, px4="legacy"), "OFB803")
+    assert "velocity_valid" in found.message
+
+
+def test_content_rules_can_be_ignored() -> None:
+    events = [AttitudeSetpoint(t=0.0, q_d=(2.0, 0, 0, 0), thrust_body=(0, 0, 3.0))]
+    settings = Settings(ignore=frozenset({"OFB405", "OFB406"}))
+    found = lint_events(events, settings=settings)
+    assert codes(found, "OFB405") == [] and codes(found, "OFB406") == []
