@@ -1,51 +1,58 @@
-"""First cut of the gate model: proof of life, request acceptance and the loss failsafe.
+"""The gate model: proof of life, requests, loss failsafe and controllers, per profile.
 
-Interface (kept stable for the engine and the checks):
+Interface (stable for the engine and the checks):
 
-* ``GateModel(profile, params=None, vehicle="")``
-* ``feed(event) -> list[GateTransition]``: advance to ``event.t``, then apply the event;
+* ``GateModel(profile, params=None, vehicle="")``: ``params`` are the user's overrides (they win
+  over the recording's ``Parameter`` events, which win over PX4's defaults); ``vehicle`` is the
+  vehicle id the events carry (the vehicle *type* comes from ``profile.vehicle``);
+* ``feed(event) -> list[GateTransition]``: advance the clock to ``event.t`` (timeouts are computed
+  arithmetically, see ``signal``), then apply the event. The returned list must not be mutated;
 * ``finish(t_end) -> list[GateTransition]``;
-* ``signal_ok``, ``armed``, ``user_intention``, ``nav_state``, ``in_offboard``, ``params``.
+* ``signal_ok``, ``armed``, ``user_intention``, ``nav_state`` (effective), ``in_offboard``,
+  ``params``.
+
+The recording's own mode history is compared with the prediction as it goes (``compare``): a
+difference that outlasts the evaluation slack becomes a ``disagreement`` transition and the model
+re-synchronises (arming, user intention) so one difference is reported once.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
+from typing import Any
 
 from fuzzoff.events import (
+    MAV_CMD_COMPONENT_ARM_DISARM,
     NAV_STATE_OFFBOARD,
     Command,
     CommandAck,
     ControlMode,
     Event,
+    FailsafeFlags,
     LegacyControlMode,
-    MavlinkTarget,
     Parameter,
+    SetAttitudeTarget,
+    SetPositionTargetGlobal,
+    SetPositionTargetLocal,
+    TrajectorySetpoint,
     VehicleStatus,
 )
-from fuzzoff.gate.transitions import GateTransition
-from fuzzoff.profiles import Profile
+from fuzzoff.gate import controllers, ocm
+from fuzzoff.gate.compare import Comparator
+from fuzzoff.gate.estimates import Estimates
+from fuzzoff.gate.failsafe import LossAction, loss_action
+from fuzzoff.gate.params import default_params
+from fuzzoff.gate.receiver import DROPPED, ReceiverContext, receive
+from fuzzoff.gate.requests import Decision, arm_decision, decode_mode, switch_decision
+from fuzzoff.gate.signal import INF, LOOP_PERIOD, estimate_failure, make_signal, slack
+from fuzzoff.gate.transitions import GateTransition, TransitionKind
+from fuzzoff.modes import nav_state_name
+from fuzzoff.profiles import Profile, at_least
 
-LOSS_ACTIONS = {
-    0: (2, "POSCTL"),
-    1: (1, "ALTCTL"),
-    2: (15, "STAB"),
-    3: (5, "AUTO_RTL"),
-    4: (18, "AUTO_LAND"),
-    5: (4, "AUTO_LOITER"),
-    6: (13, "TERMINATION"),
-    7: (None, "DISARM"),
-}
+EMPTY: list[GateTransition] = []
+"""Returned when an event changes nothing (shared: never mutate a returned list)."""
 
-
-def default_params(profile: Profile) -> dict[str, float]:
-    """PX4's defaults for the parameters the gate reads (gate spec section 13)."""
-    return {
-        "COM_OF_LOSS_T": 0.0 if profile.px4 == "legacy" else 0.5 if profile.px4 == "1.11" else 1.0,
-        "COM_OBL_RC_ACT": 0.0,
-        "COM_OBL_ACT": 0.0,
-        "MAV_FWDEXTSP": 1.0,
-    }
+TERMINATION = 13
 
 
 class GateModel:
@@ -53,160 +60,643 @@ class GateModel:
         self, profile: Profile, params: Mapping[str, float] | None = None, vehicle: str = ""
     ) -> None:
         self.profile = profile
+        self.px4 = profile.px4
+        self.vehicle_type = profile.vehicle
         self.vehicle = vehicle
         self.overrides = dict(params or {})
-        self.params = default_params(profile) | self.overrides
-        self.last_keepalive: float | None = None
-        self.signal_ok = False
+        self.recorded_params: dict[str, float] = {}
+        self.params = default_params(self.px4) | self.overrides
+        self.est = Estimates()
+        self.signal = make_signal(self.px4, self.params)
+        self.tick_based = at_least(self.px4, "1.14")
         self.armed = False
         self.user_intention: int | None = None
-        self.nav_state: int | None = None
-        self._now = 0.0
+        self._nav: int | None = None
+        self._fallback: LossAction | None = None
+        self._fallback_stage = 0
+        self._terminated = False
+        self.ocm_mask = 0
+        self._started = False
+        self._out: list[GateTransition] | None = None
+        self._cause: Event | None = None
+        # controllers (sections 7-10)
+        self._controller_key: tuple[Any, ...] | None = None
+        self._offboard_since: float | None = None
+        self._traj_t = -INF
+        self._traj_axes = -1
+        self._last_valid_t = -INF
+        self._reuse_due = INF
+        self._drop_reason: str | None = None
+        self.compare = Comparator(slack(self.px4) + LOOP_PERIOD)
+        try:
+            own: int | None = int(vehicle)
+        except ValueError:
+            own = None
+        self._rx = ReceiverContext(
+            px4=self.px4,
+            own_system=own,
+            own_component=int(self.params.get("MAV_COMP_ID", 1.0)),
+            fwdextsp=bool(self.params.get("MAV_FWDEXTSP", 1.0)),
+            est=self.est,
+        )
+        self._handlers: dict[type, Callable[[Any], None]] = {
+            ControlMode: self._on_control_mode,
+            LegacyControlMode: self._on_legacy_control_mode,
+            SetPositionTargetLocal: self._on_mavlink,
+            SetPositionTargetGlobal: self._on_mavlink,
+            SetAttitudeTarget: self._on_mavlink,
+            TrajectorySetpoint: self._on_trajectory,
+            VehicleStatus: self._on_status,
+            FailsafeFlags: self._on_failsafe_flags,
+            Command: self._on_command,
+            CommandAck: self._on_ack,
+            Parameter: self._on_parameter,
+        }
+
+    # ------------------------------------------------------------------ public state
+
+    @property
+    def signal_ok(self) -> bool:
+        return self.signal.available
+
+    @property
+    def nav_state(self) -> int | None:
+        return self._nav
 
     @property
     def in_offboard(self) -> bool:
-        return self.nav_state == NAV_STATE_OFFBOARD
+        return self._nav == NAV_STATE_OFFBOARD
 
     @property
     def loss_timeout(self) -> float:
-        if self.profile.px4 == "legacy":
-            return 0.5
-        return float(self.params["COM_OF_LOSS_T"])
+        return self.signal.timeout
 
-    def _tr(self, t: float, **kw: object) -> GateTransition:
-        return GateTransition(t=t, vehicle=self.vehicle, **kw)  # type: ignore[arg-type]
+    def current_loss_action(self) -> LossAction:
+        """What the vehicle would do if the signal were lost now (OFB701/OFB702)."""
+        return loss_action(self.px4, self.vehicle_type, self.params, self.est)
 
-    def _advance(self, t: float) -> list[GateTransition]:
-        out: list[GateTransition] = []
-        if self.signal_ok and self.last_keepalive is not None:
-            lost_at = self.last_keepalive + self.loss_timeout
-            if t >= lost_at:
-                self.signal_ok = False
-                out.append(
-                    self._tr(
-                        lost_at,
-                        what="signal_lost",
-                        spec="2.1",
-                        message=f"no keep-alive for {self.loss_timeout:.2f} s",
-                    )
-                )
-                if self.armed and self.user_intention == NAV_STATE_OFFBOARD:
-                    nav, action = LOSS_ACTIONS.get(
-                        int(self.params["COM_OBL_RC_ACT"]), LOSS_ACTIONS[0]
-                    )
-                    self.nav_state = nav
-                    out.append(
-                        self._tr(
-                            lost_at,
-                            what="failsafe",
-                            spec="5.1",
-                            action=action,
-                            nav_state=nav,
-                            message=f"offboard lost: {action}",
-                        )
-                    )
-        self._now = max(self._now, t)
-        return out
+    # ------------------------------------------------------------------ driving
 
     def feed(self, event: Event) -> list[GateTransition]:
-        out = self._advance(event.t)
-        if isinstance(event, (ControlMode, LegacyControlMode, MavlinkTarget)):
-            if isinstance(event, ControlMode) and not event.flags():
-                return out
-            self.last_keepalive = event.t
-            if not self.signal_ok:
-                self.signal_ok = True
-                out.append(
-                    self._tr(
-                        event.t,
-                        what="signal_available",
-                        spec="2.1",
-                        cause=event,
-                        message="offboard signal available",
-                    )
-                )
-                if (
-                    self.armed
-                    and self.user_intention == NAV_STATE_OFFBOARD
-                    and not self.in_offboard
-                ):
-                    self.nav_state = NAV_STATE_OFFBOARD
-                    out.append(
-                        self._tr(
-                            event.t,
-                            what="offboard_resumed",
-                            spec="5.1",
-                            cause=event,
-                            nav_state=NAV_STATE_OFFBOARD,
-                            message="back in OFFBOARD",
-                        )
-                    )
-        elif isinstance(event, Parameter) and event.name in self.params:
-            if event.name not in self.overrides:
-                self.params[event.name] = event.value
-        elif isinstance(event, VehicleStatus):
-            if self.user_intention is None and event.nav_state is not None:
-                self.user_intention = event.user_intention or event.nav_state
-                self.nav_state = event.nav_state
-            if event.armed is not None and not self.armed:
-                self.armed = event.armed
-        elif isinstance(event, Command):
-            out.extend(self._command(event))
-        elif isinstance(event, CommandAck):
-            pass
-        return out
-
-    def _command(self, cmd: Command) -> list[GateTransition]:
-        if cmd.is_offboard_switch:
-            ok = self.signal_ok or (not self.armed and self.profile.at_least("1.14"))
-            if ok:
-                self.user_intention = NAV_STATE_OFFBOARD
-                self.nav_state = NAV_STATE_OFFBOARD
-                return [
-                    self._tr(
-                        cmd.t,
-                        what="request_accepted",
-                        spec="4.1",
-                        cause=cmd,
-                        nav_state=NAV_STATE_OFFBOARD,
-                        message="switch to OFFBOARD accepted",
-                    )
-                ]
-            return [
-                self._tr(
-                    cmd.t,
-                    what="request_rejected",
-                    spec="4.1",
-                    cause=cmd,
-                    reason="no offboard signal",
-                    message="switch to OFFBOARD rejected: no offboard signal",
-                )
-            ]
-        if cmd.is_arm:
-            if (
-                self.user_intention == NAV_STATE_OFFBOARD
-                and self.profile.at_least("1.14")
-                and not self.signal_ok
-            ):
-                return [
-                    self._tr(
-                        cmd.t,
-                        what="arm_rejected",
-                        spec="4.2",
-                        cause=cmd,
-                        reason="no offboard signal",
-                        message="arming in OFFBOARD rejected: no offboard signal",
-                    )
-                ]
-            self.armed = True
-            return [self._tr(cmd.t, what="arm_accepted", spec="4.2", cause=cmd, message="armed")]
-        if cmd.is_disarm:
-            self.armed = False
-            return [self._tr(cmd.t, what="disarmed", spec="4.2", cause=cmd, message="disarmed")]
-        if cmd.is_mode_switch:
-            self.user_intention = None
-            self.nav_state = None
-        return []
+        t = event.t
+        if t > self._now_deadline:
+            self._advance(t)
+        handler = self._handlers.get(type(event))
+        if handler is not None:
+            self._cause = event
+            handler(event)
+            self._cause = None
+        return self._flush()
 
     def finish(self, t_end: float) -> list[GateTransition]:
-        return self._advance(t_end)
+        self._advance(t_end)
+        self.compare.drop_pending()
+        return self._flush()
+
+    def _flush(self) -> list[GateTransition]:
+        out = self._out
+        if out is None:
+            return EMPTY
+        self._out = None
+        return out
+
+    def _emit(
+        self,
+        t: float,
+        what: TransitionKind,
+        message: str,
+        spec: str,
+        **fields: Any,
+    ) -> None:
+        tr = GateTransition(
+            t=t,
+            vehicle=self.vehicle,
+            what=what,
+            message=message,
+            spec=spec,
+            cause=fields.pop("cause", self._cause),
+            nav_state=fields.pop("nav_state", self._nav),
+            armed=self.armed,
+            **fields,
+        )
+        if self._out is None:
+            self._out = [tr]
+        else:
+            self._out.append(tr)
+
+    @property
+    def _now_deadline(self) -> float:
+        """The earliest time at which something happens without a new event."""
+        return min(
+            self.signal.lost_at(),
+            self.signal.timeout_at(),
+            self._reuse_due,
+            self.compare.due(),
+        )
+
+    def _advance(self, t: float) -> None:
+        while True:
+            lost = self.signal.lost_at()
+            timeout = self.signal.timeout_at()
+            due = min(lost, timeout, self._reuse_due, self.compare.due())
+            if due > t:
+                return
+            if lost == due:
+                self._signal_lost(lost)
+            elif timeout == due:
+                self.signal.timed_out = True  # type: ignore[attr-defined]
+                self._refresh(timeout)
+            elif self._reuse_due == due:
+                self._reuse_due = INF
+                self._update_controller(due)
+            else:
+                self._confirm(due)
+
+    # ------------------------------------------------------------------ proof of life
+
+    def _signal_lost(self, t: float) -> None:
+        self.signal.mark_lost()
+        last = self.signal.last
+        age = f"{t - last:.2f} s after the newest keep-alive" if last is not None else ""
+        why = estimate_failure(self.px4, self.ocm_mask, self.est) if self.tick_based else None
+        reason = why or "keep-alive timeout"
+        self._emit(
+            t,
+            "signal_lost",
+            f"offboard signal lost ({reason}) {age}".strip(),
+            self.signal.spec,
+            cause=None,
+            reason=reason,
+        )
+        if self.signal.timeout_at() <= t:  # legacy: COM_OF_LOSS_T 0 = both stages at once
+            self.signal.timed_out = True  # type: ignore[attr-defined]
+        # 1.14+: the failsafe reacts one Commander iteration after the check pass (2.1.3).
+        self._refresh(t + (LOOP_PERIOD if self.tick_based else 0.0), cause=None)
+
+    def _keepalive(self, t: float, mask: int, event: Event) -> None:
+        self.ocm_mask = mask
+        if event.origin == "vehicle":
+            self.compare.sampled_keepalive()
+        if self.px4 in ("legacy", "1.11"):
+            good = True
+            why = None
+        else:
+            why = estimate_failure(self.px4, mask, self.est)
+            good = mask != 0 and why is None
+        if self.signal.keepalive(t, good):
+            self._emit(
+                t,
+                "signal_available",
+                f"offboard signal available ({ocm.names(mask)})",
+                self.signal.spec,
+            )
+            self._refresh(t)
+        self._update_controller(t)
+
+    def _on_control_mode(self, event: ControlMode) -> None:
+        self._keepalive(event.t, ocm.mask_of(event), event)
+
+    def _on_legacy_control_mode(self, event: LegacyControlMode) -> None:
+        self._keepalive(event.t, ocm.legacy_mask(event), event)
+
+    def _on_mavlink(self, event: SetPositionTargetLocal) -> None:
+        mask, axes, reason, spec = receive(event, self._rx)
+        if mask == DROPPED:
+            if reason != self._drop_reason:
+                self._drop_reason = reason
+                self._emit(
+                    event.t,
+                    "setpoint_dropped",
+                    f"{event.kind.upper()} dropped, no keep-alive: {reason}",
+                    spec,
+                    reason=reason,
+                )
+            return
+        if reason is not None and reason != self._drop_reason:
+            self._drop_reason = reason
+            self._emit(
+                event.t,
+                "setpoint_dropped",
+                f"{event.kind.upper()}: {reason}",
+                spec,
+                reason=reason,
+                unverified="unverified" in reason,
+            )
+        elif reason is None:
+            self._drop_reason = None
+        self._keepalive(event.t, mask, event)
+        if axes and self._nav == NAV_STATE_OFFBOARD:
+            self._trajectory(event.t, axes)
+
+    def _on_trajectory(self, event: TrajectorySetpoint) -> None:
+        self._trajectory(event.t, controllers.axes_of(event))
+
+    def _on_failsafe_flags(self, event: FailsafeFlags) -> None:
+        if self.est.update(event):
+            if self.tick_based and estimate_failure(self.px4, self.ocm_mask, self.est):
+                self.signal.turned_bad(event.t)
+            self._update_controller(event.t)
+
+    def _on_parameter(self, event: Parameter) -> None:
+        name = event.name.upper()
+        self.recorded_params[name] = event.value
+        if name in self.overrides:
+            return
+        self.params[name] = event.value
+        if name == "COM_OF_LOSS_T":
+            if self.px4 == "legacy":
+                self.signal.loss_extra = max(0.0, event.value)  # type: ignore[attr-defined]
+            else:
+                self.signal.timeout = max(0.0, event.value)
+        elif name == "MAV_FWDEXTSP":
+            self._rx.fwdextsp = bool(event.value)
+        elif name == "MAV_COMP_ID":
+            self._rx.own_component = int(event.value)
+
+    # ------------------------------------------------------------------ effective mode
+
+    def _needs_failsafe(self) -> bool:
+        if self.user_intention != NAV_STATE_OFFBOARD or self.signal.available:
+            return False
+        if self.tick_based:
+            return self.armed
+        return True  # 1.13 and older: recomputed even when disarmed (4.1)
+
+    def _refresh(self, t: float, cause: Event | bool | None = True) -> None:
+        """Recompute the effective nav_state after anything that can change it."""
+        kwargs: dict[str, Any] = {} if cause is True else {"cause": cause}
+        if self._terminated:
+            new: int | None = TERMINATION
+        elif self._needs_failsafe():
+            stage = 2 if getattr(self.signal, "timed_out", True) else 1
+            if self._fallback is None or self._fallback_stage != stage:
+                action = loss_action(self.px4, self.vehicle_type, self.params, self.est, stage)
+                self._fallback = action
+                self._fallback_stage = stage
+                self._failsafe(t, action, kwargs)
+            action = self._fallback
+            new = action.nav_state if action.nav_state is not None else NAV_STATE_OFFBOARD
+            if action.nav_state == TERMINATION:
+                self._terminated = True
+        else:
+            if self._fallback is not None:
+                self._fallback = None
+                self._fallback_stage = 0
+                if self.user_intention == NAV_STATE_OFFBOARD and (
+                    self.armed or not self.tick_based
+                ):
+                    self._emit(
+                        t,
+                        "offboard_resumed",
+                        "offboard signal back: OFFBOARD again (the user intention never changed)",
+                        "5.1" if self.tick_based else "5.2" if self.px4 != "legacy" else "5.3",
+                        nav_state=NAV_STATE_OFFBOARD,
+                        **kwargs,
+                    )
+            new = self.user_intention if self.user_intention is not None else self._nav
+        self._set_nav(t, new)
+
+    def _failsafe(self, t: float, action: LossAction, kwargs: dict[str, Any]) -> None:
+        note = f" ({action.note})" if action.note else ""
+        disarmed = "" if self.armed else " while disarmed"
+        self._emit(
+            t,
+            "failsafe",
+            f"offboard loss{disarmed}: {action.action}{note}",
+            action.spec,
+            action=action.action,
+            nav_state=action.nav_state if action.nav_state is not None else self._nav,
+            unverified=action.unverified,
+            **kwargs,
+        )
+        if action.disarm and self.armed:
+            self.armed = False
+            self._emit(t, "disarmed", "disarmed by the offboard-loss action", action.spec, **kwargs)
+
+    def _set_nav(self, t: float, new: int | None) -> None:
+        if new == self._nav:
+            return
+        self.compare.nav_changed(t, self._nav, new)
+        self._nav = new
+        if new == NAV_STATE_OFFBOARD:
+            self._offboard_since = t
+        self._update_controller(t)
+
+    # ------------------------------------------------------------------ controllers
+
+    def _trajectory(self, t: float, axes: int) -> None:
+        self._traj_t = t
+        if axes != self._traj_axes:
+            self._traj_axes = axes
+        if (
+            self._nav == NAV_STATE_OFFBOARD
+            and self._mc_position_control()
+            and controllers.mc_axes(axes, self.est) is None
+        ):
+            self._last_valid_t = t
+        self._update_controller(t)
+
+    def _mc_position_control(self) -> bool:
+        return self.vehicle_type in ("mc", "vtol") and controllers.position_control(
+            self.px4, self.ocm_mask
+        )
+
+    def _update_controller(self, t: float) -> None:
+        if self._nav != NAV_STATE_OFFBOARD:
+            key: tuple[Any, ...] = (self._nav,)
+            if key != self._controller_key and self._controller_key is not None:
+                self._controller_key = key
+                self._emit(
+                    t,
+                    "controller",
+                    f"offboard controllers off ({nav_state_name(self._nav)})",
+                    "7",
+                    cause=None,
+                )
+            self._controller_key = key
+            return
+        if not self._mc_position_control():
+            key = (NAV_STATE_OFFBOARD, self.ocm_mask, self._fw_state())
+            if key != self._controller_key:
+                self._controller_key = key
+                text, spec, unverified = controllers.describe(
+                    self.px4, self.vehicle_type, self.ocm_mask
+                )
+                fw = self._fw_state()
+                if fw:
+                    text += f"; {fw}"
+                self._emit(t, "controller", text, spec, unverified=unverified, cause=None)
+            return
+        key, text, reason = self._mc_state(t)
+        if key != self._controller_key:
+            self._controller_key = key
+            self._emit(
+                t,
+                "controller",
+                text,
+                "8",
+                reason=reason,
+                cause=None,
+                unverified=self.vehicle_type == "vtol" or self.px4 in ("legacy", "1.11"),
+            )
+
+    def _mc_state(self, t: float) -> tuple[tuple[Any, ...], str, str | None]:
+        mask = self.ocm_mask
+        since = self._offboard_since if self._offboard_since is not None else -INF
+        flags = ", ".join(controllers.control_flags(self.px4, mask))
+        head = f"multicopter offboard {ocm.names(ocm.first_flag(mask))} ({flags})"
+        land = float(self.params.get("MPC_LAND_SPEED", 0.7))
+        if self._traj_t < since:
+            fs = controllers.failsafe_setpoint(self.est, land)
+            why = "no TrajectorySetpoint since position control was enabled"
+            return (mask, "none", self.est.local_velocity), f"{head}: {fs} ({why})", why
+        axes = self._traj_axes
+        invalid = controllers.mc_axes(axes, self.est)
+        if invalid is None:
+            return (mask, "ok", axes), f"{head}: {controllers.mc_axes_text(axes)}", None
+        if at_least(self.px4, "1.16") and t < self._last_valid_t + controllers.LAST_VALID_S:
+            self._reuse_due = self._last_valid_t + controllers.LAST_VALID_S
+            text = f"{head}: invalid setpoint ({invalid}): last valid setpoint reused for 200 ms"
+            return (mask, "reuse", self._last_valid_t), text, invalid
+        fs = controllers.failsafe_setpoint(self.est, land)
+        return (mask, "failsafe", self.est.local_velocity), f"{head}: {fs} ({invalid})", invalid
+
+    def _fw_state(self) -> str:
+        if self.vehicle_type != "fw" or ocm.first_flag(self.ocm_mask) != ocm.POSITION:
+            return ""
+        axes = self._traj_axes
+        if axes < 0:
+            return "no trajectory setpoint yet"
+        if axes & 0b111000 == 0b111000:
+            return "path following (velocity finite)"
+        if axes & 0b111 == 0b111:
+            return "position (FW_POSCTRL_MODE_AUTO)"
+        return "setpoint invalid: needs all three position or velocity components"
+
+    # ------------------------------------------------------------------ commands
+
+    def _on_command(self, cmd: Command) -> None:
+        t = cmd.t
+        if cmd.is_mode_switch:
+            target = decode_mode(cmd)
+            decision = switch_decision(
+                self.px4, cmd, target, self.armed, self.signal.available, self._nav
+            )
+            before = (self.user_intention, self.armed)
+            self._apply_switch(t, target, decision)
+            self.compare.decided(cmd, decision, before, target)
+        elif cmd.command == MAV_CMD_COMPONENT_ARM_DISARM:
+            before = (self.user_intention, self.armed)
+            if cmd.is_arm:
+                why = estimate_failure(self.px4, self.ocm_mask, self.est) or "no offboard signal"
+                now_ok = self.signal.ok_now(t, self.ocm_mask != 0 and why == "no offboard signal")
+                decision = arm_decision(self.px4, cmd, self.user_intention, now_ok, why)
+                self._apply_arm(t, decision)
+            else:
+                decision = Decision(True, "4.2")
+                if self.armed:
+                    self.armed = False
+                    self._emit(t, "disarmed", "disarm requested", "4.2")
+                    self._refresh(t)
+            self.compare.decided(cmd, decision, before, None)
+
+    def _apply_switch(self, t: float, target: int | None, decision: Decision) -> None:
+        offboard = target == NAV_STATE_OFFBOARD
+        name = nav_state_name(target) if target is not None else "an unknown mode"
+        if not decision.accepted:
+            self._emit(
+                t,
+                "request_rejected" if offboard else "mode",
+                f"switch to {name} rejected: {decision.reason}",
+                decision.spec,
+                reason=decision.reason,
+                unverified=decision.unverified,
+            )
+            return
+        if not decision.changes or target is None:
+            self._emit(t, "mode", f"mode request acked, no change ({decision.reason})", "4.1")
+            return
+        if offboard:
+            note = ""
+            if not self.armed and self.tick_based:
+                note = " (disarmed: accepted without a stream, checked at arming)"
+            self._emit(
+                t,
+                "request_accepted",
+                f"switch to OFFBOARD accepted{note}",
+                decision.spec,
+                nav_state=target,
+                unverified=decision.unverified,
+            )
+        else:
+            self._emit(
+                t, "mode", f"switch to {name} (assumed accepted)", decision.spec, nav_state=target
+            )
+        self.user_intention = target
+        self._terminated = self._terminated and target == TERMINATION
+        self._fallback = None
+        self._fallback_stage = 0
+        self._refresh(t)
+
+    def _apply_arm(self, t: float, decision: Decision) -> None:
+        if not decision.accepted:
+            self._emit(
+                t,
+                "arm_rejected",
+                f"arming rejected: {decision.reason}",
+                decision.spec,
+                reason=decision.reason,
+            )
+            return
+        if not self.armed:
+            self.armed = True
+            note = f" ({decision.reason})" if decision.reason else ""
+            self._emit(
+                t, "arm_accepted", f"armed{note}", decision.spec, unverified=decision.unverified
+            )
+            self._refresh(t)
+
+    # ------------------------------------------------------------------ the recording
+
+    def _on_status(self, status: VehicleStatus) -> None:
+        if not self._started:
+            self._start(status)
+            return
+        self.compare.remember(status)
+        armed, intention = self._unseen_inputs(status)
+        if armed or intention is not None:
+            self._adopt(status.t, status, intention, silent=True)
+        self.compare.observe(status, self._nav)
+
+    def _unseen_inputs(self, status: VehicleStatus) -> tuple[bool, int | None]:
+        """Changes the recording shows with no recorded command near them (an RC switch, an
+        auto-disarm after landing): adopted silently. (armed changed, intention to adopt)."""
+        if self.compare.recent_command(status.t):
+            return False, None
+        armed = status.armed is not None and status.armed != self.armed
+        intention: int | None = None
+        if status.user_intention is not None:
+            if status.user_intention != self.user_intention:
+                intention = status.user_intention
+        elif (
+            status.nav_state is not None
+            and status.nav_state != self._nav
+            and (
+                self.user_intention != NAV_STATE_OFFBOARD
+                or (self.signal.available and status.failsafe is not True)
+            )
+        ):
+            intention = status.nav_state
+        return armed, intention
+
+    def _intention_for(self, status: VehicleStatus) -> int | None:
+        """The user intention a confirmed difference re-synchronises to."""
+        if status.user_intention is not None:
+            return status.user_intention
+        if (
+            self.user_intention == NAV_STATE_OFFBOARD
+            and not self.signal.available
+            and status.nav_state != NAV_STATE_OFFBOARD
+        ):
+            return None  # plausibly the failsafe: keep the intention
+        return status.nav_state
+
+    def _start(self, status: VehicleStatus) -> None:
+        """Initialise from the first recorded status (a recording may start mid-flight)."""
+        self._started = True
+        t = status.t
+        if status.armed is not None:
+            self.armed = status.armed
+        intention = status.user_intention
+        if intention is None:
+            intention = status.nav_state
+        self.user_intention = intention
+        # Assumption: a recording that starts in OFFBOARD starts with a live stream.
+        if (
+            status.nav_state == NAV_STATE_OFFBOARD
+            and not self.signal.available
+            and self.signal.keepalive(t, True)
+        ):
+            self._emit(
+                t,
+                "signal_available",
+                "offboard signal assumed available: the recording starts in OFFBOARD",
+                self.signal.spec,
+            )
+        self._nav = status.nav_state
+        self._refresh(t)
+        self.compare.remember(status)
+
+    def _adopt(self, t: float, status: VehicleStatus, intention: int | None, silent: bool) -> None:
+        """Re-synchronise arming and user intention to the recording."""
+        changed = []
+        if status.armed is not None and status.armed != self.armed:
+            self.armed = status.armed
+            changed.append("armed" if status.armed else "disarmed")
+        if intention is not None and intention != self.user_intention:
+            self.user_intention = intention
+            self._terminated = intention == TERMINATION
+            self._fallback = None
+            changed.append(f"intention {nav_state_name(intention)}")
+        if changed and silent:
+            self._emit(
+                t,
+                "mode",
+                "from the recording (no command for it in the recording): " + ", ".join(changed),
+                "12",
+                cause=status,
+            )
+        self._refresh(t, cause=status)
+
+    def _confirm(self, due: float) -> None:
+        """A recorded difference outlasted the slack (or an ack was judged): report it once
+        and re-synchronise."""
+        if self.compare.ack_due_first():
+            self._judge_ack()
+            return
+        pending = self.compare.take_pending()
+        if pending is None:
+            return
+        status = pending.status
+        model = nav_state_name(self._nav)
+        if self._fallback is not None:
+            model += f" (failsafe {self._fallback.action})"
+        self._emit(
+            pending.t,
+            "disagreement",
+            f"recorded: {nav_state_name(status.nav_state)} at {pending.t:.2f} s; model: {model}",
+            "12",
+            cause=status,
+            recorded_nav_state=status.nav_state,
+        )
+        self._adopt(due, pending.latest, self._intention_for(pending.latest), False)
+
+    def _on_ack(self, ack: CommandAck) -> None:
+        self.compare.ack(ack)
+
+    def _judge_ack(self) -> None:
+        judged = self.compare.take_ack()
+        if judged is None:
+            return
+        decided, ack = judged
+        cmd, target = decided.cmd, decided.target
+        what = "arm" if cmd.command == MAV_CMD_COMPONENT_ARM_DISARM else "mode switch"
+        if target is not None:
+            what = f"switch to {nav_state_name(target)}"
+        decision = decided.decision
+        model = "accepted" if decision.accepted else f"rejected ({decision.reason})"
+        self._emit(
+            ack.t,
+            "disagreement",
+            f"recorded: {what} acked {ack.result_name} at {ack.t:.2f} s; model: {model}",
+            "4.3",
+            cause=ack,
+        )
+        if ack.accepted and cmd.command == MAV_CMD_COMPONENT_ARM_DISARM:
+            self.armed = cmd.is_arm
+        elif ack.accepted and target is not None:
+            self.user_intention = target
+            self._fallback = None
+        elif not ack.accepted:
+            self.user_intention, self.armed = decided.before
+        self._refresh(ack.t, cause=ack)

@@ -20,7 +20,11 @@ TransitionKind = Literal[
     "controller",
     "setpoint_dropped",
     "disarmed",
+    "disagreement",
 ]
+"""``mode``: a mode change that is not an offboard request (another mode requested, or the
+model re-synchronised to the recording); ``disagreement``: the recording shows something the
+model did not predict (recorded mode or ack vs the model's), see ``recorded_nav_state``."""
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -45,3 +49,7 @@ class GateTransition(Event):
     """Why a request was rejected or a setpoint dropped, in PX4's terms."""
     unverified: bool = False
     origin: Origin = "model"
+    armed: bool | None = None
+    """The model's arming state after the transition."""
+    recorded_nav_state: int | None = None
+    """``disagreement``: the nav_state the recording shows (None for an ack disagreement)."""

@@ -1,0 +1,160 @@
+"""Recorded mode history and acks vs the model's prediction (OFB202, ``fuzzoff gate``).
+
+A recorded ``VehicleStatus`` agrees with the model when its nav_state equals the model's, or
+equals the model's previous nav_state and the model changed less than the slack ago (the
+recording lags), or the model reaches it within the slack (the recording leads: PX4's 10 Hz
+check pass has its own phase, gate spec 2.1.3). Otherwise the difference waits ``slack``; if it
+is still there it is confirmed once per episode (until the two agree again).
+
+Acks: PX4 1.16/1.17 ack a mode switch twice (4.3), so an ack is judged ``ACK_WINDOW`` after the
+first one, by the last one.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from fuzzoff.events import Command, CommandAck, VehicleStatus
+from fuzzoff.gate.requests import Decision
+
+INF = float("inf")
+ACK_WINDOW = 0.1
+"""Seconds within which a second ack for the same command replaces the first (4.3)."""
+DECISION_MAX_AGE = 1.0
+"""An ack later than this after the command is not matched to the model's decision."""
+COMMAND_WINDOW = 1.5
+"""A recorded change this close to a recorded command is the command's doing, not an unseen
+input such as an RC switch."""
+SAMPLED_SLACK = 0.1
+"""Extra slack when the keep-alive is a logged, subsampled copy (ULog logs
+``offboard_control_mode`` at 10 Hz, gate spec 13a)."""
+
+
+@dataclass(slots=True)
+class Pending:
+    t: float
+    status: VehicleStatus
+    latest: VehicleStatus
+
+
+@dataclass(slots=True)
+class Decided:
+    t: float
+    decision: Decision
+    cmd: Command
+    before: tuple[int | None, bool]
+    target: int | None
+
+
+@dataclass(slots=True)
+class AckWait:
+    t: float
+    ack: CommandAck
+
+
+class Comparator:
+    def __init__(self, slack: float) -> None:
+        self.base_slack = slack
+        self.slack = slack
+        self.pending: Pending | None = None
+        self.open_episode = False
+        self.changed_at = -INF
+        self.nav_before: int | None = None
+        self.decisions: dict[int, Decided] = {}
+        self.ack_wait: AckWait | None = None
+        self.last_command_t = -INF
+        self.last_status: VehicleStatus | None = None
+
+    def sampled_keepalive(self) -> None:
+        self.slack = self.base_slack + SAMPLED_SLACK
+
+    def due(self) -> float:
+        due = INF
+        if self.pending is not None:
+            due = self.pending.t + self.slack
+        if self.ack_wait is not None and self.ack_wait.t + ACK_WINDOW < due:
+            due = self.ack_wait.t + ACK_WINDOW
+        return due
+
+    def ack_due_first(self) -> bool:
+        if self.ack_wait is None:
+            return False
+        return self.pending is None or self.ack_wait.t + ACK_WINDOW <= self.pending.t + self.slack
+
+    # -- modes
+
+    def nav_changed(self, t: float, old: int | None, new: int | None) -> None:
+        self.changed_at = t
+        self.nav_before = old
+        pending = self.pending
+        if pending is not None and new == pending.latest.nav_state:
+            self.pending = None
+
+    def remember(self, status: VehicleStatus) -> None:
+        self.last_status = status
+
+    def recent_command(self, t: float) -> bool:
+        return t - self.last_command_t <= COMMAND_WINDOW
+
+    def observe(self, status: VehicleStatus, model_nav: int | None) -> None:
+        recorded = status.nav_state
+        if recorded is None or model_nav is None:
+            return
+        if recorded == model_nav:
+            self.pending = None
+            self.open_episode = False
+            return
+        if status.t - self.changed_at <= self.slack and recorded == self.nav_before:
+            return
+        if self.open_episode:
+            return
+        if self.pending is None:
+            self.pending = Pending(status.t, status, status)
+        else:
+            self.pending.latest = status
+
+    def take_pending(self) -> Pending | None:
+        pending = self.pending
+        self.pending = None
+        if pending is not None:
+            self.open_episode = True
+        return pending
+
+    def drop_pending(self) -> None:
+        """At the end of the recording a difference younger than the slack is not judged."""
+        self.pending = None
+
+    # -- acks
+
+    def decided(
+        self,
+        cmd: Command,
+        decision: Decision,
+        before: tuple[int | None, bool],
+        target: int | None,
+    ) -> None:
+        self.decisions[cmd.command] = Decided(cmd.t, decision, cmd, before, target)
+        self.last_command_t = cmd.t
+
+    def ack(self, ack: CommandAck) -> None:
+        decided = self.decisions.get(ack.command)
+        if decided is None or ack.t - decided.t > DECISION_MAX_AGE:
+            return
+        wait = self.ack_wait
+        if wait is not None and wait.ack.command == ack.command and ack.t - wait.t <= ACK_WINDOW:
+            wait.ack = ack
+            return
+        self.ack_wait = AckWait(ack.t, ack)
+
+    def take_ack(self) -> tuple[Decided, CommandAck] | None:
+        """The judged ack if it disagrees with the model's decision, else None."""
+        wait = self.ack_wait
+        self.ack_wait = None
+        if wait is None:
+            return None
+        decided = self.decisions.pop(wait.ack.command, None)
+        if decided is None:
+            return None
+        if wait.ack.accepted == decided.decision.accepted:
+            return None
+        return decided, wait.ack

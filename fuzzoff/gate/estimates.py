@@ -1,0 +1,63 @@
+"""What the gate knows about the vehicle's estimates and manual control (gate spec 2.1, 5).
+
+Taken from ``FailsafeFlags`` events where the recording has them; a field the recording does not
+carry (``None``) keeps its last value, and every field starts valid ("assume valid", spec 2.1).
+Manual control (RC or joystick) starts from the ``FUZZOFF_RC_PRESENT`` assumption.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from fuzzoff.events import FailsafeFlags
+
+
+@dataclass(slots=True)
+class Estimates:
+    local_position: bool = True
+    local_velocity: bool = True
+    local_altitude: bool = True
+    global_position: bool = True
+    attitude: bool = True
+    angular_velocity: bool = True
+    home_position: bool = True
+    rc_present: bool = True
+    rc_recorded: bool = False
+    """True once the recording said whether manual control is present."""
+    recorded: bool = False
+    """True once the recording carried any estimate flag."""
+
+    def update(self, flags: FailsafeFlags) -> bool:
+        """Apply a ``FailsafeFlags`` event; True when anything the gate reads changed."""
+        before = self.key()
+        for name in (
+            "local_position",
+            "local_velocity",
+            "local_altitude",
+            "global_position",
+            "attitude",
+            "angular_velocity",
+            "home_position",
+        ):
+            value = getattr(flags, name + "_valid")
+            if value is not None:
+                setattr(self, name, bool(value))
+                self.recorded = True
+        if flags.manual_control_signal_lost is not None:
+            self.rc_present = not flags.manual_control_signal_lost
+            self.rc_recorded = True
+        return self.key() != before
+
+    def key(self) -> int:
+        """A small integer summarising every flag (cheap change detection)."""
+        bits = (
+            self.local_position,
+            self.local_velocity,
+            self.local_altitude,
+            self.global_position,
+            self.attitude,
+            self.angular_velocity,
+            self.home_position,
+            self.rc_present,
+        )
+        return sum(1 << i for i, b in enumerate(bits) if b)

@@ -1,0 +1,63 @@
+"""PX4's defaults for the parameters the gate reads, per profile (gate spec section 13).
+
+Precedence (lowest to highest): these defaults, the recording's ``Parameter`` events, the
+user's overrides (``--param`` / ``[tool.fuzzoff] params``).
+
+``FUZZOFF_RC_PRESENT`` is not a PX4 parameter: it is fuzzoff's assumption about whether an RC
+transmitter or joystick is connected, used only where the recording has no
+``failsafe_flags.manual_control_signal_lost`` (1 = present, the default; 0 = none).
+"""
+
+from __future__ import annotations
+
+from fuzzoff.profiles import Profile, at_least
+
+RC_PRESENT = "FUZZOFF_RC_PRESENT"
+
+GATE_PARAMS: tuple[str, ...] = (
+    "COM_OF_LOSS_T",
+    "COM_OBL_ACT",
+    "COM_OBL_RC_ACT",
+    "COM_RCL_EXCEPT",
+    "COM_POSCTL_NAVL",
+    "NAV_RCL_ACT",
+    "MAV_FWDEXTSP",
+    "MAV_SYS_ID",
+    "MAV_COMP_ID",
+    "MPC_LAND_SPEED",
+    RC_PRESENT,
+)
+
+
+def default_params(px4: str) -> dict[str, float]:
+    """The defaults of ``px4`` (a profile name) for every parameter in ``GATE_PARAMS``."""
+    legacy = px4 == "legacy"
+    params: dict[str, float] = {
+        "COM_OF_LOSS_T": 0.0 if legacy else 0.5 if px4 == "1.11" else 1.0,
+        "COM_OBL_RC_ACT": 0.0,
+        "MAV_FWDEXTSP": 1.0,
+        "MAV_SYS_ID": 1.0,
+        "MAV_COMP_ID": 1.0,
+        "MPC_LAND_SPEED": 0.7,
+        "NAV_RCL_ACT": 2.0,
+        "COM_RCL_EXCEPT": 0.0,
+        "COM_POSCTL_NAVL": 0.0,
+        RC_PRESENT: 1.0,
+    }
+    if not at_least(px4, "1.14"):
+        params["COM_OBL_ACT"] = 0.0  # removed in 1.14 (section 13)
+    return params
+
+
+def effective_params(
+    profile: Profile, recorded: dict[str, float], overrides: dict[str, float]
+) -> dict[str, float]:
+    """Defaults < recorded < overrides."""
+    return default_params(profile.px4) | recorded | overrides
+
+
+def loss_timeout(px4: str, params: dict[str, float]) -> float:
+    """The time without keep-alive after which the signal counts as lost (sections 2.1-2.3)."""
+    if px4 == "legacy":
+        return 0.5
+    return max(0.0, float(params.get("COM_OF_LOSS_T", 1.0)))

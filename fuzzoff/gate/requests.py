@@ -1,0 +1,97 @@
+"""Mode-switch and arming requests: accepted or rejected, and why (gate spec section 4).
+
+``decode_mode`` turns a command into the nav_state it asks for; ``switch_decision`` and
+``arm_decision`` return ``Decision`` (accepted, reason, spec, ack result).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from fuzzoff.events import (
+    MAV_CMD_DO_SET_MODE,
+    NAV_STATE_OFFBOARD,
+    VEHICLE_CMD_SET_NAV_STATE,
+    Command,
+)
+from fuzzoff.modes import custom_mode_to_nav_state
+from fuzzoff.profiles import at_least
+
+TERMINATION = 13
+FORCE_ARM_MAGIC = 21196
+ACCEPTED = 0
+TEMPORARILY_REJECTED = 1
+UNSUPPORTED = 3
+
+
+@dataclass(frozen=True, slots=True)
+class Decision:
+    accepted: bool
+    spec: str
+    reason: str | None = None
+    result: int = ACCEPTED
+    changes: bool = True
+    """False for a request acked ACCEPTED that changes nothing (unsupported main mode, 4.1)."""
+    unverified: bool = False
+
+
+def decode_mode(cmd: Command) -> int | None:
+    """The nav_state a mode command asks for (None: not a mode or unknown custom mode)."""
+    if cmd.command == VEHICLE_CMD_SET_NAV_STATE:
+        return int(cmd.params[0])
+    if cmd.command == MAV_CMD_DO_SET_MODE:
+        if int(cmd.params[0]) & 1 == 0:
+            return None
+        main, sub = int(cmd.params[1]), int(cmd.params[2])
+        return custom_mode_to_nav_state((main & 0xFF) << 16 | (sub & 0xFF) << 24)
+    return None
+
+
+def switch_decision(
+    px4: str, cmd: Command, target: int | None, armed: bool, signal_ok: bool, nav_state: int | None
+) -> Decision:
+    """A mode switch (4.1). ``signal_ok`` is the last check pass's verdict (1.14+) or the
+    current flag (older)."""
+    if cmd.command == VEHICLE_CMD_SET_NAV_STATE and not at_least(px4, "1.15"):
+        return Decision(False, "4.1", "SET_NAV_STATE is not handled before 1.15", UNSUPPORTED)
+    if target is None:
+        if px4 == "main":
+            return Decision(False, "4.1", "unsupported main mode", TEMPORARILY_REJECTED)
+        if at_least(px4, "1.14"):
+            return Decision(
+                True, "4.1", "unsupported main mode: acked, no mode change", changes=False
+            )
+        return Decision(
+            False, "4.1", "unsupported main mode", TEMPORARILY_REJECTED, unverified=True
+        )
+    if at_least(px4, "1.16") and nav_state == TERMINATION and armed:
+        return Decision(False, "4.1", "never out of TERMINATION", TEMPORARILY_REJECTED)
+    if target != NAV_STATE_OFFBOARD:
+        # Other modes' requirements are not modelled: assumed accepted.
+        return Decision(True, "4.1", None, unverified=False)
+    if at_least(px4, "1.14"):
+        if not armed:
+            return Decision(True, "4.1", None)
+        if signal_ok:
+            return Decision(True, "4.1", None)
+        return Decision(False, "4.1", "no offboard signal", TEMPORARILY_REJECTED)
+    if signal_ok:
+        return Decision(True, "4.1", None)
+    return Decision(False, "4.1", "no offboard signal", TEMPORARILY_REJECTED)
+
+
+def arm_decision(
+    px4: str, cmd: Command, intention: int | None, signal_now: bool, why: str | None
+) -> Decision:
+    """Arming (4.2). ``signal_now`` is the condition evaluated at the request (1.14+ re-runs the
+    checks); ``why`` the reason it fails."""
+    if intention != NAV_STATE_OFFBOARD:
+        return Decision(True, "4.2", None)
+    if not at_least(px4, "1.14"):
+        return Decision(True, "4.2", None, unverified=px4 == "legacy")
+    forced = round(cmd.params[1]) == FORCE_ARM_MAGIC
+    if forced and cmd.from_external is False:
+        return Decision(True, "4.2", "forced arming from an internal source: checks skipped")
+    if signal_now:
+        return Decision(True, "4.2", None)
+    return Decision(False, "4.2", why or "no offboard signal", TEMPORARILY_REJECTED)

@@ -1,0 +1,215 @@
+"""Proof of life: when is the offboard signal available, per profile (gate spec section 2).
+
+Each model keeps only the newest keep-alive and computes the time of its loss arithmetically
+(no per-tick loop):
+
+* ``TickSignal`` (1.14+, 2.1): lost at the first 10 Hz check pass at or after
+  ``newest + COM_OF_LOSS_T`` (or after the newest keep-alive turned bad); available again at the
+  keep-alive that arrives while lost (2.1.3: the forced check pass).
+* ``HysteresisSignal`` (1.13, 2.2): Commander iterations every 10 ms; lost once no good keep-alive
+  was seen for ``COM_OF_LOSS_T`` counted from the first iteration without one.
+* ``AgeSignal`` (1.11, 2.2): lost at the first iteration where the keep-alive's age is
+  ``>= COM_OF_LOSS_T``; no flag or estimate conditions.
+* ``LegacySignal`` (legacy, 2.3): lost 500 ms after the newest accepted message; a second stage,
+  the loss timeout, ``COM_OF_LOSS_T`` later.
+
+Check passes and iterations are placed on a grid anchored at the recording's time zero: PX4's
+own phase is unknown, hence the evaluation slack of ``slack()``.
+"""
+
+from __future__ import annotations
+
+import math
+
+from fuzzoff.gate.estimates import Estimates
+from fuzzoff.gate.ocm import ACCELERATION, ATTITUDE, POSITION, VELOCITY
+from fuzzoff.profiles import at_least
+
+INF = math.inf
+CHECK_PERIOD = 0.1
+"""Health-check pass period, 1.14+ (2.1.3)."""
+LOOP_PERIOD = 0.01
+"""Commander iteration (``COMMANDER_MONITORING_INTERVAL``), 1.11-1.13 (2.2)."""
+LEGACY_TIMEOUT = 0.5
+"""``OFFBOARD_TIMEOUT`` of legacy (2.3)."""
+_EPS = 1e-9
+
+
+def grid_ceil(x: float, period: float) -> float:
+    """The first grid point at or after ``x``."""
+    return math.ceil(x / period - _EPS) * period
+
+
+def slack(px4: str) -> float:
+    """How late PX4 may see a loss compared with a continuous model (2.1.3: >= 110 ms on 1.14+;
+    one Commander iteration plus one on older profiles)."""
+    return 0.11 if at_least(px4, "1.14") else 2 * LOOP_PERIOD
+
+
+def estimate_failure(px4: str, mask: int, est: Estimates) -> str | None:
+    """Why the newest keep-alive's flags fail their estimate requirements (2.1 table, 2.2), or
+    None. Every set flag is checked, not only the first (D10)."""
+    if px4 in ("legacy", "1.11"):
+        return None
+    if mask & POSITION and not est.local_position:
+        return "no local position estimate (position flag)"
+    if mask & VELOCITY and not est.local_velocity:
+        return "no local velocity estimate (velocity flag)"
+    if mask & ACCELERATION:
+        if at_least(px4, "1.16"):
+            if not est.attitude:
+                return "no attitude estimate (acceleration flag)"
+        elif not est.local_velocity:
+            return "no local velocity estimate (acceleration flag)"
+    if px4 == "main" and mask & ATTITUDE and not est.attitude:
+        return "no attitude estimate (attitude flag)"
+    return None
+
+
+class Signal:
+    """Common state: ``available`` and the newest keep-alive's time (``None`` before any)."""
+
+    spec = "2"
+
+    def __init__(self, timeout: float) -> None:
+        self.timeout = timeout
+        self.available = False
+        self.last: float | None = None
+
+    def keepalive(self, t: float, good: bool) -> bool:
+        """A keep-alive at ``t`` (``good``: flags and estimates pass). True if it made the
+        signal available."""
+        raise NotImplementedError
+
+    def turned_bad(self, t: float) -> None:
+        """The newest keep-alive no longer passes (estimates changed at ``t``)."""
+
+    def lost_at(self) -> float:
+        """When the signal will be lost if nothing arrives (inf when not available)."""
+        raise NotImplementedError
+
+    def mark_lost(self) -> None:
+        self.available = False
+
+    def ok_now(self, t: float, good: bool) -> bool:
+        """The condition evaluated right now (the arming path re-runs the checks, 4.2)."""
+        return self.available and t < self.lost_at()
+
+    def timeout_at(self) -> float:
+        """Legacy's second stage (loss timeout); inf elsewhere."""
+        return INF
+
+
+class TickSignal(Signal):
+    spec = "2.1"
+
+    def __init__(self, timeout: float) -> None:
+        super().__init__(timeout)
+        self.bad_since: float | None = None
+
+    def keepalive(self, t: float, good: bool) -> bool:
+        self.last = t
+        if not good:
+            if self.available and self.bad_since is None:
+                self.bad_since = t
+            return False
+        self.bad_since = None
+        if not self.available and self.timeout > 0.0:
+            self.available = True
+            return True
+        return False
+
+    def turned_bad(self, t: float) -> None:
+        if self.available and self.bad_since is None:
+            self.bad_since = t
+
+    def lost_at(self) -> float:
+        if not self.available or self.last is None:
+            return INF
+        due = self.last + self.timeout
+        if self.bad_since is not None and self.bad_since < due:
+            due = self.bad_since
+        return grid_ceil(due, CHECK_PERIOD)
+
+    def ok_now(self, t: float, good: bool) -> bool:
+        return self.last is not None and good and t < self.last + self.timeout
+
+
+class HysteresisSignal(Signal):
+    spec = "2.2"
+
+    def __init__(self, timeout: float) -> None:
+        super().__init__(timeout)
+        self.good_iter: float | None = None
+
+    def keepalive(self, t: float, good: bool) -> bool:
+        self.last = t
+        if not good:
+            return False
+        self.good_iter = grid_ceil(t, LOOP_PERIOD)
+        if not self.available:
+            self.available = True
+            return True
+        return False
+
+    def lost_at(self) -> float:
+        if not self.available or self.good_iter is None:
+            return INF
+        return grid_ceil(self.good_iter + LOOP_PERIOD + self.timeout, LOOP_PERIOD)
+
+
+class AgeSignal(Signal):
+    spec = "2.2"
+
+    def keepalive(self, t: float, good: bool) -> bool:
+        self.last = t
+        if not self.available and self.timeout > 0.0:
+            self.available = True
+            return True
+        return False
+
+    def lost_at(self) -> float:
+        if not self.available or self.last is None:
+            return INF
+        return grid_ceil(self.last + self.timeout, LOOP_PERIOD)
+
+
+class LegacySignal(Signal):
+    """Two flags: lost (500 ms) and loss timeout (500 ms + ``COM_OF_LOSS_T``), spec 2.3."""
+
+    spec = "2.3"
+
+    def __init__(self, timeout: float, loss_extra: float) -> None:
+        super().__init__(timeout)
+        self.loss_extra = loss_extra
+        self.timed_out = False
+
+    def keepalive(self, t: float, good: bool) -> bool:
+        self.last = t
+        self.timed_out = False
+        if not self.available:
+            self.available = True
+            return True
+        return False
+
+    def lost_at(self) -> float:
+        if not self.available or self.last is None:
+            return INF
+        return self.last + LEGACY_TIMEOUT
+
+    def timeout_at(self) -> float:
+        if self.timed_out or self.last is None:
+            return INF
+        extra = self.loss_extra if self.loss_extra >= 1.19e-7 else 0.0
+        return self.last + LEGACY_TIMEOUT + extra
+
+
+def make_signal(px4: str, params: dict[str, float]) -> Signal:
+    timeout = max(0.0, float(params.get("COM_OF_LOSS_T", 1.0)))
+    if px4 == "legacy":
+        return LegacySignal(LEGACY_TIMEOUT, timeout)
+    if px4 == "1.11":
+        return AgeSignal(timeout)
+    if px4 == "1.13":
+        return HysteresisSignal(timeout)
+    return TickSignal(timeout)
