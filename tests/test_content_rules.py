@@ -1,8 +1,10 @@
-"""OFB106, OFB107, OFB203, OFB3xx, OFB4xx, OFB8xx on minimal streams: threshold edges, near misses."""
+"""OFB106, OFB107, OFB203, OFB3xx, OFB4xx, OFB8xx on minimal streams: edges and near misses."""
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
+from typing import Any
 
 import pytest
 
@@ -14,6 +16,7 @@ from fuzzoff.events import (
     Event,
     FailsafeFlags,
     LegacyControlMode,
+    Origin,
     PositionSetpointTriplet,
     RatesSetpoint,
     RoverAttitudeSetpoint,
@@ -23,27 +26,30 @@ from fuzzoff.events import (
     SetPositionTargetLocal,
     TrajectorySetpoint,
 )
-from fuzzoff.findings import Severity
+from fuzzoff.findings import Finding, Severity
 from tests.streams import OFFBOARD, POSCTL, codes, every, ocm, status, switch
 from tests.streams import lint_events as _lint_events
 
 NAN = math.nan
 MINE = frozenset(
-    "OFB002 OFB106 OFB107 OFB203 OFB301 OFB302 OFB303 OFB304 OFB305 OFB401 OFB402 OFB403 "
-    "OFB404 OFB405 OFB406 OFB407 OFB408 OFB801 OFB802 OFB803".split()
+    {"OFB002", "OFB106", "OFB107", "OFB203", "OFB404", "OFB405", "OFB406", "OFB407", "OFB408"}
+    | {"OFB301", "OFB302", "OFB303", "OFB304", "OFB305", "OFB401", "OFB402", "OFB403"}
+    | {"OFB801", "OFB802", "OFB803"}
 )
 
 
-def lint_events(events: list[Event], settings: Settings | None = None, **kw: object) -> list:
+def lint_events(
+    events: Sequence[Event], settings: Settings | None = None, **kw: Any
+) -> list[Finding]:
     """These rules alone (plus OFB002), so that a test shows only what they do."""
     chosen = settings or Settings()
     chosen = Settings(select=MINE - chosen.ignore)
-    return _lint_events(events, settings=chosen, **kw)  # type: ignore[arg-type]
+    return _lint_events(events, settings=chosen, **kw)
 
 
-def ocm_stamped(times: list[float], stamps_us: list[int], origin: str = "sent") -> list[Event]:
+def ocm_stamped(times: list[float], stamps_us: list[int], origin: Origin = "sent") -> list[Event]:
     return [
-        ControlMode(t=t, position=True, sender_time_us=s, origin=origin)  # type: ignore[arg-type]
+        ControlMode(t=t, position=True, sender_time_us=s, origin=origin)
         for t, s in zip(times, stamps_us, strict=True)
     ]
 
@@ -93,8 +99,8 @@ def test_ofb106_ulog_copies_are_not_checkable() -> None:
 # --- OFB107 -------------------------------------------------------------------------------
 
 
-def _repeat(t0: float, t1: float, hz: float, **fields: object) -> list[Event]:
-    return [TrajectorySetpoint(t=round(t, 6), **fields) for t in every(t0, t1, 1 / hz)]  # type: ignore[arg-type]
+def _repeat(t0: float, t1: float, hz: float, **fields: Any) -> list[Event]:
+    return [TrajectorySetpoint(t=round(t, 6), **fields) for t in every(t0, t1, 1 / hz)]
 
 
 @pytest.mark.parametrize(("duration", "flagged"), [(3.0, False), (3.05, True)])
@@ -251,12 +257,12 @@ def test_ofb305_follows_the_profile_table() -> None:
 # --- OFB4xx -------------------------------------------------------------------------------
 
 
-def _traj(**fields: object) -> list[Event]:
+def _traj(**fields: Any) -> list[Event]:
     return [
         status(0.0, OFFBOARD),
         ControlMode(t=0.0, position=True),
         TrajectorySetpoint(t=0.1, **fields),
-    ]  # type: ignore[arg-type]
+    ]
 
 
 def test_ofb401_acceleration_only_under_acceleration_is_clean() -> None:
