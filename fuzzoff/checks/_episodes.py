@@ -1,0 +1,92 @@
+"""One finding per stretch of offending messages, not one per message.
+
+A stream repeats the same mistake at 20-50 Hz; a finding per message would bury the report.
+``Episodes`` keeps one open stretch per (code, key): it opens at the first offending message,
+grows while the following messages of the same stream offend the same way, and is reported
+(at its first message, with ``end`` = its last) when a message no longer offends or the
+recording ends.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from fuzzoff.checks.base import CheckContext
+from fuzzoff.events import Where
+from fuzzoff.findings import Severity
+
+
+@dataclass(slots=True)
+class Offence:
+    """What one message did wrong, in the words of the finding."""
+
+    message: str
+    severity: Severity | None = None
+
+
+@dataclass(slots=True)
+class _Open:
+    offence: Offence
+    t: float
+    where: Where
+    last_t: float
+    count: int = 1
+
+
+class Episodes:
+    """Open stretches of one check, by ``(code, stream, key)``."""
+
+    def __init__(self, ctx: CheckContext) -> None:
+        self.ctx = ctx
+        self.open: dict[tuple[str, str, str], _Open] = {}
+
+    def update(
+        self, code: str, stream: str, t: float, where: Where, offences: dict[str, Offence]
+    ) -> None:
+        """This message of ``stream`` commits ``offences`` (key -> offence) under ``code``."""
+        for key in [k for k in self.open if k[0] == code and k[1] == stream]:
+            if key[2] not in offences:
+                self._close(key)
+        for name, offence in offences.items():
+            key = (code, stream, name)
+            current = self.open.get(key)
+            if current is None:
+                self.open[key] = _Open(offence, t, where, t)
+            else:
+                current.last_t = t
+                current.count += 1
+
+    def start(
+        self,
+        code: str,
+        stream: str,
+        key: str,
+        offence: Offence,
+        span: tuple[float, Where, float, int],
+    ) -> None:
+        """Open a stretch judged late: ``span`` = (first t, where, last t, message count)."""
+        t, where, last_t, count = span
+        self.open[(code, stream, key)] = _Open(offence, t, where, last_t, count)
+
+    def clear(self, code: str, stream: str | None = None) -> None:
+        """Close every stretch of ``code`` (of one ``stream`` if given)."""
+        for key in [k for k in self.open if k[0] == code and stream in (None, k[1])]:
+            self._close(key)
+
+    def finish(self) -> None:
+        for key in list(self.open):
+            self._close(key)
+
+    def _close(self, key: tuple[str, str, str]) -> None:
+        stretch = self.open.pop(key)
+        message = stretch.offence.message
+        if stretch.count > 1:
+            message += f" ({stretch.count} messages, until t={stretch.last_t:.2f} s)"
+        self.ctx.report(
+            key[0],
+            message,
+            stretch.t,
+            stretch.where,
+            severity=stretch.offence.severity,
+            end=stretch.last_t if stretch.count > 1 else None,
+        )

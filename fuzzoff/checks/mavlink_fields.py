@@ -1,0 +1,208 @@
+"""OFB601-OFB605: the fields of SET_POSITION_TARGET_LOCAL_NED / _GLOBAL_INT against the docs.
+
+Seed 000 "MAVLink Offboard Control" (1.15+) and seed 002 "MAVLink 消息" (1.13-1.14) list, per
+vehicle type, the supported ``coordinate_frame`` values and ``type_mask`` combinations; the
+tables are in ``fuzzoff.tables.mavlink``. Every setpoint the recording shows on its way to the
+vehicle is judged, in any mode: a message PX4 drops is also a keep-alive that never counted.
+"""
+
+from __future__ import annotations
+
+import math
+
+from fuzzoff.checks._episodes import Episodes, Offence
+from fuzzoff.checks.base import Check, CheckContext
+from fuzzoff.events import Event, SetPositionTargetGlobal, SetPositionTargetLocal
+from fuzzoff.findings import Severity
+from fuzzoff.profiles import at_least
+from fuzzoff.tables import mavlink as tm
+
+VEHICLE_LABELS = {"copter": "multicopter/VTOL", "fixedwing": "fixed-wing", "rover": "rover"}
+
+PositionTarget = SetPositionTargetLocal | SetPositionTargetGlobal
+
+
+def frames_text(frames: frozenset[int]) -> str:
+    return ", ".join(f"{tm.frame_name(f)} ({f})" for f in sorted(frames))
+
+
+def set_components(event: PositionTarget, group: str) -> list[str]:
+    """Components of ``group`` that are used (ignore bit clear) and carry a non-zero value."""
+    names = {"velocity": ("vx", "vy", "vz"), "acceleration": ("afx", "afy", "afz")}[group]
+    values = event.velocity if group == "velocity" else event.acceleration
+    first_bit = 8 if group == "velocity" else 64
+    out = []
+    for i, (name, value) in enumerate(zip(names, values, strict=True)):
+        ignored = event.type_mask & (first_bit << i)
+        if not ignored and value != 0 and not math.isnan(value):
+            out.append(name)
+    return out
+
+
+class PositionTargetFields(Check):
+    codes = ("OFB601", "OFB602", "OFB603", "OFB604", "OFB605")
+    wants = (SetPositionTargetLocal, SetPositionTargetGlobal)
+
+    def __init__(self, ctx: CheckContext) -> None:
+        super().__init__(ctx)
+        self.episodes = Episodes(ctx)
+        self.group = tm.vehicle_group(ctx.profile.vehicle)
+        self.vehicle_label = VEHICLE_LABELS[self.group]
+
+    def on_event(self, event: Event) -> None:
+        if event.origin != "sent" or not isinstance(
+            event, (SetPositionTargetLocal, SetPositionTargetGlobal)
+        ):
+            return
+        name = tm.MESSAGE_NAMES[event.kind]
+        update = self.episodes.update
+        update("OFB603", event.kind, event.t, event.where, self._setpoint_type(event, name))
+        rules = tm.position_rules(self.ctx.profile, event.kind)
+        if rules is None:
+            return
+        selected = tm.selected_groups(event.type_mask)
+        usable = selected - rules.ignored
+        update("OFB601", event.kind, event.t, event.where, self._frame(event, name, rules, usable))
+        update("OFB602", event.kind, event.t, event.where, self._combo(event, name, rules))
+        update("OFB604", event.kind, event.t, event.where, self._fw_ignored(event, name, rules))
+        update("OFB605", event.kind, event.t, event.where, self._global_accel(event))
+
+    # -- OFB601 -------------------------------------------------------------------------
+
+    def _frame(
+        self,
+        event: PositionTarget,
+        name: str,
+        rules: tm.PositionTargetRules,
+        usable: tm.Combo,
+    ) -> dict[str, Offence]:
+        frame = event.coordinate_frame
+        docs = rules.frames_for(usable)
+        receiver = tm.RECEIVER_FRAMES[event.kind]
+        px4 = self.ctx.profile.px4
+        what = f"{name} with coordinate_frame {tm.frame_name(frame)} ({frame})"
+        if frame in docs:
+            if frame in receiver:
+                return {}
+            return {
+                f"frame:{frame}": Offence(
+                    f"{what}: listed by the PX4 {px4} docs, but PX4's receiver accepts only "
+                    f"{frames_text(receiver)} and drops the message (no setpoint, no keep-alive)"
+                )
+            }
+        for_what = f"a {tm.describe_combo(usable)} setpoint" if usable in rules.combos else name
+        docs_text = (
+            f"the PX4 {px4} docs support only {frames_text(docs)} for {for_what} on a "
+            f"{self.vehicle_label}"
+        )
+        # In BODY_NED the receiver always drops the position (gate spec 6.2).
+        body_position = event.kind == tm.LOCAL and frame == 8 and "position" in usable
+        if frame in receiver and not body_position:
+            return {
+                f"frame:{frame}": Offence(
+                    f"{what}: {docs_text}; PX4's receiver accepts it nevertheless",
+                    Severity.WARNING,
+                )
+            }
+        consequence = (
+            "PX4 ignores the position in this frame"
+            if body_position and frame in receiver
+            else "PX4 drops the message (no setpoint, no keep-alive)"
+        )
+        return {f"frame:{frame}": Offence(f"{what}: {docs_text}; {consequence}")}
+
+    # -- OFB602 -------------------------------------------------------------------------
+
+    def _combo(
+        self, event: PositionTarget, name: str, rules: tm.PositionTargetRules
+    ) -> dict[str, Offence]:
+        mask = event.type_mask
+        selected = tm.selected_groups(mask)
+        head = f"{name} type_mask {mask}"
+        if not selected:
+            return {
+                "empty": Offence(
+                    f"{head} selects no position, velocity or acceleration: PX4 drops it "
+                    "(no setpoint, no keep-alive)"
+                )
+            }
+        if mask & tm.FORCE_BIT and "acceleration" in selected:
+            return {
+                "force": Offence(
+                    f"{head} sets the FORCE bit: force setpoints are not supported and PX4 "
+                    "drops the message (no setpoint, no keep-alive)"
+                )
+            }
+        usable = selected - rules.ignored
+        if not usable or usable in rules.combos:
+            return {}
+        supported = "; ".join(tm.describe_combo(c) for c in rules.combos)
+        return {
+            f"combo:{tm.describe_combo(usable)}": Offence(
+                f"{head} selects {tm.describe_combo(usable)}, not a combination the PX4 "
+                f"{self.ctx.profile.px4} docs support on a {self.vehicle_label} (supported: "
+                f"{supported}); PX4's receiver passes it on and the controllers decide per axis",
+                Severity.WARNING,
+            )
+        }
+
+    # -- OFB603 -------------------------------------------------------------------------
+
+    def _setpoint_type(self, event: PositionTarget, name: str) -> dict[str, Offence]:
+        if self.group != "fixedwing" or "position" not in tm.selected_groups(event.type_mask):
+            return {}
+        if tm.setpoint_type(event.type_mask, event.kind) is not None:
+            return {}
+        values = tm.FIXEDWING_TYPES_LOCAL if event.kind == tm.LOCAL else tm.FIXEDWING_TYPES_GLOBAL
+        listed = ", ".join(f"{v} {n}" for v, n in values.items())
+        message = (
+            f"fixed-wing {name} position setpoint with type_mask {event.type_mask} carries no "
+            f"setpoint-type value ({listed}): the docs say the vehicle then flies a "
+            "flower-like pattern"
+        )
+        if at_least(self.ctx.profile.px4, "1.13"):
+            message += (
+                f"; PX4 {self.ctx.profile.px4}'s receiver does not read these bits at all "
+                "(v1.12+), so the value changes nothing there"
+            )
+            return {"type": Offence(message, Severity.WARNING)}
+        return {"type": Offence(message)}
+
+    # -- OFB604 -------------------------------------------------------------------------
+
+    def _fw_ignored(
+        self, event: PositionTarget, name: str, rules: tm.PositionTargetRules
+    ) -> dict[str, Offence]:
+        if self.group != "fixedwing":
+            return {}
+        fields = [
+            c
+            for group in ("velocity", "acceleration")
+            if group in rules.ignored
+            for c in set_components(event, group)
+        ]
+        if not fields:
+            return {}
+        return {
+            "ignored": Offence(
+                f"fixed-wing {name} sets {', '.join(fields)}: the docs say fixed-wing uses the "
+                "position only and ignores velocity and acceleration"
+            )
+        }
+
+    # -- OFB605 -------------------------------------------------------------------------
+
+    def _global_accel(self, event: PositionTarget) -> dict[str, Offence]:
+        if event.kind != tm.GLOBAL or self.group != "copter":
+            return {}
+        if "acceleration" not in tm.selected_groups(event.type_mask):
+            return {}
+        return {
+            "accel": Offence(
+                f"SET_POSITION_TARGET_GLOBAL_INT type_mask {event.type_mask} uses afx/afy/afz: "
+                "the docs say PX4 maps them to a normalised thrust, not an acceleration"
+            )
+        }
+
+    def finish(self, t_end: float) -> None:
+        self.episodes.finish()

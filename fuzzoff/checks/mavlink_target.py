@@ -1,0 +1,169 @@
+"""OFB606 (SET_ATTITUDE_TARGET type_mask) and OFB607 (setpoints addressed to another vehicle).
+
+OFB606 follows seed 000 "MAVLink Offboard Control" / seed 002 "MAVLink 消息": attitude or body
+rates, each with thrust. OFB607 follows PX4's receiver (gate spec 6.1): a setpoint whose
+``target_system`` is neither the vehicle's system id nor 0, or whose ``target_component`` is
+neither its component id nor 0, is dropped, keep-alive included. The vehicle's ids are what the
+recording shows: the system id its own messages come from (HEARTBEAT and the rest), or the
+``MAV_SYS_ID`` / ``MAV_COMP_ID`` parameters; the component is PX4's autopilot (1) otherwise.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from fuzzoff.checks._episodes import Episodes, Offence
+from fuzzoff.checks.base import Check, CheckContext
+from fuzzoff.events import Event, MavlinkTarget, SetAttitudeTarget, Where
+from fuzzoff.tables import mavlink as tm
+
+AUTOPILOT_COMPONENT = 1
+
+
+class AttitudeTargetMask(Check):
+    codes = ("OFB606",)
+    wants = (SetAttitudeTarget,)
+
+    def __init__(self, ctx: CheckContext) -> None:
+        super().__init__(ctx)
+        self.episodes = Episodes(ctx)
+
+    def on_event(self, event: Event) -> None:
+        if event.origin != "sent" or not isinstance(event, SetAttitudeTarget):
+            return
+        rules = tm.attitude_rules(self.ctx.profile)
+        if rules is None or not rules.supported:
+            return  # no page for this profile, or a rover (OFB507)
+        mask = event.type_mask
+        offences: dict[str, Offence] = {}
+        head = f"SET_ATTITUDE_TARGET type_mask {mask}"
+        if not tm.attitude_used(mask) and not tm.rates_used(mask):
+            offences["neither"] = Offence(
+                f"{head} ignores both the attitude and the body rates (roll and pitch rate): "
+                "PX4 publishes nothing for it (no setpoint, no keep-alive)"
+            )
+        if not tm.thrust_used(mask):
+            if self.ctx.profile.at_least("main"):
+                effect = "PX4 main ignores such a message entirely (no setpoint, no keep-alive)"
+            else:
+                effect = (
+                    f"PX4 {self.ctx.profile.px4} accepts it and flies a thrust of 0 with an "
+                    "attitude setpoint"
+                )
+            offences["thrust"] = Offence(
+                f"{head} ignores the thrust: the docs support attitude or body rates only "
+                f"together with thrust; {effect}"
+            )
+        self.episodes.update("OFB606", event.kind, event.t, event.where, offences)
+
+    def finish(self, t_end: float) -> None:
+        self.episodes.finish()
+
+
+@dataclass(slots=True)
+class _Pending:
+    """Setpoints to one target seen before the vehicle's own id was known."""
+
+    t: float
+    where: Where
+    last_t: float
+    count: int = 1
+
+
+class SetpointTarget(Check):
+    codes = ("OFB607",)
+    wants = (Event,)
+
+    def __init__(self, ctx: CheckContext) -> None:
+        super().__init__(ctx)
+        self.episodes = Episodes(ctx)
+        self.autopilot_seen = False
+        self.pending: dict[tuple[int, int], _Pending] = {}
+
+    def _own_ids(self) -> tuple[int, int] | None:
+        params = self.ctx.state.params
+        sysid: int | None = None
+        if "MAV_SYS_ID" in params:
+            sysid = int(params["MAV_SYS_ID"])
+        elif self.autopilot_seen and self.ctx.vehicle.isdigit():
+            sysid = int(self.ctx.vehicle)
+        if sysid is None:
+            return None
+        return sysid, int(params.get("MAV_COMP_ID", AUTOPILOT_COMPONENT))
+
+    def on_event(self, event: Event) -> None:
+        if event.origin == "vehicle":
+            self.autopilot_seen = self.autopilot_seen or event.vehicle.isdigit()
+            if self.pending and self._own_ids() is not None:
+                self._resolve_pending()
+            return
+        if event.origin != "sent" or not isinstance(event, MavlinkTarget):
+            return
+        if event.transport != "mavlink":
+            return  # MAVROS fills the ids from its own parameters: not in the recording
+        if self._own_ids() is None:
+            target = (event.target_system, event.target_component)
+            pending = self.pending.get(target)
+            if pending is None:
+                self.pending[target] = _Pending(event.t, event.where, event.t)
+            else:
+                pending.last_t = event.t
+                pending.count += 1
+            return
+        self.episodes.update("OFB607", "setpoints", event.t, event.where, self._judge(event))
+
+    def _judge(self, event: MavlinkTarget) -> dict[str, Offence]:
+        offence = self._offence(event.target_system, event.target_component)
+        return {} if offence is None else {offence[0]: offence[1]}
+
+    def _offence(self, system: int, component: int) -> tuple[str, Offence] | None:
+        ids = self._own_ids()
+        assert ids is not None
+        own_sys, own_comp = ids
+        wrong = []
+        if system not in (0, own_sys):
+            wrong.append(f"target_system {system} (the vehicle is system {own_sys})")
+        if component not in (0, own_comp):
+            wrong.append(f"target_component {component} (the autopilot is component {own_comp})")
+        if not wrong:
+            return None
+        return (
+            f"{system}/{component}",
+            Offence(
+                f"setpoint addressed to {' and '.join(wrong)}: PX4 drops it silently, so it is "
+                "neither a setpoint nor a keep-alive"
+            ),
+        )
+
+    def _resolve_pending(self) -> None:
+        pending, self.pending = self.pending, {}
+        for (system, component), seen in sorted(pending.items(), key=lambda kv: kv[1].t):
+            offence = self._offence(system, component)
+            if offence is not None:
+                span = (seen.t, seen.where, seen.last_t, seen.count)
+                self.episodes.start("OFB607", "setpoints", offence[0], offence[1], span)
+
+    def finish(self, t_end: float) -> None:
+        self.episodes.finish()
+        if not self.pending:
+            return
+        others = [v for v in self.ctx.info.vehicles if v.isdigit() and v != self.ctx.vehicle]
+        if others and not self.autopilot_seen:
+            for (system, component), seen in sorted(self.pending.items(), key=lambda kv: kv[1].t):
+                if system == 0:
+                    continue  # broadcast: whichever vehicle that is takes it
+                self.ctx.report(
+                    "OFB607",
+                    f"setpoints addressed to system {system} component {component}, but the "
+                    f"recording shows no vehicle with that id (vehicles: {', '.join(others)}): "
+                    "PX4 drops them silently",
+                    seen.t,
+                    seen.where,
+                    end=seen.last_t if seen.count > 1 else None,
+                )
+            return
+        self.ctx.cannot_check(
+            "OFB607",
+            "needs the vehicle's own MAVLink messages (its HEARTBEAT) or the MAV_SYS_ID "
+            "parameter, to know the system id the setpoints must address",
+        )
