@@ -21,7 +21,7 @@ import numpy as np
 
 from fuzzoff import events as ev
 from fuzzoff.profiles import MAV_TYPE_VEHICLE, PX4_VEHICLE_TYPE, ProfileError, px4_profile_for
-from fuzzoff.sources.base import RecordingInfo, Source
+from fuzzoff.sources.base import RecordingInfo, Source, SourceError
 from fuzzoff.sources.ulog_load import Loaded, load
 from fuzzoff.sources.ulog_topics import (
     EXTRA_TOPICS,
@@ -114,11 +114,17 @@ class UlogSource(Source):
     def __init__(self, path: Path) -> None:
         super().__init__(path)
         self._loaded: Loaded | None = None
+        self._header_info: RecordingInfo | None = None
+        self._failed: SourceError | None = None
         self._info: RecordingInfo | None = None
         self._yielded = 0
         self._total = 0
 
     # -- loading ---------------------------------------------------------------------------
+
+    def open(self) -> None:
+        """Read the definition section: a file that is not a ULog fails here, at once."""
+        self._header_info = self.probe_header()
 
     def probe_header(self) -> RecordingInfo:
         """Version, parameters and vehicle type from the definition section only (instant)."""
@@ -128,8 +134,14 @@ class UlogSource(Source):
         return info
 
     def _load(self) -> Loaded:
+        if self._failed is not None:
+            raise self._failed
         if self._loaded is None:
-            self._loaded = load(self.path, LOADED_TOPICS)
+            try:
+                self._loaded = load(self.path, LOADED_TOPICS)
+            except SourceError as exc:
+                self._failed = exc
+                raise
             self.problems.extend(self._loaded.problems)
             if self._loaded.library_output:
                 self.stats["pyulog_messages"] = self._loaded.library_output[:20]
@@ -141,11 +153,10 @@ class UlogSource(Source):
     # -- probe -----------------------------------------------------------------------------
 
     def probe(self) -> RecordingInfo:
-        """Header first (cheap: fails fast on a foreign file), then the filtered data load,
-        which the kinds present and the logging intervals need (ULog has no index)."""
+        """The filtered data load (``open`` has read the header): the kinds present and the
+        logging intervals need the data, as a ULog has no index. Kept for ``events``."""
         if self._info is not None:
             return self._info
-        self.probe_header()
         ulog = self._load().ulog
         info = RecordingInfo(str(self.path), self.format, vehicles=[""])
         datasets = self._datasets()
@@ -206,6 +217,8 @@ class UlogSource(Source):
     # -- events ----------------------------------------------------------------------------
 
     def events(self) -> Iterator[ev.Event]:
+        if self._failed is not None:
+            return  # already reported by probe()
         info = self.probe()
         ulog = self._load().ulog
         t0 = int(ulog.start_timestamp)

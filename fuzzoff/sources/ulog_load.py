@@ -66,6 +66,7 @@ class _TrackedULog(ULog):  # type: ignore[misc]
         self._section = "definitions"
         self._corruption: _Corruption | None = None
         self.missing_formats: list[str] = []
+        self.missing_format_offset: int | None = None
         self._MessageHeader = self._new_header
         self._MessageAddLogged = self._add_logged
         super().__init__(
@@ -99,6 +100,9 @@ class _TrackedULog(ULog):  # type: ignore[misc]
             return ULog._MessageAddLogged(data, header, formats)
         except KeyError:
             name = ULog.parse_string(data[3:])
+            if self.missing_format_offset is None and self._headers:
+                header = self._headers[-1][1]
+                self.missing_format_offset = header.end - 3 - header.msg_size
             if name not in self.missing_formats:
                 self.missing_formats.append(name)
             raise
@@ -173,49 +177,49 @@ def _reason(exc: Exception) -> str:
 def _problems(
     ulog: _TrackedULog, size: int, header_only: bool, to_s: Callable[[int], float]
 ) -> list[SourceProblem]:
-    problems: list[SourceProblem] = []
+    """At most one problem: the first thing that went wrong (later damage follows from it)."""
+    definitions = ulog.last_header("definitions")
+    if definitions is not None and (definitions.partial or definitions.end > size):
+        return [SourceProblem("truncated in the definition section", f"byte {size}")]
+    corruption = ulog.corruption
+    if corruption is not None and corruption.section == "definitions":
+        what = "broken definition section (formats, info or parameters unreadable)"
+        return [SourceProblem(what, f"byte {corruption.offset}")]
     if ulog.missing_formats:
         names = ", ".join(ulog.missing_formats[:3])
         more = f" and {len(ulog.missing_formats) - 3} more" if len(ulog.missing_formats) > 3 else ""
-        problems.append(
-            SourceProblem(
-                f"broken definition section: no message format for topic {names}{more}, "
-                "so its data cannot be decoded",
-                "the definition section",
-            )
+        what = (
+            f"broken definition section: no message format for topic {names}{more} "
+            "(its data cannot be decoded)"
         )
-    corruption = ulog.corruption
-    definitions = ulog.last_header("definitions")
-    if definitions is not None and (definitions.partial or definitions.end > size):
-        problems.append(SourceProblem("truncated in the definition section", f"byte {size}"))
-        return problems
-    if corruption is not None and corruption.section == "definitions":
-        problems.append(
-            SourceProblem(
-                "broken definition section (formats, info or parameters unreadable)",
-                f"byte {corruption.offset}",
-            )
-        )
-    elif corruption is not None and not ulog.missing_formats:
+        where = f"byte {ulog.missing_format_offset} (the topic's subscription record)"
+        return [SourceProblem(what, where)]
+    if corruption is not None:
         t = to_s(corruption.last_timestamp) if corruption.last_timestamp else None
         after = f", after the last good message at {t:.3f} s" if t is not None else ""
-        problems.append(
-            SourceProblem(
-                "corrupt data: damaged records were skipped and reading resumed after them",
-                f"byte {corruption.offset}{after}",
-                time_s=t,
-            )
-        )
-    if header_only or corruption is not None:
-        return problems
+        what = "corrupt data: damaged records were skipped and reading resumed after them"
+        return [SourceProblem(what, f"byte {corruption.offset}{after}", time_s=t)]
     data = ulog.last_header("data")
-    if data is not None and (data.partial or data.end > size):
-        good_end = data.end if data.partial else data.end - 3 - data.msg_size
-        last = ulog.last_timestamp
-        t = to_s(last) if last else None
-        after = f" (last complete message ends at byte {good_end}"
-        after += f", time {t:.3f} s)" if t is not None else ")"
-        problems.append(
-            SourceProblem("truncated in the middle of a message", f"byte {size}{after}", time_s=t)
+    if header_only or data is None or not (data.partial or data.end > size):
+        return []
+    good_end = data.end if data.partial else data.end - 3 - data.msg_size
+    last = ulog.last_timestamp
+    t = to_s(last) if last else None
+    after = f" (the last complete message is at {t:.3f} s)" if t is not None else ""
+    if not data.partial and _implausible(data):
+        what = (
+            f"corrupt record header: it declares {data.msg_size} bytes of type "
+            f"{data.msg_type}, more than the rest of the file; nothing after it was read"
         )
-    return problems
+    else:
+        what = f"truncated in the middle of a message ({size - good_end} bytes left over)"
+    return [SourceProblem(what, f"byte {good_end}{after}", time_s=t)]
+
+
+_RECORD_TYPES = frozenset(b"FDIMPQARSOLCB")
+"""ULog record types pyulog knows (formats.md 8)."""
+
+
+def _implausible(header: _Header) -> bool:
+    """A record header no logger writes: unknown type or a size beyond pyulog's own limit."""
+    return header.msg_type not in _RECORD_TYPES or header.msg_size > 10000

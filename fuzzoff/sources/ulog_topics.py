@@ -64,7 +64,9 @@ class Chunk:
         self.sel = sel
         ts = cols["timestamp"][sel]
         self.ts: list[int] = ts.tolist()
-        self.t: list[float] = np.maximum((ts.astype(np.float64) - t0) / 1e6, 0.0).tolist()
+        with np.errstate(all="ignore"):
+            seconds = np.maximum((ts.astype(np.float64) - t0) / 1e6, 0.0)
+        self.t: list[float] = seconds.tolist()
         index = np.arange(len(cols["timestamp"]))[sel].tolist()
         self.index: list[int] = index
         self.where = [ev.Where(topic, i) for i in index]
@@ -77,7 +79,8 @@ class Chunk:
         """Float column; NaN where the layout has no such field."""
         if name not in self.cols:
             return [math.nan] * self.n
-        values: list[float] = self.cols[name][self.sel].astype(np.float64).tolist()
+        with np.errstate(all="ignore"):  # a damaged log may hold any bit pattern
+            values: list[float] = self.cols[name][self.sel].astype(np.float64).tolist()
         return values
 
     def i(self, name: str, default: int = 0) -> list[int]:
