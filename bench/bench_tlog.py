@@ -42,6 +42,16 @@ while log.recv_match(type=types, blocking=False) is not None:
 print(n)
 """
 
+READER = """
+import sys
+from pathlib import Path
+from fuzzoff.sources.tlog import TlogSource
+source = TlogSource(Path(sys.argv[1]))
+with source:
+    source.probe()
+    print(sum(1 for _ in source.events()))
+"""
+
 
 @dataclass
 class Run:
@@ -85,6 +95,10 @@ def bare(path: Path, types: str | None = None) -> Run:
     return measure([sys.executable, "-c", BARE, str(path), *([types] if types else [])])
 
 
+def reader(path: Path) -> Run:
+    return measure([sys.executable, "-c", READER, str(path)])
+
+
 def _row(name: str, what: str, messages: int, run: Run) -> None:
     rate = messages / run.wall_s if run.wall_s else 0.0
     print(f"{name:<12} {what:<26} {run.wall_s:8.2f} s {rate:11,.0f} msg/s {run.rss_mb:8.1f} MB")
@@ -102,6 +116,7 @@ def main() -> None:
         runs = {
             "pymavlink, every message": bare(path),
             "pymavlink, type filter": bare(path, WANTED_TYPES),
+            "fuzzoff tlog reader alone": reader(path),
             "fuzzoff lint": lint([path]),
         }
         results[name] = runs
@@ -110,9 +125,9 @@ def main() -> None:
             _row(name, what, messages, run)
         print(f"{'':<12} ({messages:,} messages, {size_mb:.1f} MB)")
 
-    def ratio(name: str) -> float:
+    def ratio(name: str, what: str = "fuzzoff lint") -> float:
         runs = results[name]
-        return runs["fuzzoff lint"].wall_s / runs["pymavlink, every message"].wall_s
+        return runs[what].wall_s / runs["pymavlink, every message"].wall_s
 
     print()
     print("target                                             measured   ok")
@@ -121,6 +136,9 @@ def main() -> None:
         print(f"lint / bare library ({name:<4}) <= 1.3x                  {r:7.2f}x   {r <= 1.3}")
     r = ratio("mixed-500k")
     print(f"lint / bare library (offboard < 10 %) < 1.0x          {r:7.2f}x   {r < 1.0}")
+    for name in files:
+        r = ratio(name, "fuzzoff tlog reader alone")
+        print(f"  (reader alone, no checks, {name}: {r:.2f}x the bare library)")
     rss_small = results["100k"]["fuzzoff lint"].rss_mb
     rss_big = results["1M"]["fuzzoff lint"].rss_mb
     growth = rss_big / rss_small

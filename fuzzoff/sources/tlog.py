@@ -10,7 +10,7 @@ is the autopilot's sysid as text. Setpoints and commands belong to the vehicle t
 from __future__ import annotations
 
 import struct
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import Any, BinaryIO
 
@@ -286,7 +286,7 @@ class _Decoder:
         self.index: dict[int, int] = {}
         self.mav_type: dict[int, int] = {}
         self.ignored: dict[str, int] = {}
-        self.handlers: dict[int, Callable[[Any, float, Where], Iterator[Event]]] = {
+        self.handlers: dict[int, Callable[[Any, float, Where], Iterable[Event]]] = {
             SET_POSITION_TARGET_LOCAL_NED: self._local,
             SET_POSITION_TARGET_GLOBAL_INT: self._global,
             SET_ATTITUDE_TARGET: self._attitude,
@@ -300,15 +300,15 @@ class _Decoder:
             STATUSTEXT: self._statustext,
         }
 
-    def decode(self, msgid: int, msg: Any, t: float, offset: int) -> Iterator[Event]:
+    def decode(self, msgid: int, msg: Any, t: float, offset: int) -> Iterable[Event]:
         i = self.index.get(msgid, 0)
         self.index[msgid] = i + 1
         return self.handlers[msgid](msg, t, Where(msg.get_type(), i, offset))
 
-    def _ignore(self, msg: Any, why: str) -> Iterator[Event]:
+    def _ignore(self, msg: Any, why: str) -> Iterable[Event]:
         key = f"{msg.get_type()} {why}"
         self.ignored[key] = self.ignored.get(key, 0) + 1
-        return iter(())
+        return ()
 
     def _from_autopilot(self, msg: Any) -> bool:
         compid = msg.get_srcComponent()
@@ -321,10 +321,10 @@ class _Decoder:
 
     # -- sent to the vehicle --------------------------------------------------------------
 
-    def _local(self, m: Any, t: float, where: Where) -> Iterator[Event]:
+    def _local(self, m: Any, t: float, where: Where) -> Iterable[Event]:
         if self._from_autopilot(m):
             return self._ignore(m, "from the autopilot")
-        return (
+        return [
             SetPositionTargetLocal(
                 t=t,
                 vehicle=v,
@@ -343,12 +343,12 @@ class _Decoder:
                 yaw_rate=m.yaw_rate,
             )
             for v in self._targets(m.target_system)
-        )
+        ]
 
-    def _global(self, m: Any, t: float, where: Where) -> Iterator[Event]:
+    def _global(self, m: Any, t: float, where: Where) -> Iterable[Event]:
         if self._from_autopilot(m):
             return self._ignore(m, "from the autopilot")
-        return (
+        return [
             SetPositionTargetGlobal(
                 t=t,
                 vehicle=v,
@@ -369,13 +369,13 @@ class _Decoder:
                 yaw_rate=m.yaw_rate,
             )
             for v in self._targets(m.target_system)
-        )
+        ]
 
-    def _attitude(self, m: Any, t: float, where: Where) -> Iterator[Event]:
+    def _attitude(self, m: Any, t: float, where: Where) -> Iterable[Event]:
         if self._from_autopilot(m):
             return self._ignore(m, "from the autopilot")
         thrust_body = getattr(m, "thrust_body", None)  # not in pymavlink 2.4.50's common
-        return (
+        return [
             SetAttitudeTarget(
                 t=t,
                 vehicle=v,
@@ -394,7 +394,7 @@ class _Decoder:
                 thrust_body=tuple(thrust_body) if thrust_body and any(thrust_body) else None,
             )
             for v in self._targets(m.target_system)
-        )
+        ]
 
     def _command(
         self,
@@ -404,10 +404,10 @@ class _Decoder:
         command: int,
         params: tuple[float, float, float, float, float, float, float],
         target_component: int,
-    ) -> Iterator[Event]:
+    ) -> Iterable[Event]:
         if self._from_autopilot(m):
             return self._ignore(m, "from the autopilot")
-        return (
+        return [
             Command(
                 t=t,
                 vehicle=v,
@@ -421,17 +421,17 @@ class _Decoder:
                 from_external=True,
             )
             for v in self._targets(m.target_system)
-        )
+        ]
 
-    def _command_long(self, m: Any, t: float, where: Where) -> Iterator[Event]:
+    def _command_long(self, m: Any, t: float, where: Where) -> Iterable[Event]:
         params = (m.param1, m.param2, m.param3, m.param4, m.param5, m.param6, m.param7)
         return self._command(m, t, where, m.command, params, m.target_component)
 
-    def _command_int(self, m: Any, t: float, where: Where) -> Iterator[Event]:
+    def _command_int(self, m: Any, t: float, where: Where) -> Iterable[Event]:
         params = (m.param1, m.param2, m.param3, m.param4, float(m.x), float(m.y), m.z)
         return self._command(m, t, where, m.command, params, m.target_component)
 
-    def _set_mode(self, m: Any, t: float, where: Where) -> Iterator[Event]:
+    def _set_mode(self, m: Any, t: float, where: Where) -> Iterable[Event]:
         """SET_MODE (#11, MAVROS set_mode) -> DO_SET_MODE as PX4 handles it."""
         main, sub = split_custom_mode(m.custom_mode)
         params = (float(m.base_mode), float(main), float(sub), 0.0, 0.0, 0.0, 0.0)
@@ -439,7 +439,7 @@ class _Decoder:
 
     # -- from the vehicle -----------------------------------------------------------------
 
-    def _heartbeat(self, m: Any, t: float, where: Where) -> Iterator[Event]:
+    def _heartbeat(self, m: Any, t: float, where: Where) -> Iterable[Event]:
         if not self._from_autopilot(m):
             return self._ignore(m, "not from an autopilot")
         sysid = m.get_srcSystem()
@@ -469,9 +469,9 @@ class _Decoder:
                 armed=bool(m.base_mode & MAV_MODE_FLAG_SAFETY_ARMED),
             )
         )
-        return iter(out)
+        return out
 
-    def _ack(self, m: Any, t: float, where: Where) -> Iterator[Event]:
+    def _ack(self, m: Any, t: float, where: Where) -> Iterable[Event]:
         if not self._from_autopilot(m):
             return self._ignore(m, "not from an autopilot")
         ack = CommandAck(
@@ -483,9 +483,9 @@ class _Decoder:
             target_system=m.target_system,
             target_component=m.target_component,
         )
-        return iter((ack,))
+        return (ack,)
 
-    def _param(self, m: Any, t: float, where: Where) -> Iterator[Event]:
+    def _param(self, m: Any, t: float, where: Where) -> Iterable[Event]:
         if not self._from_autopilot(m):
             return self._ignore(m, "not from an autopilot")
         param = Parameter(
@@ -495,9 +495,9 @@ class _Decoder:
             name=_text(m.param_id),
             value=param_value(m.param_value, m.param_type),
         )
-        return iter((param,))
+        return (param,)
 
-    def _version(self, m: Any, t: float, where: Where) -> Iterator[Event]:
+    def _version(self, m: Any, t: float, where: Where) -> Iterable[Event]:
         if not self._from_autopilot(m):
             return self._ignore(m, "not from an autopilot")
         info = VehicleInfo(
@@ -506,9 +506,9 @@ class _Decoder:
             where=where,
             px4_version=decode_px4_version(m.flight_sw_version),
         )
-        return iter((info,))
+        return (info,)
 
-    def _statustext(self, m: Any, t: float, where: Where) -> Iterator[Event]:
+    def _statustext(self, m: Any, t: float, where: Where) -> Iterable[Event]:
         if not self._from_autopilot(m):
             return self._ignore(m, "not from an autopilot")
         text = StatusText(
@@ -518,4 +518,4 @@ class _Decoder:
             severity=m.severity,
             text=_text(m.text),
         )
-        return iter((text,))
+        return (text,)
