@@ -1,0 +1,178 @@
+"""``--format sarif``: SARIF 2.1.0 for code-scanning services (GitHub, Azure DevOps, ...).
+
+Every catalog rule is in ``tool.driver.rules`` with its page as help text and ``Rule.url`` as
+``helpUri``. A recording is binary, so a result points at the file without a text region; the
+time, vehicle and topic go into the message and the result's properties, and
+``partialFingerprints`` is computed here from rule, vehicle, topic and time window (GitHub cannot
+fingerprint a binary file itself). Paths under the working folder are written relative to the
+``SRCROOT`` base, which is what code scanning matches against the repository.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from collections import Counter
+from pathlib import Path
+from typing import Any
+from urllib.parse import quote
+
+from fuzzoff import __version__
+from fuzzoff.catalog import Rule, load_catalog, render_page
+from fuzzoff.config import Settings
+from fuzzoff.findings import Finding, Report, Severity
+
+SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
+INFORMATION_URI = "https://fuzzoff.dev"
+FINGERPRINT_KEY = "fuzzoffFinding/v1"
+LEVEL = {Severity.ERROR: "error", Severity.WARNING: "warning", Severity.INFO: "note"}
+BASE_ID = "SRCROOT"
+
+
+def _first_sentence(text: str) -> str:
+    flat = " ".join(text.split())
+    head, dot, _ = flat.partition(". ")
+    return head + "." if dot else flat
+
+
+def rule_descriptor(rule: Rule) -> dict[str, Any]:
+    page = render_page(rule)
+    return {
+        "id": rule.code,
+        "name": "".join(part.capitalize() for part in rule.name.split("-")),
+        "shortDescription": {"text": _first_sentence(rule.summary)},
+        "fullDescription": {"text": " ".join(rule.summary.split())},
+        "help": {"text": page, "markdown": page},
+        "helpUri": rule.url,
+        "defaultConfiguration": {"level": LEVEL[rule.severity]},
+        "properties": {
+            "tags": ["px4", "offboard", *(["heuristic"] if rule.heuristic else [])],
+            "precision": "medium" if rule.heuristic else "high",
+            "profiles": rule.profiles_text(),
+        },
+    }
+
+
+def artifact_uri(path: str, root: Path) -> tuple[str, str | None]:
+    """A relative URI under ``root`` (with its base id) where possible, else an absolute one."""
+    resolved = Path(path).resolve()
+    try:
+        relative = resolved.relative_to(root)
+    except ValueError:
+        return resolved.as_uri(), None
+    return quote(relative.as_posix()), BASE_ID
+
+
+def fingerprint(finding: Finding) -> str:
+    """Stable over re-runs of the same recording: rule, vehicle, topic, time window (10 ms)."""
+    topic = finding.where.topic if finding.where is not None else ""
+    start = "file" if finding.time_s is None else f"{finding.time_s:.2f}"
+    end = "" if finding.end_s is None else f"{finding.end_s:.2f}"
+    key = "\0".join((finding.code, finding.vehicle, topic, start, end))
+    return hashlib.sha256(key.encode()).hexdigest()[:32]
+
+
+def message_text(finding: Finding) -> str:
+    where = []
+    if finding.time_s is not None:
+        when = f"at {finding.time_s:.3f} s"
+        if finding.end_s is not None:
+            when += f" to {finding.end_s:.3f} s"
+        where.append(when)
+    if finding.vehicle:
+        where.append(f"vehicle {finding.vehicle!r}")
+    if finding.where is not None and finding.where.topic:
+        where.append(f"on {finding.where}")
+    suffix = f" ({', '.join(where)})" if where else " (whole recording)"
+    return finding.message + suffix
+
+
+def region(finding: Finding) -> dict[str, int]:
+    """The byte offset where the reader knows it; ``startLine`` 1 because GitHub reads no bytes.
+
+    GitHub code scanning places results by line and does not read ``byteOffset``, so a binary
+    recording gets line 1 beside the SARIF binary form.
+    """
+    offset = finding.where.offset if finding.where is not None else None
+    return {"startLine": 1, "byteOffset": offset or 0}
+
+
+def result(
+    finding: Finding, rule_index: int, artifact: dict[str, Any], occurrence: int
+) -> dict[str, Any]:
+    props: dict[str, Any] = {"vehicle": finding.vehicle}
+    if finding.time_s is not None:
+        props["time_s"] = round(finding.time_s, 6)
+    if finding.end_s is not None:
+        props["end_s"] = round(finding.end_s, 6)
+    if finding.where is not None and finding.where.topic:
+        props["topic"] = finding.where.topic
+        if finding.where.index is not None:
+            props["index"] = finding.where.index
+        if finding.where.offset is not None:
+            props["byte_offset"] = finding.where.offset
+    mark = fingerprint(finding) + (f":{occurrence}" if occurrence else "")
+    return {
+        "ruleId": finding.code,
+        "ruleIndex": rule_index,
+        "level": LEVEL[finding.severity],
+        "message": {"text": message_text(finding)},
+        "locations": [
+            {"physicalLocation": {"artifactLocation": artifact, "region": region(finding)}}
+        ],
+        "partialFingerprints": {FINGERPRINT_KEY: mark},
+        "properties": props,
+    }
+
+
+def sarif_log(report: Report, settings: Settings, root: Path | None = None) -> dict[str, Any]:
+    root = (root or Path.cwd()).resolve()
+    catalog = load_catalog()
+    index = {code: i for i, code in enumerate(catalog)}
+    artifacts: list[dict[str, Any]] = []
+    results: list[dict[str, Any]] = []
+    notifications: list[dict[str, Any]] = []
+    for file in report.files:
+        uri, base = artifact_uri(file.path, root)
+        location: dict[str, Any] = {"uri": uri, **({"uriBaseId": base} if base else {})}
+        artifacts.append({"location": location, "properties": {"format": file.format}})
+        ref = {**location, "index": len(artifacts) - 1}
+        seen: Counter[str] = Counter()
+        for finding in file.findings:
+            key = fingerprint(finding)
+            results.append(result(finding, index[finding.code], ref, seen[key]))
+            seen[key] += 1
+        notifications.extend(
+            {
+                "level": "error",
+                "message": {"text": line},
+                "locations": [{"physicalLocation": {"artifactLocation": ref}}],
+            }
+            for line in file.problems
+        )
+    run: dict[str, Any] = {
+        "tool": {
+            "driver": {
+                "name": "fuzzoff",
+                "version": __version__,
+                "semanticVersion": __version__,
+                "informationUri": INFORMATION_URI,
+                "rules": [rule_descriptor(rule) for rule in catalog.values()],
+            }
+        },
+        "invocations": [
+            {
+                "executionSuccessful": True,
+                "toolExecutionNotifications": notifications,
+                "properties": {"fail_on": settings.fail_on.label, "complete": report.complete},
+            }
+        ],
+        "originalUriBaseIds": {BASE_ID: {"uri": root.as_uri() + "/"}},
+        "artifacts": artifacts,
+        "results": results,
+    }
+    return {"$schema": SCHEMA, "version": "2.1.0", "runs": [run]}
+
+
+def render(report: Report, settings: Settings) -> str:
+    return json.dumps(sarif_log(report, settings), indent=2, ensure_ascii=False) + "\n"

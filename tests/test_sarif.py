@@ -1,0 +1,151 @@
+"""SARIF 2.1.0 output: validated by Microsoft's SARIF Multitool, and the fields CI services read."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from fuzzoff.catalog import load_catalog
+from fuzzoff.config import Settings
+from fuzzoff.events import SetPositionTargetLocal, Where
+from fuzzoff.findings import Finding, Report, Severity
+from fuzzoff.report.sarif import fingerprint, sarif_log
+from fuzzoff.writers.tlog import write_tlog
+from tests.helpers import ROOT, run_cli
+from tests.report_fixtures import hostile_report
+
+MULTITOOL = ROOT / "build" / "node" / "node_modules" / ".bin" / "sarif-multitool"
+
+
+def multitool() -> Path:
+    found = Path(os.environ.get("SARIF_MULTITOOL", MULTITOOL))
+    if not found.exists():
+        reason = (
+            f"SARIF Multitool not found at {found} "
+            "(`make test` installs it: npm install @microsoft/sarif-multitool into build/node)"
+        )
+        if os.environ.get("CI"):
+            pytest.fail(reason)
+        pytest.skip(reason)
+    return found
+
+
+def gap_recording(path: Path) -> Path:
+    events = [
+        SetPositionTargetLocal(t=i * 0.05, target_system=1, target_component=1)
+        for i in range(60)
+        if not 1.0 < i * 0.05 < 2.2
+    ]
+    return write_tlog(path, events)
+
+
+def validate(tool: Path, logs: list[Path], out: Path) -> list[dict[str, Any]]:
+    """Multitool's own findings about ``logs`` (an empty list means valid, no warnings)."""
+    proc = subprocess.run(
+        [str(tool), "validate", *map(str, logs), "--output", str(out), "--log", "ForceOverwrite"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={**os.environ, "DOTNET_SYSTEM_GLOBALIZATION_INVARIANT": "1"},
+    )
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    results: list[dict[str, Any]] = json.loads(out.read_text(encoding="utf-8-sig"))["runs"][0][
+        "results"
+    ]
+    return results
+
+
+def test_multitool_finds_nothing_to_complain_about(tmp_path: Path) -> None:
+    tool = multitool()
+    hostile = tmp_path / "hostile.sarif"
+    hostile.write_text(json.dumps(sarif_log(hostile_report(), Settings())), encoding="utf-8")
+    recording = gap_recording(tmp_path / "gap.tlog")
+    real = tmp_path / "real.sarif"
+    result = run_cli(["lint", str(recording), "--format", "sarif", "--output", str(real)])
+    assert result.returncode in (0, 1), result.stderr
+    # A canary with a schema error proves the validator looked (it stays silent on some inputs).
+    canary = tmp_path / "canary.sarif"
+    log = sarif_log(hostile_report(), Settings())
+    log["runs"][0]["results"] = log["runs"][0]["results"][:1]
+    log["runs"][0]["results"][0]["locations"][0]["physicalLocation"]["region"]["startLine"] = 0
+    canary.write_text(json.dumps(log), encoding="utf-8")
+    problems = validate(tool, [hostile, real, canary], tmp_path / "validation.sarif")
+    where = [p["locations"][0]["physicalLocation"]["artifactLocation"]["uri"] for p in problems]
+    assert problems and all(uri.endswith("canary.sarif") for uri in where), problems
+    assert {p["ruleId"] for p in problems} == {"JSON1008"}
+
+
+def test_every_rule_is_described_with_its_page_and_url() -> None:
+    run = sarif_log(Report(), Settings())["runs"][0]
+    rules = run["tool"]["driver"]["rules"]
+    catalog = load_catalog()
+    assert [r["id"] for r in rules] == list(catalog)
+    for descriptor in rules:
+        rule = catalog[descriptor["id"]]
+        assert descriptor["helpUri"] == rule.url
+        assert descriptor["shortDescription"]["text"]
+        assert descriptor["fullDescription"]["text"]
+        assert "Why is this bad?" in descriptor["help"]["markdown"]
+        assert descriptor["defaultConfiguration"]["level"] in ("error", "warning", "note")
+
+
+def test_results_point_at_their_rule_recording_time_and_topic(tmp_path: Path) -> None:
+    report = hostile_report()
+    run = sarif_log(report, Settings(), root=Path.cwd())["runs"][0]
+    rules = run["tool"]["driver"]["rules"]
+    results = run["results"]
+    assert len(results) == len(report.findings)
+    for res, finding in zip(results, report.findings, strict=True):
+        assert rules[res["ruleIndex"]]["id"] == res["ruleId"] == finding.code
+        level = {Severity.ERROR: "error", Severity.WARNING: "warning", Severity.INFO: "note"}
+        assert res["level"] == level[finding.severity]
+        assert finding.message in res["message"]["text"]
+        if finding.time_s is not None:
+            assert f"{finding.time_s:.3f} s" in res["message"]["text"]
+        if finding.where is not None:
+            assert finding.where.topic in res["message"]["text"]
+        location = res["locations"][0]["physicalLocation"]["artifactLocation"]
+        # Relative to the working folder, percent-encoded (the hostile path has quotes and <>).
+        assert location["uriBaseId"] == "SRCROOT"
+        assert not location["uri"].startswith(("/", "file:"))
+        assert "<" not in location["uri"] and '"' not in location["uri"]
+        assert run["artifacts"][location["index"]]["location"]["uri"] == location["uri"]
+    outside = Report(files=[report.files[0]])
+    outside.files[0].path = "/elsewhere/flight.tlog"
+    artifact = sarif_log(outside, Settings(), root=tmp_path)["runs"][0]["artifacts"][0]
+    assert artifact["location"]["uri"] == "file:///elsewhere/flight.tlog"
+
+
+def test_fingerprints_are_stable_and_tell_findings_apart() -> None:
+    first = sarif_log(hostile_report(), Settings())["runs"][0]["results"]
+    again = sarif_log(hostile_report(), Settings())["runs"][0]["results"]
+    prints = [r["partialFingerprints"]["fuzzoffFinding/v1"] for r in first]
+    assert prints == [r["partialFingerprints"]["fuzzoffFinding/v1"] for r in again]
+    assert len(set(prints)) == len(prints)
+    base = Finding("OFB001", "x", Severity.ERROR, "m", time_s=1.0, where=Where("/a"), vehicle="1")
+    variants = [
+        Finding("OFB002", "x", Severity.ERROR, "m", time_s=1.0, where=Where("/a"), vehicle="1"),
+        Finding("OFB001", "x", Severity.ERROR, "m", time_s=1.0, where=Where("/b"), vehicle="1"),
+        Finding("OFB001", "x", Severity.ERROR, "m", time_s=1.0, where=Where("/a"), vehicle="2"),
+        Finding("OFB001", "x", Severity.ERROR, "m", time_s=2.0, where=Where("/a"), vehicle="1"),
+    ]
+    assert all(fingerprint(v) != fingerprint(base) for v in variants)
+    # The message wording is not part of the identity: rewording a message keeps the alert.
+    reworded = Finding("OFB001", "x", Severity.ERROR, "new", 1.0, Where("/a"), vehicle="1")
+    assert fingerprint(reworded) == fingerprint(base)
+
+
+def test_cli_writes_sarif_with_relative_uri(tmp_path: Path) -> None:
+    gap_recording(tmp_path / "gap.tlog")
+    result = run_cli(["lint", "gap.tlog", "--format", "sarif"], cwd=tmp_path)
+    log = json.loads(result.stdout)
+    assert log["version"] == "2.1.0"
+    run = log["runs"][0]
+    assert run["artifacts"][0]["location"] == {"uri": "gap.tlog", "uriBaseId": "SRCROOT"}
+    assert run["originalUriBaseIds"]["SRCROOT"]["uri"] == tmp_path.resolve().as_uri() + "/"
+    assert any(r["ruleId"] == "OFB003" for r in run["results"])
