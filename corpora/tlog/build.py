@@ -192,10 +192,12 @@ def rejected(version: str, acks: list[tuple[float, int]]) -> list[Event]:
     )
 
 
-def finding(code: str, severity: str, time_s: float | None) -> dict[str, Any]:
+def finding(
+    code: str, severity: str, time_s: float | None, vehicle: str | None = "1"
+) -> dict[str, Any]:
     out: dict[str, Any] = {"code": code, "severity": severity, "time_s": time_s}
-    if time_s is not None:
-        out["vehicle"] = "1"
+    if time_s is not None and vehicle is not None:
+        out["vehicle"] = vehicle
     return out
 
 
@@ -277,7 +279,7 @@ def main() -> None:
     write(
         "truncated",
         events,
-        [*loss_findings, finding("OFB001", "error", 13.0)],
+        [*loss_findings, finding("OFB001", "error", 13.0, vehicle=None)],
         exit_status=2,
         complete=False,
         profile=p115,
