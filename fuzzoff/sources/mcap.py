@@ -10,7 +10,7 @@ chunk is skipped and reported; a cut file keeps everything before the cut.
 from __future__ import annotations
 
 import io
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -24,6 +24,9 @@ from fuzzoff.sources import px4_msgs
 from fuzzoff.sources.base import RecordingInfo, Source, SourceError, SourceProblem
 from fuzzoff.sources.ros2_decode import Ros2Decoding, TopicDecoder
 from fuzzoff.sources.ros2_order import ChunkOrder
+
+Connect = Callable[[str, str, str | None, str], TopicDecoder | None]
+"""(topic, message type, embedded definition, its format) -> decoder or None."""
 
 MAGIC = b"\x89MCAP0\r\n"
 MAX_CHUNK_INFLATION = 1 << 30
@@ -39,9 +42,16 @@ class McapStream:
     per-connection definitions; ``problems`` collects what could not be read.
     """
 
-    def __init__(self, path: Path, decoding: Ros2Decoding, t0_ns: int | None) -> None:
+    def __init__(
+        self,
+        path: Path,
+        decoding: Ros2Decoding,
+        t0_ns: int | None,
+        connect: Connect | None = None,
+    ) -> None:
         self.path = path
         self.decoding = decoding
+        self.connect: Connect = connect or decoding.connection
         self.t0_ns = t0_ns
         self.problems: list[SourceProblem] = []
         self.schemas: dict[int, Schema] = {}
@@ -61,7 +71,7 @@ class McapStream:
             text = schema.data.decode("utf-8", errors="replace")
             fmt = SCHEMA_FORMATS[schema.encoding]
         msgtype = schema.name if schema is not None else ""
-        self.decoders[record.id] = self.decoding.connection(record.topic, msgtype, text, fmt)
+        self.decoders[record.id] = self.connect(record.topic, msgtype, text, fmt)
 
     def records(self) -> Iterator[Any]:
         """Top-level records, chunks broken up (CRC checked); problems recorded, never raised."""

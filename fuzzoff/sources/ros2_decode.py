@@ -110,17 +110,18 @@ class TopicDecoder:
     index: int = 0
     failed: int = 0
     first_failure: tuple[float, str] | None = None
+    unusable: str | None = None
+    """Why no definition can decode this topic (then every message is counted as failed)."""
 
     def event(self, raw: bytes | memoryview, t: float) -> Event | None:
         """The event for one payload, or None (not decodable: counted as a problem)."""
         index = self.index
         self.index = index + 1
         if self.builder is None:
-            if self.failed:
-                self._fail(t, "")
-                return None
-            self._resolve(raw, t)
+            if self.unusable is None:
+                self.resolve(raw, t)
             if self.builder is None:
+                self._fail(t, self.unusable or "")
                 return None
         assert self.definition is not None
         message, why = self.definition.decode(raw)
@@ -129,10 +130,11 @@ class TopicDecoder:
             return None
         return self.builder(message, t, Where(self.topic, index), message.timestamp)
 
-    def _resolve(self, sample: bytes | memoryview, t: float) -> None:
+    def resolve(self, sample: bytes | memoryview, t: float) -> None:
+        """Choose a bundled definition from a sample payload; else say why not (``unusable``)."""
         definition, why = self.owner.choose(self, sample)
         if definition is None:
-            self._fail(t, why)
+            self.unusable = why
             return
         self.use(definition)
 

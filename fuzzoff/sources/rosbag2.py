@@ -1,0 +1,337 @@
+"""ROS 2 bags (formats.md 5): a bag folder (metadata.yaml + .db3 / .mcap files) or one data file.
+
+Read with ``rosbags.rosbag2.Reader`` (split files, compression, both storages), but with
+fuzzoff's own per-connection choice of definitions (formats.md 3: AnyReader's fallback is
+all-or-nothing). What rosbags cannot open is salvaged file by file: a missing or malformed
+metadata.yaml -> each data file opened on its own; a damaged ``.db3`` -> Python's ``sqlite3`` row
+by row; a cut ``.mcap`` -> fuzzoff's streaming MCAP reader. Every salvage is a problem (OFB001).
+"""
+
+from __future__ import annotations
+
+import sqlite3
+from collections.abc import Iterator
+from contextlib import suppress
+from pathlib import Path
+from typing import Any
+
+from rosbags.interfaces import MessageDefinitionFormat
+from rosbags.rosbag2 import Reader
+from ruamel.yaml import YAML
+
+from fuzzoff.events import Event
+from fuzzoff.sources import px4_msgs
+from fuzzoff.sources.base import RecordingInfo, Source, SourceError, SourceProblem
+from fuzzoff.sources.mcap import McapStream
+from fuzzoff.sources.ros2_decode import Ros2Decoding, TopicDecoder
+from fuzzoff.sources.ros2_order import ChunkOrder
+
+DATA_SUFFIXES = (".db3", ".mcap")
+_FORMATS = {MessageDefinitionFormat.MSG: "msg", MessageDefinitionFormat.IDL: "idl"}
+
+
+def _why(exc: BaseException) -> str:
+    text = str(exc).strip().rstrip(".") or type(exc).__name__
+    return text.replace("\n", " ")
+
+
+class Rosbag2Source(Source):
+    """A ROS 2 bag, either storage. ``px4_hint`` steers bundled definitions (``--px4``)."""
+
+    format = "rosbag2-sqlite3"
+
+    def __init__(self, path: Path) -> None:
+        super().__init__(path)
+        self.px4_hint: str | None = None
+        self.decoding = Ros2Decoding()
+        self._decoders: dict[tuple[str, str], TopicDecoder | None] = {}
+        self._reader: Any = None
+        self._files: list[Path] = []
+        self._info: RecordingInfo | None = None
+        self._t0: int | None = None
+        self._messages = 0
+        self._done = 0
+        self._notes: list[str] = []
+
+    # -- opening -----------------------------------------------------------------------------
+
+    def open(self) -> None:
+        self.decoding.release = px4_msgs.release_for(self.px4_hint)
+        if not self.path.exists():
+            raise SourceError(self.path, "no such file or folder")
+        try:
+            reader = Reader(self.path)
+            reader.open()
+        except Exception as exc:
+            self._salvage_plan(exc)
+            return
+        self._reader = reader
+
+    def _salvage_plan(self, exc: BaseException) -> None:
+        """rosbags could not open the bag as a whole: find the data files to read one by one."""
+        if self.path.is_file():
+            self._files = [self.path]
+            return
+        meta = self.path / "metadata.yaml"
+        files = self._files_from_metadata(meta)
+        if files is None:
+            files = sorted(p for p in self.path.iterdir() if p.suffix in DATA_SUFFIXES)
+            if not files:
+                raise SourceError(self.path, f"not a readable ROS 2 bag ({_why(exc)})")
+            if meta.is_file():
+                what = f"metadata.yaml cannot be used ({_why(exc)})"
+            else:
+                what = "metadata.yaml is missing"
+            names = ", ".join(p.name for p in files)
+            self.problems.append(SourceProblem(f"{what}; read the data files directly: {names}"))
+        else:
+            missing = [p for p in files if not p.is_file()]
+            for p in missing:
+                self.problems.append(
+                    SourceProblem("data file listed in metadata.yaml is missing", p.name)
+                )
+            files = [p for p in files if p.is_file()]
+            if not files:
+                raise SourceError(self.path, "none of the bag's data files exist")
+        self._files = files
+
+    def _files_from_metadata(self, meta: Path) -> list[Path] | None:
+        try:
+            data = YAML(typ="safe").load(meta.read_text(encoding="utf-8"))
+            names = data["rosbag2_bagfile_information"]["relative_file_paths"]
+            return [self.path / Path(str(n)).name for n in names]
+        except Exception:
+            return None
+
+    # -- probe -------------------------------------------------------------------------------
+
+    def probe(self) -> RecordingInfo:
+        if self._info is not None:
+            return self._info
+        info = RecordingInfo(str(self.path), self.format)
+        if self._reader is not None:
+            reader = self._reader
+            info.message_count = reader.message_count
+            self._t0 = reader.start_time if reader.message_count else None
+            for conn in reader.connections:
+                self._decoder(conn.topic, conn.msgtype, conn.msgdef)
+            if reader.ros_distro:
+                info.notes.append(f"recorded with ROS 2 {reader.ros_distro}")
+            self._presample(reader)
+        else:
+            self._probe_files()
+        info.kinds = self.decoding.kinds()
+        info.vehicles = self.decoding.vehicles()
+        info.px4_version = self.decoding.detected_release()
+        info.notes.extend(self._notes)
+        self._info = info
+        return info
+
+    def _presample(self, reader: Any) -> None:
+        """Choose bundled definitions now, from each topic's first message, so the release
+        they reveal can set the profile (Humble bags embed none). VehicleStatus goes first:
+        its layout differs in every release."""
+        pending = []
+        for conn in reader.connections:
+            decoder = self._decoders.get((conn.topic, conn.msgtype))
+            if decoder is not None and decoder.definition is None and conn.msgcount:
+                pending.append((decoder.message != "VehicleStatus", conn, decoder))
+        pending.sort(key=lambda item: (item[0], item[1].id))
+        for _, conn, decoder in pending:
+            try:
+                _, stamp, raw = next(iter(reader.messages(connections=[conn])))
+            except Exception:
+                continue
+            t0 = self._t0 if self._t0 is not None else stamp
+            decoder.resolve(raw, (stamp - t0) / 1e9)
+        chosen = sorted({d.definition.source for _, _, d in pending if d.definition is not None})
+        if chosen:
+            self._notes.append(
+                "no embedded definitions for some topics: decoded with " + ", ".join(chosen)
+            )
+
+    def _probe_files(self) -> None:
+        starts = []
+        for path in self._files:
+            try:
+                with Reader(path) as reader:
+                    for conn in reader.connections:
+                        self._decoder(conn.topic, conn.msgtype, conn.msgdef)
+                    if reader.message_count:
+                        starts.append(reader.start_time)
+            except Exception:
+                start = _sqlite_start(path) if path.suffix == ".db3" else None
+                if start is not None:
+                    starts.append(start)
+        self._t0 = min(starts) if starts else None
+
+    def _decoder(self, topic: str, msgtype: str, msgdef: Any) -> TopicDecoder | None:
+        text = msgdef.data if msgdef is not None and msgdef.format in _FORMATS else None
+        fmt = _FORMATS.get(msgdef.format, "msg") if msgdef is not None else "msg"
+        return self._connect(topic, msgtype, text, fmt)
+
+    def _connect(self, topic: str, msgtype: str, text: str | None, fmt: str) -> TopicDecoder | None:
+        """One decoder per (topic, type) across the bag's files and read paths."""
+        key = (topic, msgtype)
+        if key not in self._decoders:
+            self._decoders[key] = self.decoding.connection(topic, msgtype, text, fmt)
+        return self._decoders[key]
+
+    # -- events ------------------------------------------------------------------------------
+
+    def events(self) -> Iterator[Event]:
+        self.probe()
+        try:
+            if self._reader is not None:
+                yield from self._read(self._reader, self.path)
+            else:
+                for path in self._files:
+                    yield from self._read_file(path)
+                    self._done += 1
+        finally:
+            self._finish()
+
+    def _read(self, reader: Any, where: Path) -> Iterator[Event]:
+        selected = []
+        for conn in reader.connections:
+            if self._decoder(conn.topic, conn.msgtype, conn.msgdef) is not None:
+                selected.append(conn)
+        if not selected:  # rosbags reads every message when given no connection
+            return
+        decoders = self._decoders
+        t0 = self._t0
+        count = 0
+        try:
+            for conn, stamp, raw in reader.messages(connections=selected):
+                if t0 is None:
+                    t0 = self._t0 = stamp
+                count += 1
+                decoder = decoders[(conn.topic, conn.msgtype)]
+                assert decoder is not None
+                event = decoder.event(raw, (stamp - t0) / 1e9)
+                if event is not None:
+                    yield event
+        except Exception as exc:
+            self.problems.append(
+                SourceProblem(
+                    f"reading stopped: {_why(exc)}", f"{where.name} after {count} messages"
+                )
+            )
+        finally:
+            self._messages += count
+
+    def _read_file(self, path: Path) -> Iterator[Event]:
+        try:
+            reader = Reader(path)
+            reader.open()
+        except Exception as exc:
+            if path.suffix == ".mcap":
+                yield from self._salvage_mcap(path)
+            else:
+                yield from self._salvage_sqlite(path, exc)
+            return
+        try:
+            yield from self._read(reader, path)
+        finally:
+            with suppress(Exception):
+                reader.close()
+
+    def _salvage_mcap(self, path: Path) -> Iterator[Event]:
+        stream = McapStream(path, self.decoding, self._t0, self._connect)
+        yield from stream.events()
+        if self._t0 is None:
+            self._t0 = stream.t0_ns
+        self._messages += stream.messages
+        for problem in stream.problems:
+            self.problems.append(SourceProblem(problem.what, f"{path.name} {problem.where or ''}"))
+
+    def _salvage_sqlite(self, path: Path, exc: BaseException) -> Iterator[Event]:
+        """Row by row with Python's sqlite3, in row order, until the damage (formats.md 5)."""
+        try:
+            db = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
+        except sqlite3.Error as err:
+            self.problems.append(SourceProblem(f"cannot open the database: {_why(err)}", path.name))
+            return
+        count = 0
+        try:
+            topics = self._sqlite_topics(db)
+            self.problems.append(
+                SourceProblem(
+                    f"rosbags cannot read this database ({_why(exc)}); salvaged row by row",
+                    path.name,
+                )
+            )
+            order = ChunkOrder()
+            t0 = self._t0
+            rows = db.execute("SELECT topic_id, timestamp, data FROM messages ORDER BY id")
+            for topic_id, stamp, raw in rows:
+                count += 1
+                if t0 is None:
+                    t0 = self._t0 = stamp
+                decoder = topics.get(topic_id)
+                if decoder is None:
+                    continue
+                event = decoder.event(raw, (stamp - t0) / 1e9)
+                if event is not None:
+                    yield from order.add(stamp, event)
+            yield from order.flush()
+        except sqlite3.Error as err:
+            self.problems.append(
+                SourceProblem(
+                    f"database damaged ({_why(err)}); rows after this could not be read",
+                    f"{path.name} after {count} messages",
+                )
+            )
+        finally:
+            self._messages += count
+            db.close()
+
+    def _sqlite_topics(self, db: sqlite3.Connection) -> dict[int, TopicDecoder]:
+        definitions: dict[str, tuple[str, str]] = {}
+        with suppress(sqlite3.Error):
+            for name, encoding, text in db.execute(
+                "SELECT topic_type, encoding, encoded_message_definition FROM message_definitions"
+            ):
+                if encoding in ("ros2msg", "ros2idl") and text:
+                    definitions[name] = (text, "idl" if encoding == "ros2idl" else "msg")
+        out: dict[int, TopicDecoder] = {}
+        for topic_id, name, msgtype in db.execute("SELECT id, name, type FROM topics"):
+            text, fmt = definitions.get(msgtype, (None, "msg"))
+            decoder = self._connect(name, msgtype, text, fmt)
+            if decoder is not None:
+                out[topic_id] = decoder
+        return out
+
+    def _finish(self) -> None:
+        self.problems.extend(self.decoding.problems())
+        self.stats["messages"] = self._messages
+        if self._info is not None:
+            self._info.notes.extend(self.decoding.notes)
+            self._info.kinds |= self.decoding.kinds()
+        if self._reader is not None:
+            with suppress(Exception):
+                self._reader.close()
+            self._reader = None
+
+    def close(self) -> None:
+        if self._reader is not None:
+            with suppress(Exception):
+                self._reader.close()
+            self._reader = None
+
+    def progress(self) -> float | None:
+        if self._files:
+            return self._done / len(self._files)
+        return None
+
+
+def _sqlite_start(path: Path) -> int | None:
+    try:
+        db = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
+        try:
+            row = db.execute("SELECT MIN(timestamp) FROM messages").fetchone()
+        finally:
+            db.close()
+    except sqlite3.Error:
+        return None
+    return int(row[0]) if row and row[0] is not None else None
