@@ -536,7 +536,7 @@ class GateModel:
         self._terminated = self._terminated and target == TERMINATION
         self._fallback = None
         self._fallback_stage = 0
-        self._refresh(t)
+        self._refresh(t, cause=None)
 
     def _apply_arm(self, t: float, decision: Decision) -> None:
         if not decision.accepted:
@@ -554,7 +554,7 @@ class GateModel:
             self._emit(
                 t, "arm_accepted", f"armed{note}", decision.spec, unverified=decision.unverified
             )
-            self._refresh(t)
+            self._refresh(t, cause=None)
 
     # ------------------------------------------------------------------ the recording
 

@@ -1,0 +1,168 @@
+"""Rules read straight off the gate model (gate spec sections 5 and 12).
+
+* OFB202 gate-model-disagrees: the model's ``disagreement`` transitions (recorded mode or ack vs
+  the prediction, judged with the profile's evaluation slack, see ``fuzzoff.gate.compare``);
+* OFB701 loss-action-summary: once per vehicle that uses offboard, what the vehicle does on loss;
+* OFB702 loss-action-unavailable: the configured loss action cannot run as configured (a mode
+  whose estimate is missing, a stick mode without manual control).
+"""
+
+from __future__ import annotations
+
+from fuzzoff.checks.base import Check, CheckContext
+from fuzzoff.events import Event, FailsafeFlags, Parameter, VehicleStatus
+from fuzzoff.gate import GateTransition
+from fuzzoff.gate.failsafe import LossAction
+from fuzzoff.gate.params import RC_PRESENT
+from fuzzoff.profiles import at_least
+
+
+class GateDisagrees(Check):
+    codes = ("OFB202",)
+    wants = (GateTransition,)
+
+    def on_event(self, event: Event) -> None:
+        if isinstance(event, GateTransition) and event.what == "disagreement":
+            profile = self.ctx.profile
+            self.ctx.report(
+                "OFB202",
+                f"{event.message} (PX4 {profile.px4} {profile.vehicle}, "
+                f"evaluation slack {self.ctx.gate.compare.slack:.2f} s)",
+                event.t,
+                event.cause.where if event.cause is not None else None,
+            )
+
+    def finish(self, t_end: float) -> None:
+        if not self.ctx.has("vehicle_status", "command_ack"):
+            self.ctx.cannot_check(
+                "OFB202",
+                "needs the vehicle's mode (vehicle_status, HEARTBEAT, /mavros/state) or its "
+                "command acks",
+            )
+
+
+def _param_source(ctx: CheckContext, name: str) -> str:
+    gate = ctx.gate
+    if name in gate.overrides:
+        return "set on the command line"
+    if name in gate.recorded_params:
+        return "from the recording"
+    return "PX4 default"
+
+
+def _rc_text(ctx: CheckContext) -> str:
+    est = ctx.gate.est
+    if ctx.profile.px4 in ("1.14", "1.15", "1.16"):
+        return "manual control not consulted (1.14-1.16)"
+    if est.rc_recorded:
+        return "manual control present" if est.rc_present else "no manual control (recorded)"
+    present = bool(ctx.gate.params.get(RC_PRESENT, 1.0))
+    return f"manual control assumed {'present' if present else 'absent'} ({RC_PRESENT})"
+
+
+def loss_summary(ctx: CheckContext) -> str:
+    """The OFB701 text: timeout, action parameter, what happens, and the return."""
+    gate = ctx.gate
+    px4 = ctx.profile.px4
+    action = gate.current_loss_action()
+    p = gate.params
+    loss_t = float(p.get("COM_OF_LOSS_T", 0.0))
+    src_t = _param_source(ctx, "COM_OF_LOSS_T")
+    act = p.get("COM_OBL_RC_ACT", 0.0)
+    src_a = _param_source(ctx, "COM_OBL_RC_ACT")
+    if px4 == "legacy":
+        head = (
+            f"offboard loss after 500 ms without a setpoint (fixed), then after COM_OF_LOSS_T "
+            f"{loss_t:g} s ({src_t}) more the loss action"
+        )
+    elif at_least(px4, "1.14"):
+        head = (
+            f"offboard loss when the newest keep-alive is COM_OF_LOSS_T {loss_t:g} s ({src_t}) "
+            f"old, checked at 10 Hz"
+        )
+    else:
+        head = f"offboard loss after COM_OF_LOSS_T {loss_t:g} s ({src_t}) without a keep-alive"
+    head += f"; COM_OBL_RC_ACT {act:g} ({src_a})"
+    if not at_least(px4, "1.14"):
+        head += f", COM_OBL_ACT {p.get('COM_OBL_ACT', 0.0):g} ({_param_source(ctx, 'COM_OBL_ACT')})"
+    what = _action_text(action)
+    back = (
+        "it returns to OFFBOARD by itself when the stream resumes"
+        if action.nav_state != 13 and not action.disarm
+        else "it does not return"
+    )
+    return f"{head}; {_rc_text(ctx)}: the vehicle will {what}; {back}"
+
+
+def _action_text(action: LossAction) -> str:
+    if action.disarm:
+        return "disarm (COM_OBL_RC_ACT 7)"
+    if action.none:
+        return "stay in OFFBOARD without a signal (no failsafe)"
+    text = f"switch to {action.action}"
+    if action.note:
+        text += f" ({action.note})"
+    return text
+
+
+class LossActionSummary(Check):
+    codes = ("OFB701",)
+    wants = (GateTransition, VehicleStatus)
+
+    def __init__(self, ctx: CheckContext) -> None:
+        super().__init__(ctx)
+        self.done = False
+
+    def on_event(self, event: Event) -> None:
+        if self.done:
+            return
+        if self.ctx.gate.in_offboard or self.ctx.state.in_offboard:
+            self.done = True
+            self.ctx.report("OFB701", loss_summary(self.ctx), event.t)
+
+
+class LossActionUnavailable(Check):
+    codes = ("OFB702",)
+    wants = (GateTransition, VehicleStatus, FailsafeFlags, Parameter)
+
+    def __init__(self, ctx: CheckContext) -> None:
+        super().__init__(ctx)
+        self.reported: set[tuple[str, str | None, bool]] = set()
+
+    def on_event(self, event: Event) -> None:
+        if not (self.ctx.gate.in_offboard or self.ctx.state.in_offboard):
+            return
+        if isinstance(event, GateTransition) and event.what not in (
+            "failsafe",
+            "request_accepted",
+            "offboard_resumed",
+            "signal_available",
+        ):
+            return
+        action = self.ctx.gate.current_loss_action()
+        if not (action.degraded_from or action.stick_mode_without_rc):
+            return
+        key = (action.action, action.degraded_from, action.stick_mode_without_rc)
+        if key in self.reported:
+            return
+        self.reported.add(key)
+        self.ctx.report("OFB702", self._message(action), event.t)
+
+    def _rc_source(self) -> str:
+        if self.ctx.gate.est.rc_recorded:
+            return "the recording's manual_control_signal_lost"
+        return f"{RC_PRESENT} = 0"
+
+    def _message(self, action: LossAction) -> str:
+        px4 = self.ctx.profile.px4
+        if action.degraded_from:
+            return (
+                f"the configured offboard-loss action {action.degraded_from} cannot run now "
+                f"({action.note}); PX4 {px4} would fall back to {action.action} "
+                "(mode requirements approximated by fuzzoff)"
+            )
+        return (
+            f"the offboard-loss action is the stick mode {action.action} but there is no manual "
+            f"control ({self._rc_source()}): PX4 {px4} switches to it anyway and the vehicle has "
+            "no pilot input (on 1.14 it was seen descending slowly until the stream resumed)"
+        )
