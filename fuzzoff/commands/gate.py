@@ -1,0 +1,169 @@
+"""``fuzzoff gate PATH``: the gate model's timeline beside the recorded mode.
+
+Each row is a model transition (time, what, message, gate-spec section, ``U`` for behaviour the
+spec lists as unverified) or a recorded mode change (``recorded``). Rows where the recording and
+the model differ beyond the profile's evaluation slack are ``disagreement`` rows naming both.
+Exit status: 0 the model and the recording agree (or the recording has no mode), 1 they
+disagree somewhere, 2 usage error or the recording could not be read completely.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+from fuzzoff import __version__
+from fuzzoff.commands._common import add_profile_options, settings_from_args, write_output
+from fuzzoff.config import ConfigError
+from fuzzoff.engine import Timeline, lint_file
+from fuzzoff.findings import FileReport
+from fuzzoff.gate import GateTransition
+from fuzzoff.modes import nav_state_name
+from fuzzoff.report.sanitize import printable
+
+
+def add_parser(sub: Any) -> None:
+    parser = sub.add_parser(
+        "gate", help="the gate model's timeline for a recording, beside the recorded mode"
+    )
+    parser.add_argument("path", metavar="PATH", help="a recording (any supported format)")
+    add_profile_options(parser)
+    parser.add_argument("--format", choices=("terminal", "json"), default="terminal")
+    parser.add_argument("--output", "-o", metavar="FILE", help="write the timeline here")
+    parser.add_argument(
+        "--no-controllers", action="store_true", help="leave out the 'controller' rows"
+    )
+    parser.set_defaults(run=run)
+
+
+Row = dict[str, Any]
+
+
+def _transition_row(tr: GateTransition) -> Row:
+    return {
+        "time_s": round(tr.t, 6),
+        "source": "model",
+        "what": tr.what,
+        "message": tr.message,
+        "spec": tr.spec,
+        "unverified": tr.unverified,
+        "nav_state": tr.nav_state,
+        "mode": nav_state_name(tr.nav_state) if tr.nav_state is not None else None,
+        "action": tr.action,
+        "reason": tr.reason,
+        "recorded_nav_state": tr.recorded_nav_state,
+    }
+
+
+def _recorded_row(t: float, nav: int | None, armed: bool | None) -> Row:
+    arming = "" if armed is None else (" armed" if armed else " disarmed")
+    return {
+        "time_s": round(t, 6),
+        "source": "recorded",
+        "what": "recorded",
+        "message": f"{nav_state_name(nav)}{arming}",
+        "spec": None,
+        "unverified": False,
+        "nav_state": nav,
+        "mode": nav_state_name(nav) if nav is not None else None,
+        "armed": armed,
+    }
+
+
+def timeline_rows(timeline: Timeline, controllers: bool = True) -> list[Row]:
+    """Model transitions and recorded mode changes of one vehicle, in time order."""
+    rows = [
+        _transition_row(tr) for tr in timeline.transitions if controllers or tr.what != "controller"
+    ]
+    rows += [_recorded_row(t, nav, armed) for t, nav, armed in timeline.recorded_modes]
+    rows.sort(key=lambda r: (r["time_s"], r["source"] != "recorded"))
+    return rows
+
+
+def gate_report(
+    path: str, settings_args: argparse.Namespace, controllers: bool = True
+) -> tuple[FileReport, dict[str, list[Row]]]:
+    settings = settings_from_args(settings_args)
+    # Only the gate's own rule: the timeline needs the model, not every check.
+    settings = dataclasses.replace(settings, select=frozenset({"OFB202"}), ignore=frozenset())
+    timelines: dict[str, Timeline] = {}
+    report = lint_file(path, settings, timelines=timelines)
+    rows = {v: timeline_rows(tl, controllers) for v, tl in sorted(timelines.items())}
+    return report, rows
+
+
+def _terminal(report: FileReport, rows: dict[str, list[Row]]) -> str:
+    lines = [f"{printable(report.path)}: {report.format}, {report.profile.describe()}"]
+    for vehicle, vrows in rows.items():
+        has_recorded = any(r["source"] == "recorded" for r in vrows)
+        lines.append("")
+        lines.append(
+            f"vehicle {printable(vehicle) or '(default)'}"
+            + ("" if has_recorded else " (the recording has no mode: model only)")
+        )
+        lines.append(f"{'time s':>9}  {'model':<18} {'spec':<5} {'':1} {'recorded':<14} message")
+        for r in vrows:
+            mark = "U" if r["unverified"] else ""
+            if r["source"] == "recorded":
+                line = f"{r['time_s']:9.3f}  {'':<18} {'':<5} {'':1} {r['message']:<14}"
+            else:
+                spec = r["spec"] or ""
+                what = r["what"].upper() if r["what"] == "disagreement" else r["what"]
+                line = f"{r['time_s']:9.3f}  {what:<18} {spec:<5} {mark:1} {'':<14} "
+                line += printable(r["message"], 200)
+            lines.append(line.rstrip())
+        differ = [r for r in vrows if r["what"] == "disagreement"]
+        if differ:
+            lines.append(f"  {len(differ)} place(s) where the recording and the model differ:")
+            lines += [f"    {r['time_s']:.2f} s  {printable(r['message'], 200)}" for r in differ]
+        elif has_recorded:
+            lines.append("  the recorded mode history agrees with the model")
+    if any(r["unverified"] for vrows in rows.values() for r in vrows):
+        lines.append("")
+        lines.append("U = behaviour the gate spec lists as unverified (docs/gate.md)")
+    for problem in report.problems:
+        lines.append(f"incomplete: {printable(problem)}")
+    return "\n".join(lines) + "\n"
+
+
+def _json(report: FileReport, rows: dict[str, list[Row]]) -> str:
+    data = {
+        "tool": "fuzzoff",
+        "version": __version__,
+        "files": [
+            {
+                "path": report.path,
+                "format": report.format,
+                "profile": report.to_json()["profile"],
+                "complete": report.complete,
+                "problems": list(report.problems),
+                "vehicles": [
+                    {
+                        "vehicle": vehicle,
+                        "timeline": vrows,
+                        "disagreements": [r for r in vrows if r["what"] == "disagreement"],
+                    }
+                    for vehicle, vrows in rows.items()
+                ],
+            }
+        ],
+    }
+    return json.dumps(data, indent=2, ensure_ascii=False) + "\n"
+
+
+def run(args: argparse.Namespace) -> int:
+    if not Path(args.path).exists():
+        raise ConfigError(f"no such file or folder: {args.path}")
+    report, rows = gate_report(args.path, args, controllers=not args.no_controllers)
+    text = _json(report, rows) if args.format == "json" else _terminal(report, rows)
+    write_output(text, args.output)
+    for line in report.problems:
+        print(f"fuzzoff: {printable(line)}", file=sys.stderr)
+    if not report.complete:
+        return 2
+    disagree = any(r["what"] == "disagreement" for vrows in rows.values() for r in vrows)
+    return 1 if disagree else 0
