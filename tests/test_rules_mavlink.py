@@ -1,0 +1,329 @@
+"""MAVLink setpoint-field rules (OFB601-OFB607) at the edges of the docs' tables, per profile."""
+
+from __future__ import annotations
+
+import itertools
+from typing import Any
+
+import pytest
+
+from fuzzoff.config import Settings
+from fuzzoff.events import (
+    Event,
+    Parameter,
+    SetAttitudeTarget,
+    SetPositionTargetGlobal,
+    SetPositionTargetLocal,
+    VehicleStatus,
+)
+from fuzzoff.findings import Finding, Severity
+from fuzzoff.profiles import Profile
+from fuzzoff.tables import mavlink as tm
+from tests.streams import codes, lint_events
+
+PAGE_PROFILES = ("1.13", "1.14", "1.15", "1.16", "1.17", "main")
+VEHICLES = ("mc", "fw", "vtol", "rover-ackermann", "rover-differential", "rover-mecanum")
+ALL_IGNORED = tm.POSITION_BITS | tm.VELOCITY_BITS | tm.ACCELERATION_BITS
+NO_YAW = tm.YAW_IGNORE | tm.YAW_RATE_IGNORE
+
+
+def mask_for(groups: frozenset[str], extra: int = NO_YAW) -> int:
+    mask = ALL_IGNORED | extra
+    for group in groups:
+        mask &= ~tm.GROUP_BITS[group]
+    return mask
+
+
+def setpoint(kind: str, t: float = 0.0, **fields: Any) -> Event:
+    if kind == tm.LOCAL:
+        return SetPositionTargetLocal(t=t, **fields)
+    return SetPositionTargetGlobal(t=t, **fields)
+
+
+def lint(events: list[Event], px4: str = "1.16", vehicle: str = "mc", **kw: Any) -> list[Finding]:
+    return lint_events(events, px4=px4, vehicle=vehicle, fmt="tlog", **kw)
+
+
+def documented_cases() -> list[tuple[str, str, str, frozenset[str], int]]:
+    cases = []
+    for px4, vehicle, kind in itertools.product(PAGE_PROFILES, VEHICLES, (tm.LOCAL, tm.GLOBAL)):
+        rules = tm.position_rules(Profile(px4=px4, vehicle=vehicle), kind)
+        assert rules is not None
+        for groups, frames in rules.combos.items():
+            for frame in sorted(frames):
+                cases.append((px4, vehicle, kind, groups, frame))
+    return cases
+
+
+@pytest.mark.parametrize(("px4", "vehicle", "kind", "groups", "frame"), documented_cases())
+def test_every_documented_combination_and_frame_passes_the_docs(
+    px4: str, vehicle: str, kind: str, groups: frozenset[str], frame: int
+) -> None:
+    event = setpoint(kind, type_mask=mask_for(groups), coordinate_frame=frame)
+    found = lint([event], px4, vehicle)
+    assert not codes(found, "OFB602")
+    frame_findings = codes(found, "OFB601")
+    if frame in tm.RECEIVER_FRAMES[kind]:
+        assert not frame_findings
+    else:  # seed 002 lists MAV_FRAME_GLOBAL, which PX4's receiver drops (gate spec D15)
+        assert [f.severity for f in frame_findings] == [Severity.ERROR]
+        assert "receiver accepts only" in frame_findings[0].message
+
+
+@pytest.mark.parametrize(
+    ("px4", "vehicle", "kind", "groups"),
+    [
+        ("1.16", "mc", tm.GLOBAL, frozenset({"position", "velocity", "acceleration"})),
+        ("1.14", "mc", tm.GLOBAL, frozenset({"position", "velocity", "acceleration"})),
+        ("1.16", "mc", tm.LOCAL, frozenset({"velocity", "acceleration"})),
+        ("1.16", "mc", tm.LOCAL, frozenset({"position", "acceleration"})),
+        ("1.16", "rover-differential", tm.LOCAL, frozenset({"position", "velocity"})),
+        ("1.14", "rover-ackermann", tm.GLOBAL, frozenset({"velocity"})),
+        ("1.13", "rover-differential", tm.LOCAL, frozenset({"acceleration"})),
+    ],
+)
+def test_undocumented_combination_is_a_warning(
+    px4: str, vehicle: str, kind: str, groups: frozenset[str]
+) -> None:
+    frame = 1 if kind == tm.LOCAL else (0 if px4 in ("1.13", "1.14") else 5)
+    found = codes(
+        lint([setpoint(kind, type_mask=mask_for(groups), coordinate_frame=frame)], px4, vehicle),
+        "OFB602",
+    )
+    assert [f.severity for f in found] == [Severity.WARNING]
+    assert tm.describe_combo(groups) in found[0].message
+
+
+def test_ignored_groups_are_left_to_their_own_rules() -> None:
+    # Fixed-wing position + velocity: velocity is OFB604's (ignored), not a bad combination.
+    fw = setpoint(tm.LOCAL, type_mask=12288, coordinate_frame=1, velocity=(10.0, 0.0, 0.0))
+    found = lint([fw], vehicle="fw")
+    assert not codes(found, "OFB602")
+    assert codes(found, "OFB604")
+    # Rover velocity + acceleration on 1.16: acceleration is OFB508's.
+    mask = mask_for(frozenset({"velocity", "acceleration"}))
+    rover = setpoint(tm.LOCAL, type_mask=mask, coordinate_frame=1, acceleration=(1.0, 0.0, 0.0))
+    found = lint([rover], vehicle="rover-mecanum")
+    assert not codes(found, "OFB602")
+    assert codes(found, "OFB508")
+
+
+@pytest.mark.parametrize("mask", [4095, ALL_IGNORED | NO_YAW, ALL_IGNORED])
+def test_mask_selecting_nothing_is_an_error(mask: int) -> None:
+    found = codes(lint([setpoint(tm.LOCAL, type_mask=mask, coordinate_frame=1)]), "OFB602")
+    assert [f.severity for f in found] == [Severity.ERROR]
+    assert "no position, velocity or acceleration" in found[0].message
+
+
+def test_force_setpoint_is_an_error() -> None:
+    mask = mask_for(frozenset({"acceleration"})) | tm.FORCE_BIT
+    found = codes(lint([setpoint(tm.LOCAL, type_mask=mask, coordinate_frame=1)]), "OFB602")
+    assert [f.severity for f in found] == [Severity.ERROR]
+    assert "FORCE" in found[0].message
+
+
+def test_partial_group_counts_as_that_group() -> None:
+    # x, y used and z ignored is still a position setpoint (as the 292 gliding value is).
+    mask = mask_for(frozenset({"position"})) | tm.Z_IGNORE
+    assert not codes(lint([setpoint(tm.LOCAL, type_mask=mask, coordinate_frame=1)]), "OFB602")
+
+
+@pytest.mark.parametrize(
+    ("px4", "vehicle", "kind", "groups", "frame", "severity"),
+    [
+        ("1.16", "mc", tm.LOCAL, frozenset({"position"}), 7, Severity.ERROR),
+        ("1.16", "mc", tm.LOCAL, frozenset({"velocity"}), 9, Severity.ERROR),
+        ("1.16", "mc", tm.GLOBAL, frozenset({"position"}), 0, Severity.ERROR),
+        ("1.16", "mc", tm.GLOBAL, frozenset({"position"}), 3, Severity.ERROR),
+        ("1.13", "mc", tm.GLOBAL, frozenset({"position"}), 5, Severity.WARNING),
+        ("1.14", "fw", tm.GLOBAL, frozenset({"position"}), 6, Severity.WARNING),
+        ("1.16", "rover-ackermann", tm.LOCAL, frozenset({"position"}), 8, Severity.ERROR),
+        ("1.16", "rover-ackermann", tm.GLOBAL, frozenset({"velocity"}), 1, Severity.ERROR),
+    ],
+)
+def test_unsupported_frame(
+    px4: str, vehicle: str, kind: str, groups: frozenset[str], frame: int, severity: Severity
+) -> None:
+    event = setpoint(kind, type_mask=mask_for(groups) | 12288, coordinate_frame=frame)
+    found = codes(lint([event], px4, vehicle), "OFB601")
+    assert [f.severity for f in found] == [severity]
+    assert tm.frame_name(frame) in found[0].message
+
+
+def test_rover_velocity_in_body_frame_is_fine() -> None:
+    mask = mask_for(frozenset({"velocity"}))
+    event = setpoint(tm.LOCAL, type_mask=mask, coordinate_frame=8)
+    assert not codes(lint([event], vehicle="rover-differential"), "OFB601")
+
+
+def test_rules_do_not_apply_without_a_page() -> None:
+    event = setpoint(tm.LOCAL, type_mask=4095, coordinate_frame=7)
+    found = lint([event], px4="legacy")
+    assert not codes(found, "OFB601") and not codes(found, "OFB602")
+
+
+@pytest.mark.parametrize(
+    ("kind", "value"),
+    [(tm.LOCAL, v) for v in tm.FIXEDWING_TYPES_LOCAL]
+    + [(tm.GLOBAL, v) for v in tm.FIXEDWING_TYPES_GLOBAL],
+)
+def test_fixedwing_setpoint_types_are_accepted(kind: str, value: int) -> None:
+    mask = value if value != 292 else value | NO_YAW
+    frame = 1 if kind == tm.LOCAL else 5
+    found = lint([setpoint(kind, type_mask=mask, coordinate_frame=frame)], vehicle="fw")
+    assert not codes(found, "OFB603")
+
+
+@pytest.mark.parametrize(
+    ("px4", "kind", "mask", "severity"),
+    [
+        ("1.16", tm.LOCAL, 3576, Severity.WARNING),
+        ("1.13", tm.GLOBAL, 3576, Severity.WARNING),
+        ("1.16", tm.GLOBAL, 292, Severity.WARNING),  # 292 is a LOCAL_NED value only
+        ("1.16", tm.LOCAL, 0x5000, Severity.WARNING),  # not one of the values
+        ("legacy", tm.LOCAL, 3576, Severity.ERROR),
+        ("1.11", tm.GLOBAL, 0, Severity.ERROR),
+    ],
+)
+def test_fixedwing_position_without_type(
+    px4: str, kind: str, mask: int, severity: Severity
+) -> None:
+    frame = 1 if kind == tm.LOCAL else 5
+    found = codes(
+        lint([setpoint(kind, type_mask=mask, coordinate_frame=frame)], px4, "fw"), "OFB603"
+    )
+    assert [f.severity for f in found] == [severity]
+    assert "flower" in found[0].message
+
+
+def test_fixedwing_type_not_needed_without_position_or_on_a_copter() -> None:
+    velocity_only = setpoint(tm.LOCAL, type_mask=3527, coordinate_frame=1)
+    assert not codes(lint([velocity_only], vehicle="fw"), "OFB603")
+    copter = setpoint(tm.LOCAL, type_mask=3576, coordinate_frame=1)
+    assert not codes(lint([copter], vehicle="mc"), "OFB603")
+
+
+def test_fixedwing_velocity_and_acceleration_values_are_reported_as_ignored() -> None:
+    zeros = setpoint(tm.GLOBAL, type_mask=4096, coordinate_frame=5)
+    assert not codes(lint([zeros], vehicle="fw"), "OFB604")
+    accel = setpoint(tm.GLOBAL, type_mask=4096, coordinate_frame=5, acceleration=(0, 0, 2.0))
+    (finding,) = codes(lint([accel], vehicle="fw"), "OFB604")
+    assert "afz" in finding.message and finding.severity is Severity.WARNING
+    ignored_bit = setpoint(tm.LOCAL, type_mask=4096 | 8, coordinate_frame=1, velocity=(5, 0, 0))
+    assert not codes(lint([ignored_bit], vehicle="fw"), "OFB604")
+
+
+def test_global_acceleration_on_a_copter() -> None:
+    mask = mask_for(frozenset({"acceleration"}))
+    found = codes(lint([setpoint(tm.GLOBAL, type_mask=mask, coordinate_frame=5)]), "OFB605")
+    assert [f.severity for f in found] == [Severity.WARNING]
+    local = setpoint(tm.LOCAL, type_mask=mask, coordinate_frame=1)
+    assert not codes(lint([local]), "OFB605")
+    velocity = setpoint(tm.GLOBAL, type_mask=mask_for(frozenset({"velocity"})), coordinate_frame=5)
+    assert not codes(lint([velocity]), "OFB605")
+
+
+@pytest.mark.parametrize(
+    ("mask", "expected"),
+    [
+        (7, []),  # attitude + thrust
+        (128, []),  # body rates + thrust
+        (4 | 128, []),  # roll and pitch rate + thrust
+        (7 | 64 | 32, []),  # thrust through thrust_body
+        (7 | 128, ["neither"]),
+        (1 | 128, ["neither"]),
+        (7 | 64, ["thrust"]),
+        (7 | 64 | 128, ["neither", "thrust"]),
+    ],
+)
+def test_attitude_target_masks(mask: int, expected: list[str]) -> None:
+    found = codes(lint([SetAttitudeTarget(t=0.0, type_mask=mask)]), "OFB606")
+    words = {"neither": "ignores both", "thrust": "ignores the thrust"}
+    assert len(found) == len(expected)
+    for key in expected:
+        assert any(words[key] in f.message for f in found)
+
+
+def test_attitude_without_thrust_says_what_the_version_does() -> None:
+    (old,) = codes(lint([SetAttitudeTarget(t=0.0, type_mask=71)], px4="1.17"), "OFB606")
+    assert "thrust of 0" in old.message
+    (new,) = codes(lint([SetAttitudeTarget(t=0.0, type_mask=71)], px4="main"), "OFB606")
+    assert "ignores such a message entirely" in new.message
+
+
+def test_attitude_target_on_a_new_rover_is_left_to_ofb507() -> None:
+    found = lint([SetAttitudeTarget(t=0.0, type_mask=71)], vehicle="rover-differential")
+    assert not codes(found, "OFB606")
+    assert codes(found, "OFB507")
+
+
+def test_a_repeated_mistake_is_one_finding_per_stretch() -> None:
+    bad = [setpoint(tm.LOCAL, t=i * 0.05, type_mask=3576, coordinate_frame=7) for i in range(20)]
+    good = [
+        setpoint(tm.LOCAL, t=1.0 + i * 0.05, type_mask=3576, coordinate_frame=1) for i in range(5)
+    ]
+    again = [setpoint(tm.LOCAL, t=2.0, type_mask=3576, coordinate_frame=7)]
+    found = codes(lint(bad + good + again), "OFB601")
+    assert [f.time_s for f in found] == [0.0, 2.0]
+    assert found[0].end_s == pytest.approx(0.95)
+    assert "20 messages" in found[0].message
+
+
+def heartbeat(t: float, vehicle: str = "1") -> VehicleStatus:
+    return VehicleStatus(t=t, vehicle=vehicle, nav_state=2)
+
+
+def aimed(t: float, system: int, component: int = 1, vehicle: str = "1", **kw: Any) -> Event:
+    return SetPositionTargetLocal(
+        t=t,
+        vehicle=vehicle,
+        target_system=system,
+        target_component=component,
+        type_mask=3576,
+        coordinate_frame=1,
+        **kw,
+    )
+
+
+@pytest.mark.parametrize(
+    ("system", "component", "wrong"),
+    [(1, 1, False), (0, 0, False), (1, 0, False), (0, 1, False), (2, 1, True), (1, 191, True)],
+)
+def test_setpoint_target(system: int, component: int, wrong: bool) -> None:
+    found = codes(lint([heartbeat(0.0), aimed(0.5, system, component)]), "OFB607")
+    assert bool(found) is wrong
+
+
+def test_setpoints_before_the_first_heartbeat_are_judged_once_it_comes() -> None:
+    events = [aimed(0.1 * i, 3) for i in range(5)] + [heartbeat(0.45)]
+    events += [aimed(0.5 + 0.1 * i, 3) for i in range(3)]
+    (finding,) = codes(lint(events), "OFB607")
+    assert finding.time_s == 0.0 and finding.end_s == pytest.approx(0.7)
+    assert "target_system 3" in finding.message
+
+
+def test_sysid_parameter_names_the_vehicle() -> None:
+    events = [Parameter(t=0.0, vehicle="1", name="MAV_SYS_ID", value=4.0), aimed(0.1, 1)]
+    assert codes(lint(events), "OFB607")
+
+
+def test_no_vehicle_messages_means_not_checkable() -> None:
+    found = lint([aimed(0.0, 2), aimed(0.1, 2)])
+    assert not codes(found, "OFB607")
+    (note,) = [f for f in codes(found, "OFB002") if "OFB607" in f.message]
+    assert "HEARTBEAT" in note.message
+
+
+def test_mavros_setpoints_carry_no_target_to_judge() -> None:
+    event = SetPositionTargetLocal(
+        t=0.5, vehicle="1", target_system=9, transport="mavros", type_mask=3576
+    )
+    found = lint([heartbeat(0.0), event])
+    assert not codes(found, "OFB607")
+    assert not [f for f in codes(found, "OFB002") if "OFB607" in f.message]
+
+
+def test_user_can_turn_a_rule_off() -> None:
+    settings = Settings(ignore=frozenset({"OFB601"}))
+    event = setpoint(tm.LOCAL, type_mask=3576, coordinate_frame=7)
+    assert not codes(lint([event], settings=settings), "OFB601")
