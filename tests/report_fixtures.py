@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from fuzzoff.engine import Timeline
-from fuzzoff.events import Where
+from fuzzoff.events import Event, SetPositionTargetLocal, VehicleStatus, Where
 from fuzzoff.findings import FileReport, Finding, Report, Severity
 from fuzzoff.gate import GateTransition
 from fuzzoff.profiles import Profile
+from fuzzoff.writers.tlog import write_tlog
 
 SCRIPT = "<script>document.title='pwned';console.error('pwned')</script>"
 ONERROR = '" onerror="document.title=\'pwned\'" x="'
@@ -86,3 +89,19 @@ def hostile_report() -> Report:
         ],
     )
     return Report(files=[good, bad])
+
+
+def gap_recording(path: Path) -> Path:
+    """A real tlog: 5 s of SET_POSITION_TARGET_LOCAL_NED at 20 Hz, armed in OFFBOARD from 0.5 s,
+    with a 1.5 s gap from 2 s (long enough for the keep-alive and loss rules)."""
+    events: list[Event] = []
+    for i in range(100):
+        t = i * 0.05
+        if not 2.0 < t < 3.5:
+            events.append(SetPositionTargetLocal(t=t, target_system=1, target_component=1))
+        if i % 20 == 0:
+            nav_state = 14 if t > 0.5 else 2
+            events.append(
+                VehicleStatus(t=t + 0.001, nav_state=nav_state, armed=True, origin="vehicle")
+            )
+    return write_tlog(path, events)

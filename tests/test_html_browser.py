@@ -15,12 +15,10 @@ from pathlib import Path
 import pytest
 
 from fuzzoff.config import Settings
-from fuzzoff.events import SetPositionTargetLocal, VehicleStatus
 from fuzzoff.report.html import CSP, render
-from fuzzoff.writers.tlog import write_tlog
 from tests.cdp import Browser, find_chromium
 from tests.helpers import CORPORA, ROOT, run_cli
-from tests.report_fixtures import SCRIPT, hostile_report
+from tests.report_fixtures import SCRIPT, gap_recording, hostile_report
 
 ARTIFACTS = ROOT / "build" / "test-artifacts"
 RECORDING_SUFFIXES = {".tlog", ".ulg", ".mcap", ".bag", ".db3"}
@@ -100,22 +98,6 @@ def test_plot_and_every_finding_are_shown(browser: Browser, tmp_path: Path) -> N
     )
 
 
-def _gap_recording(path: Path) -> Path:
-    """5 s of SET_POSITION_TARGET_LOCAL_NED at 20 Hz with a 1.5 s gap, OFFBOARD from 1 s."""
-    events: list[SetPositionTargetLocal | VehicleStatus] = []
-    for i in range(100):
-        t = i * 0.05
-        if not 2.0 < t < 3.5:
-            events.append(SetPositionTargetLocal(t=t, target_system=1, target_component=1))
-        if i % 20 == 0:
-            events.append(
-                VehicleStatus(
-                    t=t + 0.001, nav_state=14 if t > 0.5 else 2, armed=True, origin="vehicle"
-                )
-            )
-    return write_tlog(path, events)
-
-
 def _recordings() -> list[Path]:
     if not CORPORA.is_dir():
         return []
@@ -124,7 +106,7 @@ def _recordings() -> list[Path]:
 
 
 def test_cli_html_of_real_recordings(browser: Browser, tmp_path: Path) -> None:
-    paths = [_gap_recording(tmp_path / "gap.tlog"), *_recordings()]
+    paths = [gap_recording(tmp_path / "gap.tlog"), *_recordings()]
     page = tmp_path / "lint.html"
     args = ["lint", *map(str, paths), "--px4", "1.15", "--vehicle", "mc"]
     result = run_cli([*args, "--format", "html", "--output", str(page)])

@@ -12,12 +12,11 @@ import pytest
 
 from fuzzoff.catalog import load_catalog
 from fuzzoff.config import Settings
-from fuzzoff.events import SetPositionTargetLocal, Where
+from fuzzoff.events import Where
 from fuzzoff.findings import Finding, Report, Severity
 from fuzzoff.report.sarif import fingerprint, sarif_log
-from fuzzoff.writers.tlog import write_tlog
 from tests.helpers import ROOT, run_cli
-from tests.report_fixtures import hostile_report
+from tests.report_fixtures import gap_recording, hostile_report
 
 MULTITOOL = ROOT / "build" / "node" / "node_modules" / ".bin" / "sarif-multitool"
 
@@ -33,15 +32,6 @@ def multitool() -> Path:
             pytest.fail(reason)
         pytest.skip(reason)
     return found
-
-
-def gap_recording(path: Path) -> Path:
-    events = [
-        SetPositionTargetLocal(t=i * 0.05, target_system=1, target_component=1)
-        for i in range(60)
-        if not 1.0 < i * 0.05 < 2.2
-    ]
-    return write_tlog(path, events)
 
 
 def validate(tool: Path, logs: list[Path], out: Path) -> list[dict[str, Any]]:
