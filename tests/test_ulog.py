@@ -1,0 +1,421 @@
+"""PX4 ULog: the writer and reader round-trip every kind; damage is one line, never a traceback."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from fuzzoff.events import (
+    ActuatorMotors,
+    ActuatorServos,
+    AttitudeSetpoint,
+    Command,
+    CommandAck,
+    ControlMode,
+    Dropout,
+    Event,
+    FailsafeFlags,
+    LegacyControlMode,
+    Parameter,
+    PositionSetpointTriplet,
+    RatesSetpoint,
+    RoverAttitudeSetpoint,
+    RoverPositionSetpoint,
+    RoverRateSetpoint,
+    RoverSpeedSetpoint,
+    RoverSteeringSetpoint,
+    RoverThrottleSetpoint,
+    StatusText,
+    ThrustSetpoint,
+    TorqueSetpoint,
+    TrajectorySetpoint,
+    VehicleControlModeStatus,
+    VehicleInfo,
+    VehicleStatus,
+    event_to_dict,
+)
+from fuzzoff.sources import open_source
+from fuzzoff.sources.ulog import UlogSource, decode_release
+from fuzzoff.writers.ulog import DEFAULT_START_US, ver_sw_release, write_ulog
+from tests.helpers import run_cli, run_cli_process
+
+NAN = math.nan
+VERSIONS = {
+    "legacy": "1.7.3",
+    "1.13": "1.13.3",
+    "1.14": "1.14.4",
+    "1.15": "1.15.4",
+    "1.17": "1.17.0",
+}
+
+
+def _flags(valid: bool) -> dict[str, Any]:
+    names = ("local_position", "local_velocity", "local_altitude", "global_position")
+    names += ("attitude", "angular_velocity", "home_position")
+    return {f"{name}_valid": valid for name in names}
+
+
+def flight(era: str) -> list[Event]:
+    """One of every kind the ULog reader emits for ``era`` (values exact in float32)."""
+    legacy, modern = era == "legacy", era not in ("legacy", "1.13")
+    params = {"COM_OBL_RC_ACT": 0.0, "COM_OF_LOSS_T": 0.0 if legacy else 1.0, "MAV_TYPE": 2.0}
+    if modern:
+        params["CA_AIRFRAME"] = 0.0
+    out: list[Event] = [
+        VehicleInfo(t=0.0, px4_version=VERSIONS[era], vehicle_type="mc", mav_type=2),
+        *(Parameter(t=0.0, name=n, value=v) for n, v in params.items()),
+        VehicleStatus(
+            t=0.5,
+            nav_state=2,
+            mode="POSCTL",
+            armed=True,
+            user_intention=2,
+            failsafe=False,
+            vehicle_type=1,
+            is_vtol=False,
+        ),
+        FailsafeFlags(
+            t=0.5,
+            offboard_control_signal_lost=True,
+            manual_control_signal_lost=False,
+            **_flags(True),
+        ),
+        VehicleControlModeStatus(
+            t=0.6, offboard_enabled=True, enabled=frozenset({"offboard", "position", "velocity"})
+        ),
+    ]
+    layout = "thrust_and_torque" if era in ("1.15", "1.17") else "actuator"
+    if legacy:
+        out.append(LegacyControlMode(t=1.0, ignore_thrust=True, ignore_acceleration_force=True))
+    else:
+        out.append(
+            ControlMode(
+                t=1.0,
+                position=True,
+                thrust_and_torque=layout == "thrust_and_torque",
+                actuator=layout == "actuator",
+                layout=layout,  # type: ignore[arg-type]
+            )
+        )
+    motors = 8 if era in ("legacy", "1.13") else 12
+    out += [
+        TrajectorySetpoint(
+            t=1.0,
+            position=(1.5, -2.0, -3.25),
+            velocity=(NAN, NAN, NAN) if legacy else (0.5, 0.0, -0.25),
+            acceleration=(NAN, NAN, NAN),
+            jerk=(0.0, 0.0, 0.0),
+            yaw=1.5,
+            yawspeed=NAN,
+        ),
+        AttitudeSetpoint(
+            t=1.1, q_d=(1.0, 0.0, 0.0, 0.0), thrust_body=(0.0, 0.0, -0.5), yaw_sp_move_rate=0.0
+        ),
+        RatesSetpoint(t=1.2, roll=0.25, pitch=-0.25, yaw=0.5, thrust_body=(0.0, 0.0, -0.75)),
+        ThrustSetpoint(t=1.3, xyz=(0.0, 0.0, -0.5)),
+        TorqueSetpoint(t=1.3, xyz=(0.125, -0.125, 0.0)),
+        ActuatorMotors(t=1.4, control=(0.5,) * 4 + (NAN,) * (motors - 4), reversible_flags=3),
+        ActuatorServos(t=1.4, control=(0.25,) * 8),
+        PositionSetpointTriplet(
+            t=1.5,
+            previous_valid=True,
+            current_valid=True,
+            current_type=6,
+            current_position_valid=True,
+            current_yaw_valid=True,
+        ),
+        RoverPositionSetpoint(
+            t=1.6,
+            position_ned=(10.0, 20.0),
+            start_ned=(0.0, 0.0) if era == "1.17" else (NAN, NAN),
+            cruising_speed=2.0,
+            arrival_speed=0.5 if era == "1.17" else NAN,
+            yaw=NAN,
+        ),
+        RoverAttitudeSetpoint(t=1.6, yaw_setpoint=0.5),
+        RoverRateSetpoint(t=1.6, yaw_rate_setpoint=0.25),
+        RoverThrottleSetpoint(t=1.6, throttle_body_x=0.5, throttle_body_y=0.0),
+        RoverSpeedSetpoint(t=1.6, speed_body_x=1.5, speed_body_y=0.0),
+        RoverSteeringSetpoint(
+            t=1.6,
+            normalized_steering_angle=0.25,
+            normalized_speed_diff=NAN if era == "1.17" else 0.5,
+        ),
+        Command(
+            t=2.0,
+            command=176,
+            params=(1.0, 6.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+            target_system=1,
+            target_component=1,
+            source_system=255,
+            source_component=190,
+            from_external=True,
+            transport="uorb",
+        ),
+        CommandAck(t=2.0, command=176, result=0, target_system=255, target_component=190),
+        VehicleStatus(
+            t=2.0,
+            nav_state=14,
+            mode="OFFBOARD",
+            armed=True,
+            user_intention=14,
+            failsafe=False,
+            vehicle_type=1,
+            is_vtol=False,
+        ),
+        StatusText(t=2.5, severity=4, text="Offboard control lost"),
+        # A parameter change and a dropout are dated at the data message before them.
+        LegacyControlMode(t=3.0) if legacy else ControlMode(t=3.0, velocity=True, layout=layout),  # type: ignore[arg-type]
+        Parameter(t=3.0, name="COM_OBL_RC_ACT", value=3.0),
+        Dropout(t=3.0, duration_s=0.25),
+    ]
+    return out
+
+
+def _comparable(event: Event) -> tuple[Any, ...]:
+    data = event_to_dict(event)
+    data.pop("where")
+    data.pop("sender_time_us")
+    data.pop("origin")  # a ULog is the vehicle's copy: always "vehicle" (asserted apart)
+    text = json.dumps(data, sort_keys=True, default=str).replace("NaN", '"nan"')
+    return (round(event.t, 6), event.kind, text)
+
+
+def read(path: Path) -> list[Event]:
+    with open_source(path) as source:
+        events = list(source.events())
+        assert source.problems == []
+    return events
+
+
+@pytest.mark.parametrize("era", sorted(VERSIONS))
+def test_every_kind_round_trips_through_a_ulog(era: str, tmp_path: Path) -> None:
+    events = flight(era)
+    path = write_ulog(tmp_path / "flight.ulg", events, px4_version=VERSIONS[era])
+    back = read(path)
+    assert sorted(map(_comparable, back)) == sorted(map(_comparable, events))
+    for event in back:
+        assert event.origin == "vehicle"
+        if event.where.topic not in ("info", "parameters"):
+            assert event.sender_time_us == DEFAULT_START_US + round(event.t * 1e6)
+
+
+def test_round_trip_covers_every_kind_the_reader_emits() -> None:
+    from fuzzoff.sources.ulog_topics import TOPICS
+
+    kinds = {e.kind for era in VERSIONS for e in flight(era)}
+    assert {spec.kind for spec in TOPICS.values()} | {"legacy_control_mode"} <= kinds
+
+
+def test_events_come_out_in_time_order_with_their_place_in_the_topic(tmp_path: Path) -> None:
+    events = [ControlMode(t=0.1 * k, position=True) for k in range(1, 30)]
+    events += [TrajectorySetpoint(t=0.05 + 0.2 * k, position=(0.0, 0.0, -1.0)) for k in range(15)]
+    back = read(write_ulog(tmp_path / "a.ulg", events))
+    times = [e.t for e in back]
+    assert times == sorted(times)
+    ocm = [e for e in back if isinstance(e, ControlMode)]
+    assert [e.where.index for e in ocm] == list(range(29))
+    assert {e.where.topic for e in ocm} == {"offboard_control_mode"}
+
+
+def test_probe_reports_version_vehicle_kinds_and_logging_intervals(tmp_path: Path) -> None:
+    events: list[Event] = [VehicleStatus(t=0.1, nav_state=14, armed=True, vehicle_type=1)]
+    events += [ControlMode(t=0.5 + 0.1 * k, position=True) for k in range(50)]
+    events += [TrajectorySetpoint(t=0.5 + 0.2 * k, position=(0.0, 0.0, -2.0)) for k in range(25)]
+    path = write_ulog(tmp_path / "a.ulg", events, px4_version="1.16.1")
+    with open_source(path) as source:
+        info = source.probe()
+    assert info.format == "ulog"
+    assert info.px4_version == "1.16.1"
+    assert info.vehicle_type == "mc"
+    assert {"control_mode", "trajectory", "vehicle_status", "parameter"} <= info.kinds
+    assert info.sampled_intervals == {"control_mode": 0.1, "trajectory": 0.2}
+
+
+def test_a_stream_slower_than_the_logger_is_not_taken_for_its_interval(tmp_path: Path) -> None:
+    events = [ControlMode(t=0.5 * k, position=True) for k in range(1, 20)]
+    with open_source(write_ulog(tmp_path / "a.ulg", events)) as source:
+        assert source.probe().sampled_intervals == {"control_mode": 0.1}
+
+
+@pytest.mark.parametrize(
+    ("word", "text"),
+    [
+        (0x010F04FF, "1.15.4"),
+        (0x011100C0, "1.17.0-rc"),
+        (0x010E0080, "1.14.0-beta"),
+        (0x010D0300, "1.13.3-dev"),
+        (0, None),
+    ],
+)
+def test_ver_sw_release_is_decoded(word: int, text: str | None) -> None:
+    assert decode_release(word) == text
+    if text is not None:
+        assert ver_sw_release(text) == word
+
+
+@pytest.mark.parametrize(
+    ("params", "status", "vehicle"),
+    [
+        ({"CA_AIRFRAME": 5}, 3, "rover-ackermann"),
+        ({"CA_AIRFRAME": 13}, 3, "rover-mecanum"),
+        ({"RD_WHEEL_TRACK": 0.3, "MAV_TYPE": 10}, 3, "rover-differential"),
+        ({"RA_WHEEL_BASE": 0.3, "MAV_TYPE": 10}, 3, "rover-ackermann"),
+        ({"MAV_TYPE": 10}, 3, "rover-differential"),
+        ({"CA_AIRFRAME": 2}, 1, "vtol"),
+        ({"MAV_TYPE": 1}, 2, "fw"),
+    ],
+)
+def test_vehicle_type_comes_from_status_and_parameters(
+    params: dict[str, float], status: int, vehicle: str, tmp_path: Path
+) -> None:
+    is_vtol = vehicle == "vtol"
+    events = [VehicleStatus(t=0.1, nav_state=2, vehicle_type=status, is_vtol=is_vtol)]
+    path = write_ulog(tmp_path / "a.ulg", events, layout="1.13", params=params)
+    with open_source(path) as source:
+        assert source.probe().vehicle_type == vehicle
+
+
+def test_legacy_arming_numbering_counts_armed_error_as_armed(tmp_path: Path) -> None:
+    path = write_ulog(tmp_path / "a.ulg", [VehicleStatus(t=0.1, armed=True)], px4_version="1.7.3")
+    with open_source(path) as source:
+        (status,) = [e for e in source.events() if isinstance(e, VehicleStatus)]
+    assert status.armed is True
+
+
+# -- bad input -------------------------------------------------------------------------------
+
+
+def offboard_with_rejection() -> list[Event]:
+    """A rejected switch early (OFB201 at 1.0 s), then a long clean offboard flight."""
+    events: list[Event] = [
+        VehicleStatus(t=0.05, nav_state=2, armed=True, user_intention=2, vehicle_type=1),
+        Command(t=1.0, command=176, params=(1.0, 6.0, 0, 0, 0, 0, 0), target_system=1),
+        CommandAck(t=1.01, command=176, result=1),
+    ]
+    for k in range(300):
+        t = 2.0 + 0.1 * k
+        events.append(ControlMode(t=t, position=True))
+        events.append(TrajectorySetpoint(t=t, position=(0.0, 0.0, -5.0)))
+    return events
+
+
+@pytest.fixture(scope="module")
+def good_log(tmp_path_factory: pytest.TempPathFactory) -> bytes:
+    path = tmp_path_factory.mktemp("ulog") / "good.ulg"
+    return write_ulog(path, offboard_with_rejection()).read_bytes()
+
+
+def _damaged(data: bytes, how: str) -> bytes:
+    middle = len(data) // 2
+    if how == "empty":
+        return b""
+    if how == "foreign":
+        return b"%PDF-1.4 not a flight log at all\n" * 4
+    if how == "header":
+        return data[:10]
+    if how == "definitions":
+        return data[:400]
+    if how.startswith("cut"):
+        return data[: int(len(data) * float(how[3:]))]
+    if how == "flipped":
+        return (
+            data[:middle]
+            + bytes(b ^ 0xA5 for b in data[middle : middle + 64])
+            + data[middle + 64 :]
+        )
+    if how == "no-format":
+        at = data.index(b"trajectory_setpoint:")
+        return data[:at] + b"trajectory_setpoinX:" + data[at + 20 :]
+    raise AssertionError(how)
+
+
+BAD = {
+    "empty": "empty file",
+    "foreign": "not a recording",
+    "header": "shorter than the 16-byte ULog header",
+    "definitions": "truncated in the definition section",
+    "cut0.6": "truncated in the middle of a message",
+    "cut0.93": "truncated in the middle of a message",
+    "flipped": "corrupt",
+    "no-format": "no message format for topic trajectory_setpoint",
+}
+
+
+@pytest.mark.parametrize("how", sorted(BAD))
+def test_damaged_ulog_is_one_line_exit_2_and_json_stays_clean(
+    how: str, good_log: bytes, tmp_path: Path
+) -> None:
+    path = tmp_path / "flight.ulg"
+    path.write_bytes(_damaged(good_log, how))
+    result = run_cli(["lint", str(path), "--format", "json"])
+    assert result.returncode == 2
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1, result.stderr
+    assert str(path) in lines[0] and BAD[how] in lines[0]
+    assert "Traceback" not in result.stderr
+    (report,) = json.loads(result.stdout)["files"]  # nothing else on stdout
+    assert report["complete"] is False
+    codes = [f["code"] for f in report["findings"]]
+    assert codes.count("OFB001") == 1
+    if how.startswith("cut") or how in ("flipped", "no-format"):
+        assert " at byte " in lines[0]
+        assert "OFB201" in codes  # found in the readable part, kept
+
+
+def test_truncation_says_when_the_last_complete_message_was(
+    good_log: bytes, tmp_path: Path
+) -> None:
+    path = tmp_path / "cut.ulg"
+    path.write_bytes(good_log[: len(good_log) // 2 + 5])
+    with open_source(path) as source:
+        events = list(source.events())
+        (problem,) = source.problems
+    assert problem.time_s == pytest.approx(events[-1].t)
+    assert f"{problem.time_s:.3f} s" in (problem.where or "")
+
+
+def test_pyulog_output_never_reaches_stdout(good_log: bytes, tmp_path: Path) -> None:
+    path = tmp_path / "flipped.ulg"
+    path.write_bytes(_damaged(good_log, "flipped"))
+    result = run_cli_process(["lint", str(path), "--format", "json"])
+    assert result.returncode == 2
+    assert result.stdout.lstrip().startswith("{")
+    json.loads(result.stdout)
+    assert "corruption detected" not in result.stdout + result.stderr
+
+
+def test_reader_is_registered_for_ulog_content(tmp_path: Path) -> None:
+    path = write_ulog(tmp_path / "renamed.bin", [ControlMode(t=0.1, position=True)])
+    assert isinstance(open_source(path), UlogSource)
+
+
+# -- sampling: PX4's own setpoints are not an offboard stream -----------------------------------
+
+
+def auto_mission() -> list[Event]:
+    """Takeoff, mission and landing: PX4 logs trajectory_setpoint itself, no offboard at all."""
+    events: list[Event] = [VehicleStatus(t=0.1, nav_state=4, armed=False, vehicle_type=1)]
+    events.append(VehicleStatus(t=1.0, nav_state=17, armed=True, user_intention=17, vehicle_type=1))
+    events.append(VehicleStatus(t=5.0, nav_state=3, armed=True, user_intention=3, vehicle_type=1))
+    events.append(
+        VehicleStatus(t=40.0, nav_state=18, armed=True, user_intention=18, vehicle_type=1)
+    )
+    for k in range(1, 250):  # 5 Hz, with the logger's occasional 0.6 s hole
+        if k % 50 == 0:
+            continue
+        events.append(TrajectorySetpoint(t=0.2 * k, position=(float(k), 0.0, -10.0)))
+        events.append(AttitudeSetpoint(t=0.2 * k + 0.01, q_d=(1.0, 0.0, 0.0, 0.0)))
+    return events
+
+
+def test_auto_mission_log_gives_no_stream_findings(tmp_path: Path) -> None:
+    path = write_ulog(tmp_path / "mission.ulg", auto_mission())
+    result = run_cli(["lint", str(path), "--format", "json"])
+    (report,) = json.loads(result.stdout)["files"]
+    assert report["complete"] is True
+    assert not [f for f in report["findings"] if f["code"].startswith("OFB1")]
