@@ -24,7 +24,7 @@ from pyulog import ULog
 
 from fuzzoff import events as ev
 from fuzzoff.sources.ulog_topics import NAV_TO_MAIN_STATE
-from fuzzoff.writers.ulog_formats import NESTED, era_for, fields_for
+from fuzzoff.writers.ulog_formats import FORMATS, NESTED, era_for, fields_for
 
 DEFAULT_START_US = 20_000_000
 """PX4's logger starts some seconds after boot; the header timestamp is that moment."""
@@ -414,8 +414,7 @@ def write_ulog(
 
     formats: dict[str, Any] = {name: _format(name, fields) for name, fields in NESTED.items()}
     for msg_id, topic in enumerate(sorted(topics.rows)):
-        fields = fields_for(topic, era) or fields_for(topic, "1.17")
-        assert fields is not None, topic
+        fields = fields_for(topic, era) or FORMATS[topic][0][1]  # before it existed: its first
         formats[topic] = _format(topic, fields)
         ulog._data_list.append(_dataset(topic, msg_id, topics.rows[topic], formats))
     ulog._message_formats = formats
