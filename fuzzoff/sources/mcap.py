@@ -81,6 +81,7 @@ class McapStream:
             reader = StreamReader(
                 fh, emit_chunks=True, validate_crcs=True, record_size_limit=max(self.size, 1)
             )
+            good = 0
             try:
                 for record in reader.records:
                     if type(record) is Chunk:
@@ -89,6 +90,7 @@ class McapStream:
                         if type(record) is Footer:
                             self.footer = True
                         yield record
+                    good = fh.tell()
             except CRCValidationError as exc:
                 if isinstance(exc.record, DataEnd):
                     self.problems.append(
@@ -97,17 +99,17 @@ class McapStream:
                         )
                     )
                 else:
-                    self._cut(fh.tell(), "corrupt record")
-            except (McapError, ValueError, EOFError, OSError) as exc:
-                self._cut(fh.tell(), _reason(exc))
+                    self._cut(good, "corrupt record")
+            except Exception as exc:
+                self._cut(good, _reason(exc))
             finally:
                 self.fh = None
 
     def _cut(self, offset: int, why: str) -> None:
         self.problems.append(
             SourceProblem(
-                f"{why}: nothing after this point could be read (truncated or corrupt; "
-                "no valid footer)",
+                f"{why}: nothing after the last whole record could be read (truncated or "
+                "corrupt; no valid footer)",
                 f"byte {offset} of {self.size}",
             )
         )
@@ -177,7 +179,7 @@ class McapStream:
 
 def _reason(exc: BaseException) -> str:
     name = type(exc).__name__
-    if name == "EndOfFile":
+    if name in ("EndOfFile", "error"):
         return "file ends inside a record"
     if name == "InvalidMagic":
         return "bad magic bytes"

@@ -9,7 +9,11 @@ by row; a cut ``.mcap`` -> fuzzoff's streaming MCAP reader. Every salvage is a p
 
 from __future__ import annotations
 
+import re
+import shutil
 import sqlite3
+import struct
+import tempfile
 from collections.abc import Iterator
 from contextlib import suppress
 from pathlib import Path
@@ -32,6 +36,7 @@ _FORMATS = {MessageDefinitionFormat.MSG: "msg", MessageDefinitionFormat.IDL: "id
 
 def _why(exc: BaseException) -> str:
     text = str(exc).strip().rstrip(".") or type(exc).__name__
+    text = re.sub(r"^Cannot open database .*?: ", "", text)
     return text.replace("\n", " ")
 
 
@@ -247,39 +252,51 @@ class Rosbag2Source(Source):
 
     def _salvage_sqlite(self, path: Path, exc: BaseException) -> Iterator[Event]:
         """Row by row with Python's sqlite3, in row order, until the damage (formats.md 5)."""
-        try:
-            db = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
-        except sqlite3.Error as err:
-            self.problems.append(SourceProblem(f"cannot open the database: {_why(err)}", path.name))
-            return
+        with tempfile.TemporaryDirectory(prefix="fuzzoff-") as tmp:
+            try:
+                db = sqlite3.connect(f"file:{_readable_copy(path, Path(tmp))}?mode=ro", uri=True)
+            except (sqlite3.Error, OSError) as err:
+                what = f"cannot open the database: {_why(err)}"
+                self.problems.append(SourceProblem(what, path.name))
+                return
+            yield from self._salvage_rows(db, path, exc)
+
+    def _salvage_rows(
+        self, db: sqlite3.Connection, path: Path, exc: BaseException
+    ) -> Iterator[Event]:
         count = 0
         try:
             topics = self._sqlite_topics(db)
-            self.problems.append(
-                SourceProblem(
-                    f"rosbags cannot read this database ({_why(exc)}); salvaged row by row",
-                    path.name,
-                )
-            )
             order = ChunkOrder()
             t0 = self._t0
             rows = db.execute("SELECT topic_id, timestamp, data FROM messages ORDER BY id")
-            for topic_id, stamp, raw in rows:
-                count += 1
-                if t0 is None:
-                    t0 = self._t0 = stamp
-                decoder = topics.get(topic_id)
-                if decoder is None:
-                    continue
-                event = decoder.event(raw, (stamp - t0) / 1e9)
-                if event is not None:
-                    yield from order.add(stamp, event)
-            yield from order.flush()
+            try:
+                for topic_id, stamp, raw in rows:
+                    count += 1
+                    if t0 is None:
+                        t0 = self._t0 = stamp
+                    decoder = topics.get(topic_id)
+                    if decoder is None:
+                        continue
+                    event = decoder.event(raw, (stamp - t0) / 1e9)
+                    if event is not None:
+                        yield from order.add(stamp, event)
+            finally:
+                yield from order.flush()
         except sqlite3.Error as err:
             self.problems.append(
                 SourceProblem(
-                    f"database damaged ({_why(err)}); rows after this could not be read",
+                    f"database damaged ({_why(err)}): read row by row up to the damage, "
+                    "nothing after it",
                     f"{path.name} after {count} messages",
+                )
+            )
+        else:
+            self.problems.append(
+                SourceProblem(
+                    f"rosbags cannot read this database ({_why(exc)}); all {count} rows "
+                    "were salvaged with sqlite3",
+                    path.name,
                 )
             )
         finally:
@@ -323,6 +340,30 @@ class Rosbag2Source(Source):
         if self._files:
             return self._done / len(self._files)
         return None
+
+
+def _readable_copy(path: Path, folder: Path) -> Path:
+    """A copy of a cut database whose header no longer claims the missing pages.
+
+    SQLite trusts the page count in the header of a cleanly closed file, so a byte-truncated
+    database fails on its first query, even for pages that are all there. The copy's header
+    states the pages the file really has (and rollback-journal mode, so no -wal is needed).
+    """
+    copy = folder / path.name
+    shutil.copyfile(path, copy)
+    with copy.open("r+b") as fh:
+        header = fh.read(100)
+        if len(header) < 100 or not header.startswith(b"SQLite format 3\x00"):
+            return copy
+        page_size = struct.unpack(">H", header[16:18])[0]
+        page_size = 65536 if page_size == 1 else page_size
+        pages = copy.stat().st_size // max(page_size, 512)
+        if struct.unpack(">I", header[28:32])[0] > pages:
+            fh.seek(28)
+            fh.write(struct.pack(">I", pages))
+        fh.seek(18)
+        fh.write(b"\x01\x01")
+    return copy
 
 
 def _sqlite_start(path: Path) -> int | None:

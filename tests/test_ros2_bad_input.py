@@ -1,0 +1,213 @@
+"""Damaged MCAP files and ROS 2 bags: one clear line per problem, what was readable kept, exit 2."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+from mcap.reader import make_reader
+
+from fuzzoff import events as ev
+from fuzzoff.writers.mcap import write_mcap
+from fuzzoff.writers.ros2_messages import RawMessage
+from fuzzoff.writers.rosbag2 import write_rosbag2
+from tests.helpers import run_cli
+from tests.ros2_samples import read_all
+
+N = 400
+
+
+def flight() -> list[ev.Event]:
+    """20 s of keep-alive and setpoints at 20 Hz."""
+    out: list[ev.Event] = []
+    for i in range(N):
+        t = i * 0.05
+        out.append(ev.ControlMode(t=t, position=True, sender_time_us=1_000_000 + i * 50_000))
+        out.append(
+            ev.TrajectorySetpoint(
+                t=t + 0.001, position=(0.0, 0.0, -2.0), sender_time_us=1_000_000 + i * 50_000
+            )
+        )
+    return out
+
+
+def lint(path: Path) -> tuple[int, dict, str]:  # type: ignore[type-arg]
+    result = run_cli(["lint", str(path), "--format", "json"])
+    (report,) = json.loads(result.stdout)["files"]
+    return result.returncode, report, result.stderr
+
+
+def assert_clean_failure(path: Path, needle: str) -> list[str]:
+    code, report, stderr = lint(path)
+    assert code == 2
+    assert report["complete"] is False
+    assert "Traceback" not in stderr
+    lines = [line for line in stderr.splitlines() if line.strip()]
+    assert lines and all(line.startswith(f"fuzzoff: {path}") for line in lines)
+    assert any(needle in line for line in lines), lines
+    assert any(f["code"] == "OFB001" for f in report["findings"])
+    return lines
+
+
+def flip(path: Path, offset: int, count: int = 64) -> None:
+    data = bytearray(path.read_bytes())
+    for k in range(offset, min(offset + count, len(data))):
+        data[k] ^= 0xFF
+    path.write_bytes(bytes(data))
+
+
+@pytest.fixture
+def mcap_file(tmp_path: Path) -> Path:
+    return write_mcap(tmp_path / "flight.mcap", flight(), chunk_size=4096)
+
+
+def test_truncated_mcap_keeps_the_first_half(mcap_file: Path) -> None:
+    data = mcap_file.read_bytes()
+    mcap_file.write_bytes(data[: len(data) // 2])
+    assert_clean_failure(mcap_file, "truncated")
+    _source, events = read_all(mcap_file)
+    assert N // 4 < len(events) < 2 * N
+    assert [e.t for e in events] == sorted(e.t for e in events)
+
+
+def test_flipped_bytes_in_a_chunk_skip_that_chunk_only(mcap_file: Path) -> None:
+    with mcap_file.open("rb") as fh:
+        summary = make_reader(fh).get_summary()
+    chunks = summary.chunk_indexes
+    middle = chunks[len(chunks) // 2]
+    flip(mcap_file, middle.chunk_start_offset + middle.chunk_length // 2, 16)
+    assert_clean_failure(mcap_file, "chunk")
+    _, events = read_all(mcap_file)
+    assert 2 * N * 0.5 < len(events) < 2 * N
+    assert events[-1].t == pytest.approx((N - 1) * 0.05 + 0.001)
+
+
+def test_missing_footer_keeps_every_chunk(mcap_file: Path) -> None:
+    with mcap_file.open("rb") as fh:
+        summary = make_reader(fh).get_summary()
+    last = summary.chunk_indexes[-1]
+    data = mcap_file.read_bytes()
+    end = last.chunk_start_offset + last.chunk_length
+    mcap_file.write_bytes(data[:end])
+    assert_clean_failure(mcap_file, "no valid footer")
+    source, events = read_all(mcap_file)
+    assert len(events) == 2 * N
+    assert source.probe().kinds == {"control_mode", "trajectory"}
+
+
+def test_not_an_mcap_behind_the_name(tmp_path: Path) -> None:
+    path = tmp_path / "fake.mcap"
+    path.write_bytes(b"hello, this is text, not a recording\n" * 4)
+    assert_clean_failure(path, "not a recording")
+
+
+@pytest.fixture
+def bag(tmp_path: Path) -> Path:
+    return write_rosbag2(tmp_path / "bag", flight())
+
+
+def test_missing_metadata_reads_the_data_files(bag: Path) -> None:
+    (bag / "metadata.yaml").unlink()
+    source, events = read_all(bag)
+    (problem,) = source.problems
+    assert "metadata.yaml is missing" in problem.what
+    assert len(events) == 2 * N
+
+
+def test_malformed_metadata_reads_the_db3(bag: Path) -> None:
+    (bag / "metadata.yaml").write_text("rosbag2_bagfile_information: [unclosed\n  : :\n")
+    assert_clean_failure(bag, "metadata.yaml cannot be used")
+    _, events = read_all(bag)
+    assert len(events) == 2 * N
+
+
+def test_db3_given_directly_needs_no_metadata(bag: Path) -> None:
+    db3 = next(bag.glob("*.db3"))
+    _code, report, _stderr = lint(db3)
+    assert report["complete"] is True
+    assert report["format"] == "rosbag2-sqlite3"
+    _, events = read_all(db3)
+    assert len(events) == 2 * N
+
+
+def test_cut_db3_is_salvaged_row_by_row(bag: Path) -> None:
+    db3 = next(bag.glob("*.db3"))
+    data = db3.read_bytes()
+    db3.write_bytes(data[: len(data) // 2])
+    assert_clean_failure(bag, "database damaged")
+    _, events = read_all(bag)
+    assert N // 2 < len(events) < 2 * N
+    assert [e.t for e in events] == sorted(e.t for e in events)
+
+
+def test_db3_that_is_not_a_database(bag: Path) -> None:
+    db3 = next(bag.glob("*.db3"))
+    db3.write_bytes(b"\x00" * 4096)
+    lines = assert_clean_failure(bag, "bag.db3")
+    assert len(lines) <= 2
+
+
+def test_cut_mcap_storage_in_a_bag_is_streamed(tmp_path: Path) -> None:
+    # rosbags writes 1 MiB chunks: camera-sized messages make several.
+    camera = [
+        RawMessage(i * 0.1, "/camera", "acme_msgs/msg/Blob", "uint8[] d\n", bytes(16_000))
+        for i in range(200)
+    ]
+    bag = write_rosbag2(tmp_path / "bag", flight(), storage="mcap", extra=camera)
+    data_file = next(bag.glob("*.mcap"))
+    data = data_file.read_bytes()
+    data_file.write_bytes(data[: len(data) * 3 // 4])
+    assert_clean_failure(bag, "no valid footer")
+    _, events = read_all(bag)
+    assert len(events) > N // 2
+
+
+def test_px4_topic_of_unknown_type_is_reported_not_guessed(tmp_path: Path) -> None:
+    foreign = [
+        RawMessage(
+            0.5,
+            "/fmu/in/vehicle_command",
+            "acme_msgs/msg/Command",
+            "int32 x\n",
+            b"\0\1\0\0\5\0\0\0",
+        )
+    ]
+    for path in (
+        write_mcap(tmp_path / "f.mcap", flight(), extra=foreign),
+        write_rosbag2(tmp_path / "bag", flight(), extra=foreign),
+    ):
+        assert_clean_failure(path, "acme_msgs/msg/Command")
+        _, events = read_all(path)
+        assert len(events) == 2 * N
+
+
+def test_foreign_topics_are_ignored_quietly(tmp_path: Path) -> None:
+    camera = [
+        RawMessage(i * 0.5, "/camera/raw", "acme_msgs/msg/Blob", "uint8[] d\n", b"\0\1\0\0\0\0\0\0")
+        for i in range(5)
+    ]
+    path = write_mcap(tmp_path / "f.mcap", flight(), extra=camera)
+    _code, report, _ = lint(path)
+    assert report["complete"] is True
+    source, events = read_all(path)
+    assert len(events) == 2 * N
+    assert source.stats["messages"] == 2 * N + 5
+
+
+def test_wrong_release_payload_is_a_problem_not_a_guess(tmp_path: Path) -> None:
+    # 1.14 definitions embedded, 1.13 payloads: TrajectorySetpoint is longer in 1.13.
+    path = write_mcap(tmp_path / "f.mcap", flight(), release="1.14", payload_release="1.13")
+    lines = assert_clean_failure(path, "TrajectorySetpoint")
+    assert any("embedded definition" in line for line in lines)
+
+
+def test_damaged_copy_leaves_the_original_untouched(bag: Path, tmp_path: Path) -> None:
+    copy = tmp_path / "copy"
+    shutil.copytree(bag, copy)
+    db3 = next(copy.glob("*.db3"))
+    db3.write_bytes(db3.read_bytes()[:8192])
+    before = db3.read_bytes()
+    lint(copy)
+    assert db3.read_bytes() == before
