@@ -262,11 +262,20 @@ def test_a_repeated_mistake_is_one_finding_per_stretch() -> None:
     good = [
         setpoint(tm.LOCAL, t=1.0 + i * 0.05, type_mask=3576, coordinate_frame=1) for i in range(5)
     ]
-    again = [setpoint(tm.LOCAL, t=2.0, type_mask=3576, coordinate_frame=7)]
+    again = [setpoint(tm.LOCAL, t=2.5, type_mask=3576, coordinate_frame=7)]
     found = codes(lint(bad + good + again), "OFB601")
-    assert [f.time_s for f in found] == [0.0, 2.0]
+    assert [f.time_s for f in found] == [0.0, 2.5]
     assert found[0].end_s == pytest.approx(0.95)
     assert "20 messages" in found[0].message
+
+
+def test_good_messages_between_bad_ones_do_not_split_the_stretch() -> None:
+    events = [
+        setpoint(tm.LOCAL, t=i * 0.05, type_mask=3576, coordinate_frame=7 if i % 2 else 1)
+        for i in range(40)
+    ]
+    (finding,) = codes(lint(events), "OFB601")
+    assert finding.time_s == pytest.approx(0.05) and finding.end_s == pytest.approx(1.95)
 
 
 def heartbeat(t: float, vehicle: str = "1") -> VehicleStatus:

@@ -1,10 +1,12 @@
 """One finding per stretch of offending messages, not one per message.
 
 A stream repeats the same mistake at 20-50 Hz; a finding per message would bury the report.
-``Episodes`` keeps one open stretch per (code, key): it opens at the first offending message,
-grows while the following messages of the same stream offend the same way, and is reported
-(at its first message, with ``end`` = its last) when a message no longer offends or the
-recording ends.
+``Episodes`` keeps one open stretch per (code, stream, key): it opens at the first offending
+message and grows while messages of that stream keep offending the same way with less than
+``MERGE_GAP_S`` between them, so clean messages interleaved with bad ones (two senders, or a
+program that alternates two kinds of setpoint) do not split it. A stretch is reported (at its
+first message, with ``end`` = its last) when it is closed: by a longer pause in the offence, by
+``clear`` (e.g. the vehicle left offboard) or at the end of the recording.
 """
 
 from __future__ import annotations
@@ -14,6 +16,9 @@ from dataclasses import dataclass
 from fuzzoff.checks.base import CheckContext
 from fuzzoff.events import Where
 from fuzzoff.findings import Severity
+
+MERGE_GAP_S = 1.0
+"""Offending messages closer than this belong to one stretch."""
 
 
 @dataclass(slots=True)
@@ -45,7 +50,7 @@ class Episodes:
     ) -> None:
         """This message of ``stream`` commits ``offences`` (key -> offence) under ``code``."""
         for key in [k for k in self.open if k[0] == code and k[1] == stream]:
-            if key[2] not in offences:
+            if t - self.open[key].last_t > MERGE_GAP_S:
                 self._close(key)
         for name, offence in offences.items():
             key = (code, stream, name)
