@@ -79,7 +79,7 @@ def run(args: argparse.Namespace) -> int:
         if args.output:
             with open(args.output, "w", encoding="utf-8") as fh:
                 print_report(
-                    Console(file=fh, no_color=True, width=160),
+                    Console(file=fh, no_color=True, width=160, force_terminal=False),
                     report,
                     settings.fail_on,
                     quiet=args.quiet,

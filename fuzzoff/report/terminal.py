@@ -1,13 +1,16 @@
-"""Terminal output with rich: findings grouped per file, then a summary.
+"""Terminal output with rich: findings grouped per file, then a summary (ruff-like).
 
-Colour only on a terminal and without ``NO_COLOR`` (rich decides); every string that comes from a
-recording goes through ``printable`` and into ``Text`` objects, never into markup.
+Colour only on a terminal and without ``NO_COLOR`` (rich decides; ``FORCE_COLOR`` forces it);
+tables fall back to ASCII when the output is not a terminal. Every string that comes from a
+recording goes through ``printable`` and into ``Text`` objects, never into markup, so escape
+sequences in a recording are shown as ``\\x1b`` and never reach the terminal.
 """
 
 from __future__ import annotations
 
 from collections import Counter
 
+from rich import box
 from rich.console import Console
 from rich.table import Table
 from rich.text import Text
@@ -17,6 +20,11 @@ from fuzzoff.findings import FileReport, Finding, Report, Severity
 from fuzzoff.report.sanitize import printable
 
 STYLE = {Severity.ERROR: "bold red", Severity.WARNING: "yellow", Severity.INFO: "cyan"}
+VERDICT = {0: "passed", 1: "failed", 2: "incomplete input"}
+
+
+def _box(console: Console) -> box.Box:
+    return box.SIMPLE_HEAVY if console.is_terminal else box.ASCII
 
 
 def finding_line(finding: Finding) -> Text:
@@ -31,21 +39,27 @@ def finding_line(finding: Finding) -> Text:
     if finding.vehicle:
         line.append(f"[{printable(finding.vehicle, 40)}] ", style="magenta")
     line.append(printable(finding.message))
+    if finding.end_s is not None and finding.time_s is not None:
+        line.append(f"  (until {finding.end_s:.3f}s)", style="dim")
     if finding.where is not None and finding.where.topic:
-        line.append(f"  ({printable(str(finding.where), 120)})", style="dim")
+        line.append(f"  at {printable(str(finding.where), 120)}", style="dim")
     return line
+
+
+def file_header(file: FileReport) -> Text:
+    header = Text()
+    header.append(printable(file.path), style="bold underline")
+    header.append(f"  {file.format}, {printable(file.profile.describe(), 200)}", style="dim")
+    if not file.complete:
+        header.append("  (incomplete)", style="bold red")
+    return header
 
 
 def print_file(console: Console, file: FileReport, fail_on: Severity, quiet: bool) -> None:
     shown = [f for f in file.findings if not quiet or f.severity >= fail_on]
-    header = Text()
-    header.append(printable(file.path), style="bold underline")
-    header.append(f"  {file.format}, {file.profile.describe()}", style="dim")
-    if not file.complete:
-        header.append("  (incomplete)", style="bold red")
     if quiet and not shown:
         return
-    console.print(header)
+    console.print(file_header(file), soft_wrap=True)
     for finding in shown:
         console.print(finding_line(finding), soft_wrap=True)
     if not shown:
@@ -55,7 +69,7 @@ def print_file(console: Console, file: FileReport, fail_on: Severity, quiet: boo
 
 def print_summary(console: Console, report: Report, fail_on: Severity) -> None:
     counts = Counter(f.severity for f in report.findings)
-    table = Table(title="fuzzoff summary", show_edge=False)
+    table = Table(title="fuzzoff summary", box=_box(console), show_edge=False)
     table.add_column("files", justify="right")
     table.add_column("errors", justify="right", style=STYLE[Severity.ERROR])
     table.add_column("warnings", justify="right", style=STYLE[Severity.WARNING])
@@ -70,24 +84,30 @@ def print_summary(console: Console, report: Report, fail_on: Severity) -> None:
     )
     console.print(table)
     status = report.exit_status(fail_on)
-    verdict = {
-        0: "passed",
-        1: f"failed (findings at or above {fail_on.label})",
-        2: "incomplete input",
-    }
-    console.print(Text(f"result: {verdict[status]}", style="bold"))
+    verdict = VERDICT[status]
+    if status == 1:
+        verdict += f" (findings at or above {fail_on.label})"
+    style = "bold green" if status == 0 else "bold red"
+    console.print(Text(f"result: {verdict}", style=style))
 
 
 def print_statistics(console: Console, report: Report) -> None:
+    """Counts per rule, most frequent first (``ruff --statistics``)."""
     counts = Counter(f.code for f in report.findings)
-    table = Table(show_edge=False)
+    worst: dict[str, Severity] = {}
+    for f in report.findings:
+        worst[f.code] = max(f.severity, worst.get(f.code, f.severity))
+    if not counts:
+        console.print(Text("no findings", style="green"))
+        return
+    table = Table(box=None, show_header=False, pad_edge=False)
     table.add_column("count", justify="right")
-    table.add_column("code")
-    table.add_column("name")
+    table.add_column("code", style="bold")
     table.add_column("severity")
+    table.add_column("name")
     for code, count in sorted(counts.items(), key=lambda kv: (-kv[1], kv[0])):
-        rule = get_rule(code)
-        table.add_row(str(count), code, rule.name, rule.severity.label)
+        sev = worst[code]
+        table.add_row(str(count), code, Text(sev.label, style=STYLE[sev]), get_rule(code).name)
     console.print(table)
 
 
@@ -99,6 +119,7 @@ def print_report(
     quiet: bool = False,
     statistics: bool = False,
 ) -> None:
+    """The whole terminal report; ``quiet`` keeps only findings at the fail level, no summary."""
     if statistics:
         print_statistics(console, report)
         return

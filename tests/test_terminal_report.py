@@ -1,0 +1,123 @@
+"""The terminal report: grouping, summary, --quiet, --statistics, colour rules, hostile strings."""
+
+from __future__ import annotations
+
+import io
+import json
+import re
+from pathlib import Path
+
+import pytest
+from rich.console import Console
+
+from fuzzoff.findings import Severity
+from fuzzoff.report.terminal import print_report
+from tests.helpers import run_cli
+from tests.report_fixtures import gap_recording, hostile_report
+
+COLOUR = re.compile(r"\x1b\[[0-9;]*(?:3[0-9]|9[0-7])[0-9;]*m")
+"""An SGR sequence that sets a foreground colour (30-39, 90-97)."""
+INJECTED = ("\x1b[2J", "\x1b]0;", "\x07")
+
+
+@pytest.fixture
+def recordings(tmp_path: Path) -> tuple[Path, Path]:
+    """A recording with errors (a gap while in OFFBOARD) and one that cannot be read at all."""
+    broken = tmp_path / "evil\x1b[2J\x1b]0;pwned\x07.tlog"
+    broken.write_bytes(b"not a recording at all")
+    return gap_recording(tmp_path / "gap.tlog"), broken
+
+
+@pytest.fixture
+def no_colour_env(monkeypatch: pytest.MonkeyPatch) -> None:
+    for name in ("FORCE_COLOR", "NO_COLOR", "TTY_COMPATIBLE", "TTY_INTERACTIVE"):
+        monkeypatch.delenv(name, raising=False)
+
+
+def json_findings(paths: list[str]) -> list[dict[str, object]]:
+    data = json.loads(run_cli(["lint", *paths, "--format", "json"]).stdout)
+    return [f for file in data["files"] for f in file["findings"]]
+
+
+def test_findings_grouped_per_file_then_summary(
+    recordings: tuple[Path, Path], no_colour_env: None
+) -> None:
+    gap, broken = recordings
+    result = run_cli(["lint", str(gap), str(broken)])
+    assert result.returncode == 2  # one input could not be read
+    out = result.stdout
+    assert "\x1b" not in out  # not a terminal: plain text
+    gap_at = out.index(str(gap))
+    broken_at = out.index("evil\\x1b[2J")
+    summary_at = out.index("fuzzoff summary")
+    assert gap_at < broken_at < summary_at
+    for finding in json_findings([str(gap)]):
+        line = next(ln for ln in out[gap_at:broken_at].splitlines() if f" {finding['code']} " in ln)
+        assert str(finding["severity"]) in line
+        if finding["time_s"] is not None:
+            assert f"{finding['time_s']:.3f}s" in line
+        location = finding["location"]
+        if isinstance(location, dict):
+            assert f"at {location['topic']}" in line
+    assert "result: incomplete input" in out
+
+
+def test_escape_sequences_from_a_recording_never_reach_the_terminal(
+    recordings: tuple[Path, Path], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    _, broken = recordings
+    monkeypatch.setenv("FORCE_COLOR", "1")
+    monkeypatch.delenv("NO_COLOR", raising=False)
+    result = run_cli(["lint", str(broken), "--no-progress"])
+    assert COLOUR.search(result.stdout)  # rich's own colours are there...
+    for text in (result.stdout, result.stderr):
+        assert not any(seq in text for seq in INJECTED)  # ...the file's are not
+        assert "evil\\x1b[2J\\x1b]0;pwned\\x07.tlog" in text
+
+
+def test_hostile_strings_in_findings_are_neutralised() -> None:
+    buffer = io.StringIO()
+    console = Console(file=buffer, force_terminal=True, width=200)
+    print_report(console, hostile_report(), Severity.WARNING)
+    out = buffer.getvalue()
+    assert COLOUR.search(out)
+    assert "\x1b[2J" not in out and "\\x1b[2J" in out
+
+
+def test_no_color_turns_colour_off_even_when_forced(
+    recordings: tuple[Path, Path], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    gap, _ = recordings
+    monkeypatch.setenv("FORCE_COLOR", "1")
+    monkeypatch.setenv("NO_COLOR", "1")
+    result = run_cli(["lint", str(gap), "--no-progress"])
+    assert "OFB" in result.stdout and not COLOUR.search(result.stdout)
+
+
+def test_quiet_keeps_only_findings_at_the_fail_level(
+    recordings: tuple[Path, Path], no_colour_env: None
+) -> None:
+    gap, _ = recordings
+    findings = json_findings([str(gap)])
+    result = run_cli(["lint", str(gap), "--quiet"])
+    lines = [ln for ln in result.stdout.splitlines() if re.search(r" OFB\d{3} ", ln)]
+    expected = [f for f in findings if f["severity"] in ("error", "warning")]
+    assert expected and len(lines) == len(expected)
+    assert all(" info " not in ln for ln in lines)
+    assert "fuzzoff summary" not in result.stdout
+    quiet_pass = run_cli(["lint", str(gap), "--quiet", "--select", "OFB003"])
+    assert quiet_pass.returncode == 0 and quiet_pass.stdout.strip() == ""
+
+
+def test_statistics_counts_per_rule(recordings: tuple[Path, Path], no_colour_env: None) -> None:
+    gap, broken = recordings
+    findings = json_findings([str(gap), str(broken)])
+    result = run_cli(["lint", str(gap), str(broken), "--statistics"])
+    rows = [ln.split() for ln in result.stdout.splitlines() if ln.strip()]
+    counts = {row[1]: int(row[0]) for row in rows}
+    expected: dict[str, int] = {}
+    for f in findings:
+        expected[str(f["code"])] = expected.get(str(f["code"]), 0) + 1
+    assert counts == expected
+    assert [int(r[0]) for r in rows] == sorted((int(r[0]) for r in rows), reverse=True)
+    assert "fuzzoff summary" not in result.stdout and str(gap) not in result.stdout
