@@ -139,7 +139,7 @@ class GateModel:
 
     def feed(self, event: Event) -> list[GateTransition]:
         t = event.t
-        if t > self._now_deadline:
+        if t >= self._now_deadline:
             self._advance(t)
         handler = self._handlers.get(type(event))
         if handler is not None:

@@ -33,6 +33,7 @@ LOOP_PERIOD = 0.01
 LEGACY_TIMEOUT = 0.5
 """``OFFBOARD_TIMEOUT`` of legacy (2.3)."""
 _EPS = 1e-9
+_SAME_ITER = 1e-6
 
 
 def grid_ceil(x: float, period: float) -> float:
@@ -155,7 +156,9 @@ class HysteresisSignal(Signal):
     def lost_at(self) -> float:
         if not self.available or self.good_iter is None:
             return INF
-        return grid_ceil(self.good_iter + LOOP_PERIOD + self.timeout, LOOP_PERIOD)
+        # A message that arrives by the iteration itself keeps the candidate true: the loss
+        # needs an iteration with no new message, hence "just after" the grid point.
+        return grid_ceil(self.good_iter + LOOP_PERIOD + self.timeout, LOOP_PERIOD) + _SAME_ITER
 
 
 class AgeSignal(Signal):
