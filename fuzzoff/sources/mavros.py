@@ -138,8 +138,8 @@ def stamp_to_time_boot_us(header: Any) -> int | None:
     MAVROS sends the stamp in milliseconds truncated to 32 bits; a zero stamp (a program that
     never sets it) gives ``None``: the sender has no clock worth comparing.
     """
-    stamp = header.stamp
-    ns = int(stamp.sec) * 1_000_000_000 + int(getattr(stamp, "nanosec", getattr(stamp, "nsec", 0)))
+    stamp = header.stamp  # rosbags gives ROS 1 times the ROS 2 shape: sec, nanosec
+    ns = int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)
     if ns <= 0:
         return None
     return ((ns // 1_000_000) & 0xFFFFFFFF) * 1000
@@ -167,6 +167,10 @@ class MavrosOptions:
     """``setpoint_attitude/reverse_thrust``: thrust may be in [-1, 0)."""
 
 
+Handler = Callable[[Any, float, "int | None"], list[Event]]
+"""(message, recording time, index on its topic) -> events."""
+
+
 @dataclass(slots=True)
 class _Pending:
     """One side of the attitude/thrust pair MAVROS synchronises (message_filters)."""
@@ -188,27 +192,54 @@ class MavrosConverter:
     options: MavrosOptions = field(default_factory=MavrosOptions)
     _body: dict[str, _Pending] = field(default_factory=dict)
     _thrust: dict[str, _Pending] = field(default_factory=dict)
+    _handlers: dict[str, Handler | None] = field(default_factory=dict)
 
     def convert(self, topic: str, msg: Any, t: float, index: int | None = None) -> list[Event]:
         """The events MAVROS produces for ``msg`` on ``topic`` at recording time ``t``."""
+        handler = self.handler(topic)
+        return [] if handler is None else handler(msg, t, index)
+
+    def handler(self, topic: str) -> Handler | None:
+        """The conversion for one topic, looked up once (readers call it per connection)."""
+        if topic in self._handlers:
+            return self._handlers[topic]
+        handler = self._make_handler(topic)
+        self._handlers[topic] = handler
+        return handler
+
+    def _make_handler(self, topic: str) -> Handler | None:
         split = split_topic(topic)
         if split is None:
-            return []
-        where = Where(topic, index)
+            return None
         ns, name = split
         if name == "state":
-            return [state_to_status(msg, t=t, vehicle=ns, where=where)]
+            return lambda msg, t, index: [
+                state_to_status(msg, t=t, vehicle=ns, where=Where(topic, index))
+            ]
         if name in ("setpoint_attitude/attitude", "setpoint_attitude/cmd_vel"):
-            self._body[ns] = _Pending(t, (name, msg), where)
-            return self._pair(ns)
+
+            def body(msg: Any, t: float, index: int | None) -> list[Event]:
+                self._body[ns] = _Pending(t, (name, msg), Where(topic, index))
+                return self._pair(ns)
+
+            return body
         if name == "setpoint_attitude/thrust":
-            self._thrust[ns] = _Pending(t, msg, where)
-            return self._pair(ns)
+
+            def thrust(msg: Any, t: float, index: int | None) -> list[Event]:
+                self._thrust[ns] = _Pending(t, msg, Where(topic, index))
+                return self._pair(ns)
+
+            return thrust
         make = _CONVERTERS.get(name)
         if make is None:
-            return []
-        event = make(msg, self.options, t, ns, where)
-        return [] if event is None else [event]
+            return None
+        options = self.options
+
+        def setpoint(msg: Any, t: float, index: int | None) -> list[Event]:
+            event = make(msg, options, t, ns, Where(topic, index))
+            return [] if event is None else [event]
+
+        return setpoint
 
     def _pair(self, ns: str) -> list[Event]:
         body, thrust = self._body.get(ns), self._thrust.get(ns)

@@ -81,14 +81,14 @@ def yaw_enu_to_ned(yaw: float) -> float:
     """ENU yaw -> NED yaw as MAVROS computes it for ``setpoint_raw``: pi/2 - yaw, wrapped.
 
     MAVROS builds a yaw-only quaternion, rotates it and extracts the yaw again, which wraps the
-    result into (-pi, pi]; the closed form gives the same number.
+    result into (-pi, pi]; the closed form gives the same number (tests check both agree).
     """
-    return quat_yaw(orientation_enu_to_ned(quat_from_rpy(0.0, 0.0, yaw)))
+    return math.atan2(math.cos(yaw), math.sin(yaw))  # = wrap(pi/2 - yaw)
 
 
 def yaw_flu_to_frd(yaw: float) -> float:
     """Body-frame yaw (FLU -> FRD): the yaw changes sign (wrapped)."""
-    return quat_yaw(quat_mul(AIRCRAFT_BASELINK_Q, quat_from_rpy(0.0, 0.0, yaw)))
+    return math.atan2(-math.sin(yaw), math.cos(yaw))  # = wrap(-yaw)
 
 
 def wrap_pi(angle: float) -> float:

@@ -25,7 +25,7 @@ from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 from fuzzoff.events import Event
 from fuzzoff.sources.base import RecordingInfo, Source, SourceError, SourceProblem
-from fuzzoff.sources.mavros import TOPIC_KINDS, MavrosConverter, mavros_topic
+from fuzzoff.sources.mavros import TOPIC_KINDS, Handler, MavrosConverter, mavros_topic
 from fuzzoff.sources.mavros_msgs import mavros_typedefs
 from fuzzoff.sources.rosbag1_salvage import SalvageReader, bag_header_index_pos
 
@@ -186,11 +186,24 @@ class Rosbag1Source(Source):
             at = f"byte {salvage.stopped[1]}"
         self.problems.append(SourceProblem(what, at))
 
+    def _handler(
+        self, converter: MavrosConverter, conn: Connection
+    ) -> tuple[Handler | None, Callable[..., Any]]:
+        """The conversion and the decoder for one connection (looked up once, not per message)."""
+        store = self._typestore
+        msgtype = conn.msgtype
+
+        def decode(raw: bytes) -> Any:
+            return store.deserialize_ros1(raw, msgtype)
+
+        return converter.handler(conn.topic), decode
+
     def _convert(
         self, messages: Iterator[tuple[Connection, int, bytes]], start_ns: Callable[[], int]
     ) -> Iterator[Event]:
         """Decode, convert and yield; corrupt messages are skipped and reported once."""
         converter = MavrosConverter()
+        handlers: dict[int, tuple[Handler | None, Callable[..., Any]]] = {}
         counts: dict[int, int] = {}
         first_bad: SourceProblem | None = None
         bad = 0
@@ -201,15 +214,21 @@ class Rosbag1Source(Source):
                 index = counts.get(conn.id, 0)
                 counts[conn.id] = index + 1
                 t = (timestamp - start_ns()) / 1e9
+                entry = handlers.get(conn.id)
+                if entry is None:
+                    entry = handlers[conn.id] = self._handler(converter, conn)
+                handler, decode = entry
+                if handler is None:
+                    continue
                 try:
-                    msg = self._typestore.deserialize_ros1(raw, conn.msgtype)
+                    msg = decode(raw)
                 except Exception as exc:  # corrupt message bytes: skip it, say so once
                     what = f"message does not decode as {conn.msgtype} ({type(exc).__name__})"
                     bad += 1
                     first_bad = first_bad or SourceProblem(what, f"{conn.topic} #{index}", t)
                     continue
                 last = (f"{conn.topic} #{index}", t)
-                yield from converter.convert(conn.topic, msg, t, index)
+                yield from handler(msg, t, index)
         except Exception as exc:  # rosbags ReaderError, asserts, codec errors on corrupt chunks
             detail = str(exc).rstrip(".") if isinstance(exc, ReaderError) else type(exc).__name__
             where, t_last = last if last is not None else (None, None)
