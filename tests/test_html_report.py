@@ -1,0 +1,103 @@
+"""The HTML report as a document: self-contained, escaped, bounded in size (browser tests apart)."""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import replace
+from html.parser import HTMLParser
+from pathlib import Path
+
+from fuzzoff.config import Settings
+from fuzzoff.engine import Timeline
+from fuzzoff.findings import FileReport, Finding, Report, Severity
+from fuzzoff.profiles import Profile
+from fuzzoff.report.html import CSP, render
+from fuzzoff.report.svg_timeline import MAX_BUCKETS, min_max_buckets
+from fuzzoff.report.timelines import lint_one
+from tests.helpers import run_cli
+from tests.report_fixtures import SCRIPT, gap_recording, hostile_report
+
+
+class Markup(HTMLParser):
+    """Every tag and attribute as a browser's parser sees them."""
+
+    def __init__(self, page: str) -> None:
+        super().__init__()
+        self.tags: list[str] = []
+        self.attrs: list[tuple[str, str]] = []
+        self.text: list[str] = []
+        self.feed(page)
+
+    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+        self.tags.append(tag)
+        self.attrs.extend((name, value or "") for name, value in attrs)
+
+    def handle_data(self, data: str) -> None:
+        self.text.append(data)
+
+
+def test_page_is_self_contained_and_forbids_scripts_and_requests() -> None:
+    page = render(hostile_report(), Settings())
+    assert f'content="{CSP}"' in page and "script-src" not in CSP and "default-src 'none'" in CSP
+    markup = Markup(page)
+    assert not {"script", "link", "iframe", "img", "object", "embed"} & set(markup.tags)
+    assert "svg" in markup.tags and "style" in markup.tags
+    names = {name for name, _ in markup.attrs}
+    assert not {"src", "srcset", "xlink:href"} & names
+    assert "@import" not in page and "url(" not in page
+    external = [v for n, v in markup.attrs if n == "href" and not v.startswith("#")]
+    assert external and all(h.startswith("https://fuzzoff.dev/rules/") for h in external)
+
+
+def test_recording_text_is_escaped_everywhere() -> None:
+    markup = Markup(render(hostile_report(), Settings()))
+    assert "script" not in markup.tags and "img" not in markup.tags
+    assert not [name for name, _ in markup.attrs if name.startswith("on")]
+    # What the payloads said is there as text for the reader.
+    assert any(SCRIPT in chunk for chunk in markup.text)
+
+
+def test_every_finding_has_a_row_and_every_timed_one_a_marker() -> None:
+    report = hostile_report()
+    page = render(report, Settings())
+    for i, file in enumerate(report.files):
+        for j, finding in enumerate(file.findings):
+            assert f'id="finding-{i}-{j}"' in page
+            timed = finding.time_s is not None and file.extras.get("timelines")
+            assert (f'id="mark-{i}-{j}" href="#finding-{i}-{j}"' in page) == bool(timed)
+            assert f'href="#rule-{finding.code}"' in page and f'id="rule-{finding.code}"' in page
+
+
+def test_long_series_are_downsampled_but_keep_their_spikes() -> None:
+    times = [i * 0.02 for i in range(180_000)]  # one hour at 50 Hz
+    times = [t for t in times if not 1800.0 < t < 1802.5]  # one 2.5 s gap
+    values = [b - a for a, b in itertools.pairwise(times)]
+    points = min_max_buckets(times[1:], values, times[-1])
+    assert len(points) <= 2 * MAX_BUCKETS
+    assert max(v for _, v in points) == max(values)
+    file = FileReport("long.tlog", "tlog", Profile(), stats={"duration_s": times[-1]})
+    file.extras["timelines"] = {"1": Timeline(keepalive=times)}
+    file.findings = [Finding("OFB001", "x", Severity.ERROR, "gap", time_s=1800.0)]
+    page = render(Report(files=[file]), Settings())
+    assert len(page) < 200_000
+
+
+def test_loss_timeout_line_follows_the_profile_and_param(tmp_path: Path) -> None:
+    recording = gap_recording(tmp_path / "gap.tlog")
+    settings = replace(Settings(), px4="1.15")
+    page = render(Report(files=[lint_one(recording, settings)]), settings)
+    assert "COM_OF_LOSS_T = 1 s (PX4 1.15 default)" in page
+    settings = replace(settings, params={"COM_OF_LOSS_T": 0.3})
+    page = render(Report(files=[lint_one(recording, settings)]), settings)
+    assert "COM_OF_LOSS_T = 0.3 s" in page and "loss timeout (COM_OF_LOSS_T) 0.3 s" in page
+
+
+def test_cli_html_has_a_timeline_per_vehicle(tmp_path: Path) -> None:
+    recording = gap_recording(tmp_path / "gap.tlog")
+    out = tmp_path / "report.html"
+    result = run_cli(["lint", str(recording), "--format", "html", "--output", str(out)])
+    assert result.returncode == 1, result.stderr
+    page = out.read_text(encoding="utf-8")
+    assert page.count('<svg class="timeline"') == 1
+    assert "recorded mode" in page and "predicted mode" in page
+    assert "set_position_target_local_ned" in page
