@@ -22,10 +22,10 @@ from mcap.stream_reader import CRCValidationError, StreamReader, breakup_chunk
 from fuzzoff.events import Event
 from fuzzoff.sources import px4_msgs
 from fuzzoff.sources.base import RecordingInfo, Source, SourceError, SourceProblem
-from fuzzoff.sources.ros2_decode import Ros2Decoding, TopicDecoder
+from fuzzoff.sources.ros2_decode import Decoder, Ros2Decoding
 from fuzzoff.sources.ros2_order import ChunkOrder
 
-Connect = Callable[[str, str, str | None, str], TopicDecoder | None]
+Connect = Callable[[str, str, str | None, str], Decoder | None]
 """(topic, message type, embedded definition, its format) -> decoder or None."""
 
 MAGIC = b"\x89MCAP0\r\n"
@@ -55,7 +55,7 @@ class McapStream:
         self.t0_ns = t0_ns
         self.problems: list[SourceProblem] = []
         self.schemas: dict[int, Schema] = {}
-        self.decoders: dict[int, TopicDecoder | None] = {}
+        self.decoders: dict[int, Decoder | None] = {}
         self.messages = 0
         self.late = 0
         self.fh: io.BufferedReader | None = None

@@ -10,7 +10,6 @@ bytes): a payload that does not is never passed on half-understood; the topic be
 from __future__ import annotations
 
 import struct
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -20,7 +19,9 @@ from rosbags.typesys.store import Typestore
 from fuzzoff.events import Event, Origin, Where
 from fuzzoff.sources import px4_msgs
 from fuzzoff.sources.base import SourceProblem
+from fuzzoff.sources.mavros import MavrosConverter, mavros_topic
 from fuzzoff.sources.ros2_convert import BUILDERS, KIND_OF, Builder
+from fuzzoff.sources.ros2_mavros import MavrosTopicDecoder
 from fuzzoff.sources.ros2_topics import MESSAGE_FOR_NAME, OUTPUT_MESSAGES, TopicRef, parse_topic
 
 _DECODE_ERRORS = (struct.error, IndexError, ValueError, TypeError, UnicodeDecodeError)
@@ -138,6 +139,10 @@ class TopicDecoder:
             return
         self.use(definition)
 
+    @property
+    def kind(self) -> str:
+        return KIND_OF[self.message]
+
     def use(self, definition: Definition) -> None:
         self.definition = definition
         self.builder = BUILDERS[self.message](definition.fields, self.vehicle, self.origin)
@@ -156,7 +161,8 @@ class Ros2Decoding:
     """
 
     release: str | None = None
-    decoders: list[TopicDecoder] = field(default_factory=list)
+    decoders: list[Decoder] = field(default_factory=list)
+    mavros: MavrosConverter = field(default_factory=MavrosConverter)
     unknown: list[tuple[str, str]] = field(default_factory=list)
     evidence: set[str] | None = None
     """Releases every definition seen so far fits (for profile detection)."""
@@ -164,8 +170,17 @@ class Ros2Decoding:
 
     def connection(
         self, topic: str, msgtype: str, embedded: str | None, fmt: str = "msg"
-    ) -> TopicDecoder | None:
-        """A decoder for a connection, or None when it is not a PX4 topic fuzzoff decodes."""
+    ) -> Decoder | None:
+        """A decoder for a connection, or None when it is not a topic fuzzoff decodes."""
+        split = mavros_topic(topic, msgtype)
+        if split is not None:
+            handler = self.mavros.handler(topic)
+            if handler is None:
+                return None
+            embedded_msg = embedded if fmt == "msg" else None
+            mavros = MavrosTopicDecoder.make(topic, msgtype, split, handler, embedded_msg)
+            self.decoders.append(mavros)
+            return mavros
         message, ref = message_of(topic, msgtype)
         if message is None:
             if ref is not None and ref.name in MESSAGE_FOR_NAME:
@@ -257,7 +272,7 @@ class Ros2Decoding:
         return None
 
     def kinds(self) -> set[str]:
-        return {KIND_OF[d.message] for d in self.decoders}
+        return {d.kind for d in self.decoders}
 
     def vehicles(self) -> list[str]:
         return sorted({d.vehicle for d in self.decoders})
@@ -281,4 +296,5 @@ class Ros2Decoding:
         return out
 
 
-DecoderFactory = Callable[[str, str, str | None], TopicDecoder | None]
+Decoder = TopicDecoder | MavrosTopicDecoder
+"""What readers hold per connection: ``event(raw, t)``, plus counts for the problems."""

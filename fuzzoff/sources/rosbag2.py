@@ -27,7 +27,7 @@ from fuzzoff.events import Event
 from fuzzoff.sources import px4_msgs
 from fuzzoff.sources.base import RecordingInfo, Source, SourceError, SourceProblem
 from fuzzoff.sources.mcap import McapStream
-from fuzzoff.sources.ros2_decode import Ros2Decoding, TopicDecoder
+from fuzzoff.sources.ros2_decode import Decoder, Ros2Decoding, TopicDecoder
 from fuzzoff.sources.ros2_order import ChunkOrder
 
 DATA_SUFFIXES = (".db3", ".mcap")
@@ -49,7 +49,7 @@ class Rosbag2Source(Source):
         super().__init__(path)
         self.px4_hint: str | None = None
         self.decoding = Ros2Decoding()
-        self._decoders: dict[tuple[str, str], TopicDecoder | None] = {}
+        self._decoders: dict[tuple[str, str], Decoder | None] = {}
         self._reader: Any = None
         self._files: list[Path] = []
         self._info: RecordingInfo | None = None
@@ -136,10 +136,10 @@ class Rosbag2Source(Source):
         """Choose bundled definitions now, from each topic's first message, so the release
         they reveal can set the profile (Humble bags embed none). VehicleStatus goes first:
         its layout differs in every release."""
-        pending = []
+        pending: list[tuple[bool, Any, TopicDecoder]] = []
         for conn in reader.connections:
             decoder = self._decoders.get((conn.topic, conn.msgtype))
-            if decoder is not None and decoder.definition is None and conn.msgcount:
+            if isinstance(decoder, TopicDecoder) and decoder.definition is None and conn.msgcount:
                 pending.append((decoder.message != "VehicleStatus", conn, decoder))
         pending.sort(key=lambda item: (item[0], item[1].id))
         for _, conn, decoder in pending:
@@ -170,12 +170,12 @@ class Rosbag2Source(Source):
                     starts.append(start)
         self._t0 = min(starts) if starts else None
 
-    def _decoder(self, topic: str, msgtype: str, msgdef: Any) -> TopicDecoder | None:
+    def _decoder(self, topic: str, msgtype: str, msgdef: Any) -> Decoder | None:
         text = msgdef.data if msgdef is not None and msgdef.format in _FORMATS else None
         fmt = _FORMATS.get(msgdef.format, "msg") if msgdef is not None else "msg"
         return self._connect(topic, msgtype, text, fmt)
 
-    def _connect(self, topic: str, msgtype: str, text: str | None, fmt: str) -> TopicDecoder | None:
+    def _connect(self, topic: str, msgtype: str, text: str | None, fmt: str) -> Decoder | None:
         """One decoder per (topic, type) across the bag's files and read paths."""
         key = (topic, msgtype)
         if key not in self._decoders:
@@ -303,7 +303,7 @@ class Rosbag2Source(Source):
             self._messages += count
             db.close()
 
-    def _sqlite_topics(self, db: sqlite3.Connection) -> dict[int, TopicDecoder]:
+    def _sqlite_topics(self, db: sqlite3.Connection) -> dict[int, Decoder]:
         definitions: dict[str, tuple[str, str]] = {}
         with suppress(sqlite3.Error):
             for name, encoding, text in db.execute(
@@ -311,7 +311,7 @@ class Rosbag2Source(Source):
             ):
                 if encoding in ("ros2msg", "ros2idl") and text:
                     definitions[name] = (text, "idl" if encoding == "ros2idl" else "msg")
-        out: dict[int, TopicDecoder] = {}
+        out: dict[int, Decoder] = {}
         for topic_id, name, msgtype in db.execute("SELECT id, name, type FROM topics"):
             text, fmt = definitions.get(msgtype, (None, "msg"))
             decoder = self._connect(name, msgtype, text, fmt)
