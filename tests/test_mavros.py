@@ -20,7 +20,15 @@ from fuzzoff.sources.mavros import (
     mavros_topic,
     split_topic,
 )
-from fuzzoff.sources.mavros_frames import quat_mul
+from fuzzoff.sources.mavros_frames import (
+    AIRCRAFT_BASELINK_Q,
+    orientation_enu_to_ned,
+    quat_from_rpy,
+    quat_mul,
+    quat_yaw,
+    yaw_enu_to_ned,
+    yaw_flu_to_frd,
+)
 from fuzzoff.sources.mavros_msgs import mavros_typedefs
 from fuzzoff.writers.rosbag1 import mavros_typestore
 
@@ -342,3 +350,12 @@ def test_shipped_definitions_decode_ros2_cdr() -> None:
         f"mavros_msgs/msg/{n}"
         for n in ("PositionTarget", "GlobalPositionTarget", "AttitudeTarget", "State", "Thrust")
     }
+
+
+@pytest.mark.parametrize("yaw", [0.0, 0.3, math.pi / 2, -2.0, 3.0, math.pi, -math.pi, 7.0])
+def test_closed_form_yaw_matches_mavros_quaternion_path(yaw: float) -> None:
+    """MAVROS rotates a yaw-only quaternion and reads the yaw back; the closed form agrees."""
+    via_enu = quat_yaw(orientation_enu_to_ned(quat_from_rpy(0.0, 0.0, yaw)))
+    via_body = quat_yaw(quat_mul(AIRCRAFT_BASELINK_Q, quat_from_rpy(0.0, 0.0, yaw)))
+    assert abs(math.remainder(yaw_enu_to_ned(yaw) - via_enu, 2 * math.pi)) < 1e-12
+    assert abs(math.remainder(yaw_flu_to_frd(yaw) - via_body, 2 * math.pi)) < 1e-12
