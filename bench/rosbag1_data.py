@@ -9,6 +9,7 @@ topics are under 10 % of the messages.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Any
 
@@ -105,7 +106,7 @@ def generate(path: Path, messages: int, mixed: bool = False) -> Path:
     store = mavros_typestore()
     setpoints = _setpoints(store)
     posctl, offboard = _state(store, "POSCTL"), _state(store, "OFFBOARD")
-    tmp = path.with_suffix(".tmp")
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.partial")
     tmp.unlink(missing_ok=True)
     with Writer(tmp) as writer:
         sp = writer.add_connection(
