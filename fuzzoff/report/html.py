@@ -19,6 +19,7 @@ from fuzzoff.config import Settings
 from fuzzoff.engine import Timeline
 from fuzzoff.findings import FileReport, Finding, Report, Severity
 from fuzzoff.report.html_style import CSS
+from fuzzoff.report.sanitize import printable
 from fuzzoff.report.svg_timeline import Marker, timeline_svg
 from fuzzoff.report.timelines import loss_timeout
 
@@ -28,11 +29,15 @@ CSP = (
 )
 """Forbids every script and every request: the page cannot reach the network even by mistake."""
 
+TEXT_LIMIT = 4000
+"""Longest text shown from a recording (a message, a path) before it is cut."""
+
 VERDICT = {0: "passed", 1: "failed", 2: "incomplete input"}
 
 
 def e(text: object) -> str:
-    return escape(str(text), quote=True)
+    """Escaped for element text and double-quoted attributes; control characters shown as \\xNN."""
+    return escape(printable(str(text), TEXT_LIMIT), quote=True)
 
 
 def _rule(code: str) -> Rule | None:
@@ -114,6 +119,9 @@ def _plots(
     return "".join(out)
 
 
+COLUMNS = ("time", "rule", "severity", "vehicle", "message", "location")
+
+
 def _findings_table(markers: list[Marker]) -> str:
     if not markers:
         return '<p class="none">No findings.</p>'
@@ -138,7 +146,11 @@ def _findings_table(markers: list[Marker]) -> str:
         "<tr><th>time</th><th>rule</th><th>severity</th><th>vehicle</th><th>message</th>"
         "<th>location</th></tr>"
     )
-    return f'<table class="findings"><thead>{head}</thead><tbody>{"".join(rows)}</tbody></table>'
+    cols = "".join(f'<col class="c-{name}">' for name in COLUMNS)
+    return (
+        f'<table class="findings"><colgroup>{cols}</colgroup><thead>{head}</thead>'
+        f"<tbody>{''.join(rows)}</tbody></table>"
+    )
 
 
 def _file_section(index: int, file: FileReport, settings: Settings) -> str:

@@ -16,10 +16,12 @@ dl.summary { display: grid; grid-template-columns: max-content 1fr; gap: 2px 14p
 dl.summary dt { color: #555; } dl.summary dd { margin: 0; word-break: break-all; }
 ul.problems li { color: var(--error); word-break: break-all; }
 figure { margin: 8px 0 16px; } figcaption { color: #444; margin-bottom: 4px; }
-table.findings { border-collapse: collapse; width: 100%; }
+table.findings { border-collapse: collapse; width: 100%; table-layout: fixed; }
+col.c-time { width: 8em; } col.c-rule { width: 5.5em; } col.c-severity { width: 5.5em; }
+col.c-vehicle { width: 12%; } col.c-location { width: 22%; }
 table.findings th, table.findings td { border-bottom: 1px solid #ddd; padding: 3px 6px;
   text-align: left; vertical-align: top; }
-table.findings td:nth-child(5), table.findings td:nth-child(6) { word-break: break-word; }
+table.findings td { overflow-wrap: anywhere; }
 tr:target { background: #fff3b0; }
 .none { color: #777; font-style: italic; }
 article.rule { background: #fff; border: 1px solid #ddd; padding: 4px 14px; margin: 10px 0; }

@@ -19,6 +19,7 @@ from fuzzoff.engine import Timeline
 from fuzzoff.events import NAV_STATE_OFFBOARD
 from fuzzoff.findings import Finding
 from fuzzoff.modes import nav_state_name
+from fuzzoff.report.sanitize import printable
 
 WIDTH = 1000
 LEFT = 130
@@ -55,8 +56,8 @@ class Marker:
 
 
 def attr(value: str) -> str:
-    """Text for a double-quoted attribute or element content."""
-    return escape(value, quote=True)
+    """Text for a double-quoted attribute or element content (control characters as \\xNN)."""
+    return escape(printable(value, 4000), quote=True)
 
 
 def fmt(value: float) -> str:
