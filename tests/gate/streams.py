@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
+from typing import Any
 
 from fuzzoff.events import (
     Command,
@@ -59,22 +60,22 @@ def in_offboard(t: float = 0.0) -> VehicleStatus:
     return status(t, OFFBOARD, True, OFFBOARD)
 
 
-def ocm(t: float, layout: str = "thrust_and_torque", **flags: bool) -> ControlMode:
+def ocm(t: float, layout: str = "thrust_and_torque", **flags: Any) -> ControlMode:
     if not flags:
         flags = {"position": True}
     return ControlMode(t=t, layout=layout, **flags)  # type: ignore[arg-type]
 
 
-def stream(t0: float, t1: float, period: float = 0.1, **flags: bool) -> list[ControlMode]:
-    n = int(round((t1 - t0) / period))
+def stream(t0: float, t1: float, period: float = 0.1, **flags: Any) -> list[ControlMode]:
+    n = round((t1 - t0) / period)
     return [ocm(round(t0 + i * period, 6), **flags) for i in range(n + 1)]
 
 
-def local_ned(t: float, mask: int = 0b110111111000, frame: int = 1, **kw: object) -> Event:
+def local_ned(t: float, mask: int = 0b110111111000, frame: int = 1, **kw: Any) -> Event:
     """SET_POSITION_TARGET_LOCAL_NED; the default mask uses position only."""
     return SetPositionTargetLocal(
         t=t, type_mask=mask, coordinate_frame=frame, target_system=1, target_component=1, **kw
-    )  # type: ignore[arg-type]
+    )
 
 
 def switch_offboard(t: float) -> Command:

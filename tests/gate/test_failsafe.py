@@ -111,7 +111,7 @@ def test_5_1_rc_not_consulted_before_117(px4: str) -> None:
     assert [tr.action for tr in of("failsafe", trs)] == ["POSCTL"]
 
 
-@pytest.mark.parametrize("value", list(V113_RC) + [OUT_OF_RANGE])
+@pytest.mark.parametrize("value", [*V113_RC, OUT_OF_RANGE])
 def test_5_2_v113_loss_action_with_rc(value: float) -> None:
     """5.2: RC present -> COM_OBL_RC_ACT (-1 Disabled .. 7 Lockdown)."""
     trs = _lose("1.13", COM_OBL_RC_ACT=float(value))
@@ -151,7 +151,7 @@ def test_5_2_v113_rc_exception_bit_uses_com_obl_act() -> None:
     assert [tr.action for tr in of("failsafe", trs)] == ["AUTO_LAND"]
 
 
-@pytest.mark.parametrize("value", list(V113_RC) + [OUT_OF_RANGE])
+@pytest.mark.parametrize("value", [*V113_RC, OUT_OF_RANGE])
 def test_5_2_v111_loss_action_is_modelled_like_113_and_unverified(value: float) -> None:
     """15 / 2.2: v1.11's loss action was not read line by line: modelled as 1.13, unverified."""
     trs = _lose("1.11", COM_OBL_RC_ACT=float(value))

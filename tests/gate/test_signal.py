@@ -120,6 +120,8 @@ def test_2_2_v111_no_flag_condition() -> None:
 
 @pytest.mark.parametrize(("gap", "lost"), [(0.49, False), (0.5, True), (0.51, True)])
 @pytest.mark.parametrize("loss_t", [0.0, 2.0])
-def test_2_3_legacy_fixed_500ms_whatever_com_of_loss_t(gap: float, lost: bool, loss_t: float) -> None:
+def test_2_3_legacy_fixed_500ms_whatever_com_of_loss_t(
+    gap: float, lost: bool, loss_t: float
+) -> None:
     """2.3: legacy's loss is a hard-coded 500 ms; COM_OF_LOSS_T does not move it."""
     assert bool(_gap("legacy", 1.0, gap, COM_OF_LOSS_T=loss_t)) is lost
