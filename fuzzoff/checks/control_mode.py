@@ -11,6 +11,7 @@ from fuzzoff.checks.base import Check, CheckContext
 from fuzzoff.events import (
     PX4_SETPOINTS,
     Command,
+    CommandAck,
     ControlMode,
     Event,
     FailsafeFlags,
@@ -104,7 +105,7 @@ class DeclaredSetpointMissing(Check):
     """OFB303: in offboard, the declared setpoint message has not been published."""
 
     codes = ("OFB303",)
-    wants = (*PX4_SETPOINTS, ControlMode, VehicleStatus, GateTransition, Command)
+    wants = (*PX4_SETPOINTS, ControlMode, VehicleStatus, GateTransition, Command, CommandAck)
 
     def __init__(self, ctx: CheckContext) -> None:
         super().__init__(ctx)
@@ -120,9 +121,13 @@ class DeclaredSetpointMissing(Check):
         if event.kind in SETPOINT_NAMES and event.origin != "model":
             self.first_seen.setdefault(event.kind, event.t)
         flag = declared_flag(self.ctx) if self.ctx.state.in_offboard else None
-        if flag != self.flag or (flag is not None and self.since is None):
+        if flag != self.flag:
+            entered = self.flag is None and self.ctx.state.offboard_since is not None
             self.flag = flag
-            self.since = event.t if flag is not None else None
+            # Counted from the switch itself (an accepted ack), not from this event.
+            self.since = (
+                None if flag is None else (self.ctx.state.offboard_since if entered else event.t)
+            )
             self.checked = False
 
     def _due(self, t: float) -> None:

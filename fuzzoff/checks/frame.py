@@ -67,18 +67,19 @@ class FrameConventionSuspect(Check):
         self.thrust = Episodes(ctx, "OFB404")
         self.takeoff_pending = True
         """Waiting for the first sizeable vertical command since the vehicle was on the ground."""
-        self.armed_known = False
+        self.armed: bool | None = None
+        """The last recorded arming state (None: not recorded yet)."""
 
     def on_event(self, event: Event) -> None:
         if isinstance(event, VehicleStatus) and event.armed is not None:
-            if not event.armed:
-                self.takeoff_pending = True
-            elif not self.armed_known:
+            if not event.armed and self.armed is not False:
+                self.takeoff_pending = True  # on the ground (again)
+            elif event.armed and self.armed is None:
                 self.takeoff_pending = False  # the recording starts in flight
-            self.armed_known = True
+            self.armed = event.armed
             return
         if isinstance(event, GateTransition):
-            if event.what == "disarmed" and not self.armed_known:
+            if event.what == "disarmed" and self.armed is None:
                 self.takeoff_pending = True
             return
         if not from_external(self.ctx, event):

@@ -38,13 +38,13 @@ class SetpointsOutsideOffboard(Check):
         self.sent = False
 
     def on_event(self, event: Event) -> None:
+        if event.kind in SETPOINT_NAMES and event.origin != "sent":
+            self.logged = True
+            return
         if self.ctx.state.in_offboard:
             self._close()
             return
         if event.kind not in SETPOINT_NAMES:
-            return
-        if event.origin != "sent":
-            self.logged = True
             return
         self.sent = True
         name = SETPOINT_NAMES[event.kind]

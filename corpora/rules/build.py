@@ -1,0 +1,564 @@
+"""Build the rule corpus: one bad and one good recording per content / control-mode / legacy rule.
+
+Run ``.venv/bin/python corpora/rules/build.py``; it is deterministic. ROS 2 rules are written as
+MCAP (``fuzzoff.writers.mcap``, px4_msgs of the case's release), the estimate rule OFB305 and
+the legacy rules OFB801-OFB803 as ULog (``fuzzoff.writers.ulog``, the 1.15 and the legacy
+layouts). Each ``NAME.expected.json`` lists the findings planted here, judged against the rule
+texts (rules/OFB*.toml), and ``clean``: the rules the recording exercises that must stay silent.
+
+Every flight is built from one realistic pattern (``Flight``): a companion streams
+``OffboardControlMode`` at 10 Hz with a PX4-synced ``timestamp``, the vehicle sits disarmed in
+POSCTL, the companion switches to OFFBOARD after 1.5 s of stream (accepted, one ack on 1.15),
+arms at 2.0 s, and publishes its setpoints at 20 Hz only from the switch on, a slowly moving
+target. A case changes one thing of it.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+from fuzzoff.events import (
+    ActuatorMotors,
+    AttitudeSetpoint,
+    Command,
+    CommandAck,
+    ControlMode,
+    Event,
+    FailsafeFlags,
+    LegacyControlMode,
+    PositionSetpointTriplet,
+    RatesSetpoint,
+    ThrustSetpoint,
+    TrajectorySetpoint,
+    VehicleStatus,
+)
+from fuzzoff.writers.mcap import write_mcap
+from fuzzoff.writers.ulog import write_ulog
+
+HERE = Path(__file__).resolve().parent
+ALTCTL, POSCTL, OFFBOARD = 1, 2, 14
+NAN = math.nan
+BOOT_US = 120_000_000
+"""The companion's timestamps are PX4-synced: about two minutes after PX4's boot."""
+
+SWITCH_T, ARM_T, END_T = 1.5, 2.0, 6.0
+OCM_PERIOD, SETPOINT_PERIOD, STATUS_PERIOD = 0.1, 0.05, 0.2
+
+
+def ticks(start: float, stop: float, period: float) -> list[float]:
+    """Times in [start, stop) every ``period``, rounded to the microsecond."""
+    n = math.ceil((stop - start) / period - 1e-9)
+    return [round(start + i * period, 6) for i in range(n)]
+
+
+def stamp(t: float) -> int:
+    return BOOT_US + round(t * 1e6)
+
+
+@dataclass
+class Flight:
+    """The realistic pattern; ``setpoint(t)`` gives the companion's setpoints at ``t``."""
+
+    flags: dict[str, bool]
+    setpoint: Callable[[float], list[Event]]
+    setpoints_from: float = SWITCH_T + 0.05
+    """The companion starts its setpoints once the switch is acked (at 1.52 s)."""
+    ocm_stamp: Callable[[float], int] = stamp
+    ocm_flags: Callable[[float], dict[str, bool]] | None = None
+    extra: list[Event] = field(default_factory=list)
+
+    def events(self) -> list[Event]:
+        out: list[Event] = []
+        for t in ticks(0.0, END_T, OCM_PERIOD):
+            flags = self.ocm_flags(t) if self.ocm_flags else self.flags
+            out.append(ControlMode(t=t, sender_time_us=self.ocm_stamp(t), **flags))
+        for t in ticks(0.0, END_T, STATUS_PERIOD):
+            nav = OFFBOARD if t >= SWITCH_T + 0.05 else POSCTL
+            out.append(VehicleStatus(t=t, nav_state=nav, armed=t >= ARM_T + 0.05))
+        out += [
+            Command(t=SWITCH_T, command=176, params=(1.0, 6.0, 0, 0, 0, 0, 0), from_external=True),
+            CommandAck(t=SWITCH_T + 0.02, command=176, result=0),
+            Command(t=ARM_T, command=400, params=(1.0, 0, 0, 0, 0, 0, 0), from_external=True),
+            CommandAck(t=ARM_T + 0.02, command=400, result=0),
+        ]
+        for t in ticks(self.setpoints_from, END_T, SETPOINT_PERIOD):
+            out += self.setpoint(t)
+        out += self.extra
+        return sorted(out, key=lambda e: e.t)
+
+
+def climb(t: float) -> list[Event]:
+    """Position control: up to 5 m, then a slow circle (the content changes every message)."""
+    z = -min(5.0, max(0.5, 2.0 * (t - SWITCH_T)))
+    x, y = math.cos(0.2 * t), math.sin(0.2 * t)
+    return [TrajectorySetpoint(t=t, position=(x, y, z), yaw=0.1 * t)]
+
+
+def quat(yaw: float) -> tuple[float, float, float, float]:
+    return (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
+
+
+def attitude(t: float) -> list[Event]:
+    return [AttitudeSetpoint(t=t, q_d=quat(0.1 * t), thrust_body=(0.0, 0.0, -0.6))]
+
+
+def rates(t: float) -> list[Event]:
+    return [RatesSetpoint(t=t, roll=0.0, pitch=0.0, yaw=0.05 * t, thrust_body=(0.0, 0.0, -0.6))]
+
+
+def motors(t: float) -> list[Event]:
+    level = 0.5 + 0.01 * math.sin(t)
+    return [ActuatorMotors(t=t, control=(level, level, level, level, NAN, NAN, NAN, NAN))]
+
+
+POSITION = {"position": True}
+
+
+# ---------------------------------------------------------------------------------------------
+# Cases: (name, events, release, expected findings, clean rules, extra CLI args)
+
+
+@dataclass
+class Case:
+    name: str
+    events: list[Event]
+    findings: list[tuple[str, str, float | None]]
+    clean: list[str]
+    fmt: str = "mcap"
+    px4: str = "1.15"
+    vehicle: str = "mc"
+    release: str = "1.15"
+    ulog_version: str | None = "1.15.4"
+    ulog_layout: str | None = None
+    params: dict[str, float] = field(default_factory=dict)
+    note: str = ""
+
+    @property
+    def filename(self) -> str:
+        return f"{self.name}.{self.fmt}"
+
+    def args(self) -> list[str]:
+        if self.fmt == "mcap":
+            return ["--px4", self.px4, "--vehicle", self.vehicle]
+        return []
+
+
+def mcap_cases() -> list[Case]:
+    cases: list[Case] = []
+
+    good = Flight(POSITION, climb).events()
+    cases.append(
+        Case(
+            "good_position_flight",
+            good,
+            [],
+            [
+                *("OFB106", "OFB107", "OFB203", "OFB301", "OFB302", "OFB303", "OFB304"),
+                *("OFB401", "OFB402", "OFB403", "OFB404"),
+            ],
+            note="the realistic pattern with position control",
+        )
+    )
+    cases.append(
+        Case(
+            "good_attitude_flight",
+            Flight({"attitude": True}, attitude).events(),
+            [],
+            ["OFB302", "OFB303", "OFB404", "OFB405", "OFB406"],
+        )
+    )
+    cases.append(
+        Case(
+            "good_rates_flight",
+            Flight({"body_rate": True}, rates).events(),
+            [],
+            ["OFB302", "OFB303", "OFB404", "OFB406", "OFB408"],
+        )
+    )
+    cases.append(
+        Case(
+            "good_direct_actuator",
+            Flight({"direct_actuator": True}, motors).events(),
+            [],
+            ["OFB302", "OFB303", "OFB406", "OFB407"],
+        )
+    )
+
+    # OFB106: the companion's clock stops at 3.0 s; the first message lagging by more than
+    # COM_OF_LOSS_T (1.0 s) is at 4.1 s. PX4 1.15 would take the stream for lost (warning).
+    frozen_clock = Flight(POSITION, climb, ocm_stamp=lambda t: stamp(min(t, 3.0))).events()
+    cases.append(Case("ofb106_clock_stops", frozen_clock, [("OFB106", "warning", 4.1)], []))
+
+    # OFB107: at 2.5 s the planner dies; the library re-sends its last setpoint for 3.45 s.
+    def dead_planner(t: float) -> list[Event]:
+        return [replace(sp, t=t) for sp in climb(min(t, 2.5))]
+
+    cases.append(
+        Case(
+            "ofb107_planner_dies",
+            Flight(POSITION, dead_planner).events(),
+            [("OFB107", "warning", 2.5)],
+            [],
+        )
+    )
+
+    # OFB203: the px4_ros_com pattern: setpoints from the first second, before the switch.
+    early = Flight(POSITION, climb, setpoints_from=0.0).events()
+    cases.append(Case("ofb203_setpoints_before_switch", early, [("OFB203", "error", 0.0)], []))
+
+    # OFB301: the first 0.3 s of OffboardControlMode declare nothing.
+    def empty_first(t: float) -> dict[str, bool]:
+        return {} if t < 0.3 else POSITION
+
+    empty = Flight(POSITION, climb, ocm_flags=empty_first).events()
+    cases.append(Case("ofb301_empty_control_mode", empty, [("OFB301", "error", 0.0)], []))
+
+    # OFB302: position control, but the companion also writes VehicleAttitudeSetpoint from 3 s.
+    def with_attitude(t: float) -> list[Event]:
+        return climb(t) + (attitude(t) if t >= 3.0 else [])
+
+    cases.append(
+        Case(
+            "ofb302_attitude_under_position",
+            Flight(POSITION, with_attitude).events(),
+            [("OFB302", "error", 3.0)],
+            [],
+        )
+    )
+
+    # OFB303: thrust_and_torque declared, only VehicleThrustSetpoint published.
+    def thrust_only(t: float) -> list[Event]:
+        return [ThrustSetpoint(t=t, xyz=(0.0, 0.0, -0.6 + 0.01 * math.sin(t)))]
+
+    cases.append(
+        Case(
+            "ofb303_torque_missing",
+            Flight({"thrust_and_torque": True}, thrust_only).events(),
+            [("OFB303", "error", SWITCH_T + 0.02 + 0.5)],
+            [],
+            note="offboard from the accepted ack (1.52 s) + grace 0.5 s",
+        )
+    )
+
+    # OFB304: position control until 4 s, then velocity control (content follows).
+    def to_velocity(t: float) -> list[Event]:
+        if t < 4.0:
+            return climb(t)
+        return [TrajectorySetpoint(t=t, velocity=(1.0, 0.1 * (t - 4.0), 0.0), yaw=0.1 * t)]
+
+    cases.append(
+        Case(
+            "ofb304_position_then_velocity",
+            Flight(
+                POSITION,
+                to_velocity,
+                ocm_flags=lambda t: POSITION if t < 4.0 else {"velocity": True},
+            ).events(),
+            [("OFB304", "info", 4.0)],
+            [],
+        )
+    )
+
+    # OFB401: velocity declared, the content still carries the position target.
+    def velocity_with_position(t: float) -> list[Event]:
+        (sp,) = climb(t)
+        assert isinstance(sp, TrajectorySetpoint)
+        return [TrajectorySetpoint(t=t, position=sp.position, velocity=(0.5, 0.0, 0.0))]
+
+    cases.append(
+        Case(
+            "ofb401_velocity_declared_position_sent",
+            Flight({"velocity": True}, velocity_with_position).events(),
+            [("OFB401", "error", SWITCH_T + 0.05)],
+            [],
+        )
+    )
+
+    # OFB402: from 4 s the companion sends yaw-only setpoints.
+    def yaw_only(t: float) -> list[Event]:
+        return climb(t) if t < 4.0 else [TrajectorySetpoint(t=t, yaw=0.1 * t)]
+
+    cases.append(
+        Case(
+            "ofb402_yaw_only_setpoints",
+            Flight(POSITION, yaw_only).events(),
+            [("OFB402", "error", 4.0)],
+            [],
+        )
+    )
+
+    # OFB403: from 4 s y is NaN while x and z are positions.
+    def y_missing(t: float) -> list[Event]:
+        (sp,) = climb(t)
+        assert isinstance(sp, TrajectorySetpoint)
+        if t < 4.0:
+            return [sp]
+        return [TrajectorySetpoint(t=t, position=(sp.position[0], NAN, sp.position[2]))]
+
+    cases.append(
+        Case("ofb403_y_nan", Flight(POSITION, y_missing).events(), [("OFB403", "error", 4.0)], [])
+    )
+
+    # OFB404: a takeoff to 5 m written in ENU: z = +5 right after arming.
+    def enu_takeoff(t: float) -> list[Event]:
+        (sp,) = climb(t)
+        assert isinstance(sp, TrajectorySetpoint)
+        x, y, z = sp.position
+        return [TrajectorySetpoint(t=t, position=(x, y, -z), yaw=sp.yaw)]
+
+    cases.append(
+        Case(
+            "ofb404_enu_takeoff",
+            Flight(POSITION, enu_takeoff).events(),
+            [("OFB404", "warning", 1.8)],
+            [],
+            note="the first setpoint with |z| over 0.5 m: 2 * (t - 1.5) > 0.5 first at 1.8 s",
+        )
+    )
+
+    # OFB405: attitude control with a quaternion that is not normalised from 4 s.
+    def scaled_quat(t: float) -> list[Event]:
+        if t < 4.0:
+            return attitude(t)
+        w, x, y, z = quat(0.1 * t)
+        return [AttitudeSetpoint(t=t, q_d=(2 * w, x, y, 2 * z), thrust_body=(0.0, 0.0, -0.6))]
+
+    cases.append(
+        Case(
+            "ofb405_quaternion_scaled",
+            Flight({"attitude": True}, scaled_quat).events(),
+            [("OFB405", "error", 4.0)],
+            [],
+        )
+    )
+
+    # OFB406: thrust in newtons-like units: -1.4 from 4 s.
+    def strong(t: float) -> list[Event]:
+        thrust = -0.6 if t < 4.0 else -1.4
+        return [AttitudeSetpoint(t=t, q_d=quat(0.1 * t), thrust_body=(0.0, 0.0, thrust))]
+
+    cases.append(
+        Case(
+            "ofb406_thrust_over_one",
+            Flight({"attitude": True}, strong).events(),
+            [("OFB406", "error", 4.0)],
+            [],
+        )
+    )
+
+    # OFB407: motor 3 turns NaN at 4 s while armed.
+    def motor_dies(t: float) -> list[Event]:
+        (m,) = motors(t)
+        assert isinstance(m, ActuatorMotors)
+        if t < 4.0:
+            return [m]
+        c = list(m.control)
+        c[2] = NAN
+        return [ActuatorMotors(t=t, control=tuple(c))]
+
+    cases.append(
+        Case(
+            "ofb407_motor_nan_while_armed",
+            Flight({"direct_actuator": True}, motor_dies).events(),
+            [("OFB407", "warning", 4.0)],
+            [],
+        )
+    )
+
+    # OFB408: yaw rate NaN from 4 s.
+    def yaw_nan(t: float) -> list[Event]:
+        if t < 4.0:
+            return rates(t)
+        return [RatesSetpoint(t=t, roll=0.0, pitch=0.0, yaw=NAN, thrust_body=(0.0, 0.0, -0.6))]
+
+    cases.append(
+        Case(
+            "ofb408_yaw_rate_nan",
+            Flight({"body_rate": True}, yaw_nan).events(),
+            [("OFB408", "error", 4.0)],
+            [],
+        )
+    )
+    return cases
+
+
+def ulog_cases() -> list[Case]:
+    cases: list[Case] = []
+    valid = FailsafeFlags(t=0.0, local_position_valid=True, local_velocity_valid=True)
+    lost = FailsafeFlags(t=4.0, local_position_valid=False, local_velocity_valid=True)
+    logged = [_as_logged(e) for e in Flight(POSITION, climb).events()]
+    cases.append(Case("good_estimates", [*logged, valid], [], ["OFB305"], fmt="ulg"))
+
+    # OFB305: the local position estimate turns invalid at 4.0 s in offboard. PX4 1.15 then
+    # takes the offboard signal for lost (gate spec 2.1) and, without a position estimate, falls
+    # back to ALTCTL instead of the configured POSCTL (OFB103, OFB702); the logged status
+    # shows ALTCTL with the failsafe flag from the next 10 Hz check pass.
+    def failsafe(e: Event) -> Event:
+        if isinstance(e, VehicleStatus) and e.t >= 4.1:
+            return replace(e, nav_state=ALTCTL, failsafe=True, user_intention=OFFBOARD)
+        return e
+
+    cases.append(
+        Case(
+            "ofb305_position_estimate_lost",
+            [*(failsafe(e) for e in logged), valid, lost],
+            [("OFB305", "error", 4.0), ("OFB702", "warning", 4.0), ("OFB103", "error", 4.01)],
+            [],
+            fmt="ulg",
+        )
+    )
+    cases += legacy_cases()
+    return cases
+
+
+def _as_logged(event: Event) -> Event:
+    """The ULog copy of an event: PX4 logged it (origin ``vehicle``)."""
+    return replace(event, origin="vehicle", sender_time_us=None)
+
+
+LEGACY_GOOD = {
+    "ignore_thrust": True,
+    "ignore_attitude": True,
+    "ignore_bodyrate": True,
+    "ignore_acceleration_force": True,
+}
+
+
+def legacy_flight(
+    mode: Callable[[float], dict[str, bool]],
+    triplet: Callable[[float], dict[str, bool]],
+) -> list[Event]:
+    """A uORB-era offboard flight as its ULog shows it (seed 003): the companion publishes
+    ``offboard_control_mode`` and ``position_setpoint_triplet`` directly."""
+    out: list[Event] = []
+    for t in ticks(0.0, END_T, OCM_PERIOD):
+        out.append(LegacyControlMode(t=t, origin="vehicle", **mode(t)))
+        if t >= SWITCH_T:
+            out.append(PositionSetpointTriplet(t=t, origin="vehicle", **triplet(t)))
+    for t in ticks(0.0, END_T, STATUS_PERIOD):
+        nav = OFFBOARD if t >= SWITCH_T + 0.05 else POSCTL
+        out.append(VehicleStatus(t=t, nav_state=nav, armed=t >= ARM_T + 0.05))
+    return sorted(out, key=lambda e: e.t)
+
+
+def legacy_cases() -> list[Case]:
+    ok_triplet = {"current_valid": True, "current_position_valid": True, "current_type": 0}
+
+    def legacy(name: str, events: list[Event], findings: list[Any], clean: list[str]) -> Case:
+        return Case(
+            name,
+            events,
+            findings,
+            clean,
+            fmt="ulg",
+            px4="legacy",
+            ulog_version="1.7.3",
+            ulog_layout="legacy",
+        )
+
+    cases = [
+        legacy(
+            "legacy_good",
+            legacy_flight(lambda t: LEGACY_GOOD, lambda t: ok_triplet),
+            [],
+            ["OFB801", "OFB802", "OFB803"],
+        )
+    ]
+    no_acc_ignore = {**LEGACY_GOOD, "ignore_acceleration_force": False}
+    cases.append(
+        legacy(
+            "ofb801_acceleration_not_ignored",
+            legacy_flight(
+                lambda t: no_acc_ignore if t >= 3.0 else LEGACY_GOOD, lambda t: ok_triplet
+            ),
+            [("OFB801", "error", 3.0)],
+            [],
+        )
+    )
+    cases.append(
+        legacy(
+            "ofb802_next_filled",
+            legacy_flight(
+                lambda t: LEGACY_GOOD,
+                lambda t: {**ok_triplet, "next_valid": True} if t >= 3.0 else ok_triplet,
+            ),
+            [("OFB802", "info", 3.0)],
+            [],
+        )
+    )
+    cases.append(
+        legacy(
+            "ofb803_position_invalid",
+            legacy_flight(
+                lambda t: LEGACY_GOOD,
+                lambda t: {**ok_triplet, "current_position_valid": t < 3.0},
+            ),
+            [("OFB803", "error", 3.0)],
+            [],
+        )
+    )
+    return cases
+
+
+# ---------------------------------------------------------------------------------------------
+
+
+def context_findings(case: Case) -> list[tuple[str, str, float | None]]:
+    """What every recording of the case's format also gets, checked against the rule texts.
+
+    * OFB701 (info): the loss-action summary at the offboard request (1.5 s; the legacy flights
+      have no recorded command, so at the first OFFBOARD status, 1.6 s).
+    * OFB002 (info, no time), one per rule the format cannot show: in MCAP OFB305 (no estimator
+      flags on ROS 2); in a 1.15 ULog OFB104, OFB105 (subsampled keep-alive), OFB106, OFB203,
+      OFB302 (only PX4's copies of the messages); in a legacy ULog OFB104, OFB105.
+    """
+    not_checkable = {"mcap": 1, "ulg": 2 if case.px4 == "legacy" else 5}[case.fmt]
+    request = 1.6 if case.px4 == "legacy" else SWITCH_T
+    return [("OFB002", "info", None)] * not_checkable + [("OFB701", "info", request)]
+
+
+def write(case: Case) -> None:
+    path = HERE / case.filename
+    if case.fmt == "mcap":
+        write_mcap(path, case.events, release=case.release)
+    else:
+        write_ulog(
+            path,
+            case.events,
+            px4_version=case.ulog_version,
+            layout=case.ulog_layout,
+            vehicle_type=case.vehicle,
+            params=case.params or None,
+        )
+    expected: dict[str, Any] = {
+        "recording": case.filename,
+        "args": case.args(),
+        "exit_status": 1 if any(sev != "info" for _, sev, _ in case.findings) else 0,
+        "complete": True,
+        "findings": [
+            {"code": code, "severity": sev, "time_s": t}
+            for code, sev, t in [*context_findings(case), *case.findings]
+        ],
+        "clean": case.clean,
+    }
+    (HERE / f"{case.name}.expected.json").write_text(json.dumps(expected, indent=2) + "\n")
+
+
+def all_cases() -> Iterable[Case]:
+    yield from mcap_cases()
+    yield from ulog_cases()
+
+
+def main() -> None:
+    for case in all_cases():
+        write(case)
+        print(f"{case.filename}: {(HERE / case.filename).stat().st_size} bytes")
+
+
+if __name__ == "__main__":
+    main()
