@@ -19,10 +19,10 @@ from mcap.reader import SeekingReader
 from mcap.records import Channel, Chunk, DataEnd, Footer, Message, Schema
 from mcap.stream_reader import CRCValidationError, StreamReader, breakup_chunk
 
-from fuzzoff.events import Event
+from fuzzoff.events import NOWHERE, Event
 from fuzzoff.sources import px4_msgs
 from fuzzoff.sources.base import RecordingInfo, Source, SourceError, SourceProblem
-from fuzzoff.sources.ros2_decode import Decoder, Ros2Decoding
+from fuzzoff.sources.ros2_decode import Decoder, Ros2Decoding, TopicDecoder
 from fuzzoff.sources.ros2_order import ChunkOrder
 
 Connect = Callable[[str, str, str | None, str], Decoder | None]
@@ -225,6 +225,7 @@ class McapSource(Source):
                 info.message_count = summary.statistics.message_count
                 if summary.statistics.message_count:
                     stream.t0_ns = summary.statistics.message_start_time
+            info.vehicle_type = self._vehicle_type(stream)
         else:
             info.notes.append("no MCAP summary (footer missing or damaged): scanned for channels")
             self._scan(stream)
@@ -238,6 +239,32 @@ class McapSource(Source):
                 return SeekingReader(fh, validate_crcs=True).get_summary()
         except Exception:
             return None
+
+    def _vehicle_type(self, stream: McapStream) -> str | None:
+        """The vehicle type from the first ``VehicleStatus`` (read through the chunk index)."""
+        topics = {
+            d.topic: d
+            for d in stream.decoders.values()
+            if isinstance(d, TopicDecoder) and d.message == "VehicleStatus" and d.builder
+        }
+        if not topics:
+            return None
+        try:
+            with self.path.open("rb") as fh:
+                reader = SeekingReader(fh, validate_crcs=True)
+                for _, channel, message in reader.iter_messages(
+                    topics=sorted(topics), log_time_order=False
+                ):
+                    decoder = topics[channel.topic]
+                    assert decoder.definition is not None and decoder.builder is not None
+                    decoded, why = decoder.definition.decode(message.data)
+                    if why is None:
+                        event = decoder.builder(decoded, 0.0, NOWHERE, 0)
+                        return self.decoding.vehicle_type(event)
+                    return None
+        except Exception:
+            return None
+        return None
 
     def _scan(self, stream: McapStream) -> None:
         """Channels and the earliest log time without a summary (a full pass; salvage only)."""

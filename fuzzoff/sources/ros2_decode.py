@@ -16,7 +16,8 @@ from typing import Any
 from rosbags.typesys import get_types_from_idl
 from rosbags.typesys.store import Typestore
 
-from fuzzoff.events import Event, Origin, Where
+from fuzzoff.events import Event, Origin, VehicleStatus, Where
+from fuzzoff.profiles import PX4_VEHICLE_TYPE
 from fuzzoff.sources import px4_msgs
 from fuzzoff.sources.base import SourceProblem
 from fuzzoff.sources.mavros import MavrosConverter, mavros_topic
@@ -270,6 +271,14 @@ class Ros2Decoding:
         if self.evidence and len(self.evidence) == 1:
             return next(iter(self.evidence))
         return None
+
+    def vehicle_type(self, status: Event) -> str | None:
+        """The profile vehicle type a decoded ``VehicleStatus`` names (VTOL first)."""
+        if not isinstance(status, VehicleStatus):
+            return None
+        if status.is_vtol:
+            return "vtol"
+        return PX4_VEHICLE_TYPE.get(status.vehicle_type or 0)
 
     def kinds(self) -> set[str]:
         return {d.kind for d in self.decoders}

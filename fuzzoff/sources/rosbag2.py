@@ -23,7 +23,7 @@ from rosbags.interfaces import MessageDefinitionFormat
 from rosbags.rosbag2 import Reader
 from ruamel.yaml import YAML
 
-from fuzzoff.events import Event
+from fuzzoff.events import NOWHERE, Event
 from fuzzoff.sources import px4_msgs
 from fuzzoff.sources.base import RecordingInfo, Source, SourceError, SourceProblem
 from fuzzoff.sources.mcap import McapStream
@@ -57,6 +57,7 @@ class Rosbag2Source(Source):
         self._messages = 0
         self._done = 0
         self._notes: list[str] = []
+        self._vehicle: str | None = None
 
     # -- opening -----------------------------------------------------------------------------
 
@@ -128,6 +129,7 @@ class Rosbag2Source(Source):
         info.kinds = self.decoding.kinds()
         info.vehicles = self.decoding.vehicles()
         info.px4_version = self.decoding.detected_release()
+        info.vehicle_type = self._vehicle
         info.notes.extend(self._notes)
         self._info = info
         return info
@@ -149,11 +151,31 @@ class Rosbag2Source(Source):
                 continue
             t0 = self._t0 if self._t0 is not None else stamp
             decoder.resolve(raw, (stamp - t0) / 1e9)
+        self._vehicle_type(reader)
         chosen = sorted({d.definition.source for _, _, d in pending if d.definition is not None})
         if chosen:
             self._notes.append(
                 "no embedded definitions for some topics: decoded with " + ", ".join(chosen)
             )
+
+    def _vehicle_type(self, reader: Any) -> None:
+        """The vehicle type from the first ``VehicleStatus`` (a cheap indexed read)."""
+        for conn in reader.connections:
+            decoder = self._decoders.get((conn.topic, conn.msgtype))
+            if not isinstance(decoder, TopicDecoder) or decoder.message != "VehicleStatus":
+                continue
+            if decoder.definition is None or not conn.msgcount:
+                continue
+            try:
+                _, _, raw = next(iter(reader.messages(connections=[conn])))
+            except Exception:
+                continue
+            message, why = decoder.definition.decode(raw)
+            if why is None and decoder.builder is not None:
+                event = decoder.builder(message, 0.0, NOWHERE, 0)
+                self._vehicle = self.decoding.vehicle_type(event)
+                if self._vehicle:
+                    return
 
     def _probe_files(self) -> None:
         starts = []
