@@ -41,6 +41,8 @@ from fuzzoff.writers.mcap import write_mcap
 from fuzzoff.writers.ulog import write_ulog
 
 HERE = Path(__file__).resolve().parent
+Fields = dict[str, Any]
+"""Keyword fields of an event (flags of a control mode, validity of a triplet)."""
 ALTCTL, POSCTL, OFFBOARD = 1, 2, 14
 NAN = math.nan
 BOOT_US = 120_000_000
@@ -64,12 +66,12 @@ def stamp(t: float) -> int:
 class Flight:
     """The realistic pattern; ``setpoint(t)`` gives the companion's setpoints at ``t``."""
 
-    flags: dict[str, bool]
+    flags: Fields
     setpoint: Callable[[float], list[Event]]
     setpoints_from: float = SWITCH_T + 0.05
     """The companion starts its setpoints once the switch is acked (at 1.52 s)."""
     ocm_stamp: Callable[[float], int] = stamp
-    ocm_flags: Callable[[float], dict[str, bool]] | None = None
+    ocm_flags: Callable[[float], Fields] | None = None
     extra: list[Event] = field(default_factory=list)
 
     def events(self) -> list[Event]:
@@ -212,7 +214,7 @@ def mcap_cases() -> list[Case]:
     cases.append(Case("ofb203_setpoints_before_switch", early, [("OFB203", "error", 0.0)], []))
 
     # OFB301: the first 0.3 s of OffboardControlMode declare nothing.
-    def empty_first(t: float) -> dict[str, bool]:
+    def empty_first(t: float) -> Fields:
         return {} if t < 0.3 else POSITION
 
     empty = Flight(POSITION, climb, ocm_flags=empty_first).events()
@@ -430,8 +432,8 @@ LEGACY_GOOD = {
 
 
 def legacy_flight(
-    mode: Callable[[float], dict[str, bool]],
-    triplet: Callable[[float], dict[str, bool]],
+    mode: Callable[[float], Fields],
+    triplet: Callable[[float], Fields],
 ) -> list[Event]:
     """A uORB-era offboard flight as its ULog shows it (seed 003): the companion publishes
     ``offboard_control_mode`` and ``position_setpoint_triplet`` directly."""
@@ -447,7 +449,7 @@ def legacy_flight(
 
 
 def legacy_cases() -> list[Case]:
-    ok_triplet = {"current_valid": True, "current_position_valid": True, "current_type": 0}
+    ok_triplet: Fields = {"current_valid": True, "current_position_valid": True, "current_type": 0}
 
     def legacy(name: str, events: list[Event], findings: list[Any], clean: list[str]) -> Case:
         return Case(
