@@ -431,3 +431,30 @@ def test_cli_truncated_keeps_findings_of_the_readable_part(tmp_path: Path) -> No
     assert whole_codes, "the planted gap should give findings"
     for code in whole_codes:
         assert code in codes
+
+
+def test_signed_packets_are_read(tmp_path: Path) -> None:
+    class Capture:
+        data = b""
+
+        def write(self, data: bytes) -> None:
+            Capture.data = bytes(data)
+
+    link = mavlink.MAVLink(Capture(), srcSystem=1, srcComponent=191)
+    link.signing.secret_key = bytes(range(32))
+    link.signing.sign_outgoing = True
+    link.signing.link_id = 1
+    records = []
+    for i in range(3):
+        link.send(
+            mavlink.MAVLink_set_position_target_local_ned_message(
+                i, 1, 1, 1, 0x09F8, 0, 0, -1, 0, 0, 0, 0, 0, 0, 0, 0
+            )
+        )
+        assert Capture.data[2] & 1  # the signed flag
+        records.append((0.1 * i, Capture.data))
+        link.send(mavlink.MAVLink_attitude_message(i, 0, 0, 0, 0, 0, 0))
+        records.append((0.1 * i + 0.01, Capture.data))
+    source, back = read(_tlog(tmp_path / "signed.tlog", records))
+    assert [e.sender_time_us for e in back] == [0, 1000, 2000]
+    assert not source.problems and source.stats["messages"]["ATTITUDE"] == 3

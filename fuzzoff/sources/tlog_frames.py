@@ -180,15 +180,23 @@ class Framer:
             if pos + 11 > n:
                 self._tail(pos)
                 break
-            end = self._record_end(buf, pos)
-            if end is None:
+            # _record_end and _msgid inlined: this runs once per packet
+            magic = buf[pos + 8]
+            if magic == 0xFD:
+                end = pos + 20 + buf[pos + 9] + (13 if buf[pos + 10] & 1 else 0)
+            elif magic == 0xFE:
+                end = pos + 16 + buf[pos + 9]
+            else:
                 pos, buf, n = self._resync(pos, "no MAVLink start byte")
                 continue
             if end > n:
                 self._tail(pos)
                 break
             ts = unpack_ts(buf, pos)[0]
-            msgid = self._msgid(buf, pos)
+            if magic == 0xFD:
+                msgid = buf[pos + 15] | (buf[pos + 16] << 8) | (buf[pos + 17] << 16)
+            else:
+                msgid = buf[pos + 13]
             last = stats.last_ts
             if (
                 last is not None
