@@ -347,22 +347,33 @@ def _format(name: str, fields: list[str]) -> Any:
     return ULog.MessageFormat(text.encode(), None)
 
 
-def _dataset(topic: str, msg_id: int, rows: list[Row], formats: dict[str, Any]) -> Any:
-    """A ``ULog.Data`` built the way pyulog's reader builds one (same flattening and dtype)."""
+def _dataset(
+    topic: str, msg_id: int, columns: Mapping[str, Any], rows: int, formats: dict[str, Any]
+) -> Any:
+    """A ``ULog.Data`` built the way pyulog's reader builds one (same flattening and dtype).
+    ``columns``: flattened field name (``position[0]``) -> values; None or absent = default
+    (NaN for floats, 0 otherwise)."""
     record = struct.pack("<BH", 0, msg_id) + topic.encode()
     added = ULog._MessageAddLogged(record, None, formats)
-    array = np.zeros(len(rows), dtype=added.dtype)
+    array = np.zeros(rows, dtype=added.dtype)
     for name in array.dtype.names or ():
         if name.startswith("_padding") or "._padding" in name:
             continue
-        kind = array.dtype[name].kind
-        default: Any = math.nan if kind == "f" else 0
-        column = [row.get(name, default) for row in rows]
-        if kind == "f":
-            column = [default if v is None else v for v in column]
-        array[name] = column
+        default: Any = math.nan if array.dtype[name].kind == "f" else 0
+        values = columns.get(name)
+        if values is None:
+            array[name] = default
+        elif isinstance(values, np.ndarray):
+            array[name] = values
+        else:
+            array[name] = [default if v is None else v for v in values]
     added.buffer = bytearray(array.tobytes())
     return ULog.Data(added)
+
+
+def _columns(rows: list[Row]) -> dict[str, list[Any]]:
+    names = {name for row in rows for name in row}
+    return {name: [row.get(name) for row in rows] for name in names}
 
 
 def write_ulog(
@@ -385,7 +396,6 @@ def write_ulog(
     (added to a few defaults); ``Parameter`` events at t > 0 become parameter changes.
     ``vehicle_type`` (or a ``VehicleInfo`` event) sets ``CA_AIRFRAME``/``MAV_TYPE``.
     """
-    path = Path(path)
     era = layout or era_for(px4_version)
     stream = list(events)
     for event in stream:
@@ -394,7 +404,43 @@ def write_ulog(
     topics = _Topics(era, start_us, vehicle_type)
     for event in stream:
         topics.add(event)
+    ulog = _new_ulog(px4_version, start_us)
+    initial = default_params(era, vehicle_type) | dict(params or {}) | topics.initial_params
+    ulog._initial_parameters = dict(initial)
+    ulog._changed_parameters = topics.changed_params
+    columns = {topic: (_columns(rows), len(rows)) for topic, rows in topics.rows.items()}
+    _add_topics(ulog, columns, era)
+    for ts, level, text in topics.logged:
+        message = ULog.MessageLogging.__new__(ULog.MessageLogging)
+        message.log_level, message.timestamp, message.message = level, ts, text
+        ulog._logged_messages.append(message)
+    for ts, duration_ms in topics.dropouts:
+        dropout = ULog.MessageDropout.__new__(ULog.MessageDropout)
+        dropout.duration, dropout.timestamp = duration_ms, ts
+        ulog._dropouts.append(dropout)
+    return _write(ulog, Path(path))
 
+
+def write_ulog_columns(
+    path: str | Path,
+    topics: Mapping[str, Mapping[str, Any]],
+    *,
+    px4_version: str | None = "1.15.4",
+    params: Mapping[str, ParamValue] | None = None,
+    layout: str | None = None,
+    start_us: int = DEFAULT_START_US,
+) -> Path:
+    """Write whole topics given as columns (uORB topic -> flattened field -> numpy array, with
+    ``timestamp`` in microseconds): for logs too long to hold as events (the benchmarks)."""
+    era = layout or era_for(px4_version)
+    ulog = _new_ulog(px4_version, start_us)
+    ulog._initial_parameters = default_params(era, None) | dict(params or {})
+    sized = {topic: (cols, len(cols["timestamp"])) for topic, cols in topics.items()}
+    _add_topics(ulog, sized, era)
+    return _write(ulog, Path(path))
+
+
+def _new_ulog(px4_version: str | None, start_us: int) -> Any:
     ulog = ULog(None)
     ulog._file_version = 1
     ulog._start_timestamp = start_us
@@ -408,26 +454,20 @@ def write_ulog(
     for key, (kind, value) in info.items():
         ulog._msg_info_dict[key] = value
         ulog._msg_info_dict_types[key] = kind
-    initial = default_params(era, vehicle_type) | dict(params or {}) | topics.initial_params
-    ulog._initial_parameters = dict(initial)
-    ulog._changed_parameters = topics.changed_params
+    return ulog
 
+
+def _add_topics(ulog: Any, topics: Mapping[str, tuple[Mapping[str, Any], int]], era: str) -> None:
     formats: dict[str, Any] = {name: _format(name, fields) for name, fields in NESTED.items()}
-    for msg_id, topic in enumerate(sorted(topics.rows)):
+    for msg_id, topic in enumerate(sorted(topics)):
         fields = fields_for(topic, era) or FORMATS[topic][0][1]  # before it existed: its first
         formats[topic] = _format(topic, fields)
-        ulog._data_list.append(_dataset(topic, msg_id, topics.rows[topic], formats))
+        columns, rows = topics[topic]
+        ulog._data_list.append(_dataset(topic, msg_id, columns, rows, formats))
     ulog._message_formats = formats
 
-    for ts, level, text in topics.logged:
-        message = ULog.MessageLogging.__new__(ULog.MessageLogging)
-        message.log_level, message.timestamp, message.message = level, ts, text
-        ulog._logged_messages.append(message)
-    for ts, duration_ms in topics.dropouts:
-        dropout = ULog.MessageDropout.__new__(ULog.MessageDropout)
-        dropout.duration, dropout.timestamp = duration_ms, ts
-        ulog._dropouts.append(dropout)
 
+def _write(ulog: Any, path: Path) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     ulog.write_ulog(str(path))
     return path

@@ -1,0 +1,146 @@
+"""ULog speed and memory: ``fuzzoff lint`` beside pyulog alone on the same files (issue 3/10).
+
+Targets: lint at most 1.3x the bare library's time on the same file (pyulog ``ULog(path)``
+loading everything); on a log where offboard topics are under 10 % of the messages, lint faster
+than pyulog loading everything. Also shown: pyulog with fuzzoff's filter list, and fuzzoff's
+ULog reader alone (load + every event, no checks), which is the part this format adds.
+
+Every measurement is its own process (wall time from outside, CPU time and peak RSS from
+``os.wait4``), so imports and start-up count for both sides. The data (bench/data/,
+git-ignored) are generated on the first run; ``python -m bench ulog`` runs only this one.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from bench.ulog_data import generate
+from fuzzoff.sources.ulog import LOADED_TOPICS
+
+DATA = Path(__file__).resolve().parent / "data"
+ROOT = DATA.parent.parent
+
+BARE = """
+import sys
+from pyulog import ULog
+topics = sys.argv[2].split(",") if len(sys.argv) > 2 else None
+ulog = ULog(sys.argv[1], message_name_filter_list=topics)
+print(sum(len(d.data["timestamp"]) for d in ulog.data_list))
+"""
+
+READER = """
+import sys
+from pathlib import Path
+from fuzzoff.sources.ulog import UlogSource
+source = UlogSource(Path(sys.argv[1]))
+with source:
+    source.probe()
+    print(sum(1 for _ in source.events()))
+"""
+
+
+@dataclass
+class Run:
+    wall_s: float
+    cpu_s: float
+    rss_mb: float
+    output: str
+
+
+def measure(args: list[str]) -> Run:
+    """Run ``args``; wall time, CPU time and this child's own peak RSS."""
+    env = {**os.environ, "NO_COLOR": "1"}
+    with tempfile.TemporaryFile() as out:
+        start = time.perf_counter()
+        proc = subprocess.Popen(args, stdout=out, stderr=subprocess.DEVNULL, cwd=ROOT, env=env)
+        _, status, usage = os.wait4(proc.pid, 0)
+        wall = time.perf_counter() - start
+        proc.returncode = os.waitstatus_to_exitcode(status)
+        out.seek(0)
+        text = out.read().decode(errors="replace")
+    return Run(wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024, text)
+
+
+def lint(path: Path) -> Run:
+    args = [sys.executable, "-m", "fuzzoff.cli", "lint", str(path), "--format", "json"]
+    return measure([*args, "--no-progress"])
+
+
+def bare(path: Path, topics: tuple[str, ...] | None = None) -> Run:
+    extra = [",".join(topics)] if topics else []
+    return measure([sys.executable, "-c", BARE, str(path), *extra])
+
+
+def reader(path: Path) -> Run:
+    return measure([sys.executable, "-c", READER, str(path)])
+
+
+def _row(name: str, what: str, messages: int, run: Run) -> None:
+    rate = messages / run.wall_s if run.wall_s else 0.0
+    print(
+        f"{name:<12} {what:<30} {run.wall_s:8.2f} s {run.cpu_s:8.2f} s "
+        f"{rate:11,.0f} msg/s {run.rss_mb:8.1f} MB"
+    )
+
+
+def main() -> None:
+    files = {
+        "100k": generate(DATA / "ulog_100k.ulg", 100_000),
+        "1M": generate(DATA / "ulog_1m.ulg", 1_000_000),
+        "mixed-1M": generate(DATA / "ulog_mixed_1m.ulg", 1_000_000, mixed=True),
+    }
+    header = f"{'file':<12} {'method':<30} {'wall':>10} {'cpu':>10} {'rate (wall)':>17}"
+    print(f"{header} {'peak RSS':>11}")
+    results: dict[str, dict[str, Run]] = {}
+    for name, path in files.items():
+        runs = {
+            "pyulog, everything": bare(path),
+            "pyulog, fuzzoff's filter list": bare(path, LOADED_TOPICS),
+            "fuzzoff ulog reader alone": reader(path),
+            "fuzzoff lint": lint(path),
+        }
+        results[name] = runs
+        messages = int(runs["pyulog, everything"].output.strip() or 0)
+        for what, run in runs.items():
+            _row(name, what, messages, run)
+        events = runs["fuzzoff ulog reader alone"].output.strip()
+        size_mb = path.stat().st_size / 1e6
+        print(f"{'':<12} ({messages:,} messages, {events} events, {size_mb:.1f} MB)")
+
+    def ratio(name: str, what: str, against: str = "pyulog, everything") -> tuple[float, float]:
+        runs = results[name]
+        return (
+            runs[what].wall_s / runs[against].wall_s,
+            runs[what].cpu_s / runs[against].cpu_s,
+        )
+
+    print()
+    print("target (wall; cpu in brackets)                           measured           ok")
+    for name in ("100k", "1M"):
+        wall, cpu = ratio(name, "fuzzoff lint")
+        print(
+            f"lint / pyulog everything ({name:<4}) <= 1.3x          {wall:7.2f}x ({cpu:5.2f}x)   "
+            f"{wall <= 1.3}"
+        )
+    wall, cpu = ratio("mixed-1M", "fuzzoff lint")
+    print(
+        f"lint / pyulog everything (offboard < 10 %) < 1.0x   {wall:7.2f}x ({cpu:5.2f}x)   "
+        f"{wall < 1.0}"
+    )
+    for name in files:
+        wall, cpu = ratio(name, "fuzzoff ulog reader alone")
+        fwall, fcpu = ratio(name, "fuzzoff ulog reader alone", "pyulog, fuzzoff's filter list")
+        print(
+            f"  ({name}: reader alone {wall:.2f}x ({cpu:.2f}x) pyulog everything, "
+            f"{fwall:.2f}x ({fcpu:.2f}x) pyulog with the same filter list)"
+        )
+
+
+if __name__ == "__main__":
+    main()
