@@ -1,0 +1,192 @@
+"""Requests and acks (gate spec 4), the recording as input (12: start mid-flight, estimates,
+parameters) and the recorded-vs-model comparison with the evaluation slack (2.1.3)."""
+
+from __future__ import annotations
+
+import pytest
+
+from fuzzoff.events import Command, CommandAck, Parameter, VehicleStatus
+from tests.gate.streams import (
+    ALL,
+    OFFBOARD,
+    POSCTL,
+    TERMINATION,
+    TICK,
+    arm,
+    flags,
+    in_offboard,
+    model,
+    ocm,
+    of,
+    run,
+    status,
+    stream,
+    switch_mode,
+    switch_offboard,
+)
+
+
+def _set_nav_state(t: float, nav: int) -> Command:
+    return Command(t=t, command=100001, params=(float(nav), 0, 0, 0, 0, 0, 0))
+
+
+@pytest.mark.parametrize(("px4", "handled"), [("1.14", False), *[(p, True) for p in TICK[1:]]])
+def test_4_1_set_nav_state_from_115(px4: str, handled: bool) -> None:
+    """4.1: ROS 2 VEHICLE_CMD_SET_NAV_STATE (100001) is handled from 1.15, not in 1.14."""
+    events = [status(0.0, POSCTL, False, POSCTL), _set_nav_state(1.0, OFFBOARD)]
+    trs = run(px4, events)
+    assert bool(of("request_accepted", trs)) is handled
+
+
+@pytest.mark.parametrize(("px4", "rejected"), [*[(p, False) for p in TICK[:-1]], ("main", True)])
+def test_4_1_unsupported_main_mode(px4: str, rejected: bool) -> None:
+    """4.1: an unknown custom main mode: main rejects it; 1.14-1.17 ack it with no change."""
+    trs = run(px4, [status(0.0, POSCTL, True, POSCTL), switch_mode(1.0, 42)])
+    assert any("unsupported main mode" in (t.message or "") for t in trs)
+    assert any("rejected" in t.message for t in trs) is rejected
+
+
+@pytest.mark.parametrize(("px4", "stays"), [("1.14", False), ("1.15", False), ("1.16", True)])
+def test_4_1_never_out_of_termination_from_116(px4: str, stays: bool) -> None:
+    """4.1: from 1.16 no mode switch leaves TERMINATION."""
+    events = [status(0.0, TERMINATION, True, TERMINATION), *stream(0.0, 1.0), switch_offboard(0.5)]
+    assert bool(of("request_rejected", run(px4, events))) is stays
+
+
+@pytest.mark.parametrize("px4", TICK)
+@pytest.mark.parametrize(("external", "armed"), [(False, True), (True, False)])
+def test_4_2_forced_arm_skips_checks_only_from_internal(
+    px4: str, external: bool, armed: bool
+) -> None:
+    """4.2: param2 = 21196 skips the checks only for commands not from external sources."""
+    forced = Command(
+        t=1.0, command=400, params=(1.0, 21196.0, 0, 0, 0, 0, 0), from_external=external
+    )
+    trs = run(px4, [status(0.0, OFFBOARD, False, OFFBOARD), forced])
+    assert bool(of("arm_accepted", trs)) is armed
+
+
+@pytest.mark.parametrize("px4", TICK)
+def test_4_2_arm_rechecks_at_the_request(px4: str) -> None:
+    """4.2: arming re-runs the checks at the request: 1.05 s after the only keep-alive (before
+    the next 10 Hz pass would have flagged it) the arm is already rejected."""
+    events = [status(0.0, OFFBOARD, False, OFFBOARD), ocm(1.0), arm(2.05)]
+    assert of("arm_rejected", run(px4, events))
+
+
+@pytest.mark.parametrize("px4", ["1.16", "1.17"])
+def test_4_3_double_ack_last_one_decides(px4: str) -> None:
+    """4.3: 1.16/1.17 ack ACCEPTED first, then Commander's result: the model's rejection agrees
+    with the second ack, so no disagreement."""
+    events = [
+        status(0.0, POSCTL, True, POSCTL),
+        switch_offboard(1.0),
+        CommandAck(t=1.002, command=176, result=0),
+        CommandAck(t=1.008, command=176, result=1),
+        status(2.0, POSCTL, True, POSCTL),
+    ]
+    trs = run(px4, events)
+    assert of("request_rejected", trs) and not of("disagreement", trs)
+
+
+@pytest.mark.parametrize("px4", ALL)
+def test_4_3_ack_that_contradicts_the_model_is_a_disagreement(px4: str) -> None:
+    """12 / 4.3: the vehicle accepted a switch the model rejects: reported, model follows."""
+    events = [
+        status(0.0, POSCTL, True, POSCTL),
+        switch_offboard(1.0),
+        CommandAck(t=1.01, command=176, result=0),
+        *stream(1.02, 1.5),
+    ]
+    gate = model(px4)
+    trs = run(px4, events, model=gate)
+    (differ,) = of("disagreement", trs)
+    assert "acked ACCEPTED" in differ.message and "rejected" in differ.message
+    assert gate.user_intention == OFFBOARD
+
+
+@pytest.mark.parametrize("px4", TICK)
+def test_12_recording_that_starts_in_offboard(px4: str) -> None:
+    """12: the model starts from the first recorded status; a live stream is assumed there."""
+    events = [in_offboard(3.0), *stream(3.02, 5.0)]
+    trs = run(px4, events)
+    assert of("failsafe", trs) == [] and of("disagreement", trs) == []
+
+
+@pytest.mark.parametrize("px4", TICK)
+def test_12_recorded_failsafe_within_slack_agrees(px4: str) -> None:
+    """2.1.3: PX4's check pass has its own phase: a recorded loss up to ~0.1 s before or after
+    the model's is agreement."""
+    for recorded_at in (1.98, 2.05, 2.12):
+        events = [
+            in_offboard(),
+            *stream(0.0, 1.0),
+            VehicleStatus(t=recorded_at, nav_state=POSCTL, armed=True, user_intention=OFFBOARD),
+            VehicleStatus(t=3.0, nav_state=POSCTL, armed=True, user_intention=OFFBOARD),
+        ]
+        assert of("disagreement", run(px4, events)) == [], recorded_at
+
+
+@pytest.mark.parametrize("px4", TICK)
+def test_12_recorded_offboard_after_predicted_loss_disagrees(px4: str) -> None:
+    """12: the recording stays in OFFBOARD well after the model's failsafe: one disagreement
+    naming both sides."""
+    events = [in_offboard(), *stream(0.0, 1.0)]
+    events += [in_offboard(t) for t in (2.5, 3.0, 3.5)]
+    (differ,) = of("disagreement", run(px4, events))
+    assert differ.t == pytest.approx(2.5)
+    assert "recorded: OFFBOARD" in differ.message and "model: POSCTL" in differ.message
+
+
+@pytest.mark.parametrize("px4", TICK)
+def test_12_pilot_switch_without_command_is_adopted(px4: str) -> None:
+    """12: a user-intention change with no command near it (an RC switch) is an input the
+    recording shows: adopted, not a disagreement."""
+    events = [in_offboard(), *stream(0.0, 5.0), status(3.0, POSCTL, True, POSCTL)]
+    gate = model(px4)
+    trs = run(px4, events, model=gate)
+    assert of("disagreement", trs) == [] and gate.user_intention == POSCTL
+
+
+def test_13_parameter_precedence() -> None:
+    """13: defaults < recorded parameters < user overrides."""
+    recorded = [Parameter(t=0.0, name="COM_OF_LOSS_T", value=2.0)]
+    assert model("1.15").params["COM_OF_LOSS_T"] == 1.0
+    gate = model("1.15")
+    run("1.15", recorded, model=gate)
+    assert gate.params["COM_OF_LOSS_T"] == 2.0 and gate.loss_timeout == 2.0
+    gate = model("1.15", COM_OF_LOSS_T=0.5)
+    run("1.15", recorded, model=gate)
+    assert gate.params["COM_OF_LOSS_T"] == 0.5
+
+
+@pytest.mark.parametrize(
+    ("px4", "default"),
+    [("legacy", 0.0), ("1.11", 0.5), ("1.13", 1.0), *[(p, 1.0) for p in TICK]],
+)
+def test_13_com_of_loss_t_defaults(px4: str, default: float) -> None:
+    """13 / 2.1.2: COM_OF_LOSS_T defaults per profile."""
+    assert model(px4).params["COM_OF_LOSS_T"] == default
+
+
+@pytest.mark.parametrize("px4", ["1.14", "1.15"])
+def test_2_1_estimate_loss_drops_the_signal(px4: str) -> None:
+    """2.1: estimates come from failsafe_flags: losing local position with a position stream
+    makes the signal lost at the next check pass, while the stream goes on."""
+    events = [in_offboard(), *stream(0.0, 3.0), flags(1.53, local_position_valid=False)]
+    (lost,) = [t for t in of("signal_lost", run(px4, events))]
+    assert lost.t == pytest.approx(1.6) and "position" in (lost.reason or "")
+
+
+def test_15_unverified_points_are_marked() -> None:
+    """15: behaviour the spec could not confirm is marked unverified."""
+    legacy_arm = of(
+        "arm_accepted", run("legacy", [status(0.0, OFFBOARD, False, OFFBOARD), arm(1.0)])
+    )
+    assert legacy_arm and legacy_arm[0].unverified
+    vtol = of("controller", run("1.15", [in_offboard(), ocm(0.0)], vehicle="vtol"))
+    assert vtol and vtol[-1].unverified
+    fw_velocity = of(
+        "controller", run("1.15", [in_offboard(), ocm(0.0, velocity=True)], vehicle="fw")
+    )
+    assert fw_velocity and fw_velocity[-1].unverified
