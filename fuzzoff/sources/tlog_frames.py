@@ -30,7 +30,7 @@ import os
 import re
 import struct
 from collections import Counter
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any, BinaryIO
 
@@ -57,6 +57,8 @@ _MAGIC = re.compile(b"[\xfd\xfe]")
 _TS = struct.Struct(">Q")
 _CRC = struct.Struct("<H")
 _CRC_EXTRA: dict[int, int] = {mid: cls.crc_extra for mid, cls in mavlink.mavlink_map.items()}
+_EXTRA_BYTE: tuple[bytes, ...] = tuple(bytes((i,)) for i in range(256))
+_FAST_CRC: Callable[[bytes, int], int] | None = getattr(mavlink, "mcrf4xx", None)
 _NAMES: dict[int, str] = {mid: cls.msgname for mid, cls in mavlink.mavlink_map.items()}
 
 
@@ -144,9 +146,13 @@ class Framer:
         if extra is None:
             return False
         crc_at = end - (13 if buf[pos + 8] == 0xFD and buf[pos + 10] & 1 else 0) - 2
-        crc = mavlink.x25crc(buf[pos + 9 : crc_at])
-        crc.accumulate(bytes((extra,)))
         expected: int = _CRC.unpack_from(buf, crc_at)[0]
+        if _FAST_CRC is not None:  # the routine pymavlink's x25crc calls, without its wrapper
+            return bool(
+                _FAST_CRC(_EXTRA_BYTE[extra], _FAST_CRC(buf[pos + 9 : crc_at], 0xFFFF)) == expected
+            )
+        crc = mavlink.x25crc(buf[pos + 9 : crc_at])
+        crc.accumulate(_EXTRA_BYTE[extra])
         return bool(crc.crc == expected)
 
     def _plausible(self, ts: int, slack: int = 1) -> bool:
