@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import itertools
+import math
 from dataclasses import replace
 from html.parser import HTMLParser
 from pathlib import Path
@@ -12,8 +13,8 @@ from fuzzoff.engine import Timeline
 from fuzzoff.findings import FileReport, Finding, Report, Severity
 from fuzzoff.profiles import Profile
 from fuzzoff.report.html import CSP, render
-from fuzzoff.report.svg_timeline import MAX_BUCKETS, min_max_buckets
-from fuzzoff.report.timelines import lint_one
+from fuzzoff.report.svg_timeline import MAX_BUCKETS, min_max_buckets, with_ramps
+from fuzzoff.report.timelines import lint_one, loss_timeout
 from tests.helpers import run_cli
 from tests.report_fixtures import SCRIPT, gap_recording, hostile_report
 
@@ -101,3 +102,29 @@ def test_cli_html_has_a_timeline_per_vehicle(tmp_path: Path) -> None:
     assert page.count('<svg class="timeline"') == 1
     assert "recorded mode" in page and "predicted mode" in page
     assert "set_position_target_local_ned" in page
+
+
+def test_a_gap_crosses_the_threshold_lines_when_the_keepalive_is_that_old() -> None:
+    points = with_ramps([(0.05 * i, 0.05) for i in range(1, 40)] + [(5.0, 3.05)], 0.01)
+    # On the log axis consecutive points are joined by straight segments: find where the
+    # drawn curve crosses 0.5 s and 1 s; the newest keep-alive was at 1.95 s.
+    for level in (0.5, 1.0):
+        (t0, v0), (t1, v1) = next(
+            (a, b) for a, b in itertools.pairwise(points) if a[1] < level <= b[1]
+        )
+        frac = (math.log(level) - math.log(v0)) / (math.log(v1) - math.log(v0))
+        assert abs(t0 + frac * (t1 - t0) - (1.95 + level)) < 0.03
+
+
+def test_loss_timeout_from_the_recording_when_the_engine_records_it() -> None:
+    class Recorded(Timeline):  # what engine.Timeline carries once it copies the gate's params
+        pass
+
+    timeline = Recorded()
+    timeline.loss_timeout = 0.7  # type: ignore[attr-defined]
+    timeline.recorded_params = {"COM_OF_LOSS_T": 0.7}  # type: ignore[attr-defined]
+    profile = Profile("1.15", "mc")
+    assert loss_timeout(timeline, profile, Settings()) == (0.7, "from the recording")
+    forced = replace(Settings(), params={"COM_OF_LOSS_T": 0.7})
+    assert loss_timeout(timeline, profile, forced) == (0.7, "--param / configuration")
+    assert loss_timeout(Timeline(), profile, Settings()) == (1.0, "PX4 1.15 default")

@@ -34,7 +34,7 @@ svg .rate-l { text-anchor: end; font-weight: 600; } svg .loss-l { font-weight: 6
 svg .panel { fill: #fcfcfc; stroke: #bbb; } svg .band-bg { fill: #f1f1f1; }
 svg .grid { stroke: #e4e4e4; } svg .axis { stroke: #666; }
 svg .series { fill: none; stroke: #1565c0; stroke-width: 1.2; }
-svg .tail { stroke: #1565c0; stroke-dasharray: 4 3; }
+svg .tail { fill: none; stroke: #1565c0; stroke-dasharray: 4 3; }
 svg .rate { stroke: #b26a00; stroke-dasharray: 6 3; } svg .rate-l { fill: #b26a00; }
 svg .loss { stroke: #c62828; stroke-dasharray: 2 2; } svg .loss-l { fill: #c62828; }
 svg .seg { fill: #fff; font-size: 10px; pointer-events: none; }

@@ -30,11 +30,16 @@ BAND_H = 16
 BAND_GAP = 4
 AXIS_H = 30
 LABEL_CHARS = 20
+CHAR_W = 6.5
+"""Width of one character of a band label (10 px sans-serif), to leave out labels that overflow."""
 MAX_BUCKETS = WIDTH - LEFT - RIGHT
 """Keep-alive intervals are reduced to a min and a max per pixel column (at most 2 per column)."""
 
 KEEPALIVE_RATE_S = 0.5
 """The 2 Hz minimum rate of the offboard docs (rules.md OFB101)."""
+
+RAMP_MIN_S = 0.1
+"""Intervals shorter than this are drawn as they are (the ramp would be invisible)."""
 
 SEVERITY_CLASS = {0: "info", 1: "warning", 2: "error"}
 
@@ -118,6 +123,32 @@ def min_max_buckets(
     return out
 
 
+def ramp(
+    t_from: float, age_from: float, age_to: float, steps: int = 16
+) -> list[tuple[float, float]]:
+    """The age of the newest keep-alive growing from ``age_from`` to ``age_to`` after ``t_from``.
+
+    Sampled geometrically so that, on the log axis, the curve crosses the 500 ms and loss-timeout
+    lines at the right time (a straight segment between two samples would cross them late).
+    """
+    if age_to <= age_from:
+        return [(t_from + age_to, age_to)]
+    ratio = (age_to / age_from) ** (1 / steps)
+    return [(t_from + age_from * ratio**k, age_from * ratio**k) for k in range(steps + 1)]
+
+
+def with_ramps(points: list[tuple[float, float]], floor: float) -> list[tuple[float, float]]:
+    """Insert the growing age before every interval much longer than the one before it."""
+    out: list[tuple[float, float]] = []
+    previous = floor
+    for t, interval in points:
+        if interval > 1.5 * previous and interval > RAMP_MIN_S:
+            out.extend(ramp(t - interval, max(previous, floor), interval)[:-1])
+        out.append((t, interval))
+        previous = max(interval, floor)
+    return out
+
+
 def mode_css(nav_state: int | None) -> str:
     if nav_state is None:
         return "m-unknown"
@@ -129,11 +160,16 @@ def mode_css(nav_state: int | None) -> str:
 def steps_to_segments(steps: Iterable[tuple[float, str, str]], t_end: float) -> list[Segment]:
     """``(t, label, css)`` changes -> segments lasting until the next change or ``t_end``."""
     items = sorted(steps, key=lambda s: s[0])
-    segments = []
+    segments: list[Segment] = []
     for i, (t, label, css) in enumerate(items):
-        end = items[i + 1][0] if i + 1 < len(items) else t_end
-        if end > t or i + 1 == len(items):
-            segments.append(Segment(t, max(end, t), label, css))
+        end = max(items[i + 1][0] if i + 1 < len(items) else t_end, t)
+        if end == t and i + 1 < len(items):
+            continue  # replaced at the same instant
+        last = segments[-1] if segments else None
+        if last is not None and (last.label, last.css) == (label, css):
+            segments[-1] = Segment(last.start, end, label, css)  # no change: one segment
+        else:
+            segments.append(Segment(t, end, label, css))
     return segments
 
 
@@ -213,7 +249,7 @@ def _band(y: float, label: str, segments: list[Segment], scale: _Scale, empty: s
             f'height="{BAND_H}"><title>{attr(title)} from {seg.start:.3f} s to {seg.end:.3f} s'
             f"</title></rect>"
         )
-        if seg.label and w > 7 * len(seg.label) * 0.9:
+        if seg.label and w > CHAR_W * len(seg.label) + 6:
             out.append(
                 f'<text class="seg" x="{fmt(x + 3)}" y="{fmt(y + BAND_H - 4)}">'
                 f"{attr(seg.label)}</text>"
@@ -264,18 +300,19 @@ def _keepalive_panel(tl: Timeline, scale: _Scale, loss_timeout: float, t_end: fl
             f'<text class="none" x="{LEFT + 8}" y="{top + 20}">no keep-alive messages from '
             "this vehicle</text>"
         )
-    points = min_max_buckets(times[1:], intervals, t_end)
+    points = with_ramps(min_max_buckets(times[1:], intervals, t_end), lo)
     if points:
         path = " ".join(f"{fmt(scale.x(t))},{fmt(y(v))}" for t, v in points)
         out.append(
-            f'<polyline class="series" points="{path}"><title>interval between '
-            "consecutive keep-alive messages</title></polyline>"
+            f'<polyline class="series" points="{path}"><title>time since the previous '
+            "keep-alive message</title></polyline>"
         )
     if times and tail > KEEPALIVE_RATE_S:
+        start = points[-1][1] if points else lo
+        path = " ".join(f"{fmt(scale.x(t))},{fmt(y(v))}" for t, v in ramp(times[-1], start, tail))
         out.append(
-            f'<line class="tail" x1="{fmt(scale.x(times[-1]))}" y1="{fmt(y(lo))}" '
-            f'x2="{fmt(scale.x(t_end))}" y2="{fmt(y(tail))}"><title>no keep-alive for the last '
-            f"{tail:.3f} s of the recording</title></line>"
+            f'<polyline class="tail" points="{path}"><title>no keep-alive for the last '
+            f"{tail:.3f} s of the recording</title></polyline>"
         )
     out.append(
         f'<line class="rate" x1="{LEFT}" x2="{scale.x1}" y1="{fmt(y(KEEPALIVE_RATE_S))}" '

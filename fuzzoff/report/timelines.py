@@ -19,18 +19,21 @@ from fuzzoff.sources import find_recordings
 
 
 def loss_timeout(timeline: Timeline, profile: Profile, settings: Settings) -> tuple[float, str]:
-    """COM_OF_LOSS_T as the gate used it: the engine's value where the timeline carries one.
+    """COM_OF_LOSS_T as the gate used it, and where the value came from.
 
-    An engine that records the gate's final ``loss_timeout`` on the timeline (the value read from
-    the recording's parameters) wins; else ``--param`` / config, else the profile's default.
+    An engine that copies the gate's final ``loss_timeout`` and ``recorded_params`` onto the
+    timeline gives the recording's own value; without them the value is ``--param`` /
+    configuration, else the profile's default (what the gate model starts from).
     """
-    recorded = getattr(timeline, "loss_timeout", None)
-    if isinstance(recorded, int | float):
-        return float(recorded), "gate model (recording, --param or default)"
-    value = GateModel(profile, settings.params).loss_timeout
+    recorded = getattr(timeline, "recorded_params", None) or {}
+    value = getattr(timeline, "loss_timeout", None)
+    if not isinstance(value, int | float):
+        value = GateModel(profile, settings.params).loss_timeout
     if "COM_OF_LOSS_T" in settings.params:
-        return value, "--param / configuration"
-    return value, f"PX4 {profile.px4} default"
+        return float(value), "--param / configuration"
+    if "COM_OF_LOSS_T" in recorded:
+        return float(value), "from the recording"
+    return float(value), f"PX4 {profile.px4} default"
 
 
 def lint_one(path: str | Path, settings: Settings) -> FileReport:
