@@ -18,6 +18,7 @@ from pymavlink.dialects.v20 import common as mavlink
 from fuzzoff.events import (
     Command,
     CommandAck,
+    ControlMode,
     Event,
     Parameter,
     SetAttitudeTarget,
@@ -458,3 +459,29 @@ def test_signed_packets_are_read(tmp_path: Path) -> None:
     source, back = read(_tlog(tmp_path / "signed.tlog", records))
     assert [e.sender_time_us for e in back] == [0, 1000, 2000]
     assert not source.problems and source.stats["messages"]["ATTITUDE"] == 3
+
+
+def test_cli_corrupt_middle_exit_2_and_names_the_bytes(good: Path) -> None:
+    offsets = _records(good)
+    data = bytearray(good.read_bytes())
+    for i in range(offsets[20] + 3, offsets[20] + 30):
+        data[i] ^= 0x5A
+    bad = good.with_name("corrupt.tlog")
+    bad.write_bytes(bytes(data))
+    code, report, stderr = _lint(bad)
+    assert code == 2 and report["complete"] is False
+    (line,) = stderr.strip().splitlines()
+    assert str(bad) in line and "corrupt data" in line and f"bytes {offsets[20]}-" in line
+    assert report["stats"]["bad_data"] == 1
+    assert report["stats"]["messages"]["SET_POSITION_TARGET_LOCAL_NED"] == len(offsets) - 2
+
+
+def test_writer_refuses_or_skips_what_a_tlog_cannot_carry(tmp_path: Path) -> None:
+    events: list[Event] = [
+        ControlMode(t=0.0, position=True),
+        VehicleStatus(t=0.5, vehicle="1", nav_state=2, armed=False),
+    ]
+    with pytest.raises(ValueError, match="ControlMode"):
+        write_tlog(tmp_path / "x.tlog", events)
+    _, back = read(write_tlog(tmp_path / "y.tlog", events, skip_unsupported=True))
+    assert [e.kind for e in back] == ["vehicle_info", "vehicle_status"]

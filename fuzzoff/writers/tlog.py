@@ -66,6 +66,19 @@ FIRMWARE_VERSION_TYPE_OFFICIAL = 255
 FLOAT_PARAMS = frozenset({"COM_OF_LOSS_T", "COM_OBC_LOSS_T", "COM_RC_LOSS_T", "COM_DL_LOSS_T"})
 """PX4 float parameters that may hold whole numbers; other whole values are written INT32."""
 
+SUPPORTED: tuple[type[Event], ...] = (
+    SetPositionTargetLocal,
+    SetPositionTargetGlobal,
+    SetAttitudeTarget,
+    Command,
+    CommandAck,
+    Parameter,
+    StatusText,
+    VehicleInfo,
+    VehicleStatus,
+)
+"""The event kinds a tlog carries (what ``fuzzoff.sources.tlog`` emits)."""
+
 _RELEASE = re.compile(r"^v?(\d+)\.(\d+)(?:\.(\d+))?")
 
 
@@ -275,8 +288,11 @@ def encode_events(
     gcs: Sender = (255, 190),
     start_us: int = DEFAULT_START_US,
     mavlink1: bool = False,
+    skip_unsupported: bool = False,
 ) -> Iterable[bytes]:
     """The tlog records (timestamp + packet) for ``events``, in order."""
+    if skip_unsupported:
+        events = [e for e in events if isinstance(e, SUPPORTED)]
     writer = _Writer(autopilot, companion, gcs, mavlink1)
     gcs_heartbeat = mavlink.MAVLink_heartbeat_message(
         MAV_TYPE_GCS, MAV_AUTOPILOT_INVALID, 0, 0, MAV_STATE_ACTIVE, 3
@@ -298,12 +314,14 @@ def write_tlog(
     gcs: Sender = (255, 190),
     start_us: int = DEFAULT_START_US,
     mavlink1: bool = False,
+    skip_unsupported: bool = False,
 ) -> Path:
     """Write ``events`` (in time order) as a tlog; returns the path.
 
     ``autopilot``/``companion``/``gcs`` are the (sysid, compid) of the default senders; an
     event's ``vehicle`` (a number) picks the autopilot's sysid. ``mavlink1`` writes MAVLink 1
-    packets.
+    packets. Events a tlog cannot carry (ROS 2 and uORB topics) raise ``ValueError`` unless
+    ``skip_unsupported``.
     """
     path = Path(path)
     records = encode_events(
@@ -313,6 +331,7 @@ def write_tlog(
         gcs=gcs,
         start_us=start_us,
         mavlink1=mavlink1,
+        skip_unsupported=skip_unsupported,
     )
     with path.open("wb") as fh:
         for record in records:
