@@ -228,7 +228,7 @@ class McapSource(Source):
             info.vehicle_type = self._vehicle_type(stream)
         else:
             info.notes.append("no MCAP summary (footer missing or damaged): scanned for channels")
-            self._scan(stream)
+            info.vehicle_type = self._scan(stream)
         self._fill(info)
         self._info = info
         return info
@@ -266,18 +266,33 @@ class McapSource(Source):
             return None
         return None
 
-    def _scan(self, stream: McapStream) -> None:
-        """Channels and the earliest log time without a summary (a full pass; salvage only)."""
+    def _scan(self, stream: McapStream) -> str | None:
+        """Channels, the earliest log time and the vehicle type without a summary (a full
+        pass; only for files whose footer is gone)."""
         scan = McapStream(self.path, Ros2Decoding(), None)
         start: int | None = None
+        vehicle: str | None = None
         for record in scan.records():
             if type(record) is Message:
                 start = record.log_time if start is None else min(start, record.log_time)
+                if vehicle is None:
+                    vehicle = self._status_vehicle(stream.decoders.get(record.channel_id), record)
             elif type(record) is Schema:
                 stream.schemas[record.id] = record
             elif type(record) is Channel:
                 stream.channel(record)
         stream.t0_ns = start
+        return vehicle
+
+    def _status_vehicle(self, decoder: Decoder | None, record: Message) -> str | None:
+        if not isinstance(decoder, TopicDecoder) or decoder.message != "VehicleStatus":
+            return None
+        if decoder.definition is None or decoder.builder is None:
+            return None
+        decoded, why = decoder.definition.decode(record.data)
+        if why is not None:
+            return None
+        return self.decoding.vehicle_type(decoder.builder(decoded, 0.0, NOWHERE, 0))
 
     def _fill(self, info: RecordingInfo) -> None:
         info.kinds = self.decoding.kinds()

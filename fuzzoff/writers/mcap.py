@@ -3,7 +3,7 @@
 The file embeds the px4_msgs definitions of ``release`` (a ``ros2msg`` schema per type), as
 rosbag2's MCAP plugin does. ``payload_release`` encodes the payloads with another release's
 definitions while still embedding ``release``'s: the wrong-release recording of formats.md 2.3,
-for tests and the corpus.
+for tests and the corpus (a dict: per message name, e.g. ``{"VehicleControlMode": "1.15"}``).
 """
 
 from __future__ import annotations
@@ -23,6 +23,7 @@ from fuzzoff.writers.ros2_messages import (
     encode,
     log_time,
     merged,
+    payload_for,
     to_messages,
 )
 
@@ -32,7 +33,7 @@ def write_mcap(
     events: Iterable[Event],
     *,
     release: str = "main",
-    payload_release: str | None = None,
+    payload_release: str | dict[str, str] | None = None,
     extra: Iterable[RawMessage] = (),
     start_ns: int = START_NS,
     chunk_size: int = 1024 * 1024,
@@ -67,8 +68,8 @@ def write_mcap(
                 raw_writer.add_message(
                     channel_id=cid, log_time=stamp, data=item.data, publish_time=stamp
                 )
-            elif payload_release is not None:
-                _write_other_release(item, payload_release, channel, raw_writer, stamp)
+            elif (other := payload_for(payload_release, item.message)) is not None:
+                _write_other_release(item, other, channel, raw_writer, stamp)
             else:
                 schema = schemas.get(item.typename)
                 if schema is None:

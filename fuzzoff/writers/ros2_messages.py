@@ -284,3 +284,10 @@ def encode(msg: Px4Message, release: str | None = None) -> bytes:
         msg.topic, msg.message, release, msg.log_time_ns, complete(msg.values, release, msg.message)
     )
     return bytes(store.serialize_cdr(rosbags_message(store, relaid), msg.typename))
+
+
+def payload_for(payload_release: str | dict[str, str] | None, message: str) -> str | None:
+    """The release whose layout encodes ``message`` (None: the declared one)."""
+    if isinstance(payload_release, dict):
+        return payload_release.get(message)
+    return payload_release

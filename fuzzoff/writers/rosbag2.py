@@ -26,6 +26,7 @@ from fuzzoff.writers.ros2_messages import (
     encode,
     log_time,
     merged,
+    payload_for,
     to_messages,
 )
 
@@ -40,7 +41,7 @@ def write_rosbag2(
     storage: Storage = "sqlite3",
     release: str = "main",
     definitions: bool = True,
-    payload_release: str | None = None,
+    payload_release: str | dict[str, str] | None = None,
     extra: Iterable[RawMessage] = (),
     start_ns: int = START_NS,
 ) -> Path:
@@ -64,7 +65,7 @@ def write_rosbag2(
                 w.write(connection(item.topic, item.msgtype, item.msgdef), stamp, item.data)
                 continue
             text = px4_msgs.definition(release, item.message) or ""
-            data = encode(item, payload_release)
+            data = encode(item, payload_for(payload_release, item.message))
             w.write(connection(item.topic, item.typename, text), stamp, data)
     if not definitions:
         _humble(path)
