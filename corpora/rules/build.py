@@ -1,16 +1,19 @@
-"""Build the rule corpus: one bad and one good recording per content / control-mode / legacy rule.
+"""Build the rule corpus: one bad and one good recording per content, control-mode, legacy rule.
 
 Run ``.venv/bin/python corpora/rules/build.py``; it is deterministic. ROS 2 rules are written as
 MCAP (``fuzzoff.writers.mcap``, px4_msgs of the case's release), the estimate rule OFB305 and
 the legacy rules OFB801-OFB803 as ULog (``fuzzoff.writers.ulog``, the 1.15 and the legacy
-layouts). Each ``NAME.expected.json`` lists the findings planted here, judged against the rule
+layouts), and the MAVLink side of OFB405/OFB406 (``SET_ATTITUDE_TARGET``) as a tlog
+(``fuzzoff.writers.tlog``). Each ``NAME.expected.json`` lists the findings planted here, judged against the rule
 texts (rules/OFB*.toml), and ``clean``: the rules the recording exercises that must stay silent.
 
 Every flight is built from one realistic pattern (``Flight``): a companion streams
 ``OffboardControlMode`` at 10 Hz with a PX4-synced ``timestamp``, the vehicle sits disarmed in
 POSCTL, the companion switches to OFFBOARD after 1.5 s of stream (accepted, one ack on 1.15),
 arms at 2.0 s, and publishes its setpoints at 20 Hz only from the switch on, a slowly moving
-target. A case changes one thing of it.
+target. A case changes one thing of it. Every planted finding is at the time the rule text
+says (the first message of the bad run, or the threshold crossing); the findings every
+recording of a format also gets are listed in ``context_findings``.
 """
 
 from __future__ import annotations
@@ -33,11 +36,14 @@ from fuzzoff.events import (
     LegacyControlMode,
     PositionSetpointTriplet,
     RatesSetpoint,
+    SetAttitudeTarget,
     ThrustSetpoint,
     TrajectorySetpoint,
+    VehicleInfo,
     VehicleStatus,
 )
 from fuzzoff.writers.mcap import write_mcap
+from fuzzoff.writers.tlog import write_tlog
 from fuzzoff.writers.ulog import write_ulog
 
 HERE = Path(__file__).resolve().parent
@@ -138,6 +144,8 @@ class Case:
     ulog_version: str | None = "1.15.4"
     ulog_layout: str | None = None
     params: dict[str, float] = field(default_factory=dict)
+    request: float | None = None
+    """Time of the offboard request (for OFB701), where it is not the flights' 1.5 s."""
     note: str = ""
 
     @property
@@ -389,6 +397,84 @@ def mcap_cases() -> list[Case]:
     return cases
 
 
+# MAVLink: OFB405 and OFB406 also judge SET_ATTITUDE_TARGET (a tlog of the companion's link).
+MAV: Fields = {"vehicle": "1", "source_system": 1, "source_component": 191}
+ATTITUDE_ONLY = 0b111  # body rates ignored: the quaternion and the thrust are used
+
+
+def attitude_target_flight(target: Callable[[float], tuple[Any, float]]) -> list[Event]:
+    """MAVSDK-style attitude control: SET_ATTITUDE_TARGET at 20 Hz from 0 s (the keep-alive),
+    the switch at 1.5 s, arming at 2.5 s, 1 Hz HEARTBEAT; ``target(t)`` gives (q, thrust)."""
+    out: list[Event] = [
+        VehicleInfo(t=0.0, vehicle="1", px4_version="1.15.4"),
+        VehicleInfo(t=0.0, vehicle="1", mav_type=2, vehicle_type="mc"),
+    ]
+    for t in ticks(0.0, 8.0, 1.0):
+        nav = OFFBOARD if t >= 2.0 else POSCTL
+        out.append(VehicleStatus(t=t, vehicle="1", nav_state=nav, armed=t >= 3.0))
+    for t in ticks(0.0, 8.0, SETPOINT_PERIOD):
+        q, thrust = target(t)
+        out.append(
+            SetAttitudeTarget(
+                t=t,
+                sender_time_us=stamp(t),
+                type_mask=ATTITUDE_ONLY,
+                target_system=1,
+                target_component=1,
+                q=q,
+                thrust=thrust,
+                **MAV,
+            )
+        )
+    link: Fields = {"target_system": 1, "target_component": 1, "from_external": True, **MAV}
+    out += [
+        Command(t=1.5, command=176, params=(1.0, 6.0, 0, 0, 0, 0, 0), **link),
+        CommandAck(t=1.51, vehicle="1", command=176, result=0, target_system=1),
+        Command(t=2.5, command=400, params=(1.0, 0, 0, 0, 0, 0, 0), **link),
+        CommandAck(t=2.51, vehicle="1", command=400, result=0, target_system=1),
+    ]
+    return sorted(out, key=lambda e: e.t)
+
+
+def tlog_cases() -> list[Case]:
+    def good(t: float) -> tuple[Any, float]:
+        return quat(0.1 * t), 0.6
+
+    def scaled(t: float) -> tuple[Any, float]:
+        w, x, y, z = quat(0.1 * t)
+        return ((w, x, y, z) if t < 4.0 else (0.5 * w, x, y, 0.5 * z)), 0.6
+
+    def too_strong(t: float) -> tuple[Any, float]:
+        return quat(0.1 * t), 0.6 if t < 4.0 else 1.2
+
+    return [
+        Case(
+            "good_attitude_target",
+            attitude_target_flight(good),
+            [],
+            ["OFB405", "OFB406"],
+            fmt="tlog",
+            request=1.5,
+        ),
+        Case(
+            "ofb405_attitude_target_half_quaternion",
+            attitude_target_flight(scaled),
+            [("OFB405", "error", 4.0)],
+            [],
+            fmt="tlog",
+            request=1.5,
+        ),
+        Case(
+            "ofb406_attitude_target_thrust_over_one",
+            attitude_target_flight(too_strong),
+            [("OFB406", "error", 4.0)],
+            [],
+            fmt="tlog",
+            request=1.5,
+        ),
+    ]
+
+
 def ulog_cases() -> list[Case]:
     cases: list[Case] = []
     valid = FailsafeFlags(t=0.0, local_position_valid=True, local_velocity_valid=True)
@@ -519,8 +605,10 @@ def context_findings(case: Case) -> list[tuple[str, str, float | None]]:
       flags on ROS 2); in a 1.15 ULog OFB104, OFB105 (subsampled keep-alive), OFB106, OFB203,
       OFB302 (only PX4's copies of the messages); in a legacy ULog OFB104, OFB105.
     """
-    not_checkable = {"mcap": 1, "ulg": 2 if case.px4 == "legacy" else 5}[case.fmt]
-    request = 1.6 if case.px4 == "legacy" else SWITCH_T
+    not_checkable = {"mcap": 1, "tlog": 0, "ulg": 2 if case.px4 == "legacy" else 5}[case.fmt]
+    request = (
+        case.request if case.request is not None else 1.6 if case.px4 == "legacy" else SWITCH_T
+    )
     return [("OFB002", "info", None)] * not_checkable + [("OFB701", "info", request)]
 
 
@@ -528,6 +616,8 @@ def write(case: Case) -> None:
     path = HERE / case.filename
     if case.fmt == "mcap":
         write_mcap(path, case.events, release=case.release)
+    elif case.fmt == "tlog":
+        write_tlog(path, case.events)
     else:
         write_ulog(
             path,
@@ -553,6 +643,7 @@ def write(case: Case) -> None:
 
 def all_cases() -> Iterable[Case]:
     yield from mcap_cases()
+    yield from tlog_cases()
     yield from ulog_cases()
 
 
