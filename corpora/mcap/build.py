@@ -20,8 +20,8 @@ of these topics lacks) and OFB701 (the loss parameters assumed, at the offboard 
 * ``switch_rejected``: the ack says TEMPORARILY_REJECTED: OFB201, and OFB202 as the gate model
   expected PX4 1.15 to accept a switch after 2 s of stream.
 * ``wrong_release_payload``: the good flight whose VehicleControlMode payloads are 1.15's while
-  the embedded definition is 1.18's (profile main): OFB001 at its first message (never decoded half-right);
-  exit status 2, the other topics' findings kept.
+  the embedded definitions are 1.18's (profile main): OFB001 at its first message (never
+  decoded half-right); exit status 2, the other topics' findings kept.
 * ``truncated``: the stream-lost flight cut at 80 %: OFB001 (no footer), exit status 2; the
   findings of the readable part (OFB101, OFB103) are kept.
 """

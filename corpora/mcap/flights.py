@@ -47,9 +47,9 @@ class Flight:
             return POSCTL
         if t >= self.land_at + 0.02:
             return AUTO_LAND
-        if self.lost_mode_at is not None and self.lost_mode_at <= t:
-            if self.resume_mode_at is None or t < self.resume_mode_at:
-                return POSCTL
+        lost = self.lost_mode_at is not None and self.lost_mode_at <= t
+        if lost and (self.resume_mode_at is None or t < self.resume_mode_at):
+            return POSCTL
         return OFFBOARD
 
     def in_gap(self, t: float) -> bool:
