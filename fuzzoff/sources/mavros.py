@@ -295,20 +295,28 @@ def raw_local(
     pi/2 - yaw); the yaw rate changes sign either way (MAVROS applies ENU -> NED to it).
     """
     frame = int(msg.coordinate_frame)
-    to_px4 = flu_to_frd if frame in BODY_FRAMES else enu_to_ned
-    yaw_fn = yaw_flu_to_frd if frame in BODY_FRAMES else yaw_enu_to_ned
-    return _local(
-        t,
-        ns,
-        where,
-        msg.header,
-        frame=frame,
-        mask=int(msg.type_mask),
-        position=to_px4(_vec(msg.position)),
-        velocity=to_px4(_vec(msg.velocity)),
-        acceleration=to_px4(_vec(msg.acceleration_or_force)),
-        yaw=yaw_fn(float(msg.yaw)),
-        yaw_rate=-float(msg.yaw_rate),
+    p, v, a = msg.position, msg.velocity, msg.acceleration_or_force
+    if frame in BODY_FRAMES:
+        position, velocity = (p.x, -p.y, -p.z), (v.x, -v.y, -v.z)
+        acceleration, yaw = (a.x, -a.y, -a.z), yaw_flu_to_frd(msg.yaw)
+    else:  # inlined enu_to_ned: this is the hot path of a MAVROS bag
+        position, velocity = (p.y, p.x, -p.z), (v.y, v.x, -v.z)
+        acceleration, yaw = (a.y, a.x, -a.z), yaw_enu_to_ned(msg.yaw)
+    return SetPositionTargetLocal(
+        t=t,
+        vehicle=ns,
+        where=where,
+        sender_time_us=stamp_to_time_boot_us(msg.header),
+        target_system=MAVROS_TARGET_SYSTEM,
+        target_component=MAVROS_TARGET_COMPONENT,
+        type_mask=int(msg.type_mask),
+        transport="mavros",
+        coordinate_frame=frame,
+        position=position,
+        velocity=velocity,
+        acceleration=acceleration,
+        yaw=yaw,
+        yaw_rate=-msg.yaw_rate,
     )
 
 

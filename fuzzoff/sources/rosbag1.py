@@ -160,26 +160,25 @@ class Rosbag1Source(Source):
         reader = self._reader
         if reader is None or not self._wanted:
             return
-        start = reader.start_time
-        yield from self._convert(reader.messages(connections=self._wanted), lambda: start)
+        yield from self._convert(reader.messages(connections=self._wanted), [reader.start_time])
 
     def _salvaged_events(self) -> Iterator[Event]:
         """File order, as recorded; the first message of any topic is time zero."""
         salvage = self._salvage
         assert salvage is not None
-        first: list[int] = []
+        first = [-1]
 
         def wanted() -> Iterator[tuple[Connection, int, bytes]]:
             for conn, timestamp, raw in salvage.messages():
-                if not first:
-                    first.append(timestamp)
+                if first[0] < 0:
+                    first[0] = timestamp
                 if mavros_topic(conn.topic, conn.msgtype):
                     if conn.msgtype not in self._typestore.fielddefs:
                         self._typestore = self._build_typestore(salvage.connections)
                     yield conn, timestamp, raw
 
         self._typestore = self._build_typestore(salvage.connections)
-        yield from self._convert(wanted(), lambda: first[0])
+        yield from self._convert(wanted(), first)
         what, at = self._salvage_reason, None
         if salvage.stopped is not None and "truncated" not in what:
             what = f"{what}; reading stopped: {salvage.stopped[0]}"
@@ -199,9 +198,12 @@ class Rosbag1Source(Source):
         return converter.handler(conn.topic), decode
 
     def _convert(
-        self, messages: Iterator[tuple[Connection, int, bytes]], start_ns: Callable[[], int]
+        self, messages: Iterator[tuple[Connection, int, bytes]], start_ns: list[int]
     ) -> Iterator[Event]:
-        """Decode, convert and yield; corrupt messages are skipped and reported once."""
+        """Decode, convert and yield; corrupt messages are skipped and reported once.
+
+        ``start_ns[0]`` is the recording's first time (set by the salvage once it has read it).
+        """
         converter = MavrosConverter()
         handlers: dict[int, tuple[Handler | None, Callable[..., Any]]] = {}
         counts: dict[int, int] = {}
@@ -213,7 +215,7 @@ class Rosbag1Source(Source):
                 self._done += 1
                 index = counts.get(conn.id, 0)
                 counts[conn.id] = index + 1
-                t = (timestamp - start_ns()) / 1e9
+                t = (timestamp - start_ns[0]) / 1e9
                 entry = handlers.get(conn.id)
                 if entry is None:
                     entry = handlers[conn.id] = self._handler(converter, conn)
