@@ -38,6 +38,7 @@ MAX_BUCKETS = WIDTH - LEFT - RIGHT
 KEEPALIVE_RATE_S = 0.5
 """The 2 Hz minimum rate of the offboard docs (rules.md OFB101)."""
 
+RAMP_STEPS = 16
 RAMP_MIN_S = 0.1
 """Intervals shorter than this are drawn as they are (the ramp would be invisible)."""
 
@@ -124,7 +125,7 @@ def min_max_buckets(
 
 
 def ramp(
-    t_from: float, age_from: float, age_to: float, steps: int = 16
+    t_from: float, age_from: float, age_to: float, steps: int = RAMP_STEPS
 ) -> list[tuple[float, float]]:
     """The age of the newest keep-alive growing from ``age_from`` to ``age_to`` after ``t_from``.
 
@@ -137,13 +138,20 @@ def ramp(
     return [(t_from + age_from * ratio**k, age_from * ratio**k) for k in range(steps + 1)]
 
 
-def with_ramps(points: list[tuple[float, float]], floor: float) -> list[tuple[float, float]]:
-    """Insert the growing age before every interval much longer than the one before it."""
+def with_ramps(
+    points: list[tuple[float, float]], floor: float, px_per_s: float = math.inf
+) -> list[tuple[float, float]]:
+    """Insert the growing age before every interval much longer than the one before it.
+
+    A ramp gets a point per two pixels it spans (at most 16), so ramps add at most half the
+    plot width in points however many gaps there are.
+    """
     out: list[tuple[float, float]] = []
     previous = floor
     for t, interval in points:
         if interval > 1.5 * previous and interval > RAMP_MIN_S:
-            out.extend(ramp(t - interval, max(previous, floor), interval)[:-1])
+            steps = int(max(1.0, min(RAMP_STEPS, interval * px_per_s / 2)))
+            out.extend(ramp(t - interval, max(previous, floor), interval, steps)[:-1])
         out.append((t, interval))
         previous = max(interval, floor)
     return out
@@ -300,7 +308,8 @@ def _keepalive_panel(tl: Timeline, scale: _Scale, loss_timeout: float, t_end: fl
             f'<text class="none" x="{LEFT + 8}" y="{top + 20}">no keep-alive messages from '
             "this vehicle</text>"
         )
-    points = with_ramps(min_max_buckets(times[1:], intervals, t_end), lo)
+    px_per_s = (scale.x1 - scale.x0) / scale.t_end
+    points = with_ramps(min_max_buckets(times[1:], intervals, t_end), lo, px_per_s)
     if points:
         path = " ".join(f"{fmt(scale.x(t))},{fmt(y(v))}" for t, v in points)
         out.append(
