@@ -429,3 +429,14 @@ def test_content_rules_can_be_ignored() -> None:
     settings = Settings(ignore=frozenset({"OFB405", "OFB406"}))
     found = lint_events(events, settings=settings)
     assert codes(found, "OFB405") == [] and codes(found, "OFB406") == []
+
+
+def test_ofb801_from_a_legacy_mavlink_type_mask() -> None:
+    use_all = SetPositionTargetLocal(t=0.0, type_mask=0, position=(0.0, 0.0, -2.0))
+    (found,) = codes(lint_events([use_all], px4="legacy", fmt="tlog"), "OFB801")
+    assert "type_mask 0" in found.message
+    position_only = SetPositionTargetLocal(t=0.0, type_mask=0b110111111000)
+    assert codes(lint_events([position_only], px4="legacy", fmt="tlog"), "OFB801") == []
+    # One acceleration bit set is enough for the legacy receiver to ignore acceleration.
+    one_bit = SetPositionTargetLocal(t=0.0, type_mask=0b000001000000)
+    assert codes(lint_events([one_bit], px4="legacy", fmt="tlog"), "OFB801") == []

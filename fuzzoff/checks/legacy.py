@@ -12,35 +12,51 @@ from fuzzoff.events import (
     Event,
     LegacyControlMode,
     PositionSetpointTriplet,
+    SetPositionTargetLocal,
     VehicleStatus,
 )
 from fuzzoff.gate import GateTransition
-from fuzzoff.tables.control_mode import legacy_controllers, legacy_disabled_by_acceleration
+from fuzzoff.tables.control_mode import (
+    legacy_controllers,
+    legacy_disabled_by_acceleration,
+    legacy_mode_from_mask,
+)
 
 
 class LegacyAccelerationNotIgnored(Check):
     """OFB801: acceleration/force not ignored switches position and velocity control off."""
 
     codes = ("OFB801",)
-    wants = (LegacyControlMode,)
+    wants = (LegacyControlMode, SetPositionTargetLocal)
 
     def __init__(self, ctx: CheckContext) -> None:
         super().__init__(ctx)
         self.episodes = Episodes(ctx, "OFB801")
 
     def on_event(self, event: Event) -> None:
-        assert isinstance(event, LegacyControlMode)
-        disabled = legacy_disabled_by_acceleration(event)
+        if isinstance(event, SetPositionTargetLocal):
+            # The legacy receiver turns the type_mask into offboard_control_mode (gate 6.5).
+            mode = legacy_mode_from_mask(event)
+            key = "mask"
+            what = (
+                f"SET_POSITION_TARGET_LOCAL_NED type_mask {event.type_mask} leaves the "
+                "acceleration bits clear"
+            )
+        else:
+            assert isinstance(event, LegacyControlMode)
+            mode = event
+            key = "mode"
+            what = "offboard_control_mode.ignore_acceleration_force is false"
+        disabled = " and ".join(legacy_disabled_by_acceleration(mode))
         if not disabled:
-            self.episodes.good("acc")
+            self.episodes.good(key)
             return
         self.episodes.bad(
-            "acc",
+            key,
             event.t,
             event.where,
-            "offboard_control_mode.ignore_acceleration_force is false while "
-            f"{' and '.join(disabled)} are not ignored: enabling acceleration/force disables "
-            f"{' and '.join(disabled)} control",
+            f"{what} with {disabled} not ignored: enabling acceleration/force disables "
+            f"{disabled} control",
         )
 
     def finish(self, t_end: float) -> None:

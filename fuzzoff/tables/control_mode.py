@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from fuzzoff.events import FailsafeFlags, LegacyControlMode
+from fuzzoff.events import FailsafeFlags, LegacyControlMode, SetPositionTargetLocal
 from fuzzoff.profiles import Profile
 
 
@@ -225,3 +225,21 @@ def legacy_disabled_by_acceleration(mode: LegacyControlMode) -> tuple[str, ...]:
     if not mode.ignore_velocity:
         wanted.append("velocity")
     return tuple(wanted)
+
+
+def legacy_mode_from_mask(sp: SetPositionTargetLocal) -> LegacyControlMode:
+    """The ``offboard_control_mode`` a legacy receiver publishes for this message (gate spec
+    6.5): a group is ignored when ANY of its ignore bits is set."""
+    mask = sp.type_mask
+    return LegacyControlMode(
+        t=sp.t,
+        vehicle=sp.vehicle,
+        where=sp.where,
+        origin="model",
+        ignore_position=bool(mask & 0b111),
+        ignore_alt_hold=bool(mask & 0b100),
+        ignore_velocity=bool(mask & 0b111000),
+        ignore_acceleration_force=bool(mask & 0b111000000),
+        ignore_attitude=bool(mask & 1024),
+        ignore_bodyrate=bool(mask & 2048),
+    )
