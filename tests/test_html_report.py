@@ -132,3 +132,21 @@ def test_loss_timeout_from_the_recording_when_the_engine_records_it() -> None:
     forced = replace(Settings(), params={"COM_OF_LOSS_T": 0.7})
     assert loss_timeout(timeline, profile, forced) == (0.7, "--param / configuration")
     assert loss_timeout(Timeline(), profile, Settings()) == (1.0, "PX4 1.15 default")
+
+
+def test_each_vehicle_has_its_plot_and_its_own_markers() -> None:
+    file = FileReport("fleet.mcap", "mcap", Profile(), stats={"duration_s": 10.0})
+    file.extras["timelines"] = {
+        "/px4_1": Timeline(keepalive=[0.1 * i for i in range(100)]),
+        "/px4_2": Timeline(keepalive=[0.1 * i for i in range(50)]),
+    }
+    file.findings = [
+        Finding("OFB001", "x", Severity.ERROR, "one", time_s=2.0, vehicle="/px4_1"),
+        Finding("OFB001", "x", Severity.ERROR, "two", time_s=6.0, vehicle="/px4_2"),
+        Finding("OFB002", "x", Severity.INFO, "whole file", time_s=1.0),
+    ]
+    page = render(Report(files=[file]), Settings())
+    plots = page.split('<svg class="timeline"')[1:]
+    assert len(plots) == 2
+    assert 'id="mark-0-0"' in plots[0] and 'id="mark-0-1"' in plots[1]
+    assert 'id="mark-0-2"' in plots[0] and 'id="mark-0-2"' not in plots[1]
