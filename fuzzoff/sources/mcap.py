@@ -19,7 +19,7 @@ from mcap.reader import SeekingReader
 from mcap.records import Channel, Chunk, DataEnd, Footer, Message, Schema
 from mcap.stream_reader import CRCValidationError, StreamReader, breakup_chunk
 
-from fuzzoff.events import NOWHERE, Event
+from fuzzoff.events import Event
 from fuzzoff.sources import px4_msgs
 from fuzzoff.sources.base import RecordingInfo, Source, SourceError, SourceProblem
 from fuzzoff.sources.ros2_decode import Decoder, Ros2Decoding, TopicDecoder
@@ -255,13 +255,7 @@ class McapSource(Source):
                 for _, channel, message in reader.iter_messages(
                     topics=sorted(topics), log_time_order=False
                 ):
-                    decoder = topics[channel.topic]
-                    assert decoder.definition is not None and decoder.builder is not None
-                    decoded, why = decoder.definition.decode(message.data)
-                    if why is None:
-                        event = decoder.builder(decoded, 0.0, NOWHERE, 0)
-                        return self.decoding.vehicle_type(event)
-                    return None
+                    return self.decoding.vehicle_from(topics[channel.topic], message.data)
         except Exception:
             return None
         return None
@@ -285,14 +279,7 @@ class McapSource(Source):
         return vehicle
 
     def _status_vehicle(self, decoder: Decoder | None, record: Message) -> str | None:
-        if not isinstance(decoder, TopicDecoder) or decoder.message != "VehicleStatus":
-            return None
-        if decoder.definition is None or decoder.builder is None:
-            return None
-        decoded, why = decoder.definition.decode(record.data)
-        if why is not None:
-            return None
-        return self.decoding.vehicle_type(decoder.builder(decoded, 0.0, NOWHERE, 0))
+        return self.decoding.vehicle_from(decoder, record.data)
 
     def _fill(self, info: RecordingInfo) -> None:
         info.kinds = self.decoding.kinds()

@@ -16,7 +16,7 @@ from typing import Any
 from rosbags.typesys import get_types_from_idl
 from rosbags.typesys.store import Typestore
 
-from fuzzoff.events import Event, Origin, VehicleStatus, Where
+from fuzzoff.events import NOWHERE, Event, Origin, VehicleStatus, Where
 from fuzzoff.profiles import PX4_VEHICLE_TYPE
 from fuzzoff.sources import px4_msgs
 from fuzzoff.sources.base import SourceProblem
@@ -271,6 +271,19 @@ class Ros2Decoding:
         if self.evidence and len(self.evidence) == 1:
             return next(iter(self.evidence))
         return None
+
+    def vehicle_from(self, decoder: Decoder | None, raw: bytes | memoryview) -> str | None:
+        """The vehicle type one ``VehicleStatus`` payload names (None for anything else)."""
+        if not isinstance(decoder, TopicDecoder) or decoder.message != "VehicleStatus":
+            return None
+        if decoder.definition is None and decoder.unusable is None:
+            decoder.resolve(raw, 0.0)
+        if decoder.definition is None or decoder.builder is None:
+            return None
+        decoded, why = decoder.definition.decode(raw)
+        if why is not None:
+            return None
+        return self.vehicle_type(decoder.builder(decoded, 0.0, NOWHERE, 0))
 
     def vehicle_type(self, status: Event) -> str | None:
         """The profile vehicle type a decoded ``VehicleStatus`` names (VTOL first)."""

@@ -23,7 +23,7 @@ from rosbags.interfaces import MessageDefinitionFormat
 from rosbags.rosbag2 import Reader
 from ruamel.yaml import YAML
 
-from fuzzoff.events import NOWHERE, Event
+from fuzzoff.events import Event
 from fuzzoff.sources import px4_msgs
 from fuzzoff.sources.base import RecordingInfo, Source, SourceError, SourceProblem
 from fuzzoff.sources.mcap import McapStream
@@ -58,6 +58,7 @@ class Rosbag2Source(Source):
         self._done = 0
         self._notes: list[str] = []
         self._vehicle: str | None = None
+        self._tmp: tempfile.TemporaryDirectory[str] | None = None
 
     # -- opening -----------------------------------------------------------------------------
 
@@ -164,18 +165,15 @@ class Rosbag2Source(Source):
             decoder = self._decoders.get((conn.topic, conn.msgtype))
             if not isinstance(decoder, TopicDecoder) or decoder.message != "VehicleStatus":
                 continue
-            if decoder.definition is None or not conn.msgcount:
+            if not conn.msgcount:
                 continue
             try:
                 _, _, raw = next(iter(reader.messages(connections=[conn])))
-            except Exception:
+            except Exception:  # the main pass reports damage
                 continue
-            message, why = decoder.definition.decode(raw)
-            if why is None and decoder.builder is not None:
-                event = decoder.builder(message, 0.0, NOWHERE, 0)
-                self._vehicle = self.decoding.vehicle_type(event)
-                if self._vehicle:
-                    return
+            self._vehicle = self.decoding.vehicle_from(decoder, raw)
+            if self._vehicle:
+                return
 
     def _probe_files(self) -> None:
         starts = []
@@ -186,11 +184,41 @@ class Rosbag2Source(Source):
                         self._decoder(conn.topic, conn.msgtype, conn.msgdef)
                     if reader.message_count:
                         starts.append(reader.start_time)
-            except Exception:
-                start = _sqlite_start(path) if path.suffix == ".db3" else None
+            except Exception:  # salvaged below or in the reading pass
+                start = self._probe_salvage(path) if path.suffix == ".db3" else None
                 if start is not None:
                     starts.append(start)
         self._t0 = min(starts) if starts else None
+
+    def _probe_salvage(self, path: Path) -> int | None:
+        """Topics, definitions and start time of a database rosbags cannot open."""
+        try:
+            db = self._salvage_db(path)
+        except (sqlite3.Error, OSError):
+            return None
+        try:
+            topics = self._sqlite_topics(db)
+            for topic_id, decoder in topics.items():
+                first = db.execute(
+                    "SELECT data FROM messages WHERE topic_id = ? ORDER BY id LIMIT 1", (topic_id,)
+                ).fetchone()
+                if first is not None and self._vehicle is None:
+                    self._vehicle = self.decoding.vehicle_from(decoder, first[0])
+            row = db.execute("SELECT MIN(timestamp) FROM messages").fetchone()
+            return int(row[0]) if row and row[0] is not None else None
+        except sqlite3.Error:
+            return None
+        finally:
+            db.close()
+
+    def _salvage_db(self, path: Path) -> sqlite3.Connection:
+        """A read-only connection to a header-fixed copy (made once per file, see close())."""
+        if self._tmp is None:
+            self._tmp = tempfile.TemporaryDirectory(prefix="fuzzoff-")
+        copy = Path(self._tmp.name) / path.name
+        if not copy.exists():
+            _readable_copy(path, Path(self._tmp.name))
+        return sqlite3.connect(f"file:{copy}?mode=ro", uri=True)
 
     def _decoder(self, topic: str, msgtype: str, msgdef: Any) -> Decoder | None:
         text = msgdef.data if msgdef is not None and msgdef.format in _FORMATS else None
@@ -274,14 +302,13 @@ class Rosbag2Source(Source):
 
     def _salvage_sqlite(self, path: Path, exc: BaseException) -> Iterator[Event]:
         """Row by row with Python's sqlite3, in row order, until the damage (formats.md 5)."""
-        with tempfile.TemporaryDirectory(prefix="fuzzoff-") as tmp:
-            try:
-                db = sqlite3.connect(f"file:{_readable_copy(path, Path(tmp))}?mode=ro", uri=True)
-            except (sqlite3.Error, OSError) as err:
-                what = f"cannot open the database: {_why(err)}"
-                self.problems.append(SourceProblem(what, path.name))
-                return
-            yield from self._salvage_rows(db, path, exc)
+        try:
+            db = self._salvage_db(path)
+        except (sqlite3.Error, OSError) as err:
+            what = f"cannot open the database: {_why(err)}"
+            self.problems.append(SourceProblem(what, path.name))
+            return
+        yield from self._salvage_rows(db, path, exc)
 
     def _salvage_rows(
         self, db: sqlite3.Connection, path: Path, exc: BaseException
@@ -353,6 +380,9 @@ class Rosbag2Source(Source):
             self._reader = None
 
     def close(self) -> None:
+        if self._tmp is not None:
+            self._tmp.cleanup()
+            self._tmp = None
         if self._reader is not None:
             with suppress(Exception):
                 self._reader.close()
@@ -386,15 +416,3 @@ def _readable_copy(path: Path, folder: Path) -> Path:
         fh.seek(18)
         fh.write(b"\x01\x01")
     return copy
-
-
-def _sqlite_start(path: Path) -> int | None:
-    try:
-        db = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
-        try:
-            row = db.execute("SELECT MIN(timestamp) FROM messages").fetchone()
-        finally:
-            db.close()
-    except sqlite3.Error:
-        return None
-    return int(row[0]) if row and row[0] is not None else None
