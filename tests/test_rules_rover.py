@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import replace
 from typing import Any
 
 import pytest
@@ -326,3 +327,12 @@ def test_forwarding_unknown_is_not_checkable() -> None:
 def test_forwarding_given_by_the_user() -> None:
     settings = Settings(params={"MAV_FWDEXTSP": 0.0})
     assert codes(lint(velocity_stream(0.0, 5), settings=settings), "OFB509")
+
+
+def test_a_ulog_cannot_show_what_the_companion_published() -> None:
+    events = drive({tr.SPEED}, flags={"velocity": True})
+    logged = [replace(e, origin="vehicle") if e.kind == tr.SPEED else e for e in events]
+    found = lint_events(logged, px4="1.16", vehicle="rover-differential", fmt="ulog")
+    assert not codes(found, "OFB502")
+    notes = [f.message for f in codes(found, "OFB002")]
+    assert any("OFB502" in n and "ULog" in n for n in notes)

@@ -37,8 +37,24 @@ ROVER_SETPOINTS = (
 )
 
 
+ULOG_NOTE = (
+    "needs the ROS 2 topics as sent (/fmu/in/...): a ULog logs PX4's own copies, which the "
+    "rover modules also write"
+)
+
+
 def flags_text(mode: ControlMode) -> str:
     return ", ".join(mode.flags()) or "none"
+
+
+def logged_only(ctx: CheckContext, codes: tuple[str, ...], kinds: tuple[str, ...]) -> bool:
+    """A ULog cannot tell the companion's setpoints from PX4's own: say so (OFB002)."""
+    if ctx.info.format != "ulog":
+        return False
+    if ctx.has(*kinds):
+        for code in codes:
+            ctx.cannot_check(code, ULOG_NOTE)
+    return True
 
 
 class RoverTrajectory(Check):
@@ -51,6 +67,7 @@ class RoverTrajectory(Check):
         super().__init__(ctx)
         self.episodes = Episodes(ctx)
         self.tables = tr.rover_tables(ctx.profile)
+        logged_only(ctx, self.codes, (TrajectorySetpoint.kind,))
 
     def on_event(self, event: Event) -> None:
         if event.origin != "sent" or self.tables is None or not self.ctx.profile.is_rover:
@@ -98,6 +115,7 @@ class RoverCombination(Check):
         self.nan_window = float(ctx.option("OFB504", "window_s"))
         self.last: dict[str, tuple[float, bool]] = {}
         """Rover setpoint kind -> (time of its last message, whether it carried a value)."""
+        logged_only(ctx, self.codes, tr.ROVER_KINDS)
 
     def on_event(self, event: Event) -> None:
         if self.tables is None or not self.ctx.profile.is_rover:
@@ -192,6 +210,7 @@ class RoverDirectActuator(Check):
     def __init__(self, ctx: CheckContext) -> None:
         super().__init__(ctx)
         self.episodes = Episodes(ctx)
+        logged_only(ctx, self.codes, (ActuatorMotors.kind, ActuatorServos.kind))
 
     def on_event(self, event: Event) -> None:
         if event.origin != "sent" or not self.ctx.profile.is_rover:
