@@ -16,12 +16,12 @@ import pytest
 
 from fuzzoff.config import Settings
 from fuzzoff.report.html import CSP, render
+from fuzzoff.sources import find_recordings
 from tests.cdp import Browser, find_chromium
 from tests.helpers import CORPORA, ROOT, run_cli
 from tests.report_fixtures import SCRIPT, gap_recording, hostile_report
 
 ARTIFACTS = ROOT / "build" / "test-artifacts"
-RECORDING_SUFFIXES = {".tlog", ".ulg", ".mcap", ".bag", ".db3"}
 
 
 @pytest.fixture
@@ -98,15 +98,16 @@ def test_plot_and_every_finding_are_shown(browser: Browser, tmp_path: Path) -> N
     )
 
 
-def _recordings() -> list[Path]:
+def _corpus_recordings() -> list[Path]:
+    """One recording per corpus folder (each format once), when the corpora exist."""
     if not CORPORA.is_dir():
         return []
-    found = [p for p in sorted(CORPORA.rglob("*")) if p.suffix in RECORDING_SUFFIXES]
-    return found[:1]
+    folders = sorted(p for p in CORPORA.iterdir() if p.is_dir())
+    return [found[0] for found in map(find_recordings, folders) if found]
 
 
 def test_cli_html_of_real_recordings(browser: Browser, tmp_path: Path) -> None:
-    paths = [gap_recording(tmp_path / "gap.tlog"), *_recordings()]
+    paths = [gap_recording(tmp_path / "gap.tlog"), *_corpus_recordings()]
     page = tmp_path / "lint.html"
     args = ["lint", *map(str, paths), "--px4", "1.15", "--vehicle", "mc"]
     result = run_cli([*args, "--format", "html", "--output", str(page)])
