@@ -188,6 +188,8 @@ def _contents(report: Report, fail_on: Severity) -> str:
             f'<li><a href="#file-{i}">{e(file.path)}</a> <span class="sev {css}">{label}</span> '
             f"({len(file.findings)} findings)</li>"
         )
+    if not report.files:
+        return '<p class="none">No recordings were found in the paths given.</p>'
     status = report.exit_status(fail_on)
     total = Counter(f.severity for f in report.findings)
     return (
