@@ -12,11 +12,11 @@ git-ignored) are generated on the first run; ``python -m bench ulog`` runs only 
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
 import tempfile
-import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -53,18 +53,34 @@ class Run:
     output: str
 
 
+WRAPPER = """
+import json, os, subprocess, sys, time
+start = time.perf_counter()
+proc = subprocess.Popen(sys.argv[1:], stderr=subprocess.DEVNULL)
+_, status, usage = os.wait4(proc.pid, 0)
+wall = time.perf_counter() - start
+print(json.dumps([wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss]), file=sys.stderr)
+"""
+"""Runs the measured command from a small process: Linux carries a parent's peak RSS over to a
+child at exec, so spawning from this (large) benchmark process would floor every figure."""
+
+
 def measure(args: list[str]) -> Run:
-    """Run ``args``; wall time, CPU time and this child's own peak RSS."""
+    """Run ``args``; wall time, CPU time and its own peak RSS (measured by ``WRAPPER``)."""
     env = {**os.environ, "NO_COLOR": "1"}
     with tempfile.TemporaryFile() as out:
-        start = time.perf_counter()
-        proc = subprocess.Popen(args, stdout=out, stderr=subprocess.DEVNULL, cwd=ROOT, env=env)
-        _, status, usage = os.wait4(proc.pid, 0)
-        wall = time.perf_counter() - start
-        proc.returncode = os.waitstatus_to_exitcode(status)
+        proc = subprocess.run(
+            [sys.executable, "-c", WRAPPER, *args],
+            stdout=out,
+            stderr=subprocess.PIPE,
+            cwd=ROOT,
+            env=env,
+            check=False,
+        )
         out.seek(0)
         text = out.read().decode(errors="replace")
-    return Run(wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024, text)
+    wall, cpu, rss_kb = json.loads(proc.stderr.decode().strip().splitlines()[-1])
+    return Run(wall, cpu, rss_kb / 1024, text)
 
 
 def lint(path: Path) -> Run:

@@ -148,7 +148,11 @@ class UlogSource(Source):
         return self._loaded
 
     def _datasets(self) -> list[Any]:
-        return [d for d in self._load().ulog.data_list if len(d.data["timestamp"])]
+        return [
+            d
+            for d in self._load().ulog.data_list
+            if "timestamp" in d.data and len(d.data["timestamp"])
+        ]
 
     # -- probe -----------------------------------------------------------------------------
 
@@ -240,9 +244,14 @@ class UlogSource(Source):
                 _stream(legacy.data, "vehicle_status", rank, t0, failsafe_flags, context)
             )
         streams.append(self._records(ulog, t0))
-        for _key, _rank, _index, event in heapq.merge(*streams):
-            self._yielded += 1
-            yield event
+        try:
+            for _key, _rank, _index, event in heapq.merge(*streams):
+                self._yielded += 1
+                yield event
+        except (KeyError, ValueError, TypeError, IndexError, OverflowError) as exc:
+            # A layout no release has (a damaged format record that still parsed).
+            where = f"after {self._yielded} events"
+            raise SourceError(self.path, f"cannot decode the data ({exc!r})", where) from None
 
     def _context(self, info: RecordingInfo) -> Context:
         context = Context()
@@ -256,7 +265,7 @@ class UlogSource(Source):
             profile is None and ev.LegacyControlMode.kind in info.kinds
         )
         commander = next((d for d in self._datasets() if d.name == "commander_state"), None)
-        if commander is not None:
+        if commander is not None and "main_state" in commander.data:
             ts = commander.data["timestamp"]
             order = np.argsort(ts, kind="stable")
             context.intention_ts = ts[order]

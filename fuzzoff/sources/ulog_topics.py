@@ -19,6 +19,8 @@ import numpy as np
 from fuzzoff import events as ev
 from fuzzoff.modes import nav_state_name
 
+VEHICLE: Literal["vehicle"] = "vehicle"
+
 Columns = Mapping[str, Any]
 """Field name -> numpy array (one topic instance, as in ``ULog.Data.data``)."""
 
@@ -112,11 +114,6 @@ class Chunk:
             size += 1
         return size
 
-    def head(self) -> Iterator[dict[str, Any]]:
-        """The common header of each row's event."""
-        for t, where, ts in zip(self.t, self.where, self.ts, strict=True):
-            yield {"t": t, "where": where, "sender_time_us": ts, "origin": "vehicle"}
-
 
 Decoder = Callable[[Chunk, Context], Iterator[ev.Event]]
 
@@ -135,8 +132,10 @@ def control_mode(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
         else:  # v1.7-v1.11 split it per axis; the rates are used if any axis is
             x, y, z = c.b("ignore_bodyrate_x"), c.b("ignore_bodyrate_y"), c.b("ignore_bodyrate_z")
             bodyrate = [a and b and d for a, b, d in zip(x, y, z, strict=True)]
-        for h, *row in zip(
-            c.head(),
+        for t, w, ts, *row in zip(
+            c.t,
+            c.where,
+            c.ts,
             c.b("ignore_thrust"),
             c.b("ignore_attitude"),
             bodyrate,
@@ -147,7 +146,10 @@ def control_mode(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
             strict=True,
         ):
             yield ev.LegacyControlMode(
-                **h,
+                t=t,
+                where=w,
+                sender_time_us=ts,
+                origin=VEHICLE,
                 ignore_thrust=row[0],
                 ignore_attitude=row[1],
                 ignore_bodyrate=row[2],
@@ -159,8 +161,10 @@ def control_mode(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
         return
     new = c.has("thrust_and_torque")
     layout: Literal["actuator", "thrust_and_torque"] = "thrust_and_torque" if new else "actuator"
-    for h, pos, vel, acc, att, rate, tt, direct, act in zip(
-        c.head(),
+    for t, w, ts, pos, vel, acc, att, rate, tt, direct, act in zip(
+        c.t,
+        c.where,
+        c.ts,
         c.b("position"),
         c.b("velocity"),
         c.b("acceleration"),
@@ -172,7 +176,10 @@ def control_mode(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
         strict=True,
     ):
         yield ev.ControlMode(
-            **h,
+            t=t,
+            where=w,
+            sender_time_us=ts,
+            origin=VEHICLE,
             position=pos,
             velocity=vel,
             acceleration=acc,
@@ -191,8 +198,10 @@ def trajectory(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
     else:  # v1.13 layout
         position = list(zip(c.f("x"), c.f("y"), c.f("z"), strict=True))
         velocity = list(zip(c.f("vx"), c.f("vy"), c.f("vz"), strict=True))
-    for h, pos, vel, acc, jerk, yaw, yawspeed in zip(
-        c.head(),
+    for t, w, ts, pos, vel, acc, jerk, yaw, yawspeed in zip(
+        c.t,
+        c.where,
+        c.ts,
         position,
         velocity,
         c.vec("acceleration", 3),
@@ -202,7 +211,10 @@ def trajectory(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
         strict=True,
     ):
         yield ev.TrajectorySetpoint(
-            **h,
+            t=t,
+            where=w,
+            sender_time_us=ts,
+            origin=VEHICLE,
             position=pos,
             velocity=vel,
             acceleration=acc,
@@ -213,43 +225,68 @@ def trajectory(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
 
 
 def attitude(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
-    for h, q, thrust, move in zip(
-        c.head(), c.vec("q_d", 4), _legacy_thrust(c), c.f("yaw_sp_move_rate"), strict=True
+    for t, w, ts, q, thrust, move in zip(
+        c.t, c.where, c.ts, c.vec("q_d", 4), _legacy_thrust(c), c.f("yaw_sp_move_rate"), strict=True
     ):
-        yield ev.AttitudeSetpoint(**h, q_d=q, thrust_body=thrust, yaw_sp_move_rate=move)
+        yield ev.AttitudeSetpoint(
+            t=t,
+            where=w,
+            sender_time_us=ts,
+            origin=VEHICLE,
+            q_d=q,
+            thrust_body=thrust,
+            yaw_sp_move_rate=move,
+        )
 
 
 def rates(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
-    for h, roll, pitch, yaw, thrust in zip(
-        c.head(), c.f("roll"), c.f("pitch"), c.f("yaw"), _legacy_thrust(c), strict=True
+    for t, w, ts, roll, pitch, yaw, thrust in zip(
+        c.t, c.where, c.ts, c.f("roll"), c.f("pitch"), c.f("yaw"), _legacy_thrust(c), strict=True
     ):
-        yield ev.RatesSetpoint(**h, roll=roll, pitch=pitch, yaw=yaw, thrust_body=thrust)
+        yield ev.RatesSetpoint(
+            t=t,
+            where=w,
+            sender_time_us=ts,
+            origin=VEHICLE,
+            roll=roll,
+            pitch=pitch,
+            yaw=yaw,
+            thrust_body=thrust,
+        )
 
 
 def thrust(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
-    for h, xyz in zip(c.head(), c.vec("xyz", 3), strict=True):
-        yield ev.ThrustSetpoint(**h, xyz=xyz)
+    for t, w, ts, xyz in zip(c.t, c.where, c.ts, c.vec("xyz", 3), strict=True):
+        yield ev.ThrustSetpoint(t=t, where=w, sender_time_us=ts, origin=VEHICLE, xyz=xyz)
 
 
 def torque(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
-    for h, xyz in zip(c.head(), c.vec("xyz", 3), strict=True):
-        yield ev.TorqueSetpoint(**h, xyz=xyz)
+    for t, w, ts, xyz in zip(c.t, c.where, c.ts, c.vec("xyz", 3), strict=True):
+        yield ev.TorqueSetpoint(t=t, where=w, sender_time_us=ts, origin=VEHICLE, xyz=xyz)
 
 
 def motors(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
     control = c.vec("control", c.width("control"))
-    for h, values, flags in zip(c.head(), control, c.i("reversible_flags"), strict=True):
-        yield ev.ActuatorMotors(**h, control=values, reversible_flags=flags)
+    for t, w, ts, values, flags in zip(
+        c.t, c.where, c.ts, control, c.i("reversible_flags"), strict=True
+    ):
+        yield ev.ActuatorMotors(
+            t=t, where=w, sender_time_us=ts, origin=VEHICLE, control=values, reversible_flags=flags
+        )
 
 
 def servos(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
-    for h, values in zip(c.head(), c.vec("control", c.width("control")), strict=True):
-        yield ev.ActuatorServos(**h, control=values)
+    for t, w, ts, values in zip(
+        c.t, c.where, c.ts, c.vec("control", c.width("control")), strict=True
+    ):
+        yield ev.ActuatorServos(t=t, where=w, sender_time_us=ts, origin=VEHICLE, control=values)
 
 
 def rover_position(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
-    for h, pos, start, cruise, arrival, yaw in zip(
-        c.head(),
+    for t, w, ts, pos, start, cruise, arrival, yaw in zip(
+        c.t,
+        c.where,
+        c.ts,
         c.vec("position_ned", 2),
         c.vec("start_ned", 2),
         c.f("cruising_speed"),
@@ -258,7 +295,10 @@ def rover_position(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
         strict=True,
     ):
         yield ev.RoverPositionSetpoint(
-            **h,
+            t=t,
+            where=w,
+            sender_time_us=ts,
+            origin=VEHICLE,
             position_ned=pos,
             start_ned=start,
             cruising_speed=cruise,
@@ -270,8 +310,14 @@ def rover_position(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
 def _plain(cls: type[ev.Event], names: tuple[str, ...]) -> Decoder:
     def decode(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
         columns = [c.f(name) for name in names]
-        for h, *values in zip(c.head(), *columns, strict=True):
-            yield cls(**h, **dict(zip(names, values, strict=True)))
+        for t, w, ts, *values in zip(c.t, c.where, c.ts, *columns, strict=True):
+            yield cls(
+                t=t,
+                where=w,
+                sender_time_us=ts,
+                origin=VEHICLE,
+                **dict(zip(names, values, strict=True)),
+            )
 
     return decode
 
@@ -282,15 +328,24 @@ def steering(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
         if c.has("normalized_steering_setpoint")
         else "normalized_steering_angle"
     )
-    for h, angle, diff in zip(c.head(), c.f(name), c.f("normalized_speed_diff"), strict=True):
+    for t, w, ts, angle, diff in zip(
+        c.t, c.where, c.ts, c.f(name), c.f("normalized_speed_diff"), strict=True
+    ):
         yield ev.RoverSteeringSetpoint(
-            **h, normalized_steering_angle=angle, normalized_speed_diff=diff
+            t=t,
+            where=w,
+            sender_time_us=ts,
+            origin=VEHICLE,
+            normalized_steering_angle=angle,
+            normalized_speed_diff=diff,
         )
 
 
 def triplet(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
-    for h, prev, cur, nxt, kind, pos, vel, yaw in zip(
-        c.head(),
+    for t, w, ts, prev, cur, nxt, kind, pos, vel, yaw in zip(
+        c.t,
+        c.where,
+        c.ts,
         c.b("previous.valid"),
         c.b("current.valid"),
         c.b("next.valid"),
@@ -301,7 +356,10 @@ def triplet(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
         strict=True,
     ):
         yield ev.PositionSetpointTriplet(
-            **h,
+            t=t,
+            where=w,
+            sender_time_us=ts,
+            origin=VEHICLE,
             previous_valid=prev,
             current_valid=cur,
             next_valid=nxt,
@@ -338,8 +396,10 @@ def _intentions(c: Chunk, ctx: Context) -> list[int | None]:
 def vehicle_status(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
     arming = c.i("arming_state")
     armed = [a in (2, 3) if ctx.legacy_arming else a == 2 for a in arming]
-    for h, nav, arm, intention, failsafe, vtype, vtol in zip(
-        c.head(),
+    for t, w, ts, nav, arm, intention, failsafe, vtype, vtol in zip(
+        c.t,
+        c.where,
+        c.ts,
         c.i("nav_state"),
         armed,
         _intentions(c, ctx),
@@ -349,7 +409,10 @@ def vehicle_status(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
         strict=True,
     ):
         yield ev.VehicleStatus(
-            **h,
+            t=t,
+            where=w,
+            sender_time_us=ts,
+            origin=VEHICLE,
             nav_state=nav,
             mode=nav_state_name(nav),
             armed=arm,
@@ -369,11 +432,18 @@ def control_mode_status(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
     ]
     short = [name[len(_FLAG_PREFIX) : -len(_FLAG_SUFFIX)] for name in names]
     columns = [c.b(name) for name in names]
-    for h, offboard, *flags in zip(
-        c.head(), c.b("flag_control_offboard_enabled"), *columns, strict=True
+    for t, w, ts, offboard, *flags in zip(
+        c.t, c.where, c.ts, c.b("flag_control_offboard_enabled"), *columns, strict=True
     ):
         enabled = frozenset(s for s, on in zip(short, flags, strict=True) if on)
-        yield ev.VehicleControlModeStatus(**h, offboard_enabled=offboard, enabled=enabled)
+        yield ev.VehicleControlModeStatus(
+            t=t,
+            where=w,
+            sender_time_us=ts,
+            origin=VEHICLE,
+            offboard_enabled=offboard,
+            enabled=enabled,
+        )
 
 
 _ESTIMATES = (
@@ -402,11 +472,14 @@ def failsafe_flags(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
         "manual_control_signal_lost" if c.has("manual_control_signal_lost") else "rc_signal_lost"
     )
     valid = [_valid(c, name) for name in _ESTIMATES]
-    for h, lost, manual_lost, *flags in zip(
-        c.head(), c.ob("offboard_control_signal_lost"), c.ob(manual), *valid, strict=True
+    for t, w, ts, lost, manual_lost, *flags in zip(
+        c.t, c.where, c.ts, c.ob("offboard_control_signal_lost"), c.ob(manual), *valid, strict=True
     ):
         yield ev.FailsafeFlags(
-            **h,
+            t=t,
+            where=w,
+            sender_time_us=ts,
+            origin=VEHICLE,
             offboard_control_signal_lost=lost,
             manual_control_signal_lost=manual_lost,
             **{f"{name}_valid": v for name, v in zip(_ESTIMATES, flags, strict=True)},
@@ -415,8 +488,10 @@ def failsafe_flags(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
 
 def command(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
     params = list(zip(*(c.f(f"param{k}") for k in range(1, 8)), strict=True))
-    for h, p, cmd, tsys, tcomp, ssys, scomp, external in zip(
-        c.head(),
+    for t, w, ts, p, cmd, tsys, tcomp, ssys, scomp, external in zip(
+        c.t,
+        c.where,
+        c.ts,
         params,
         c.i("command"),
         c.i("target_system"),
@@ -427,7 +502,10 @@ def command(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
         strict=True,
     ):
         yield ev.Command(
-            **h,
+            t=t,
+            where=w,
+            sender_time_us=ts,
+            origin=VEHICLE,
             command=cmd,
             params=p,
             target_system=tsys,
@@ -440,8 +518,10 @@ def command(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
 
 
 def ack(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
-    for h, cmd, result, tsys, tcomp in zip(
-        c.head(),
+    for t, w, ts, cmd, result, tsys, tcomp in zip(
+        c.t,
+        c.where,
+        c.ts,
         c.i("command"),
         c.i("result"),
         c.i("target_system"),
@@ -449,7 +529,14 @@ def ack(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
         strict=True,
     ):
         yield ev.CommandAck(
-            **h, command=cmd, result=result, target_system=tsys, target_component=tcomp
+            t=t,
+            where=w,
+            sender_time_us=ts,
+            origin=VEHICLE,
+            command=cmd,
+            result=result,
+            target_system=tsys,
+            target_component=tcomp,
         )
 
 
