@@ -49,6 +49,8 @@ class Episodes:
         self, code: str, stream: str, t: float, where: Where, offences: dict[str, Offence]
     ) -> None:
         """This message of ``stream`` commits ``offences`` (key -> offence) under ``code``."""
+        if not offences and not self.open:
+            return  # the common case: a clean message and nothing open
         for key in [k for k in self.open if k[0] == code and k[1] == stream]:
             if t - self.open[key].last_t > MERGE_GAP_S:
                 self._close(key)

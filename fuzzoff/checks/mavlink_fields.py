@@ -48,24 +48,39 @@ class PositionTargetFields(Check):
         self.episodes = Episodes(ctx)
         self.group = tm.vehicle_group(ctx.profile.vehicle)
         self.vehicle_label = VEHICLE_LABELS[self.group]
+        self.by_mask: dict[tuple[str, int, int], list[tuple[str, dict[str, Offence]]]] = {}
+        """Verdicts by (message, type_mask, frame): a stream repeats the same few."""
 
     def on_event(self, event: Event) -> None:
         if event.origin != "sent" or not isinstance(
             event, (SetPositionTargetLocal, SetPositionTargetGlobal)
         ):
             return
+        key = (event.kind, event.type_mask, event.coordinate_frame)
+        judged = self.by_mask.get(key)
+        if judged is None:
+            judged = self.by_mask[key] = self._judge_mask(event)
+        for code, offences in judged:
+            self.episodes.update(code, event.kind, event.t, event.where, offences)
+        if self.group == "fixedwing":
+            rules = tm.position_rules(self.ctx.profile, event.kind)
+            if rules is not None:
+                name = tm.MESSAGE_NAMES[event.kind]
+                offences = self._fw_ignored(event, name, rules)
+                self.episodes.update("OFB604", event.kind, event.t, event.where, offences)
+
+    def _judge_mask(self, event: PositionTarget) -> list[tuple[str, dict[str, Offence]]]:
+        """The verdicts that depend only on the message, its type_mask and its frame."""
         name = tm.MESSAGE_NAMES[event.kind]
-        update = self.episodes.update
-        update("OFB603", event.kind, event.t, event.where, self._setpoint_type(event, name))
+        out = [("OFB603", self._setpoint_type(event, name))]
         rules = tm.position_rules(self.ctx.profile, event.kind)
         if rules is None:
-            return
-        selected = tm.selected_groups(event.type_mask)
-        usable = selected - rules.ignored
-        update("OFB601", event.kind, event.t, event.where, self._frame(event, name, rules, usable))
-        update("OFB602", event.kind, event.t, event.where, self._combo(event, name, rules))
-        update("OFB604", event.kind, event.t, event.where, self._fw_ignored(event, name, rules))
-        update("OFB605", event.kind, event.t, event.where, self._global_accel(event))
+            return out
+        usable = tm.selected_groups(event.type_mask) - rules.ignored
+        out.append(("OFB601", self._frame(event, name, rules, usable)))
+        out.append(("OFB602", self._combo(event, name, rules)))
+        out.append(("OFB605", self._global_accel(event)))
+        return out
 
     # -- OFB601 -------------------------------------------------------------------------
 
@@ -173,8 +188,6 @@ class PositionTargetFields(Check):
     def _fw_ignored(
         self, event: PositionTarget, name: str, rules: tm.PositionTargetRules
     ) -> dict[str, Offence]:
-        if self.group != "fixedwing":
-            return {}
         fields = [
             c
             for group in ("velocity", "acceleration")

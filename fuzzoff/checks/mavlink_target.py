@@ -79,6 +79,8 @@ class SetpointTarget(Check):
         self.episodes = Episodes(ctx)
         self.autopilot_seen = False
         self.pending: dict[tuple[int, int], _Pending] = {}
+        self.judged: dict[tuple[int, int, tuple[int, int] | None], dict[str, Offence]] = {}
+        """Verdicts by (target system, target component, the vehicle's ids)."""
 
     def _own_ids(self) -> tuple[int, int] | None:
         params = self.ctx.state.params
@@ -113,8 +115,12 @@ class SetpointTarget(Check):
         self.episodes.update("OFB607", "setpoints", event.t, event.where, self._judge(event))
 
     def _judge(self, event: MavlinkTarget) -> dict[str, Offence]:
-        offence = self._offence(event.target_system, event.target_component)
-        return {} if offence is None else {offence[0]: offence[1]}
+        key = (event.target_system, event.target_component, self._own_ids())
+        judged = self.judged.get(key)
+        if judged is None:
+            offence = self._offence(event.target_system, event.target_component)
+            judged = self.judged[key] = {} if offence is None else {offence[0]: offence[1]}
+        return judged
 
     def _offence(self, system: int, component: int) -> tuple[str, Offence] | None:
         ids = self._own_ids()
