@@ -236,8 +236,8 @@ class TlogSource(Source):
             offset, ts = stats.unknown_first[msgid]
             lines.append(
                 SourceProblem(
-                    f"{count} packet(s) of message id {msgid} unknown to the MAVLink common "
-                    "dialect (UNKNOWN_%d), not read" % msgid,
+                    f"{count} packet(s) of message id {msgid} (UNKNOWN_{msgid}) unknown to "
+                    "the MAVLink common dialect, not read",
                     f"byte {offset}",
                     t_of(ts),
                 )

@@ -44,11 +44,18 @@ CHUNK = 1 << 20
 MAX_RECORD = 8 + 10 + 255 + 2 + 13
 """Largest record: timestamp, MAVLink 2 header, payload, CRC, signature."""
 
-BACKWARD_US = 5_000_000
-"""A timestamp this far before the previous one is not plausible."""
+BACKWARD_US = 100_000
+"""A record may be this much older than the one before it without a second look."""
 
-FORWARD_US = 3_600_000_000
-"""Nor one this far after it (unless the following record confirms the jump)."""
+FORWARD_US = 250_000
+"""Or this much newer. A larger step is checked against the next record (``_step_real``)."""
+
+FIRST_STEP_US = 60_000_000
+"""The first record is doubted when the second is more than this far from it; a step this
+large is doubted when there is no next record to confirm it."""
+
+RESYNC_WINDOW_US = (120_000_000, 86_400_000_000)
+"""After bad bytes, a candidate record may be this much older / newer than the last good one."""
 
 MAX_UNKNOWN_IDS = 256
 """Distinct unknown message ids tracked one by one; beyond that they are only counted."""
@@ -155,9 +162,10 @@ class Framer:
         crc.accumulate(_EXTRA_BYTE[extra])
         return bool(crc.crc == expected)
 
-    def _plausible(self, ts: int, slack: int = 1) -> bool:
+    def _plausible(self, ts: int) -> bool:
         last = self.stats.last_ts
-        return last is None or last - BACKWARD_US * slack <= ts <= last + FORWARD_US * slack
+        back, forward = RESYNC_WINDOW_US
+        return last is None or last - back <= ts <= last + forward
 
     # -- main loop ------------------------------------------------------------------------
 
@@ -207,15 +215,15 @@ class Framer:
             if (
                 last is not None
                 and not last - BACKWARD_US <= ts <= last + FORWARD_US
-                and not self._jump_confirmed(buf, pos, end, ts, n)
-            ):
+                and not self._step_real(buf, end, ts, last, n)
+            ) or (last is None and not self._first_ts_ok(buf, end, ts, n)):
                 pos, buf, n = self._resync(pos, "implausible timestamp")
                 continue
             msg: Any = None
             if msgid in wanted:
                 try:
                     msg = decode(bytearray(buf[pos + 8 : end]))
-                except mavlink.MAVError:
+                except (mavlink.MAVError, struct.error, ValueError, TypeError, IndexError):
                     pos, buf, n = self._resync(pos, "bad CRC or length")
                     continue
             elif verify or first:
@@ -259,15 +267,26 @@ class Framer:
         else:
             self.stats.truncated_at = self.base + pos
 
-    def _jump_confirmed(self, buf: bytes, pos: int, end: int, ts: int, n: int) -> bool:
-        """A large time jump is real if the next record frames and agrees with it."""
-        if end + 11 > n:
-            return True  # nothing (yet) contradicts it
-        nxt = self._record_end(buf, end)
-        if nxt is None:
-            return False
-        ts2: int = _TS.unpack_from(buf, end)[0]
-        return ts - BACKWARD_US <= ts2 <= ts + FORWARD_US
+    def _next_ts(self, buf: bytes, end: int, n: int) -> int | None:
+        """Timestamp of the record at ``end`` if one visibly starts there."""
+        if end + 11 > n or self._record_end(buf, end) is None:
+            return None
+        ts: int = _TS.unpack_from(buf, end)[0]
+        return ts
+
+    def _step_real(self, buf: bytes, end: int, ts: int, last: int, n: int) -> bool:
+        """A time step is real (a pause in the log, a clock step) if the next record is nearer
+        to the new time than to the old one; a corrupt timestamp is a spike the next record
+        does not follow. With no next record to judge by, only a step under a minute stands."""
+        ts2 = self._next_ts(buf, end, n)
+        if ts2 is None:
+            return abs(ts - last) <= FIRST_STEP_US
+        return abs(ts2 - ts) < abs(ts2 - last)
+
+    def _first_ts_ok(self, buf: bytes, end: int, ts: int, n: int) -> bool:
+        """The first record has no predecessor: doubt it when the second is far away."""
+        ts2 = self._next_ts(buf, end, n)
+        return ts2 is None or abs(ts2 - ts) <= FIRST_STEP_US
 
     def _resync(self, bad: int, why: str) -> tuple[int, bytes, int]:
         """Find the next good record after ``bad``; record the skipped bytes as a region.
@@ -292,7 +311,7 @@ class Framer:
                 if end is not None and end <= n:
                     ts = _TS.unpack_from(buf, cand)[0]
                     msgid = self._msgid(buf, cand)
-                    if self._plausible(ts, slack=24) and self._crc_ok(buf, cand, end, msgid):
+                    if self._plausible(ts) and self._crc_ok(buf, cand, end, msgid):
                         self.stats.regions.append(
                             Region(start_abs, self.base + cand, why, self.stats.last_ts)
                         )
