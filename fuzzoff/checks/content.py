@@ -8,7 +8,6 @@ judge MAVLink ``SET_ATTITUDE_TARGET`` where its ``type_mask`` uses the field.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
 
 from fuzzoff.checks._external import Episodes, declared_flag, from_external, is_armed
 from fuzzoff.checks.base import Check, CheckContext
@@ -22,7 +21,6 @@ from fuzzoff.events import (
     ThrustSetpoint,
     TorqueSetpoint,
     TrajectorySetpoint,
-    Vec3,
     VehicleStatus,
 )
 from fuzzoff.tables.control_mode import SETPOINT_NAMES
@@ -38,28 +36,39 @@ MAVLINK_THRUST_RANGE: dict[str, tuple[float, float]] = {"mc": (0.0, 1.0), "vtol"
 """SET_ATTITUDE_TARGET ``thrust``: 0..1, -1..1 where the vehicle can reverse (fw, rovers)."""
 
 
-def _finite(values: Iterable[float]) -> bool:
-    return any(math.isfinite(v) for v in values)
+def finiteness(sp: TrajectorySetpoint) -> tuple[tuple[bool, bool, bool], ...]:
+    """Which components of position, velocity and acceleration are finite (computed once)."""
+    isf = math.isfinite
+    return tuple(
+        (isf(vec[0]), isf(vec[1]), isf(vec[2]))
+        for vec in (sp.position, sp.velocity, sp.acceleration)
+    )
 
 
 def content_controller(sp: TrajectorySetpoint) -> str | None:
     """The controller the docs say the content selects (seed 000 "Мультикоптери")."""
-    for name in TRAJECTORY_CONTROLS:
-        vec: Vec3 = getattr(sp, name)
-        if _finite(vec):
+    return _selected(finiteness(sp))
+
+
+def _selected(finite: tuple[tuple[bool, bool, bool], ...]) -> str | None:
+    for name, components in zip(TRAJECTORY_CONTROLS, finite, strict=True):
+        if any(components):
             return name
     return None
 
 
 def axis_problems(sp: TrajectorySetpoint) -> list[str]:
     """What PX4's position controller rejects (gate spec section 8, ``_inputValid``)."""
+    return _axis_problems(finiteness(sp))
+
+
+def _axis_problems(finite: tuple[tuple[bool, bool, bool], ...]) -> list[str]:
     problems = []
     for i, axis in enumerate("xyz"):
-        if not any(math.isfinite(getattr(sp, name)[i]) for name in TRAJECTORY_CONTROLS):
+        if not (finite[0][i] or finite[1][i] or finite[2][i]):
             problems.append(f"axis {axis} has no finite position, velocity or acceleration")
-    for name in TRAJECTORY_CONTROLS:
-        vec = getattr(sp, name)
-        if math.isfinite(vec[0]) != math.isfinite(vec[1]):
+    for name, (fx, fy, _) in zip(TRAJECTORY_CONTROLS, finite, strict=True):
+        if fx != fy:
             problems.append(f"{name} x and y are not both finite or both NaN")
     return problems
 
@@ -75,13 +84,15 @@ class TrajectoryContent(Check):
         self.mismatch = Episodes(ctx, "OFB401")
         self.all_nan = Episodes(ctx, "OFB402")
         self.axis = Episodes(ctx, "OFB403")
+        self.multicopter = ctx.profile.vehicle in ("mc", "vtol")
 
     def on_event(self, event: Event) -> None:
         assert isinstance(event, TrajectorySetpoint)
         flag = declared_flag(self.ctx)
         if not from_external(self.ctx, event) or flag not in TRAJECTORY_CONTROLS:
             return
-        selected = content_controller(event)
+        finite = finiteness(event)
+        selected = _selected(finite)
         if selected is None:
             self.all_nan.bad(
                 "nan",
@@ -102,7 +113,7 @@ class TrajectoryContent(Check):
             )
         else:
             self.mismatch.close_all()
-        problems = axis_problems(event) if self.ctx.profile.vehicle in ("mc", "vtol") else []
+        problems = _axis_problems(finite) if self.multicopter else []
         if problems:
             self.axis.bad(
                 "axis",

@@ -8,7 +8,10 @@ in content restarts the count.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, fields
+from operator import attrgetter
+from typing import Any
 
 from fuzzoff.checks._external import from_external, mode_note
 from fuzzoff.checks.base import Check, CheckContext
@@ -18,21 +21,21 @@ from fuzzoff.gate import GateTransition
 HEADER_FIELDS = frozenset({"t", "vehicle", "where", "sender_time_us", "origin"})
 """Fields that change with every message and say nothing about the setpoint."""
 
-_CONTENT_FIELDS: dict[type[Event], tuple[str, ...]] = {}
+_CONTENT: dict[type[Event], Callable[[Event], Any]] = {}
 
 
-def content_of(event: Event) -> tuple[str, ...]:
+def content_of(event: Event) -> str:
     """The setpoint's content as comparable text (``repr`` keeps NaN equal to NaN)."""
-    names = _CONTENT_FIELDS.get(type(event))
-    if names is None:
-        names = tuple(f.name for f in fields(event) if f.name not in HEADER_FIELDS)
-        _CONTENT_FIELDS[type(event)] = names
-    return tuple(repr(getattr(event, name)) for name in names)
+    getter = _CONTENT.get(type(event))
+    if getter is None:
+        names = [f.name for f in fields(event) if f.name not in HEADER_FIELDS]
+        getter = _CONTENT[type(event)] = attrgetter(*names)
+    return repr(getter(event))
 
 
 @dataclass(slots=True)
 class _Run:
-    content: tuple[str, ...]
+    content: str
     start: float
     last: float
     where: Where
