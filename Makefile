@@ -3,8 +3,9 @@ PY ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
+MULTITOOL := build/node/node_modules/.bin/sarif-multitool
 
-.PHONY: install demo test check bench fuzz clean
+.PHONY: install demo test test-tools check bench fuzz clean
 
 $(STAMP): pyproject.toml
 	$(PY) -m venv $(VENV)
@@ -14,16 +15,27 @@ $(STAMP): pyproject.toml
 
 install: $(STAMP)
 
+# Lint the bundled corpus (it holds deliberately damaged files, so exit 2 is expected) and write
+# the HTML report.
 demo: $(STAMP)
-	$(BIN)/fuzzoff lint corpora --fail-on error --output build/demo-report.json --format json || [ $$? -eq 1 ]
-	$(BIN)/fuzzoff lint corpora --fail-on error || [ $$? -eq 1 ]
-	@echo "report written to $$(pwd)/build/demo-report.json"
+	$(BIN)/fuzzoff lint corpora --fail-on error --format html --output build/demo-report.html || [ $$? -le 2 ]
+	$(BIN)/fuzzoff lint corpora --fail-on error --quiet || [ $$? -le 2 ]
+	@echo "HTML report written to $$(pwd)/build/demo-report.html"
 
-test: $(STAMP)
+# The SARIF validator (Microsoft's SARIF Multitool, from npm) and Chromium for the browser tests.
+$(MULTITOOL):
+	mkdir -p build/node
+	npm install --prefix build/node --no-audit --no-fund --silent @microsoft/sarif-multitool@5.7.0
+	chmod u+x build/node/node_modules/@microsoft/sarif-multitool-linux/Sarif.Multitool
+
+test-tools: $(MULTITOOL)
+	@command -v chromium >/dev/null 2>&1 || { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium; } || echo "fuzzoff: chromium could not be installed: the browser tests will be skipped (and fail under CI)"
+
+test: $(STAMP) test-tools
 	$(BIN)/python -m pytest -q -n 2
 
 check: $(STAMP)
-	$(BIN)/ruff check fuzzoff tests bench
+	$(BIN)/ruff check fuzzoff tests bench corpora
 	$(BIN)/mypy
 
 bench: $(STAMP)

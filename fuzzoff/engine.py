@@ -58,6 +58,9 @@ class Timeline:
     recorded_modes: list[tuple[float, int | None, bool | None]] = field(default_factory=list)
     transitions: list[GateTransition] = field(default_factory=list)
     setpoint_kinds: dict[str, list[float]] = field(default_factory=dict)
+    loss_timeout: float | None = None
+    """The gate's effective loss timeout (recording's COM_OF_LOSS_T, overrides, defaults)."""
+    recorded_params: dict[str, float] = field(default_factory=dict)
 
 
 class VehicleRun:
@@ -132,6 +135,9 @@ class VehicleRun:
         self._transitions(self.gate.finish(t_end))
         for check in self.checks:
             check.finish(t_end)
+        if self.timeline is not None:
+            self.timeline.loss_timeout = self.gate.loss_timeout
+            self.timeline.recorded_params = dict(self.gate.recorded_params)
         return self.ctx.findings
 
 
