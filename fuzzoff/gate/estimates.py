@@ -26,10 +26,11 @@ class Estimates:
     """True once the recording said whether manual control is present."""
     recorded: bool = False
     """True once the recording carried any estimate flag."""
+    _key: int = 255
 
     def update(self, flags: FailsafeFlags) -> bool:
         """Apply a ``FailsafeFlags`` event; True when anything the gate reads changed."""
-        before = self.key()
+        before = self._key
         for name in (
             "local_position",
             "local_velocity",
@@ -46,10 +47,14 @@ class Estimates:
         if flags.manual_control_signal_lost is not None:
             self.rc_present = not flags.manual_control_signal_lost
             self.rc_recorded = True
-        return self.key() != before
+        self._key = self._compute_key()
+        return self._key != before
 
     def key(self) -> int:
         """A small integer summarising every flag (cheap change detection)."""
+        return self._key
+
+    def _compute_key(self) -> int:
         bits = (
             self.local_position,
             self.local_velocity,

@@ -87,6 +87,13 @@ class GateModel:
         self._last_valid_t = -INF
         self._reuse_due = INF
         self._drop_reason: str | None = None
+        self._good = False
+        self._pc = False
+        self._sampled = False
+        self._mc_kind = "none"
+        self._axes_memo: dict[int, str | None] = {}
+        self._deadline = INF
+        self._dirty = False
         self.compare = Comparator(slack(self.px4) + LOOP_PERIOD)
         try:
             own: int | None = int(vehicle)
@@ -139,14 +146,22 @@ class GateModel:
 
     def feed(self, event: Event) -> list[GateTransition]:
         t = event.t
-        if t >= self._now_deadline:
+        if t >= self._deadline:
             self._advance(t)
+            self._deadline = self._now_deadline
         handler = self._handlers.get(type(event))
         if handler is not None:
             self._cause = event
+            self._dirty = True
             handler(event)
             self._cause = None
-        return self._flush()
+            if self._dirty:
+                self._deadline = self._now_deadline
+        out = self._out
+        if out is None:
+            return EMPTY
+        self._out = None
+        return out
 
     def finish(self, t_end: float) -> list[GateTransition]:
         self._advance(t_end)
@@ -234,16 +249,18 @@ class GateModel:
         self._refresh(t + (LOOP_PERIOD if self.tick_based else 0.0), cause=None)
 
     def _keepalive(self, t: float, mask: int, event: Event) -> None:
-        self.ocm_mask = mask
-        if event.origin == "vehicle":
+        changed = mask != self.ocm_mask
+        if changed:
+            self.ocm_mask = mask
+            self._mask_changed()
+        if event.origin == "vehicle" and not self._sampled:
+            self._sampled = True
             self.compare.sampled_keepalive()
-        if self.px4 in ("legacy", "1.11"):
-            good = True
-            why = None
-        else:
-            why = estimate_failure(self.px4, mask, self.est)
-            good = mask != 0 and why is None
-        if self.signal.keepalive(t, good):
+        became = self.signal.keepalive(t, self._good)
+        # A good keep-alive while available only moves the loss later: the cached deadline
+        # stays a valid lower bound (feed() recomputes it when it is reached).
+        self._dirty = became or not self._good or changed
+        if became:
             self._emit(
                 t,
                 "signal_available",
@@ -251,7 +268,20 @@ class GateModel:
                 self.signal.spec,
             )
             self._refresh(t)
-        self._update_controller(t)
+        if changed:
+            self._update_controller(t)
+
+    def _mask_changed(self) -> None:
+        """Recompute what depends only on the OCM flags and the estimates (cached: the hot path
+        is one keep-alive per message)."""
+        mask = self.ocm_mask
+        if self.px4 in ("legacy", "1.11"):
+            self._good = True
+        else:
+            self._good = mask != 0 and estimate_failure(self.px4, mask, self.est) is None
+        self._pc = self.vehicle_type in ("mc", "vtol") and controllers.position_control(
+            self.px4, mask
+        )
 
     def _on_control_mode(self, event: ControlMode) -> None:
         self._keepalive(event.t, ocm.mask_of(event), event)
@@ -286,13 +316,16 @@ class GateModel:
             self._drop_reason = None
         self._keepalive(event.t, mask, event)
         if axes and self._nav == NAV_STATE_OFFBOARD:
+            dirty = self._dirty
             self._trajectory(event.t, axes)
+            self._dirty = self._dirty or dirty
 
     def _on_trajectory(self, event: TrajectorySetpoint) -> None:
         self._trajectory(event.t, controllers.axes_of(event))
 
     def _on_failsafe_flags(self, event: FailsafeFlags) -> None:
         if self.est.update(event):
+            self._mask_changed()
             if self.tick_based and estimate_failure(self.px4, self.ocm_mask, self.est):
                 self.signal.turned_bad(event.t)
             self._update_controller(event.t)
@@ -386,20 +419,31 @@ class GateModel:
 
     def _trajectory(self, t: float, axes: int) -> None:
         self._traj_t = t
-        if axes != self._traj_axes:
-            self._traj_axes = axes
-        if (
-            self._nav == NAV_STATE_OFFBOARD
-            and self._mc_position_control()
-            and controllers.mc_axes(axes, self.est) is None
-        ):
+        self._dirty = False
+        if self._nav != NAV_STATE_OFFBOARD or not self._pc:
+            if axes != self._traj_axes:
+                self._traj_axes = axes
+                if self.vehicle_type == "fw" and self._nav == NAV_STATE_OFFBOARD:
+                    self._update_controller(t)
+            return
+        invalid = self._axes_invalid(axes)
+        if invalid is None:
             self._last_valid_t = t
-        self._update_controller(t)
+        if axes != self._traj_axes or invalid is not None or self._mc_kind != "ok":
+            self._traj_axes = axes
+            self._update_controller(t)
+            self._dirty = True
+
+    def _axes_invalid(self, axes: int) -> str | None:
+        key = (axes << 8) | self.est.key()
+        try:
+            return self._axes_memo[key]
+        except KeyError:
+            value = self._axes_memo[key] = controllers.mc_axes(axes, self.est)
+            return value
 
     def _mc_position_control(self) -> bool:
-        return self.vehicle_type in ("mc", "vtol") and controllers.position_control(
-            self.px4, self.ocm_mask
-        )
+        return self._pc
 
     def _update_controller(self, t: float) -> None:
         if self._nav != NAV_STATE_OFFBOARD:
@@ -441,25 +485,44 @@ class GateModel:
             )
 
     def _mc_state(self, t: float) -> tuple[tuple[Any, ...], str, str | None]:
+        """(key, text, reason) of what the multicopter position controller does now; the text
+        is built only when the key changed."""
         mask = self.ocm_mask
         since = self._offboard_since if self._offboard_since is not None else -INF
+        axes = self._traj_axes
+        invalid: str | None = None
+        if self._traj_t < since:
+            kind = "none"
+            key: tuple[Any, ...] = (mask, kind, self.est.local_velocity)
+        else:
+            invalid = self._axes_invalid(axes)
+            if invalid is None:
+                kind = "ok"
+                key = (mask, kind, axes)
+            elif at_least(self.px4, "1.16") and t < self._last_valid_t + controllers.LAST_VALID_S:
+                kind = "reuse"
+                self._reuse_due = self._last_valid_t + controllers.LAST_VALID_S
+                key = (mask, kind, self._last_valid_t)
+            else:
+                kind = "failsafe"
+                key = (mask, kind, self.est.local_velocity)
+        self._mc_kind = kind
+        if key == self._controller_key:
+            return key, "", invalid
         flags = ", ".join(controllers.control_flags(self.px4, mask))
         head = f"multicopter offboard {ocm.names(ocm.first_flag(mask))} ({flags})"
         land = float(self.params.get("MPC_LAND_SPEED", 0.7))
-        if self._traj_t < since:
+        if kind == "none":
             fs = controllers.failsafe_setpoint(self.est, land)
             why = "no TrajectorySetpoint since position control was enabled"
-            return (mask, "none", self.est.local_velocity), f"{head}: {fs} ({why})", why
-        axes = self._traj_axes
-        invalid = controllers.mc_axes(axes, self.est)
-        if invalid is None:
-            return (mask, "ok", axes), f"{head}: {controllers.mc_axes_text(axes)}", None
-        if at_least(self.px4, "1.16") and t < self._last_valid_t + controllers.LAST_VALID_S:
-            self._reuse_due = self._last_valid_t + controllers.LAST_VALID_S
+            return key, f"{head}: {fs} ({why})", why
+        if kind == "ok":
+            return key, f"{head}: {controllers.mc_axes_text(axes)}", None
+        if kind == "reuse":
             text = f"{head}: invalid setpoint ({invalid}): last valid setpoint reused for 200 ms"
-            return (mask, "reuse", self._last_valid_t), text, invalid
+            return key, text, invalid
         fs = controllers.failsafe_setpoint(self.est, land)
-        return (mask, "failsafe", self.est.local_velocity), f"{head}: {fs} ({invalid})", invalid
+        return key, f"{head}: {fs} ({invalid})", invalid
 
     def _fw_state(self) -> str:
         if self.vehicle_type != "fw" or ocm.first_flag(self.ocm_mask) != ocm.POSITION:
