@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import json
 import os
 import struct
@@ -485,3 +486,25 @@ def test_writer_refuses_or_skips_what_a_tlog_cannot_carry(tmp_path: Path) -> Non
         write_tlog(tmp_path / "x.tlog", events)
     _, back = read(write_tlog(tmp_path / "y.tlog", events, skip_unsupported=True))
     assert [e.kind for e in back] == ["vehicle_info", "vehicle_status"]
+
+
+def test_a_corrupt_timestamp_is_skipped_but_a_real_pause_is_kept(good: Path) -> None:
+    offsets = _records(good)
+    data = bytearray(good.read_bytes())
+    data[offsets[30] + 3] ^= 0x40  # the timestamp of one record jumps by days
+    spiked = good.with_name("spike.tlog")
+    spiked.write_bytes(bytes(data))
+    source, events = read(spiked)
+    assert len(events) == len(offsets) - 1
+    assert all(b.t >= a.t for a, b in itertools.pairwise(events))
+    (problem,) = source.problems
+    assert "implausible timestamp" in problem.what
+    assert problem.where == f"bytes {offsets[30]}-{offsets[31]}"
+
+    paused: list[Event] = [
+        SetPositionTargetLocal(t=t, vehicle="1", type_mask=0x09F8, **SENT)
+        for t in (0.0, 0.1, 0.2, 600.0, 600.1)
+    ]
+    source, events = read(write_tlog(good.with_name("pause.tlog"), paused))
+    assert [e.t for e in events] == [0.0, 0.1, 0.2, 600.0, 600.1]
+    assert not source.problems
