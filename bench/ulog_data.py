@@ -2,8 +2,10 @@
 
 ``generate(path, messages)``: an offboard flight as a high-rate logger profile records it
 (``offboard_control_mode`` and ``trajectory_setpoint`` at 50 Hz each, ``vehicle_status``,
-``vehicle_control_mode`` and ``failsafe_flags`` now and then). ``mixed=True``: the same with
-``sensor_combined`` and ``vehicle_imu`` making up over 90 % of the messages, as in a real log.
+``vehicle_control_mode`` and ``failsafe_flags`` now and then): nearly every message becomes an
+event, the worst case for fuzzoff. ``mixed=True``: a log as PX4's default logger profile writes
+it, ``sensor_combined`` and ``vehicle_imu`` making up over 98 % of the messages, the offboard
+topics at 10 Hz and 5 Hz.
 Deterministic; an existing file of the right name is reused.
 """
 
@@ -96,18 +98,19 @@ def generate(path: Path, messages: int, *, mixed: bool = False) -> Path:
         return path
     topics: dict[str, Columns] = {}
     if mixed:
-        # 1 kHz of sensor data (as sensor_combined + vehicle_imu at 500 Hz), 20 Hz offboard.
-        duration = messages / 1052.0
+        # PX4's default logger profile: sensors at their own rate, offboard_control_mode at
+        # 10 Hz and trajectory_setpoint at 5 Hz (formats.md 8.1): offboard is ~1.5 % of it.
+        duration = messages / 966.0
         rates = {"sensor_combined": 500.0, "vehicle_imu": 450.0}
         for phase, (name, rate) in enumerate(rates.items()):
             topics[name] = _sensor(name, round(duration * rate), 1 / rate, 0.0002 * phase)
-        offboard_rate = 50.0
-    else:
+        ocm_rate, trajectory_rate = 10.0, 5.0
+    else:  # a high-rate logger profile: 50 Hz each, every message an event
         duration = messages / 102.0
-        offboard_rate = 50.0
-    count = round(duration * offboard_rate)
-    topics["offboard_control_mode"] = _ocm(count, 1 / offboard_rate)
-    topics["trajectory_setpoint"] = _trajectory(count, 1 / offboard_rate)
+        ocm_rate = trajectory_rate = 50.0
+    topics["offboard_control_mode"] = _ocm(round(duration * ocm_rate), 1 / ocm_rate)
+    count = round(duration * trajectory_rate)
+    topics["trajectory_setpoint"] = _trajectory(count, 1 / trajectory_rate)
     slow = round(duration)
     topics["vehicle_status"] = _status(slow, 1.0)
     topics["vehicle_control_mode"] = _control_mode(slow // 10 + 1, 10.0)
