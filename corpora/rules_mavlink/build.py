@@ -44,6 +44,7 @@ from fuzzoff.writers.tlog import write_tlog
 
 HERE = Path(__file__).resolve().parent
 POSCTL, OFFBOARD, AUTO_LOITER = 2, 14, 4
+TEMPORARILY_REJECTED = 1
 VERSION, PX4 = "1.16.2", "1.16"
 MAV_TYPES = {"mc": 2, "fw": 1, "rover-differential": 10}
 PERIOD, EXTRA_PERIOD = 0.05, 0.1
@@ -129,7 +130,7 @@ def flight(
     main: Maker,
     extra: Maker | None = None,
     params: dict[str, float] | None = None,
-    switch: bool = True,
+    arm_result: int = 0,
 ) -> list[Event]:
     events: list[Event] = [
         VehicleInfo(t=0.0, vehicle="1", px4_version=VERSION),
@@ -139,26 +140,26 @@ def flight(
         Parameter(t=0.5, vehicle="1", name=name, value=value)
         for name, value in (params or {}).items()
     ]
+    armed_ok = arm_result == 0
     for t in ticks(0.0, END + 0.5, 1.0):
-        if t < SWITCH + 1.0 or not switch:
+        if t < SWITCH + 1.0:
             nav, armed = POSCTL, False
         elif t < LOITER:
-            nav, armed = OFFBOARD, t >= ARM + 0.5
+            nav, armed = OFFBOARD, armed_ok and t >= ARM + 0.5
         else:
-            nav, armed = AUTO_LOITER, True
+            nav, armed = AUTO_LOITER, armed_ok
         events.append(VehicleStatus(t=t, vehicle="1", nav_state=nav, armed=armed))
     events += [main(t) for t in ticks(START, STOP, PERIOD)]
     if extra is not None:
         events += [extra(t) for t in ticks(EXTRA_FROM, EXTRA_TO, EXTRA_PERIOD)]
-    if switch:
-        events += [
-            command(SWITCH, 176, (1.0, 6.0, 0.0)),
-            ack(SWITCH + 0.01, 176),
-            command(ARM, 400, (1.0, 0.0, 0.0)),
-            ack(ARM + 0.01, 400),
-            command(LOITER, 176, (1.0, 4.0, 3.0)),
-            ack(LOITER + 0.01, 176),
-        ]
+    events += [
+        command(SWITCH, 176, (1.0, 6.0, 0.0)),
+        ack(SWITCH + 0.01, 176),
+        command(ARM, 400, (1.0, 0.0, 0.0)),
+        ack(ARM + 0.01, 400, arm_result),
+        command(LOITER, 176, (1.0, 4.0, 3.0)),
+        ack(LOITER + 0.01, 176),
+    ]
     return sorted(events, key=lambda e: e.t)
 
 
@@ -168,9 +169,9 @@ def command(t: float, number: int, params: tuple[float, float, float]) -> Comman
     )
 
 
-def ack(t: float, number: int) -> CommandAck:
+def ack(t: float, number: int, result: int = 0) -> CommandAck:
     return CommandAck(
-        t=t, vehicle="1", command=number, result=0, target_system=1, target_component=191
+        t=t, vehicle="1", command=number, result=result, target_system=1, target_component=191
     )
 
 
@@ -191,8 +192,6 @@ class Case:
     bag_findings: list[Planted] | None = None
     """What the bag shows where it differs from the tlog (None: the same)."""
     notes: list[str] = field(default_factory=list)
-    switch: bool = True
-    """The flight requests OFFBOARD (so the gate model's loss summary, OFB701, appears)."""
 
 
 MC_RULES = ["OFB601", "OFB602", "OFB605", "OFB606", "OFB607"]
@@ -337,16 +336,15 @@ def cases() -> list[Case]:
                 "rover-differential",
                 rover_velocity,
                 params={"MAV_FWDEXTSP": 0.0},
-                switch=False,
+                arm_result=TEMPORARILY_REJECTED,
             ),
             [("OFB509", "error", START)],
             ["OFB507", "OFB508", "OFB601", "OFB602", "OFB607"],
             bag=False,
             notes=[
-                "no OFFBOARD request: with MAV_FWDEXTSP = 0 PX4 drops the stream, keep-alive "
-                "included, so a request would be refused; the stream alone shows the rule"
+                "PX4 1.16 accepts the switch while disarmed (no stream needed), then refuses "
+                "to arm: with MAV_FWDEXTSP = 0 the stream is no keep-alive (OFB201 below)"
             ],
-            switch=False,
         ),
     ]
 
@@ -382,16 +380,13 @@ def write_spec(
 def main() -> None:
     for case in cases():
         tlog = write_tlog(HERE / f"{case.name}.tlog", case.events)
-        other = OTHER_RULES.get(case.name, [])
-        if case.switch:
-            other = [("OFB701", "info", SWITCH), *other]
+        other: list[Planted] = [("OFB701", "info", SWITCH), *OTHER_RULES.get(case.name, [])]
         write_spec(case.name, tlog.name, case, case.findings + other, [], True)
         if case.bag:
             bag = write_rosbag1(HERE / f"{case.name}.bag", case.events)
             planted = case.bag_findings if case.bag_findings is not None else case.findings
-            extra = list(BAG_OTHER_RULES.get(case.name, []))
-            if case.switch:
-                extra.append(("OFB701", "info", SWITCH_SEEN_IN_BAG))
+            extra: list[Planted] = [("OFB701", "info", SWITCH_SEEN_IN_BAG)]
+            extra += BAG_OTHER_RULES.get(case.name, [])
             if case.vehicle.startswith("rover"):
                 extra.append(("OFB002", "info", None))  # OFB509: no parameters in a bag
             args = ["--px4", PX4, "--vehicle", case.vehicle]
@@ -401,9 +396,13 @@ def main() -> None:
 SWITCH_SEEN_IN_BAG = 4.0
 """A MAVROS bag records no commands: the request shows as the ``state`` change at 4.0 s."""
 
-OTHER_RULES: dict[str, list[Planted]] = {}
+OTHER_RULES: dict[str, list[Planted]] = {
+    # The arm request in OFFBOARD is refused, and the gate model gives the reason: with
+    # MAV_FWDEXTSP = 0 the setpoints are no keep-alive (gate spec 4.2, 6.1).
+    "ofb509_rover_not_forwarded": [("OFB201", "error", ARM + 0.01)],
+}
 """Findings of other rules a tlog case also shows, each judged by hand against the rule text.
-Every flight with a request also gets OFB701 (the gate model's loss-action summary, info)."""
+Every flight also gets OFB701 at the request (the gate model's loss-action summary, info)."""
 
 BAG_OTHER_RULES: dict[str, list[Planted]] = {}
 """The same for the MAVROS bags."""
