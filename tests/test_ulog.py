@@ -419,3 +419,26 @@ def test_auto_mission_log_gives_no_stream_findings(tmp_path: Path) -> None:
     (report,) = json.loads(result.stdout)["files"]
     assert report["complete"] is True
     assert not [f for f in report["findings"] if f["code"].startswith("OFB1")]
+
+
+def test_a_damaged_record_is_skipped_and_reported_with_the_last_good_time(tmp_path: Path) -> None:
+    events = offboard_with_rejection()
+    whole = write_ulog(tmp_path / "whole.ulg", events).read_bytes()
+    head = write_ulog(tmp_path / "head.ulg", [e for e in events if e.t <= 10.0]).read_bytes()
+    assert whole.startswith(head)  # the head ends on a record boundary of the whole log
+    bogus = b"\x03\x00D\xff\xff\x00"  # a data record for a topic that was never subscribed
+    path = tmp_path / "damaged.ulg"
+    path.write_bytes(head + bogus + whole[len(head) :])
+    result = run_cli(["lint", str(path), "--format", "json"])
+    assert result.returncode == 2
+    (line,) = result.stderr.strip().splitlines()
+    at = len(head) + len(bogus)
+    assert (
+        f"corrupt data: damaged records were skipped and reading resumed after them at byte {at}"
+        in line
+    )
+    assert "after the last good message at 10.000 s" in line
+    assert json.loads(result.stdout)["files"][0]["complete"] is False
+    with open_source(path) as source:
+        times = [e.t for e in source.events() if isinstance(e, ControlMode)]
+    assert times[-1] == pytest.approx(31.9)  # read on after the damage
