@@ -543,7 +543,13 @@ class GateModel:
         if cmd.is_mode_switch:
             target = decode_mode(cmd)
             decision = switch_decision(
-                self.px4, cmd, target, self.armed, self.signal.available, self._nav
+                self.px4,
+                cmd,
+                target,
+                self.armed,
+                self.signal.available,
+                self._nav,
+                self.est.attitude and self.est.angular_velocity,
             )
             before = (self.user_intention, self.armed)
             self._apply_switch(t, target, decision)
@@ -553,7 +559,14 @@ class GateModel:
             if cmd.is_arm:
                 why = estimate_failure(self.px4, self.ocm_mask, self.est) or "no offboard signal"
                 now_ok = self.signal.ok_now(t, self.ocm_mask != 0 and why == "no offboard signal")
-                decision = arm_decision(self.px4, cmd, self.user_intention, now_ok, why)
+                decision = arm_decision(
+                    self.px4,
+                    cmd,
+                    self.user_intention,
+                    now_ok,
+                    why,
+                    self.est.attitude and self.est.angular_velocity,
+                )
                 self._apply_arm(t, decision)
             else:
                 decision = Decision(True, "4.2")

@@ -22,6 +22,7 @@ FORCE_ARM_MAGIC = 21196
 ACCEPTED = 0
 TEMPORARILY_REJECTED = 1
 UNSUPPORTED = 3
+NO_ATTITUDE = "no attitude or angular-velocity estimate (OFFBOARD mode requirement, D11)"
 
 
 @dataclass(frozen=True, slots=True)
@@ -48,7 +49,13 @@ def decode_mode(cmd: Command) -> int | None:
 
 
 def switch_decision(
-    px4: str, cmd: Command, target: int | None, armed: bool, signal_ok: bool, nav_state: int | None
+    px4: str,
+    cmd: Command,
+    target: int | None,
+    armed: bool,
+    signal_ok: bool,
+    nav_state: int | None,
+    attitude_ok: bool = True,
 ) -> Decision:
     """A mode switch (4.1). ``signal_ok`` is the last check pass's verdict (1.14+) or the
     current flag (older)."""
@@ -72,6 +79,8 @@ def switch_decision(
     if at_least(px4, "1.14"):
         if not armed:
             return Decision(True, "4.1", None)
+        if not attitude_ok:
+            return Decision(False, "4.1", NO_ATTITUDE, TEMPORARILY_REJECTED)
         if signal_ok:
             return Decision(True, "4.1", None)
         return Decision(False, "4.1", "no offboard signal", TEMPORARILY_REJECTED)
@@ -81,7 +90,12 @@ def switch_decision(
 
 
 def arm_decision(
-    px4: str, cmd: Command, intention: int | None, signal_now: bool, why: str | None
+    px4: str,
+    cmd: Command,
+    intention: int | None,
+    signal_now: bool,
+    why: str | None,
+    attitude_ok: bool = True,
 ) -> Decision:
     """Arming (4.2). ``signal_now`` is the condition evaluated at the request (1.14+ re-runs the
     checks); ``why`` the reason it fails."""
@@ -92,6 +106,8 @@ def arm_decision(
     forced = round(cmd.params[1]) == FORCE_ARM_MAGIC
     if forced and cmd.from_external is False:
         return Decision(True, "4.2", "forced arming from an internal source: checks skipped")
+    if not attitude_ok:
+        return Decision(False, "4.2", NO_ATTITUDE, TEMPORARILY_REJECTED)
     if signal_now:
         return Decision(True, "4.2", None)
     return Decision(False, "4.2", why or "no offboard signal", TEMPORARILY_REJECTED)

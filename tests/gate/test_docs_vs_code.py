@@ -239,6 +239,19 @@ def test_d11_body_rate_needs_no_angular_velocity_in_offboard_checks(px4: str) ->
     assert of("signal_available", run(px4, events))
 
 
+@pytest.mark.parametrize("px4", TICK)
+def test_d11_offboard_mode_needs_angular_velocity_whatever_the_flags(px4: str) -> None:
+    """D11 / 4.1: the OFFBOARD mode requirement asks for attitude and angular velocity even for
+    a direct_actuator stream: the armed switch is rejected without them."""
+    events = [
+        status(0.0, POSCTL, True, POSCTL),
+        flags(0.0, angular_velocity_valid=False),
+        ocm(1.0, direct_actuator=True),
+        switch_offboard(1.05),
+    ]
+    assert of("request_rejected", run(px4, events))
+
+
 # D12 -------------------------------------------------------------------------------------------
 
 
