@@ -440,3 +440,23 @@ def test_ofb801_from_a_legacy_mavlink_type_mask() -> None:
     # One acceleration bit set is enough for the legacy receiver to ignore acceleration.
     one_bit = SetPositionTargetLocal(t=0.0, type_mask=0b000001000000)
     assert codes(lint_events([one_bit], px4="legacy", fmt="tlog"), "OFB801") == []
+
+
+def test_ofb303_counts_from_arming_when_parked_disarmed_in_offboard() -> None:
+    events: list[Event] = [
+        status(0.0, OFFBOARD, armed=False),
+        *ocm(every(0.0, 3.0, 0.1), attitude=True),
+        status(2.0, OFFBOARD, armed=True),
+    ]
+    (found,) = codes(lint_events(events), "OFB303")
+    assert found.time_s == pytest.approx(2.5)
+    parked = [status(0.0, OFFBOARD, armed=False), *ocm(every(0.0, 3.0, 0.1), attitude=True)]
+    assert codes(lint_events(parked), "OFB303") == []
+
+
+def test_ofb107_not_while_disarmed() -> None:
+    events = [
+        status(0.0, OFFBOARD, armed=False),
+        *_repeat(0.0, 5.0, 20.0, position=(0.0, 0.0, -2.0)),
+    ]
+    assert codes(lint_events(events), "OFB107") == []

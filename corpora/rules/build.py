@@ -249,9 +249,9 @@ def mcap_cases() -> list[Case]:
         Case(
             "ofb303_torque_missing",
             Flight({"thrust_and_torque": True}, thrust_only).events(),
-            [("OFB303", "error", SWITCH_T + 0.02 + 0.5)],
+            [("OFB303", "error", 2.2 + 0.5)],
             [],
-            note="offboard from the accepted ack (1.52 s) + grace 0.5 s",
+            note="in offboard from the ack (1.52 s), armed per the status at 2.2 s; + grace 0.5 s",
         )
     )
 

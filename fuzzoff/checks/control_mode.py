@@ -115,19 +115,27 @@ class DeclaredSetpointMissing(Check):
         """When the current (offboard, first flag) period began."""
         self.flag: str | None = None
         self.checked = False
+        self.armed: bool | None = None
+        self.armed_at = 0.0
 
     def on_event(self, event: Event) -> None:
         self._due(event.t)
         if event.kind in SETPOINT_NAMES and event.origin != "model":
             self.first_seen.setdefault(event.kind, event.t)
-        flag = declared_flag(self.ctx) if self.ctx.state.in_offboard else None
+        state = self.ctx.state
+        if state.armed is not self.armed:
+            self.armed = state.armed
+            self.armed_at = event.t
+        # A vehicle parked disarmed in OFFBOARD (accepted from 1.14) needs no setpoint yet.
+        active = state.in_offboard and state.armed is not False
+        flag = declared_flag(self.ctx) if active else None
         if flag != self.flag:
-            entered = self.flag is None and self.ctx.state.offboard_since is not None
+            if self.flag is None and state.offboard_since is not None:
+                # Counted from the switch itself (an accepted ack) or the arming, if later.
+                self.since = max(state.offboard_since, self.armed_at)
+            else:
+                self.since = None if flag is None else event.t
             self.flag = flag
-            # Counted from the switch itself (an accepted ack), not from this event.
-            self.since = (
-                None if flag is None else (self.ctx.state.offboard_since if entered else event.t)
-            )
             self.checked = False
 
     def _due(self, t: float) -> None:

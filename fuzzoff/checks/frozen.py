@@ -53,7 +53,7 @@ class SetpointFrozen(Check):
         self.runs: dict[str, _Run] = {}
 
     def on_event(self, event: Event) -> None:
-        if not self.ctx.state.in_offboard:
+        if not self.ctx.state.in_offboard or self.ctx.state.armed is False:
             for kind in list(self.runs):
                 self._close(kind)
             return
