@@ -4,8 +4,9 @@ Run ``.venv/bin/python corpora/rules/build.py``; it is deterministic. ROS 2 rule
 MCAP (``fuzzoff.writers.mcap``, px4_msgs of the case's release), the estimate rule OFB305 and
 the legacy rules OFB801-OFB803 as ULog (``fuzzoff.writers.ulog``, the 1.15 and the legacy
 layouts), and the MAVLink side of OFB405/OFB406 (``SET_ATTITUDE_TARGET``) as a tlog
-(``fuzzoff.writers.tlog``). Each ``NAME.expected.json`` lists the findings planted here, judged against the rule
-texts (rules/OFB*.toml), and ``clean``: the rules the recording exercises that must stay silent.
+(``fuzzoff.writers.tlog``). Each ``NAME.expected.json`` lists the findings planted here, judged
+against the rule texts (rules/OFB*.toml), and ``clean``: the rules the recording exercises that
+must stay silent.
 
 Every flight is built from one realistic pattern (``Flight``): a companion streams
 ``OffboardControlMode`` at 10 Hz with a PX4-synced ``timestamp``, the vehicle sits disarmed in
