@@ -442,3 +442,42 @@ def test_a_damaged_record_is_skipped_and_reported_with_the_last_good_time(tmp_pa
     with open_source(path) as source:
         times = [e.t for e in source.events() if isinstance(e, ControlMode)]
     assert times[-1] == pytest.approx(31.9)  # read on after the damage
+
+
+def _chunk(columns: dict[str, list[Any]]) -> Any:
+    import numpy as np
+
+    from fuzzoff.sources.ulog_topics import Chunk
+
+    cols = {name: np.asarray(values) for name, values in columns.items()}
+    return Chunk(cols, slice(None), "vehicle_status", 0)
+
+
+def test_older_layouts_the_writer_does_not_produce_are_read() -> None:
+    """The seed's single ``ignore_bodyrate`` and the link-loss flags of a legacy status."""
+    from fuzzoff.sources.ulog_topics import Context, control_mode, failsafe_flags
+
+    ocm = _chunk(
+        {
+            "timestamp": [1_000_000],
+            "ignore_thrust": [1],
+            "ignore_bodyrate": [0],
+            "ignore_alt_hold": [1],
+        }
+    )
+    (legacy,) = control_mode(ocm, Context())
+    assert isinstance(legacy, LegacyControlMode)
+    assert (legacy.ignore_thrust, legacy.ignore_bodyrate, legacy.ignore_alt_hold) == (
+        True,
+        False,
+        True,
+    )
+    status = _chunk(
+        {"timestamp": [2_000_000], "offboard_control_signal_lost": [1], "rc_signal_lost": [0]}
+    )
+    (flags,) = failsafe_flags(status, Context())
+    assert isinstance(flags, FailsafeFlags)
+    assert flags.offboard_control_signal_lost is True
+    assert flags.manual_control_signal_lost is False
+    assert flags.local_position_valid is None  # not in that layout: unknown, not invalid
+    assert flags.t == 2.0
