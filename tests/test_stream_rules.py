@@ -158,3 +158,18 @@ def test_ofb201_a_late_second_ack_is_a_new_answer_not_a_double_ack() -> None:
         ack(1.5, 1),
     ]
     assert codes(lint_events(events), "OFB201") == []
+
+
+def test_ofb101_silence_after_leaving_offboard_does_not_count() -> None:
+    # the stream stops 50 ms before the recorded mode leaves OFFBOARD, then the recording goes on
+    events = [status(0.0, OFFBOARD), *ocm(every(0.0, 5.0, 0.1)), status(5.05, POSCTL)]
+    events.append(status(8.0, POSCTL))
+    found = lint_events(events)
+    assert codes(found, "OFB101") == [] and codes(found, "OFB103") == []
+
+
+def test_ofb101_silence_in_offboard_until_the_vehicle_leaves_counts_up_to_the_switch() -> None:
+    events = [status(0.0, OFFBOARD), *ocm(every(0.0, 5.0, 0.1)), status(5.7, POSCTL)]
+    (found,) = codes(lint_events(events), "OFB101")
+    assert found.end_s == pytest.approx(5.7)
+    assert "0.70 s" in found.message

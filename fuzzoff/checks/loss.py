@@ -57,6 +57,9 @@ class OffboardLoss(Check):
         elif isinstance(event, VehicleStatus):
             if self.pending is not None and event.nav_state is not None and not event.in_offboard:
                 self._flush(event)
+            if self.last_flying and not offboard_and_flying(self.ctx):
+                self._gap_from_recording(event.t)  # only the silence spent in OFFBOARD counts
+                self.last_flying = False
         elif counts_as_keepalive(self.ctx, event):
             self._gap_from_recording(event.t)
             self.last, self.last_where = event.t, event.where

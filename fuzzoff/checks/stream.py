@@ -70,6 +70,8 @@ class KeepaliveRate(Check):
                 self._request(event.t)  # no commands recorded (MAVROS): the switch itself
             if event.nav_state is not None:
                 self.was_offboard = event.in_offboard
+            if self.last_in_offboard and not offboard_and_flying(self.ctx):
+                self._left_offboard(event)
         elif counts_as_keepalive(self.ctx, event):
             if self.last is not None and not self.dropout_since_last:
                 gap = event.t - self.last
@@ -85,6 +87,17 @@ class KeepaliveRate(Check):
             self.dropout_since_last = False
         if self.recent:
             self.recent = [g for g in self.recent if event.t - g.end <= self.window]
+
+    def _left_offboard(self, event: Event) -> None:
+        """The vehicle left OFFBOARD (or disarmed) with no keep-alive since ``last``: only the part
+        of the silence spent in OFFBOARD counts."""
+        assert self.last is not None
+        self.last_in_offboard = False
+        if self.dropout_since_last:
+            return
+        gap = proven_gap(self.ctx, event, event.t - self.last)
+        if gap >= self.max_gap:
+            self._report(_Gap(self.last, event.t, gap, event.where), "in OFFBOARD (until it left)")
 
     def _request(self, t: float) -> None:
         for found in self.recent:
