@@ -2,7 +2,8 @@
 
 Only the connections that matter are decoded: the MAVROS topics ``fuzzoff.sources.mavros``
 converts (setpoints and ``state``). Every other connection (images, IMU, ...) is filtered out
-before its messages are read, using the bag's index. Message definitions come from the bag
+before its messages are read, using the bag's index, one chunk at a time
+(``rosbag1_chunkwise``: memory does not grow with the bag). Message definitions come from the bag
 itself (every ROS 1 connection record embeds them, formats.md section 3); the shipped
 mavros_msgs definitions are the fallback for a connection whose embedded text does not parse.
 
@@ -20,13 +21,14 @@ from pathlib import Path
 from typing import Any
 
 from rosbags.interfaces import Connection
-from rosbags.rosbag1 import Reader, ReaderError
+from rosbags.rosbag1 import ReaderError
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 from fuzzoff.events import Event
 from fuzzoff.sources.base import RecordingInfo, Source, SourceError, SourceProblem
 from fuzzoff.sources.mavros import TOPIC_KINDS, Handler, MavrosConverter, mavros_topic
 from fuzzoff.sources.mavros_msgs import mavros_typedefs
+from fuzzoff.sources.rosbag1_chunkwise import ChunkwiseReader
 from fuzzoff.sources.rosbag1_salvage import SalvageReader, bag_header_index_pos
 
 REINDEX_HINT = "run `rosbag reindex` on it for a complete read"
@@ -39,7 +41,7 @@ class Rosbag1Source(Source):
 
     def __init__(self, path: Path) -> None:
         super().__init__(path)
-        self._reader: Reader | None = None
+        self._reader: ChunkwiseReader | None = None
         self._salvage: SalvageReader | None = None
         self._salvage_reason = ""
         self._typestore: Any = None
@@ -50,7 +52,7 @@ class Rosbag1Source(Source):
     # -- opening -------------------------------------------------------------------------------
 
     def open(self) -> None:
-        reader = Reader(self.path)
+        reader = ChunkwiseReader(self.path)
         try:
             reader.open()
         except ReaderError as exc:
@@ -62,7 +64,6 @@ class Rosbag1Source(Source):
             self._open_damaged(f"{type(exc).__name__}: {exc}")
             return
         self._reader = reader
-        self._check_chunks(reader)
         self._wanted = [c for c in reader.connections if mavros_topic(c.topic, c.msgtype)]
         self._total = sum(c.msgcount for c in self._wanted)
         self._typestore = self._build_typestore(self._wanted)
@@ -91,17 +92,6 @@ class Rosbag1Source(Source):
             self._salvage.open()
         except ReaderError as exc:
             raise SourceError(self.path, f"unreadable bag: {exc}") from None
-
-    def _check_chunks(self, reader: Reader) -> None:
-        """A chunk whose size field points past the end is corruption, not a read request."""
-        size = self.path.stat().st_size
-        for pos, chunk in reader.chunks.items():
-            if chunk.datapos + chunk.datasize > size:
-                raise SourceError(
-                    self.path,
-                    f"chunk size field points past the end of the file ({size} bytes)",
-                    f"byte {pos}",
-                )
 
     def _build_typestore(self, connections: list[Connection]) -> Any:
         """Embedded definitions first, per connection; the shipped mavros_msgs as fallback."""
