@@ -108,7 +108,10 @@ def main() -> None:
     files = {
         "100k": (generate(DATA / "rosbag1_100k.bag", 100_000), 100_000),
         "1M": (generate(DATA / "rosbag1_1m.bag", 1_000_000), 1_000_000),
-        "mixed-300k": (generate(DATA / "rosbag1_mixed_300k.bag", 300_000, mixed=True), 300_000),
+        "mixed-300k": (
+            generate(DATA / "rosbag1_mixed_9pct_300k.bag", 300_000, mixed=True),
+            300_000,
+        ),
     }
     head = f"{'file':<11} {'method':<30} {'wall':>9} {'CPU':>9}"
     print(f"{head} {'rate (wall)':>16} {'peak RSS':>10}")
