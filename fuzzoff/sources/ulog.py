@@ -192,7 +192,7 @@ class UlogSource(Source):
             info.notes.append(f"the logger dropped data {len(ulog.dropouts)} times ({total_ms} ms)")
         if info.sampled_intervals:
             info.notes.append(
-                "offboard topics are subsampled by PX4's logger: "
+                "keep-alive and setpoint topics are subsampled by PX4's logger: "
                 + ", ".join(
                     f"{k} every {v:.3f} s" for k, v in sorted(info.sampled_intervals.items())
                 )
