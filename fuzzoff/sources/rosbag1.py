@@ -224,7 +224,8 @@ class Rosbag1Source(Source):
         except Exception as exc:  # rosbags ReaderError, asserts, codec errors on corrupt chunks
             detail = str(exc).rstrip(".") if isinstance(exc, ReaderError) else type(exc).__name__
             where, t_last = last if last is not None else (None, None)
-            what = f"bag data corrupt ({detail}); reading stopped after the message"
+            after = "after the message" if last is not None else "before the first message"
+            what = f"bag data corrupt ({detail}); reading stopped {after}"
             self.problems.append(SourceProblem(what, where, t_last))
         if first_bad is not None:
             more = f" (and {bad - 1} more)" if bad > 1 else ""
