@@ -419,6 +419,10 @@ def test_auto_mission_log_gives_no_stream_findings(tmp_path: Path) -> None:
     (report,) = json.loads(result.stdout)["files"]
     assert report["complete"] is True
     assert not [f for f in report["findings"] if f["code"].startswith("OFB1")]
+    with open_source(path) as source:
+        info = source.probe()
+    assert "control_mode" not in info.kinds  # no offboard source: PX4 never published it
+    assert info.sampled_intervals["trajectory"] == 0.2
 
 
 def test_a_damaged_record_is_skipped_and_reported_with_the_last_good_time(tmp_path: Path) -> None:
