@@ -103,7 +103,7 @@ class VehicleRun:
 
     def _transitions(self, transitions: list[GateTransition]) -> None:
         for tr in transitions:
-            self.state.predicted_offboard = self.gate.in_offboard
+            self.state.set_predicted(self.gate.in_offboard, tr.t)
             if self.timeline is not None:
                 self.timeline.transitions.append(tr)
             self._dispatch(tr)
@@ -112,7 +112,7 @@ class VehicleRun:
         self.last_t = event.t
         self.state.update(event)
         self._transitions(self.gate.feed(event))
-        self.state.predicted_offboard = self.gate.in_offboard
+        self.state.set_predicted(self.gate.in_offboard, event.t)
         if self.timeline is not None:
             self._record(event)
         self._dispatch(event)

@@ -60,6 +60,15 @@ class VehicleState:
     def mode_source(self) -> str:
         return "recorded" if self.mode_recorded else "predicted by the gate model"
 
+    def set_predicted(self, in_offboard: bool, t: float) -> None:
+        """The gate model's verdict after an event; it drives ``in_offboard`` when no mode is
+        recorded, so ``offboard_since`` follows it then."""
+        if self.predicted_offboard == in_offboard:
+            return
+        self.predicted_offboard = in_offboard
+        if not self.mode_recorded:
+            self.offboard_since = t if in_offboard else None
+
     def update(self, event: Event) -> None:
         was = self.in_offboard
         if isinstance(event, VehicleStatus):

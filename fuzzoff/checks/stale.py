@@ -8,15 +8,15 @@ from __future__ import annotations
 
 from fuzzoff.checks._keepalive import mode_note, offboard_and_flying
 from fuzzoff.checks.base import Check, CheckContext
-from fuzzoff.events import ControlMode, Event, Where
-from fuzzoff.tables.declared import MESSAGE_NAMES, declared_setpoints
+from fuzzoff.events import PX4_SETPOINTS, ControlMode, Event, Where
+from fuzzoff.tables.control_mode import SETPOINT_NAMES, row_for
 
 ROS2_FORMATS = ("mcap", "rosbag2-sqlite3", "rosbag2-mcap")
 
 
 class StaleSetpoints(Check):
     codes = ("OFB104",)
-    wants = (Event,)
+    wants = (*PX4_SETPOINTS, ControlMode)
 
     def __init__(self, ctx: CheckContext) -> None:
         super().__init__(ctx)
@@ -44,24 +44,23 @@ class StaleSetpoints(Check):
         if not flying:
             self._close(event.t)
             return
-        flag = event.first_flag()
-        if flag is None:
+        row = row_for(self.ctx.profile, event.first_flag())
+        if row is None:
             return
-        stale_what = None
-        since = 0.0
-        for group in declared_setpoints(flag, self.ctx.profile):
-            times = [self.last_sent[k] for k in group if k in self.last_sent]
-            if not times:
-                continue  # never published: OFB303's finding, not a stale one
-            newest = max(times)
-            if event.t - newest > self.stale:
-                stale_what = " or ".join(MESSAGE_NAMES.get(k, k) for k in group)
-                since = newest
-                break
-        if stale_what is None:
-            self._close(event.t)
-        elif self.episode is None:
-            self.episode = (stale_what, since, event.where)
+        stale: list[tuple[float, str]] = []
+        for alternative in row.required:
+            published = [(self.last_sent.get(kind), kind) for kind in sorted(alternative)]
+            quiet = [(t, kind) for t, kind in published if t is not None]
+            if len(quiet) < len(published):
+                continue  # never published in full: OFB303's finding, not a stale one
+            oldest, kind = min(quiet)
+            if event.t - oldest <= self.stale:
+                self._close(event.t)  # one alternative is being served
+                return
+            stale.append((oldest, SETPOINT_NAMES.get(kind, kind)))
+        if stale and self.episode is None:
+            since, what = max(stale)
+            self.episode = (what, since, event.where)
 
     def _close(self, t: float) -> None:
         if self.episode is None:
