@@ -26,7 +26,7 @@ from ruamel.yaml import YAML
 from fuzzoff.events import Event
 from fuzzoff.sources import px4_msgs
 from fuzzoff.sources.base import RecordingInfo, Source, SourceError, SourceProblem
-from fuzzoff.sources.mcap import McapStream
+from fuzzoff.sources.mcap_stream import McapStream
 from fuzzoff.sources.ros2_decode import Decoder, Ros2Decoding, TopicDecoder
 from fuzzoff.sources.ros2_order import ChunkOrder
 
@@ -184,8 +184,14 @@ class Rosbag2Source(Source):
                         self._decoder(conn.topic, conn.msgtype, conn.msgdef)
                     if reader.message_count:
                         starts.append(reader.start_time)
-            except Exception:  # salvaged below or in the reading pass
-                start = self._probe_salvage(path) if path.suffix == ".db3" else None
+            except Exception:  # salvaged below, and again in the reading pass
+                if path.suffix == ".db3":
+                    start = self._probe_salvage(path)
+                else:
+                    stream = McapStream(path, self.decoding, None, self._connect)
+                    start, vehicle = stream.scan()
+                    self._vehicle = self._vehicle or vehicle
+                    self._notes.append(f"{path.name}: no usable MCAP summary; scanned for channels")
                 if start is not None:
                     starts.append(start)
         self._t0 = min(starts) if starts else None
@@ -256,24 +262,37 @@ class Rosbag2Source(Source):
         decoders = self._decoders
         t0 = self._t0
         count = 0
+        last = -1
         try:
             for conn, stamp, raw in reader.messages(connections=selected):
                 if t0 is None:
                     t0 = self._t0 = stamp
                 count += 1
+                last = stamp
                 decoder = decoders[(conn.topic, conn.msgtype)]
                 assert decoder is not None
                 event = decoder.event(raw, (stamp - t0) / 1e9)
                 if event is not None:
                     yield event
-        except Exception as exc:
-            self.problems.append(
-                SourceProblem(
-                    f"reading stopped: {_why(exc)}", f"{where.name} after {count} messages"
+        except Exception as exc:  # rosbags, sqlite and codec errors mid-read
+            files = self._data_files(where)
+            if len(files) == 1 and files[0].suffix == ".mcap":
+                # rosbags stops at the first bad chunk; the streaming reader skips it and
+                # goes on (only messages after the last one already read are taken).
+                yield from self._salvage_mcap(files[0], after_ns=last)
+            else:
+                self.problems.append(
+                    SourceProblem(
+                        f"reading stopped: {_why(exc)}", f"{where.name} after {count} messages"
+                    )
                 )
-            )
         finally:
             self._messages += count
+
+    def _data_files(self, where: Path) -> list[Path]:
+        if where.is_file():
+            return [where]
+        return sorted(p for p in where.iterdir() if p.suffix in DATA_SUFFIXES)
 
     def _read_file(self, path: Path) -> Iterator[Event]:
         try:
@@ -291,8 +310,9 @@ class Rosbag2Source(Source):
             with suppress(Exception):
                 reader.close()
 
-    def _salvage_mcap(self, path: Path) -> Iterator[Event]:
-        stream = McapStream(path, self.decoding, self._t0, self._connect)
+    def _salvage_mcap(self, path: Path, after_ns: int = -1) -> Iterator[Event]:
+        """fuzzoff's streaming MCAP reader: CRC-checked chunk by chunk, past bad chunks."""
+        stream = McapStream(path, self.decoding, self._t0, self._connect, after_ns=after_ns)
         yield from stream.events()
         if self._t0 is None:
             self._t0 = stream.t0_ns
