@@ -39,6 +39,11 @@ class ReceiverContext:
     own_component: int
     fwdextsp: bool
     est: Estimates
+    old_rule: bool = False
+    """v1.13's "any component finite" flag rule instead of 1.14's "not all NaN" (6.2)."""
+
+    def __post_init__(self) -> None:
+        self.old_rule = not at_least(self.px4, "1.14")
 
 
 def _target_ok(msg: MavlinkTarget, ctx: ReceiverContext) -> str | None:
@@ -88,7 +93,7 @@ def receive(msg: MavlinkTarget, ctx: ReceiverContext) -> Result:
 
 def _position(msg: MavlinkTarget, ctx: ReceiverContext) -> Result:
     mask = msg.type_mask
-    old_rule = not at_least(ctx.px4, "1.14")
+    old_rule = ctx.old_rule
     frame: int = getattr(msg, "coordinate_frame", 1)
     velocity: tuple[float, float, float] = getattr(msg, "velocity", (0.0, 0.0, 0.0))
     acceleration: tuple[float, float, float] = getattr(msg, "acceleration", (0.0, 0.0, 0.0))
@@ -111,9 +116,27 @@ def _position(msg: MavlinkTarget, ctx: ReceiverContext) -> Result:
         spec = "6.2"
         position: tuple[float, float, float] = getattr(msg, "position", (0.0, 0.0, 0.0))
         if frame == 1:
-            pos_f, pos_p = _present3(position, mask & _POS_BITS, old_rule)
-            vel_f, vel_p = _present3(velocity, (mask & _VEL_BITS) >> 3, old_rule)
-            acc_f, acc_p = _present3(acceleration, (mask & _ACC_BITS) >> 6, old_rule)
+            used = ~mask & 0x1FF
+            isf = math.isfinite
+            finite = (
+                isf(position[0])
+                | isf(position[1]) << 1
+                | isf(position[2]) << 2
+                | isf(velocity[0]) << 3
+                | isf(velocity[1]) << 4
+                | isf(velocity[2]) << 5
+                | isf(acceleration[0]) << 6
+                | isf(acceleration[1]) << 7
+                | isf(acceleration[2]) << 8
+            )
+            if used & ~finite:  # a used field is NaN or Inf: the exact per-version rule
+                pos_f, pos_p = _present3(position, mask & _POS_BITS, old_rule)
+                vel_f, vel_p = _present3(velocity, (mask & _VEL_BITS) >> 3, old_rule)
+                acc_f, acc_p = _present3(acceleration, (mask & _ACC_BITS) >> 6, old_rule)
+            else:
+                axes = used & finite
+                pos_f, vel_f, acc_f = axes & 7, (axes >> 3) & 7, axes >> 6
+                pos_p, vel_p, acc_p = pos_f != 0, vel_f != 0, acc_f != 0
         elif frame == 8:
             # BODY_NED: position always ignored; any ignore bit drops the whole vector.
             if not mask & _VEL_BITS:
