@@ -238,7 +238,7 @@ class GateModel:
         self._emit(
             t,
             "signal_lost",
-            f"offboard signal lost ({reason}) {age}".strip(),
+            f"offboard signal lost ({reason}) {age if why is None else ''}".strip(),
             self.signal.spec,
             cause=None,
             reason=reason,
