@@ -6,6 +6,9 @@ recording lags), or the model reaches it within the slack (the recording leads: 
 check pass has its own phase, gate spec 2.1.3). Otherwise the difference waits ``slack``; if it
 is still there it is confirmed once per episode (until the two agree again).
 
+A mode that reached the recording over a link (HEARTBEAT, ``/mavros/state``) may also lag by
+``LINK_LAG``.
+
 Acks: PX4 1.16/1.17 ack a mode switch twice (4.3), so an ack is judged ``ACK_WINDOW`` after the
 first one, by the last one.
 """
@@ -25,6 +28,9 @@ DECISION_MAX_AGE = 1.0
 COMMAND_WINDOW = 1.5
 """A recorded change this close to a recorded command is the command's doing, not an unseen
 input such as an RC switch."""
+LINK_LAG = 0.5
+"""How much later than the vehicle a mode reported over a link may be recorded (HEARTBEAT in a
+ground-station tlog, ``/mavros/state``): transport latency, not PX4's timing."""
 SAMPLED_SLACK = 0.1
 """Extra slack when the keep-alive is a logged, subsampled copy (ULog logs
 ``offboard_control_mode`` at 10 Hz, gate spec 13a)."""
@@ -50,6 +56,11 @@ class Decided:
 class AckWait:
     t: float
     ack: CommandAck
+
+
+def _over_a_link(status: VehicleStatus) -> bool:
+    topic = status.where.topic
+    return topic == "HEARTBEAT" or topic.endswith("/state")
 
 
 class Comparator:
@@ -104,7 +115,8 @@ class Comparator:
             self.pending = None
             self.open_episode = False
             return
-        if status.t - self.changed_at <= self.slack and recorded == self.nav_before:
+        lag = self.slack + (LINK_LAG if _over_a_link(status) else 0.0)
+        if status.t - self.changed_at <= lag and recorded == self.nav_before:
             return
         if self.open_episode:
             return

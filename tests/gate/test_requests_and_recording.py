@@ -190,3 +190,20 @@ def test_15_unverified_points_are_marked() -> None:
         "controller", run("1.15", [in_offboard(), ocm(0.0, velocity=True)], vehicle="fw")
     )
     assert fw_velocity and fw_velocity[-1].unverified
+
+
+@pytest.mark.parametrize("px4", TICK)
+def test_12_heartbeat_may_lag_by_the_link(px4: str) -> None:
+    """12: a HEARTBEAT recorded by a ground station shows the old mode for a while after PX4
+    switched (1 Hz, link latency): not a disagreement."""
+    from fuzzoff.events import Where
+
+    hb = Where("HEARTBEAT")
+    events = [
+        VehicleStatus(t=0.0, nav_state=POSCTL, armed=True, where=hb),
+        *stream(0.0, 3.0),
+        switch_offboard(1.0),
+        VehicleStatus(t=1.4, nav_state=POSCTL, armed=True, where=hb),
+        VehicleStatus(t=2.4, nav_state=OFFBOARD, armed=True, where=hb),
+    ]
+    assert of("disagreement", run(px4, events)) == []
