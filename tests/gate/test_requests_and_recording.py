@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from fuzzoff.events import Command, CommandAck, Parameter, VehicleStatus
+from fuzzoff.events import Command, CommandAck, Parameter, VehicleStatus, Where
 from tests.gate.streams import (
     ALL,
     OFFBOARD,
@@ -196,8 +196,6 @@ def test_15_unverified_points_are_marked() -> None:
 def test_12_heartbeat_may_lag_by_the_link(px4: str) -> None:
     """12: a HEARTBEAT recorded by a ground station shows the old mode for a while after PX4
     switched (1 Hz, link latency): not a disagreement."""
-    from fuzzoff.events import Where
-
     hb = Where("HEARTBEAT")
     events = [
         VehicleStatus(t=0.0, nav_state=POSCTL, armed=True, where=hb),
