@@ -22,17 +22,14 @@ ARMING_STATE_ARMED = 2
 
 
 def _vec(value: Any) -> tuple[float, ...]:
-    return tuple(value.tolist()) if hasattr(value, "tolist") else tuple(value)
+    """A fixed array (rosbags: a numpy array) as a tuple of Python floats."""
+    return tuple(value.tolist())
 
 
-def _v3(value: Any) -> ev.Vec3:
-    a, b, c = _vec(value)[:3]
-    return (a, b, c)
-
-
-def _v2(value: Any) -> ev.Vec2:
-    a, b = _vec(value)[:2]
-    return (a, b)
+_v3: Any = _vec
+"""float32[3] -> Vec3 (the definition fixes the length)."""
+_v2: Any = _vec
+_v4: Any = _vec
 
 
 def _control_mode(fields: frozenset[str], vehicle: str, origin: Origin) -> Builder:
@@ -115,14 +112,13 @@ def _trajectory(fields: frozenset[str], vehicle: str, origin: Origin) -> Builder
 
 def _attitude(fields: frozenset[str], vehicle: str, origin: Origin) -> Builder:
     def build(m: Any, t: float, where: Where, ts: int) -> Event:
-        w, x, y, z = _vec(m.q_d)[:4]
         return ev.AttitudeSetpoint(
             t=t,
             vehicle=vehicle,
             where=where,
             sender_time_us=ts,
             origin=origin,
-            q_d=(w, x, y, z),
+            q_d=_v4(m.q_d),
             thrust_body=_v3(m.thrust_body),
             yaw_sp_move_rate=m.yaw_sp_move_rate,
         )
