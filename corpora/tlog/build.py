@@ -5,7 +5,8 @@ through ``fuzzoff.writers.tlog`` (pymavlink packs the packets) and gets ``NAME.e
 with the findings planted here, judged against the rule texts (rules/OFB*.toml):
 
 * ``good_offboard``: 20 Hz SET_POSITION_TARGET_LOCAL_NED from the companion (1/191) for 2 s
-  before an accepted switch, arming in OFFBOARD, flight, AUTO_LAND; no finding.
+  before an accepted switch, arming in OFFBOARD, flight, AUTO_LAND; no finding but the OFB701
+  summary of the loss behaviour (info, in every flight that uses offboard).
 * ``keepalive_gap_0_7s``: one 0.7 s gap in offboard: OFB101 as a warning (the docs' 2 Hz is
   broken, but 0.7 s is under COM_OF_LOSS_T = 1.0 s so PX4 1.15 keeps offboard).
 * ``stream_lost_in_offboard``: the stream stops for 3.5 s in offboard: OFB101 error and OFB103
@@ -237,20 +238,22 @@ def truncation_point(events: list[Event], after_t: float) -> int:
 
 def main() -> None:
     p115 = {"px4": "1.15", "vehicle": "mc", "detected": True}
-    write("good_offboard", good_flight(), [], exit_status=0, profile=p115)
+    # OFB701 (info) states the loss behaviour once per vehicle that uses offboard, at its request
+    summary = finding("OFB701", "info", 3.0)
+    write("good_offboard", good_flight(), [summary], exit_status=0, profile=p115)
     write(
         "keepalive_gap_0_7s",
         good_flight(gaps=[(8.0, 8.7)]),
-        [finding("OFB101", "warning", 8.0)],
+        [summary, finding("OFB101", "warning", 8.0)],
         exit_status=1,
         profile=p115,
     )
-    loss_findings = [finding("OFB101", "error", 8.0), finding("OFB103", "error", 9.0)]
+    loss_findings = [summary, finding("OFB101", "error", 8.0), finding("OFB103", "error", 9.0)]
     write("stream_lost_in_offboard", lost_stream(), loss_findings, exit_status=1, profile=p115)
     write(
         "switch_50ms_after_first_setpoint",
         switch_50ms(),
-        [finding("OFB102", "warning", 2.05)],
+        [finding("OFB701", "info", 2.05), finding("OFB102", "warning", 2.05)],
         exit_status=1,
         profile=p115,
     )
@@ -271,7 +274,7 @@ def main() -> None:
     write(
         "no_autopilot_version",
         good_flight(version=None),
-        [finding("OFB003", "info", None)],
+        [finding("OFB003", "info", None), summary],
         exit_status=0,
         profile={"px4": "1.15", "vehicle": "mc", "detected": False},
     )
