@@ -21,8 +21,6 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from bench.ros2_data import generate
-
 DATA = Path(__file__).resolve().parent / "data"
 ROOT = DATA.parent.parent
 
@@ -103,14 +101,30 @@ def _row(name: str, what: str, messages: int, run: Run) -> None:
     )
 
 
+GENERATE = """
+import sys
+from pathlib import Path
+from bench.ros2_data import generate
+generate(Path(sys.argv[1]), sys.argv[2], int(sys.argv[3]), mixed=sys.argv[4] == "mixed")
+"""
+
+
+def _generate(path: Path, kind: str, messages: int, mixed: bool = False) -> Path:
+    """Generate in a child process: the parent stays small, so the children it forks for the
+    measurements start small too (a forked child's peak RSS counts the parent's pages)."""
+    args = [str(path), kind, str(messages), "mixed" if mixed else "plain"]
+    subprocess.run([sys.executable, "-c", GENERATE, *args], cwd=ROOT, check=True)
+    return path
+
+
 def _files(kind: str) -> dict[str, tuple[Path, int]]:
     suffix = ".mcap" if kind == "mcap" else ""
     tag = kind.replace("rosbag2-", "bag-")
     return {
-        f"{tag} 100k": (generate(DATA / f"ros2_{tag}_100k{suffix}", kind, 100_000), 100_000),
-        f"{tag} 1M": (generate(DATA / f"ros2_{tag}_1m{suffix}", kind, 1_000_000), 1_000_000),
+        f"{tag} 100k": (_generate(DATA / f"ros2_{tag}_100k{suffix}", kind, 100_000), 100_000),
+        f"{tag} 1M": (_generate(DATA / f"ros2_{tag}_1m{suffix}", kind, 1_000_000), 1_000_000),
         f"{tag} mixed-40k": (
-            generate(DATA / f"ros2_{tag}_mixed_40k{suffix}", kind, 40_000, mixed=True),
+            _generate(DATA / f"ros2_{tag}_mixed_40k{suffix}", kind, 40_000, mixed=True),
             40_000,
         ),
     }
