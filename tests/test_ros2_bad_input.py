@@ -75,6 +75,7 @@ def test_truncated_mcap_keeps_the_first_half(mcap_file: Path) -> None:
 def test_flipped_bytes_in_a_chunk_skip_that_chunk_only(mcap_file: Path) -> None:
     with mcap_file.open("rb") as fh:
         summary = make_reader(fh).get_summary()
+    assert summary is not None
     chunks = summary.chunk_indexes
     middle = chunks[len(chunks) // 2]
     flip(mcap_file, middle.chunk_start_offset + middle.chunk_length // 2, 16)
@@ -87,6 +88,7 @@ def test_flipped_bytes_in_a_chunk_skip_that_chunk_only(mcap_file: Path) -> None:
 def test_missing_footer_keeps_every_chunk(mcap_file: Path) -> None:
     with mcap_file.open("rb") as fh:
         summary = make_reader(fh).get_summary()
+    assert summary is not None
     last = summary.chunk_indexes[-1]
     data = mcap_file.read_bytes()
     end = last.chunk_start_offset + last.chunk_length

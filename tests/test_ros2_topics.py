@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -101,7 +102,7 @@ def test_an_extra_trailing_field_is_not_decoded_away(tmp_path: Path) -> None:
     assert "OffboardControlMode" in problem.what and "embedded definition" in problem.what
 
 
-def _mavros_raw(t: float, topic: str, name: str, **values: object) -> RawMessage:
+def _mavros_raw(t: float, topic: str, name: str, **values: Any) -> RawMessage:
     store = get_typestore(Stores.ROS2_HUMBLE)
     store.register({k: v for k, v in mavros_typedefs().items() if k not in store.fielddefs})
     types = store.types
