@@ -5,8 +5,9 @@ memory before it yields anything (about 150 bytes per message: 150 MB for a mill
 grows with the bag. The bag keeps each chunk's index records right after the chunk, so this
 subclass reads only the bag's connection and chunk-info records on ``open`` and, while
 iterating, one chunk's index at a time. Chunks holding none of the wanted connections are not
-read at all. The record parsing and message extraction are rosbags' own (``read_connection``,
-``read_chunk_info``, ``read_chunk``, ``read_index_data``, ``messages``).
+read at all, and the index records of unwanted connections are skipped. The record parsing
+and message extraction are rosbags' own (``Header``, ``read_connection``, ``read_chunk_info``,
+``read_chunk``, ``read_index_data``, ``messages``).
 
 Order: chunks by start time, messages within a chunk by time. Bags written by ``rosbag record``
 are in receive order, so this is the same order rosbags gives; chunks whose times overlap
@@ -21,7 +22,7 @@ from collections.abc import Collection, Generator
 
 from rosbags.interfaces import Connection
 from rosbags.rosbag1 import Reader, ReaderError
-from rosbags.rosbag1.reader import Header, IndexData, RecordType
+from rosbags.rosbag1.reader import Header, IndexData, RecordType, read_uint32
 
 MAGIC = b"#ROSBAG V2.0\n"
 
@@ -84,7 +85,23 @@ class ChunkwiseReader(Reader):
                 raise ReaderError(f"chunk at byte {info.pos} runs past the end of the file")
             local: defaultdict[int, list[IndexData]] = defaultdict(list)
             for _ in range(len(info.connection_counts)):
-                self.read_index_data(info.pos, local)
+                self._index_data(info.pos, local, ids)
             self.chunks = {info.pos: chunk}
             self.indexes = {c.id: sorted(local.get(c.id, ())) for c in self.connections}
             yield from super().messages(wanted, start, stop)
+
+    def _index_data(self, pos: int, local: dict[int, list[IndexData]], ids: set[int]) -> None:
+        """One index record: read by rosbags if its connection is wanted, else skipped unread.
+
+        A camera or IMU connection has an index entry per message; parsing those only to throw
+        them away would cost as much as rosbags' whole-bag index.
+        """
+        assert self.bio is not None
+        start = self.bio.tell()
+        header = Header.read(self.bio, RecordType.IDXDATA)
+        size = read_uint32(self.bio)
+        if header.get_uint32("conn") in ids:
+            self.bio.seek(start)
+            self.read_index_data(pos, local)
+        else:
+            self.bio.seek(size, os.SEEK_CUR)
