@@ -1,0 +1,194 @@
+"""Build the gate corpus: PX4 ULogs (as the vehicle logs them) for the gate-model rules.
+
+Run ``.venv/bin/python corpora/gate/build.py``; deterministic. Every recording is written
+through ``fuzzoff.writers.ulog`` (pyulog) and gets ``NAME.expected.json`` with the findings
+planted here, judged against the rule texts (rules/OFB202.toml, OFB701.toml, OFB702.toml and the
+stream rules the flights also touch):
+
+* ``loss_and_resume_agrees`` (1.15): offboard flight, the stream stops at 5.0 s and resumes at
+  8.0 s; the log shows POSCTL with the failsafe flag from 6.1 s and OFFBOARD again at 8.05 s, as
+  the gate model predicts (loss at the 6.0 s check pass, action Position, automatic return).
+  OFB202 must stay clean; OFB701 states the loss behaviour at the request (1.5 s); OFB103 is the
+  loss (6.01 s) and OFB101 the 3 s gap.
+* ``recorded_stays_offboard`` (1.15): the same stream, but the log stays in OFFBOARD through the
+  gap (as if COM_OF_LOSS_T were larger on the vehicle than in the log): OFB202 at the first status
+  that contradicts the model (6.5 s).
+* ``no_offboard`` (1.15): a POSCTL flight with no offboard use: OFB701, OFB702, OFB202 clean.
+* ``rc_lost_117_return`` (1.17.0): no manual control; on loss 1.17 replaces Position by
+  NAV_RCL_ACT (Return): the log shows AUTO_RTL; OFB702 clean (no stick mode without RC on
+  1.17), OFB202 clean.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+from fuzzoff.events import (
+    Command,
+    CommandAck,
+    ControlMode,
+    Event,
+    FailsafeFlags,
+    TrajectorySetpoint,
+    VehicleStatus,
+)
+from fuzzoff.writers.ulog import write_ulog
+
+HERE = Path(__file__).resolve().parent
+POSCTL, RTL, OFFBOARD = 2, 5, 14
+SWITCH_T, ARM_T, STOP_T, RESUME_T, END_T = 1.5, 2.0, 5.0, 8.0, 10.0
+
+
+def logged(event: Event) -> Event:
+    return replace(event, origin="vehicle", sender_time_us=None)
+
+
+def stream(start: float, stop: float) -> list[Event]:
+    """OffboardControlMode and TrajectorySetpoint as PX4 logs them (10 Hz)."""
+    out: list[Event] = []
+    k = 0
+    while True:
+        t = round(start + 0.1 * k, 6)
+        if t > stop + 1e-9:
+            return out
+        out.append(logged(ControlMode(t=t, position=True)))
+        out.append(logged(TrajectorySetpoint(t=t, position=(0.0, 0.0, -2.0))))
+        k += 1
+
+
+def commands() -> list[Event]:
+    return [
+        logged(Command(t=SWITCH_T, command=176, params=(1.0, 6.0, 0, 0, 0, 0, 0))),
+        CommandAck(t=SWITCH_T + 0.02, command=176, result=0),
+        logged(Command(t=ARM_T, command=400, params=(1.0, 0, 0, 0, 0, 0, 0))),
+        CommandAck(t=ARM_T + 0.02, command=400, result=0),
+    ]
+
+
+def statuses(during_gap: tuple[int, bool] | None) -> list[Event]:
+    """vehicle_status every 0.5 s and at each change; ``during_gap`` = (nav, failsafe) shown
+    from 6.1 s until the stream is back (None: no offboard flight at all)."""
+    out: list[Event] = []
+    times = sorted({round(0.5 * i, 6) for i in range(int(END_T * 2) + 1)} | {1.55, 2.05, 6.1, 8.05})
+    for t in times:
+        if during_gap is None:
+            out.append(VehicleStatus(t=t, nav_state=POSCTL, armed=True, user_intention=POSCTL))
+            continue
+        armed = t >= ARM_T + 0.05
+        if t < SWITCH_T + 0.05:
+            nav, intention, failsafe = POSCTL, POSCTL, False
+        elif 6.1 <= t < RESUME_T + 0.05:
+            nav, failsafe = during_gap
+            intention = OFFBOARD
+        else:
+            nav, intention, failsafe = OFFBOARD, OFFBOARD, False
+        out.append(
+            VehicleStatus(
+                t=t, nav_state=nav, armed=armed, user_intention=intention, failsafe=failsafe
+            )
+        )
+    return out
+
+
+@dataclass
+class Case:
+    name: str
+    events: list[Event]
+    findings: list[tuple[str, str, float | None]]
+    clean: list[str]
+    px4_version: str = "1.15.4"
+    params: dict[str, float] = field(default_factory=dict)
+
+
+def valid(rc: bool = True) -> FailsafeFlags:
+    return FailsafeFlags(
+        t=0.0,
+        local_position_valid=True,
+        local_velocity_valid=True,
+        local_altitude_valid=True,
+        global_position_valid=True,
+        attitude_valid=True,
+        angular_velocity_valid=True,
+        home_position_valid=True,
+        manual_control_signal_lost=not rc,
+        offboard_control_signal_lost=False,
+    )
+
+
+def offboard_flight(during_gap: tuple[int, bool], rc: bool = True) -> list[Event]:
+    events = [
+        valid(rc),
+        *stream(0.0, STOP_T),
+        *stream(RESUME_T, END_T),
+        *commands(),
+        *statuses(during_gap),
+    ]
+    return sorted(events, key=lambda e: e.t)
+
+
+# Findings every 1.15 ULog flight of this corpus also gets, checked against the rule texts:
+# OFB002 x5: OFB104, OFB105 (keep-alive subsampled by the logger), OFB106 (timestamps rewritten),
+# OFB203 and OFB302 (only PX4's own copies of the messages) cannot be judged on a ULog.
+NOT_CHECKABLE_115 = [("OFB002", "info", None)] * 5
+# The 3 s gap in OFFBOARD: OFB101 (docs: keep-alive gaps under 0.5 s) from the last keep-alive,
+# and OFB103 (PX4's loss after COM_OF_LOSS_T, at the 10 Hz check pass plus one iteration).
+GAP = [("OFB101", "error", STOP_T), ("OFB103", "error", 6.01)]
+
+
+def cases() -> list[Case]:
+    return [
+        Case(
+            "loss_and_resume_agrees",
+            offboard_flight((POSCTL, True)),
+            [*NOT_CHECKABLE_115, ("OFB701", "info", SWITCH_T), *GAP],
+            ["OFB202", "OFB702"],
+        ),
+        Case(
+            "recorded_stays_offboard",
+            offboard_flight((OFFBOARD, False)),
+            [*NOT_CHECKABLE_115, ("OFB701", "info", SWITCH_T), *GAP, ("OFB202", "warning", 6.5)],
+            ["OFB702"],
+        ),
+        Case(
+            "no_offboard",
+            sorted([valid(), *statuses(None)], key=lambda e: e.t),
+            [],  # nothing to judge: no keep-alive, so no rule is even "not checkable"
+            ["OFB202", "OFB701", "OFB702"],
+        ),
+        Case(
+            "rc_lost_117_return",
+            offboard_flight((RTL, True), rc=False),
+            [*NOT_CHECKABLE_115, ("OFB701", "info", SWITCH_T), *GAP],
+            ["OFB202", "OFB702"],
+            px4_version="1.17.0",
+        ),
+    ]
+
+
+def write(case: Case) -> None:
+    path = HERE / f"{case.name}.ulg"
+    write_ulog(path, case.events, px4_version=case.px4_version, vehicle_type="mc")
+    expected: dict[str, Any] = {
+        "recording": path.name,
+        "args": [],
+        "exit_status": 1 if any(sev != "info" for _, sev, _ in case.findings) else 0,
+        "complete": True,
+        "findings": [
+            {"code": code, "severity": sev, "time_s": t} for code, sev, t in case.findings
+        ],
+        "clean": case.clean,
+    }
+    (HERE / f"{case.name}.expected.json").write_text(json.dumps(expected, indent=2) + "\n")
+
+
+def main() -> None:
+    for case in cases():
+        write(case)
+        print(f"{case.name}.ulg: {(HERE / f'{case.name}.ulg').stat().st_size} bytes")
+
+
+if __name__ == "__main__":
+    main()
