@@ -11,6 +11,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 os.environ.setdefault("MAVLINK20", "1")
 
@@ -30,7 +32,7 @@ from fuzzoff.events import (
     VehicleStatus,
     Where,
 )
-from fuzzoff.modes import nav_state_to_custom_mode
+from fuzzoff.modes import custom_mode_to_nav_state, nav_state_name, nav_state_to_custom_mode
 from fuzzoff.sources import SourceError, open_source
 from fuzzoff.sources.tlog import TlogSource
 from fuzzoff.writers.tlog import DEFAULT_START_US, write_tlog
@@ -508,3 +510,126 @@ def test_a_corrupt_timestamp_is_skipped_but_a_real_pause_is_kept(good: Path) -> 
     source, events = read(write_tlog(good.with_name("pause.tlog"), paused))
     assert [e.t for e in events] == [0.0, 0.1, 0.2, 600.0, 600.1]
     assert not source.problems
+
+
+# ------------------------------------------------------------------------- round-trip property
+
+_F32 = st.floats(width=32, allow_nan=False, allow_infinity=False)
+_U8 = st.integers(0, 255)
+_SENDER = st.tuples(st.integers(1, 255), st.integers(2, 255))  # never compid 1 (autopilot)
+_NAV_STATES = [n for n in range(31) if custom_mode_to_nav_state(nav_state_to_custom_mode(n)) == n]
+
+
+@st.composite
+def _sent(draw: st.DrawFn) -> dict[str, Any]:
+    target = draw(st.integers(1, 255))
+    sysid, compid = draw(_SENDER)
+    return {
+        "vehicle": str(target),
+        "target_system": target,
+        "target_component": draw(_U8),
+        "source_system": sysid,
+        "source_component": compid,
+    }
+
+
+@st.composite
+def _event(draw: st.DrawFn, t: float) -> Event:
+    ms = draw(st.integers(0, 2**32 - 1)) * 1000
+    vec = st.tuples(_F32, _F32, _F32)
+    kind = draw(st.sampled_from(range(8)))
+    if kind == 0:
+        return SetPositionTargetLocal(
+            t=t,
+            sender_time_us=ms,
+            type_mask=draw(st.integers(0, 0xFFFF)),
+            coordinate_frame=draw(_U8),
+            position=draw(vec),
+            velocity=draw(vec),
+            acceleration=draw(vec),
+            yaw=draw(_F32),
+            yaw_rate=draw(_F32),
+            **draw(_sent()),
+        )
+    if kind == 1:
+        return SetPositionTargetGlobal(
+            t=t,
+            sender_time_us=ms,
+            type_mask=draw(st.integers(0, 0xFFFF)),
+            coordinate_frame=draw(_U8),
+            lat_int=draw(st.integers(-(2**31), 2**31 - 1)),
+            lon_int=draw(st.integers(-(2**31), 2**31 - 1)),
+            alt=draw(_F32),
+            velocity=draw(vec),
+            acceleration=draw(vec),
+            yaw=draw(_F32),
+            yaw_rate=draw(_F32),
+            **draw(_sent()),
+        )
+    if kind == 2:
+        return SetAttitudeTarget(
+            t=t,
+            sender_time_us=ms,
+            type_mask=draw(_U8),
+            q=draw(st.tuples(_F32, _F32, _F32, _F32)),
+            body_roll_rate=draw(_F32),
+            body_pitch_rate=draw(_F32),
+            body_yaw_rate=draw(_F32),
+            thrust=draw(_F32),
+            **draw(_sent()),
+        )
+    if kind == 3:
+        params = draw(st.tuples(*[_F32] * 7))
+        return Command(
+            t=t,
+            command=draw(st.integers(0, 0xFFFF)),
+            params=params,
+            from_external=True,
+            **draw(_sent()),
+        )
+    if kind == 4:
+        return CommandAck(
+            t=t,
+            vehicle="1",
+            command=draw(st.integers(0, 0xFFFF)),
+            result=draw(_U8),
+            target_system=draw(_U8),
+            target_component=draw(_U8),
+        )
+    if kind == 5:
+        name = draw(st.text("ABCDEFGHIJKLMNOPQRSTUVWXYZ_0123456789", min_size=1, max_size=16))
+        value = draw(st.one_of(_F32, st.integers(-(2**31), 2**31 - 1).map(float)))
+        return Parameter(t=t, vehicle="1", name=name, value=value)
+    if kind == 6:
+        nav = draw(st.sampled_from(_NAV_STATES))
+        return VehicleStatus(
+            t=t, vehicle="1", nav_state=nav, mode=nav_state_name(nav), armed=draw(st.booleans())
+        )
+    if kind == 7 and draw(st.booleans()):
+        version = ".".join(str(draw(st.integers(0, 255))) for _ in range(3))
+        return VehicleInfo(t=t, vehicle="1", px4_version=version)
+    text = draw(st.text(st.characters(min_codepoint=32, max_codepoint=126), max_size=50))
+    return StatusText(t=t, vehicle="1", severity=draw(st.integers(0, 7)), text=text.rstrip())
+
+
+@st.composite
+def _stream(draw: st.DrawFn) -> list[Event]:
+    steps = draw(st.lists(st.integers(0, 2000), max_size=25))
+    start: list[Event] = [
+        VehicleInfo(t=0.0, vehicle="1", mav_type=2, vehicle_type="mc"),
+        VehicleStatus(t=0.0, vehicle="1", nav_state=2, mode="POSCTL", armed=False),
+    ]
+    ms = 0
+    for step in steps:
+        ms += step
+        start.append(draw(_event(ms / 1000)))
+    return start
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(_stream())
+def test_round_trip_property(tmp_path_factory: pytest.TempPathFactory, events: list[Event]) -> None:
+    path = write_tlog(tmp_path_factory.mktemp("rt") / "rt.tlog", events)
+    source, back = read(path)
+    assert not source.problems
+    assert [strip(e) for e in back] == [strip(e) for e in events]
