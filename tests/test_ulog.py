@@ -8,6 +8,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from fuzzoff.events import (
     ActuatorMotors,
@@ -485,3 +487,40 @@ def test_older_layouts_the_writer_does_not_produce_are_read() -> None:
     assert flags.manual_control_signal_lost is False
     assert flags.local_position_valid is None  # not in that layout: unknown, not invalid
     assert flags.t == 2.0
+
+
+# -- round trip as a property ------------------------------------------------------------------
+
+
+_F32 = st.floats(width=32, allow_nan=True, allow_infinity=False)
+_VEC3 = st.tuples(_F32, _F32, _F32)
+_TIME = st.integers(min_value=0, max_value=600_000_000).map(lambda us: us / 1e6)
+
+
+@st.composite
+def _setpoint(draw: st.DrawFn) -> Event:
+    t = draw(_TIME)
+    if draw(st.booleans()):
+        flags = draw(st.lists(st.booleans(), min_size=7, max_size=7))
+        names = ("position", "velocity", "acceleration", "attitude", "body_rate")
+        names += ("thrust_and_torque", "direct_actuator")
+        return ControlMode(t=t, **dict(zip(names, flags, strict=True)))
+    return TrajectorySetpoint(
+        t=t,
+        position=draw(_VEC3),
+        velocity=draw(_VEC3),
+        acceleration=draw(_VEC3),
+        jerk=draw(_VEC3),
+        yaw=draw(_F32),
+        yawspeed=draw(_F32),
+    )
+
+
+@settings(
+    max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(events=st.lists(_setpoint(), min_size=1, max_size=30))
+def test_any_setpoint_stream_round_trips(events: list[Event], tmp_path: Path) -> None:
+    path = write_ulog(tmp_path / "p.ulg", events, params={})
+    back = [e for e in read(path) if e.kind in ("control_mode", "trajectory")]
+    assert sorted(map(_comparable, back)) == sorted(map(_comparable, events))
