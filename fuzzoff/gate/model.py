@@ -45,6 +45,7 @@ from fuzzoff.gate.params import default_params
 from fuzzoff.gate.receiver import DROPPED, ReceiverContext, receive
 from fuzzoff.gate.requests import Decision, arm_decision, decode_mode, switch_decision
 from fuzzoff.gate.signal import INF, LOOP_PERIOD, estimate_failure, make_signal, slack
+from fuzzoff.gate.tracker import ControllerTracker
 from fuzzoff.gate.transitions import GateTransition, TransitionKind
 from fuzzoff.modes import nav_state_name
 from fuzzoff.profiles import Profile, at_least
@@ -80,18 +81,10 @@ class GateModel:
         self._out: list[GateTransition] | None = None
         self._cause: Event | None = None
         # controllers (sections 7-10)
-        self._controller_key: tuple[Any, ...] | None = None
-        self._offboard_since: float | None = None
-        self._traj_t = -INF
-        self._traj_axes = -1
-        self._last_valid_t = -INF
-        self._reuse_due = INF
         self._drop_reason: str | None = None
         self._good = False
-        self._pc = False
         self._sampled = False
-        self._mc_kind = "none"
-        self._axes_memo: dict[int, str | None] = {}
+        self.ctl = ControllerTracker(self.px4, self.vehicle_type, self.est)
         self._deadline = INF
         self._dirty = False
         self.compare = Comparator(slack(self.px4) + LOOP_PERIOD)
@@ -205,7 +198,7 @@ class GateModel:
         return min(
             self.signal.lost_at(),
             self.signal.timeout_at(),
-            self._reuse_due,
+            self.ctl.reuse_due,
             self.compare.due(),
         )
 
@@ -213,7 +206,7 @@ class GateModel:
         while True:
             lost = self.signal.lost_at()
             timeout = self.signal.timeout_at()
-            due = min(lost, timeout, self._reuse_due, self.compare.due())
+            due = min(lost, timeout, self.ctl.reuse_due, self.compare.due())
             if due > t:
                 return
             if lost == due:
@@ -221,8 +214,8 @@ class GateModel:
             elif timeout == due:
                 self.signal.timed_out = True  # type: ignore[attr-defined]
                 self._refresh(timeout)
-            elif self._reuse_due == due:
-                self._reuse_due = INF
+            elif self.ctl.reuse_due == due:
+                self.ctl.reuse_due = INF
                 self._update_controller(due)
             else:
                 self._confirm(due)
@@ -279,9 +272,7 @@ class GateModel:
             self._good = True
         else:
             self._good = mask != 0 and estimate_failure(self.px4, mask, self.est) is None
-        self._pc = self.vehicle_type in ("mc", "vtol") and controllers.position_control(
-            self.px4, mask
-        )
+        self.ctl.set_mask(mask)
 
     def _on_control_mode(self, event: ControlMode) -> None:
         self._keepalive(event.t, ocm.mask_of(event), event)
@@ -412,129 +403,29 @@ class GateModel:
         self.compare.nav_changed(t, self._nav, new)
         self._nav = new
         if new == NAV_STATE_OFFBOARD:
-            self._offboard_since = t
+            self.ctl.entered_offboard(t)
         self._update_controller(t)
 
     # ------------------------------------------------------------------ controllers
 
     def _trajectory(self, t: float, axes: int) -> None:
-        self._traj_t = t
-        self._dirty = False
-        if self._nav != NAV_STATE_OFFBOARD or not self._pc:
-            if axes != self._traj_axes:
-                self._traj_axes = axes
-                if self.vehicle_type == "fw" and self._nav == NAV_STATE_OFFBOARD:
-                    self._update_controller(t)
-            return
-        invalid = self._axes_invalid(axes)
-        if invalid is None:
-            self._last_valid_t = t
-        if axes != self._traj_axes or invalid is not None or self._mc_kind != "ok":
-            self._traj_axes = axes
+        self._dirty = self.ctl.trajectory(t, axes, self._nav == NAV_STATE_OFFBOARD)
+        if self._dirty:
             self._update_controller(t)
-            self._dirty = True
-
-    def _axes_invalid(self, axes: int) -> str | None:
-        key = (axes << 8) | self.est.key()
-        try:
-            return self._axes_memo[key]
-        except KeyError:
-            value = self._axes_memo[key] = controllers.mc_axes(axes, self.est)
-            return value
-
-    def _mc_position_control(self) -> bool:
-        return self._pc
 
     def _update_controller(self, t: float) -> None:
-        if self._nav != NAV_STATE_OFFBOARD:
-            key: tuple[Any, ...] = (self._nav,)
-            if key != self._controller_key and self._controller_key is not None:
-                self._controller_key = key
-                self._emit(
-                    t,
-                    "controller",
-                    f"offboard controllers off ({nav_state_name(self._nav)})",
-                    "7",
-                    cause=None,
-                )
-            self._controller_key = key
-            return
-        if not self._mc_position_control():
-            key = (NAV_STATE_OFFBOARD, self.ocm_mask, self._fw_state())
-            if key != self._controller_key:
-                self._controller_key = key
-                text, spec, unverified = controllers.describe(
-                    self.px4, self.vehicle_type, self.ocm_mask
-                )
-                fw = self._fw_state()
-                if fw:
-                    text += f"; {fw}"
-                self._emit(t, "controller", text, spec, unverified=unverified, cause=None)
-            return
-        key, text, reason = self._mc_state(t)
-        if key != self._controller_key:
-            self._controller_key = key
+        self.ctl.land_speed = float(self.params.get("MPC_LAND_SPEED", 0.7))
+        change = self.ctl.update(t, self._nav)
+        if change is not None:
             self._emit(
                 t,
                 "controller",
-                text,
-                "8",
-                reason=reason,
+                change.text,
+                change.spec,
+                reason=change.reason,
+                unverified=change.unverified,
                 cause=None,
-                unverified=self.vehicle_type == "vtol" or self.px4 in ("legacy", "1.11"),
             )
-
-    def _mc_state(self, t: float) -> tuple[tuple[Any, ...], str, str | None]:
-        """(key, text, reason) of what the multicopter position controller does now; the text
-        is built only when the key changed."""
-        mask = self.ocm_mask
-        since = self._offboard_since if self._offboard_since is not None else -INF
-        axes = self._traj_axes
-        invalid: str | None = None
-        if self._traj_t < since:
-            kind = "none"
-            key: tuple[Any, ...] = (mask, kind, self.est.local_velocity)
-        else:
-            invalid = self._axes_invalid(axes)
-            if invalid is None:
-                kind = "ok"
-                key = (mask, kind, axes)
-            elif at_least(self.px4, "1.16") and t < self._last_valid_t + controllers.LAST_VALID_S:
-                kind = "reuse"
-                self._reuse_due = self._last_valid_t + controllers.LAST_VALID_S
-                key = (mask, kind, self._last_valid_t)
-            else:
-                kind = "failsafe"
-                key = (mask, kind, self.est.local_velocity)
-        self._mc_kind = kind
-        if key == self._controller_key:
-            return key, "", invalid
-        flags = ", ".join(controllers.control_flags(self.px4, mask))
-        head = f"multicopter offboard {ocm.names(ocm.first_flag(mask))} ({flags})"
-        land = float(self.params.get("MPC_LAND_SPEED", 0.7))
-        if kind == "none":
-            fs = controllers.failsafe_setpoint(self.est, land)
-            why = "no TrajectorySetpoint since position control was enabled"
-            return key, f"{head}: {fs} ({why})", why
-        if kind == "ok":
-            return key, f"{head}: {controllers.mc_axes_text(axes)}", None
-        if kind == "reuse":
-            text = f"{head}: invalid setpoint ({invalid}): last valid setpoint reused for 200 ms"
-            return key, text, invalid
-        fs = controllers.failsafe_setpoint(self.est, land)
-        return key, f"{head}: {fs} ({invalid})", invalid
-
-    def _fw_state(self) -> str:
-        if self.vehicle_type != "fw" or ocm.first_flag(self.ocm_mask) != ocm.POSITION:
-            return ""
-        axes = self._traj_axes
-        if axes < 0:
-            return "no trajectory setpoint yet"
-        if axes & 0b111000 == 0b111000:
-            return "path following (velocity finite)"
-        if axes & 0b111 == 0b111:
-            return "position (FW_POSCTRL_MODE_AUTO)"
-        return "setpoint invalid: needs all three position or velocity components"
 
     # ------------------------------------------------------------------ commands
 
