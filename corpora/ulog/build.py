@@ -11,6 +11,11 @@ subsampled copies) and OFB701, the loss-action summary, at the first offboard re
 
 * ``good_offboard``: PX4 1.15.4, 2 s of keep-alive before an accepted switch, arming in
   OFFBOARD, a moving position setpoint, AUTO_LAND; no finding (profile detected).
+* ``keepalive_gap_0_8s``: the good flight with no ``offboard_control_mode`` sample logged
+  between 8.0 and 8.8 s: OFB101 as a warning (0.7 s proven, the logged gap minus the logger's
+  0.1 s: the docs' 2 Hz is broken, but PX4 1.15 keeps offboard below COM_OF_LOSS_T 1.0 s).
+* ``logger_dropout``: the same hole in every topic, explained by a 750 ms logger dropout
+  record: the log proves nothing about the stream there, no finding.
 * ``stream_lost_in_offboard``: the keep-alive stops for 3.5 s in offboard (last logged sample
   at 8.0 s): OFB101 error (3.4 s proven: the logged gap minus the logger's 0.1 s) and OFB103
   (loss after COM_OF_LOSS_T 1.0 s, action Position). The log shows PX4's own failsafe at 9.08 s
@@ -41,6 +46,7 @@ from fuzzoff.events import (
     Command,
     CommandAck,
     ControlMode,
+    Dropout,
     Event,
     FailsafeFlags,
     LegacyControlMode,
@@ -181,6 +187,15 @@ def good_flight() -> list[Event]:
         [set_mode(15.0, 4, 6), ack(15.01, 176)],
         [StatusText(t=4.52, severity=6, text="Armed by external command")],
     )
+
+
+def with_gap(dropout: bool) -> list[Event]:
+    """The good flight with 0.8 s of missing keep-alive samples in offboard (8.0-8.8 s): a
+    logger dropout (everything missing, a dropout record) or a stream gap (only the OCM)."""
+    if not dropout:
+        return [e for e in good_flight() if not (isinstance(e, ControlMode) and 8.0 < e.t < 8.8)]
+    kept = [e for e in good_flight() if not 8.0 < e.t < 8.8]
+    return ordered(kept, [Dropout(t=8.0, duration_s=0.75)])
 
 
 def lost_stream() -> list[Event]:
@@ -346,6 +361,14 @@ def main() -> None:
     p115 = {"px4": "1.15", "vehicle": "mc", "detected": True}
     context = offboard_context(*NOT_CHECKABLE_ON_ULOG)
     write("good_offboard", good_flight(), context, exit_status=0, profile=p115)
+    write(
+        "keepalive_gap_0_8s",
+        with_gap(dropout=False),
+        [*context, finding("OFB101", "warning", 8.0)],
+        exit_status=1,
+        profile=p115,
+    )
+    write("logger_dropout", with_gap(dropout=True), context, exit_status=0, profile=p115)
     loss = [finding("OFB101", "error", 8.0), finding("OFB103", "error", 9.0)]
     write("stream_lost_in_offboard", lost_stream(), [*context, *loss], exit_status=1, profile=p115)
     write(
