@@ -34,12 +34,20 @@ LAST_VALID_S = 0.2
 
 
 def axes_of(sp: TrajectorySetpoint) -> int:
+    """The 9-bit per-axis finiteness of a trajectory setpoint (position, velocity, acceleration)."""
     isf = math.isfinite
-    bits = 0
-    for i, v in enumerate((*sp.position, *sp.velocity, *sp.acceleration)):
-        if isf(v):
-            bits |= 1 << i
-    return bits
+    p, v, a = sp.position, sp.velocity, sp.acceleration
+    return (
+        isf(p[0])
+        | isf(p[1]) << 1
+        | isf(p[2]) << 2
+        | isf(v[0]) << 3
+        | isf(v[1]) << 4
+        | isf(v[2]) << 5
+        | isf(a[0]) << 6
+        | isf(a[1]) << 7
+        | isf(a[2]) << 8
+    )
 
 
 _BASE: dict[int, tuple[str, ...]] = {
