@@ -59,6 +59,7 @@ class Rosbag2Source(Source):
         self._notes: list[str] = []
         self._vehicle: str | None = None
         self._tmp: tempfile.TemporaryDirectory[str] | None = None
+        self._last_ns = -1
 
     # -- opening -----------------------------------------------------------------------------
 
@@ -262,13 +263,13 @@ class Rosbag2Source(Source):
         decoders = self._decoders
         t0 = self._t0
         count = 0
-        last = -1
+        self._last_ns = -1
         try:
             for conn, stamp, raw in reader.messages(connections=selected):
                 if t0 is None:
                     t0 = self._t0 = stamp
                 count += 1
-                last = stamp
+                self._last_ns = stamp
                 decoder = decoders[(conn.topic, conn.msgtype)]
                 assert decoder is not None
                 event = decoder.event(raw, (stamp - t0) / 1e9)
@@ -279,7 +280,7 @@ class Rosbag2Source(Source):
             if len(files) == 1 and files[0].suffix == ".mcap":
                 # rosbags stops at the first bad chunk; the streaming reader skips it and
                 # goes on (only messages after the last one already read are taken).
-                yield from self._salvage_mcap(files[0], after_ns=last)
+                yield from self._salvage_mcap(files[0], after_ns=self._last_ns)
             else:
                 self.problems.append(
                     SourceProblem(
@@ -411,7 +412,11 @@ class Rosbag2Source(Source):
     def progress(self) -> float | None:
         if self._files:
             return self._done / len(self._files)
-        return None
+        reader = self._reader
+        if reader is None or self._t0 is None or self._last_ns < 0 or not reader.duration:
+            return None
+        fraction = (self._last_ns - self._t0) / float(reader.duration)
+        return min(1.0, max(0.0, fraction))
 
 
 def _readable_copy(path: Path, folder: Path) -> Path:
