@@ -86,7 +86,7 @@ class VehicleRun:
         )
         self.checks = [cls(self.ctx) for cls in load_all() if cls.wanted(self.ctx)]
         self.handlers: dict[type, list[Callable[[Event], None]]] = {}
-        self._wants = [(check.wants, check.on_event) for check in self.checks]
+        self._wants = [(check.subscriptions, check.on_event) for check in self.checks]
         self.timeline = timeline
         self.last_t = 0.0
 

@@ -6,6 +6,7 @@ and maps it to the modelled profile; the report always says whether it was detec
 
 from __future__ import annotations
 
+import functools
 import re
 from dataclasses import dataclass
 
@@ -94,8 +95,9 @@ def vehicle_type_for(name: str) -> str:
     return text
 
 
+@functools.cache
 def at_least(profile: str, oldest: str) -> bool:
-    """True when ``profile`` is ``oldest`` or newer."""
+    """True when ``profile`` is ``oldest`` or newer (cached: checks ask on every message)."""
     return PX4_PROFILES.index(profile) >= PX4_PROFILES.index(oldest)
 
 

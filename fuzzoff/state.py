@@ -48,10 +48,14 @@ class VehicleState:
     params: dict[str, float] = field(default_factory=dict)
     control_mode: ControlMode | LegacyControlMode | None = None
     failsafe_flags: FailsafeFlags | None = None
+    declared_flag: str | None = None
+    """The first true field of the latest boolean ``OffboardControlMode`` (None: none/empty)."""
+    in_offboard: bool = False
+    """Recorded mode (acks applied), or the gate's prediction when no mode is recorded; kept as
+    a plain attribute because every check asks on every message."""
     _pending: dict[int, _PendingSwitch] = field(default_factory=dict)
 
-    @property
-    def in_offboard(self) -> bool:
+    def _now_in_offboard(self) -> bool:
         if self.mode_recorded:
             return self.nav_state == NAV_STATE_OFFBOARD
         return self.predicted_offboard
@@ -67,6 +71,7 @@ class VehicleState:
             return
         self.predicted_offboard = in_offboard
         if not self.mode_recorded:
+            self.in_offboard = in_offboard
             self.offboard_since = t if in_offboard else None
 
     def update(self, event: Event) -> None:
@@ -76,8 +81,12 @@ class VehicleState:
                 self.nav_state = event.nav_state
             if event.armed is not None:
                 self.armed = event.armed
-        elif isinstance(event, (ControlMode, LegacyControlMode)):
+        elif isinstance(event, ControlMode):
             self.control_mode = event
+            self.declared_flag = event.first_flag()
+        elif isinstance(event, LegacyControlMode):
+            self.control_mode = event
+            self.declared_flag = None
         elif isinstance(event, Parameter):
             self.params[event.name] = event.value
         elif isinstance(event, FailsafeFlags):
@@ -89,7 +98,7 @@ class VehicleState:
             VEHICLE_CMD_SET_NAV_STATE,
         ):
             self._ack(event)
-        now = self.in_offboard
+        now = self.in_offboard = self._now_in_offboard()
         if now and not was:
             self.offboard_since = event.t
         elif was and not now:

@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from fuzzoff.checks.base import CheckContext
-from fuzzoff.events import ControlMode, Event, Where
+from fuzzoff.events import Event, Where
 from fuzzoff.findings import Severity
 from fuzzoff.tables.control_mode import row_for
 
@@ -23,10 +23,7 @@ def mode_note(ctx: CheckContext) -> str:
 
 def declared_flag(ctx: CheckContext) -> str | None:
     """The first true field of the latest ``OffboardControlMode`` (None: none seen, or empty)."""
-    mode = ctx.state.control_mode
-    if isinstance(mode, ControlMode):
-        return mode.first_flag()
-    return None
+    return ctx.state.declared_flag
 
 
 def from_external(ctx: CheckContext, event: Event) -> bool:

@@ -100,6 +100,9 @@ class Check:
 
     def __init__(self, ctx: CheckContext) -> None:
         self.ctx = ctx
+        self.subscriptions: tuple[type[Event], ...] = self.wants
+        """What the engine sends this instance; a check that finds in ``__init__`` that the
+        recording cannot show its rule sets it to ``()`` and costs nothing per message."""
 
     @classmethod
     def wanted(cls, ctx: CheckContext) -> bool:

@@ -22,6 +22,8 @@ class StaleSetpoints(Check):
         super().__init__(ctx)
         self.stale = float(ctx.option("OFB104", "stale_s"))
         self.active = ctx.info.format in ROS2_FORMATS
+        if not self.active:
+            self.subscriptions = ()
         if not self.active and ctx.has("control_mode", "legacy_control_mode"):
             ctx.cannot_check(
                 "OFB104",

@@ -9,6 +9,7 @@ spec section 7 (legacy). Everything version-dependent about the declaration live
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 from fuzzoff.events import FailsafeFlags, LegacyControlMode, SetPositionTargetLocal
@@ -154,6 +155,7 @@ SETPOINT_NAMES: dict[str, str] = {
 SETPOINT_KINDS = frozenset(SETPOINT_NAMES)
 
 
+@functools.cache
 def table_for(profile: Profile) -> dict[str, FlagRow]:
     """The docs' table that applies to this profile (empty before 1.13: no boolean fields)."""
     if not profile.at_least("1.13"):
