@@ -156,3 +156,22 @@ def test_mavros_topics_become_what_mavros_sends(tmp_path: Path, definitions: boo
     (status,) = [e for e in read if isinstance(e, ev.VehicleStatus)]
     assert status.nav_state == ev.NAV_STATE_OFFBOARD
     assert source.probe().kinds >= {"set_position_target_local_ned", "vehicle_status"}
+
+
+def test_unparsable_embedded_definition_falls_back_to_bundled(tmp_path: Path) -> None:
+    from fuzzoff.writers.ros2_messages import encode, to_message
+
+    raws = [
+        RawMessage(
+            0.1 * k,
+            "/fmu/in/offboard_control_mode",
+            "px4_msgs/msg/OffboardControlMode",
+            "this is not a message definition ]]]",
+            encode(to_message(ev.ControlMode(t=0.1 * k, position=True), "main")),
+        )
+        for k in range(5)
+    ]
+    source, read = read_all(write_mcap(tmp_path / "f.mcap", [], extra=raws))
+    assert source.problems == []
+    assert [e.kind for e in read] == ["control_mode"] * 5
+    assert any("embedded definition not usable" in note for note in source.probe().notes)

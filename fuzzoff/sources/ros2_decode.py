@@ -211,8 +211,12 @@ class Ros2Decoding:
         if embedded and embedded.strip():
             try:
                 definition = Definition.make(px4_msgs.type_name(message), embedded, "embedded", fmt)
-            except Exception as exc:
-                decoder._fail(0.0, f"its embedded definition cannot be parsed ({exc})")
+            except Exception as exc:  # rosbags raises many types on bad text
+                # Fall back to the bundled definitions (still checked against every payload).
+                why = " ".join(str(exc).split())[:80]
+                self.notes.append(
+                    f"{topic}: embedded definition not usable ({why}); bundled px4_msgs used"
+                )
                 return decoder
             self._note_evidence(message, definition)
             decoder.use(definition)
