@@ -87,6 +87,7 @@ class GateModel:
         self.ctl = ControllerTracker(self.px4, self.vehicle_type, self.est)
         self._deadline = INF
         self._dirty = False
+        self._stamp_offset: float | None = None
         self.compare = Comparator(slack(self.px4) + LOOP_PERIOD)
         try:
             own: int | None = int(vehicle)
@@ -227,6 +228,8 @@ class GateModel:
         last = self.signal.last
         age = f"{t - last:.2f} s after the newest keep-alive" if last is not None else ""
         why = estimate_failure(self.px4, self.ocm_mask, self.est) if self.tick_based else None
+        if why is None and self.tick_based and self.signal.stamps_lag:
+            why = "the newest keep-alive's timestamp is older than COM_OF_LOSS_T (2.1.1)"
         reason = why or "keep-alive timeout"
         self._emit(
             t,
@@ -241,7 +244,7 @@ class GateModel:
         # 1.14+: the failsafe reacts one Commander iteration after the check pass (2.1.3).
         self._refresh(t + (LOOP_PERIOD if self.tick_based else 0.0), cause=None)
 
-    def _keepalive(self, t: float, mask: int, event: Event) -> None:
+    def _keepalive(self, t: float, mask: int, event: Event, stamp: float | None = None) -> None:
         changed = mask != self.ocm_mask
         if changed:
             self.ocm_mask = mask
@@ -249,7 +252,7 @@ class GateModel:
         if event.origin == "vehicle" and not self._sampled:
             self._sampled = True
             self.compare.sampled_keepalive()
-        became = self.signal.keepalive(t, self._good)
+        became = self.signal.keepalive(t, self._good, stamp)
         # A good keep-alive while available only moves the loss later: the cached deadline
         # stays a valid lower bound (feed() recomputes it when it is reached).
         self._dirty = became or not self._good or changed
@@ -275,7 +278,25 @@ class GateModel:
         self.ctl.set_mask(mask)
 
     def _on_control_mode(self, event: ControlMode) -> None:
-        self._keepalive(event.t, ocm.mask_of(event), event)
+        stamp = None
+        if self.tick_based and event.origin == "sent" and event.sender_time_us is not None:
+            stamp = self._px4_stamp(event.t, event.sender_time_us)
+        self._keepalive(event.t, ocm.mask_of(event), event, stamp)
+
+    def _px4_stamp(self, t: float, sender_us: int) -> float:
+        """The OCM ``timestamp`` after PX4's uXRCE-DDS rewrite (2.1.1): 0 becomes the receive
+        time, any other value ``min(value - offset, now)``. The agent-PX4 offset is unknown;
+        fuzzoff takes the first stamped keep-alive as fresh (a sender clock that runs with the
+        recording's is always fresh; one that stops or lags ages)."""
+        if sender_us == 0:
+            return t
+        sender = sender_us * 1e-6
+        if self._stamp_offset is None:
+            self._stamp_offset = sender - t
+        stamp = sender - self._stamp_offset
+        if stamp < 0.0:  # unsigned wrap in PX4: clamped to now
+            return t
+        return stamp if stamp < t else t
 
     def _on_legacy_control_mode(self, event: LegacyControlMode) -> None:
         self._keepalive(event.t, ocm.legacy_mask(event), event)

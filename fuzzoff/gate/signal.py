@@ -76,8 +76,19 @@ class Signal:
         self.timeout = timeout
         self.available = False
         self.last: float | None = None
+        self.stale_stamp = False
+        """The newest keep-alive arrived with a timestamp already older than the timeout."""
+        self.arrived: float | None = None
+        """When the newest keep-alive arrived (``last`` is its timestamp as PX4 sees it)."""
 
-    def keepalive(self, t: float, good: bool) -> bool:
+    @property
+    def stamps_lag(self) -> bool:
+        """Keep-alives still arrive but their timestamps lag by more than a check period."""
+        if self.stale_stamp:
+            return True
+        return self.arrived is not None and self.last is not None and self.arrived - self.last > 0.1
+
+    def keepalive(self, t: float, good: bool, stamp: float | None = None) -> bool:
         """A keep-alive at ``t`` (``good``: flags and estimates pass). True if it made the
         signal available."""
         raise NotImplementedError
@@ -108,14 +119,18 @@ class TickSignal(Signal):
         super().__init__(timeout)
         self.bad_since: float | None = None
 
-    def keepalive(self, t: float, good: bool) -> bool:
-        self.last = t
-        if not good:
+    def keepalive(self, t: float, good: bool, stamp: float | None = None) -> bool:
+        """``stamp``: the OCM ``timestamp`` as PX4 sees it (2.1.1); the receive time if None.
+        A sample already older than the timeout on arrival counts as bad."""
+        self.last = t if stamp is None else stamp
+        self.arrived = t
+        self.stale_stamp = good and t >= self.last + self.timeout and stamp is not None
+        if not good or t >= self.last + self.timeout:
             if self.available and self.bad_since is None:
                 self.bad_since = t
             return False
         self.bad_since = None
-        if not self.available and self.timeout > 0.0:
+        if not self.available:
             self.available = True
             return True
         return False
@@ -127,9 +142,10 @@ class TickSignal(Signal):
     def lost_at(self) -> float:
         if not self.available or self.last is None:
             return INF
-        due = self.last + self.timeout
-        if self.bad_since is not None and self.bad_since < due:
-            due = self.bad_since
+        # Once the newest sample is bad (flags, estimates, an old stamp) the next check pass
+        # after that moment drops the signal; otherwise the pass after its age reaches the
+        # timeout.
+        due = self.bad_since if self.bad_since is not None else self.last + self.timeout
         return grid_ceil(due, CHECK_PERIOD)
 
     def ok_now(self, t: float, good: bool) -> bool:
@@ -143,7 +159,7 @@ class HysteresisSignal(Signal):
         super().__init__(timeout)
         self.good_iter: float | None = None
 
-    def keepalive(self, t: float, good: bool) -> bool:
+    def keepalive(self, t: float, good: bool, stamp: float | None = None) -> bool:
         self.last = t
         if not good:
             return False
@@ -164,7 +180,7 @@ class HysteresisSignal(Signal):
 class AgeSignal(Signal):
     spec = "2.2"
 
-    def keepalive(self, t: float, good: bool) -> bool:
+    def keepalive(self, t: float, good: bool, stamp: float | None = None) -> bool:
         self.last = t
         if not self.available and self.timeout > 0.0:
             self.available = True
@@ -187,7 +203,7 @@ class LegacySignal(Signal):
         self.loss_extra = loss_extra
         self.timed_out = False
 
-    def keepalive(self, t: float, good: bool) -> bool:
+    def keepalive(self, t: float, good: bool, stamp: float | None = None) -> bool:
         self.last = t
         self.timed_out = False
         if not self.available:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import pytest
 
+from fuzzoff.events import ControlMode
 from tests.gate.streams import (
     TICK,
     in_offboard,
@@ -125,3 +126,39 @@ def test_2_3_legacy_fixed_500ms_whatever_com_of_loss_t(
 ) -> None:
     """2.3: legacy's loss is a hard-coded 500 ms; COM_OF_LOSS_T does not move it."""
     assert bool(_gap("legacy", 1.0, gap, COM_OF_LOSS_T=loss_t)) is lost
+
+
+def _stamped(t: float, sender_s: float) -> ControlMode:
+    return ControlMode(t=t, position=True, sender_time_us=round(sender_s * 1e6))
+
+
+@pytest.mark.parametrize("px4", TICK)
+def test_2_1_1_frozen_sender_clock_loses_the_signal(px4: str) -> None:
+    """2.1.1: PX4 judges the ROS 2 keep-alive by its own timestamp field: a sender clock that
+    stops at 3.0 s makes every later OCM old once COM_OF_LOSS_T has passed."""
+    events = [in_offboard(), *[_stamped(0.1 * i, min(0.1 * i, 3.0) + 1000.0) for i in range(60)]]
+    (lost,) = of("signal_lost", run(px4, events, t_end=5.9))
+    assert 4.0 <= lost.t <= 4.1 + 1e-9
+    assert "timestamp" in (lost.reason or "")
+
+
+@pytest.mark.parametrize("px4", TICK)
+@pytest.mark.parametrize("offset", [0.0, 1000.0, -0.5])
+def test_2_1_1_sender_clock_with_constant_offset_is_fresh(px4: str, offset: float) -> None:
+    """2.1.1: stamps rewritten by the agent-PX4 offset (or clamped to now): a sender clock that
+    runs with the recording's is fresh whatever its origin."""
+    events = [in_offboard(), *[_stamped(0.1 * i, 0.1 * i + 5.0 + offset) for i in range(60)]]
+    assert loss_times(run(px4, events, t_end=5.9)) == []
+
+
+@pytest.mark.parametrize("px4", TICK)
+def test_2_1_1_zero_timestamp_is_the_receive_time(px4: str) -> None:
+    """2.1.1: a zero timestamp is replaced by the receive time: fresh."""
+    events = [in_offboard(), *[_stamped(0.1 * i, 0.0) for i in range(60)]]
+    assert loss_times(run(px4, events, t_end=5.9)) == []
+
+
+def test_2_2_v113_ignores_the_timestamp() -> None:
+    """2.2: v1.13's gate counts new messages; the timestamp field is not used."""
+    events = [in_offboard(), *[_stamped(0.1 * i, 1000.0) for i in range(60)]]
+    assert loss_times(run("1.13", events, t_end=5.9)) == []
