@@ -260,7 +260,11 @@ class Rosbag2Source(Source):
                 selected.append(conn)
         if not selected:  # rosbags reads every message when given no connection
             return
-        decoders = self._decoders
+        by_id: dict[int, Decoder] = {}
+        for conn in selected:
+            decoder = self._decoders[(conn.topic, conn.msgtype)]
+            assert decoder is not None
+            by_id[conn.id] = decoder
         t0 = self._t0
         count = 0
         self._last_ns = -1
@@ -270,9 +274,7 @@ class Rosbag2Source(Source):
                     t0 = self._t0 = stamp
                 count += 1
                 self._last_ns = stamp
-                decoder = decoders[(conn.topic, conn.msgtype)]
-                assert decoder is not None
-                event = decoder.event(raw, (stamp - t0) / 1e9)
+                event = by_id[conn.id].event(raw, (stamp - t0) / 1e9)
                 if event is not None:
                     yield event
         except Exception as exc:  # rosbags, sqlite and codec errors mid-read
