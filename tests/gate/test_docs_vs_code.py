@@ -533,3 +533,12 @@ def test_d23_non_finite_ignored_field_is_fine_from_v112(px4: str) -> None:
 def test_mavlink_command_type_is_the_one_from_events() -> None:
     """Sanity: the streams use the real Command event (DO_SET_MODE main mode 6)."""
     assert Command(t=0.0, command=176, params=(1.0, 6.0, 0, 0, 0, 0, 0)).is_offboard_switch
+
+
+@pytest.mark.parametrize("px4", RECEIVER_NEW)
+def test_d19_quaternion_and_thrust_not_validated(px4: str) -> None:
+    """D19 / 6.4: the receiver neither normalises the quaternion nor checks the thrust."""
+    msg = SetAttitudeTarget(
+        t=0.0, type_mask=7, q=(2.0, 0.0, 0.0, 0.0), thrust=3.0, target_system=1, target_component=1
+    )
+    assert _accepted(px4, msg)

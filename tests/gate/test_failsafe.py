@@ -210,3 +210,13 @@ def test_5_1_terminate_never_clears(px4: str) -> None:
     events = [in_offboard(), *stream(0.0, 1.0), *stream(3.0, 3.5)]
     trs = run(px4, events, params={"COM_OBL_RC_ACT": 6.0}, t_end=4.0)
     assert of("offboard_resumed", trs) == []
+
+
+@pytest.mark.parametrize("px4", ["1.17", "main"])
+def test_5_1_nav_rcl_act_disabled_gives_no_failsafe_unverified(px4: str) -> None:
+    """5.1: NAV_RCL_ACT 0 as the replacement action: no failsafe is raised (presumably stays in
+    OFFBOARD without a signal; unverified in SITL)."""
+    trs = _lose(px4, extra=[flags(0.0, manual_control_signal_lost=True)], NAV_RCL_ACT=0.0)
+    (failsafe,) = of("failsafe", trs)
+    assert failsafe.action == "NONE" and failsafe.unverified
+    assert failsafe.nav_state == OFFBOARD

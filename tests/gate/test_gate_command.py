@@ -84,3 +84,15 @@ def test_gate_unreadable_file(tmp_path: Path) -> None:
 def test_gate_missing_file(tmp_path: Path) -> None:
     result = run_cli(["gate", str(tmp_path / "nope.tlog")])
     assert result.returncode == 2
+
+
+def test_gate_on_ulog_corpus() -> None:
+    """The gate corpus ULogs: agreement exits 0, the planted difference exits 1."""
+    from tests.helpers import CORPORA
+
+    agrees = run_cli(["gate", str(CORPORA / "gate" / "loss_and_resume_agrees.ulg")])
+    assert agrees.returncode == 0, agrees.stdout
+    assert "agrees with the model" in agrees.stdout
+    differs = run_cli(["gate", str(CORPORA / "gate" / "recorded_stays_offboard.ulg")])
+    assert differs.returncode == 1
+    assert "recorded: OFFBOARD at 6.50 s; model: POSCTL" in differs.stdout

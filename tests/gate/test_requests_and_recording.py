@@ -205,3 +205,14 @@ def test_12_heartbeat_may_lag_by_the_link(px4: str) -> None:
         VehicleStatus(t=2.4, nav_state=OFFBOARD, armed=True, where=hb),
     ]
     assert of("disagreement", run(px4, events)) == []
+
+
+@pytest.mark.parametrize(("px4", "fallback"), [("legacy", True), ("1.13", True), ("1.15", False)])
+def test_4_1_disarmed_in_offboard_without_signal(px4: str, fallback: bool) -> None:
+    """4.1: 1.13 and legacy recompute nav_state to the loss fallback even when disarmed; 1.14+
+    evaluate no failsafe while disarmed (nav_state stays OFFBOARD)."""
+    gate = model(px4)
+    events = [status(0.0, POSCTL, False, POSCTL), *stream(0.0, 1.0), switch_offboard(0.5)]
+    trs = run(px4, events, t_end=3.0, model=gate)
+    assert bool(of("failsafe", trs)) is fallback
+    assert (gate.nav_state != OFFBOARD) is fallback
