@@ -8,7 +8,7 @@ from pathlib import Path
 
 from fuzzoff.events import Event, SetPositionTargetLocal, VehicleInfo, VehicleStatus
 from fuzzoff.writers.tlog import write_tlog
-from tests.helpers import run_cli
+from tests.helpers import CORPORA, run_cli
 
 OFFBOARD, POSCTL = 14, 2
 SENT = {
@@ -88,8 +88,6 @@ def test_gate_missing_file(tmp_path: Path) -> None:
 
 def test_gate_on_ulog_corpus() -> None:
     """The gate corpus ULogs: agreement exits 0, the planted difference exits 1."""
-    from tests.helpers import CORPORA
-
     agrees = run_cli(["gate", str(CORPORA / "gate" / "loss_and_resume_agrees.ulg")])
     assert agrees.returncode == 0, agrees.stdout
     assert "agrees with the model" in agrees.stdout
