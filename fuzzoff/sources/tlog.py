@@ -286,6 +286,7 @@ class _Decoder:
         self.index: dict[int, int] = {}
         self.mav_type: dict[int, int] = {}
         self.ignored: dict[str, int] = {}
+        self.target_names: dict[int, tuple[str, ...]] = {}
         self.handlers: dict[int, Callable[[Any, float, Where], Iterable[Event]]] = {
             SET_POSITION_TARGET_LOCAL_NED: self._local,
             SET_POSITION_TARGET_GLOBAL_INT: self._global,
@@ -303,7 +304,7 @@ class _Decoder:
     def decode(self, msgid: int, msg: Any, t: float, offset: int) -> Iterable[Event]:
         i = self.index.get(msgid, 0)
         self.index[msgid] = i + 1
-        return self.handlers[msgid](msg, t, Where(msg.get_type(), i, offset))
+        return self.handlers[msgid](msg, t, Where(message_name(msgid), i, offset))
 
     def _ignore(self, msg: Any, why: str) -> Iterable[Event]:
         key = f"{msg.get_type()} {why}"
@@ -314,10 +315,16 @@ class _Decoder:
         compid = msg.get_srcComponent()
         return compid == MAV_COMP_ID_AUTOPILOT1 or (msg.get_srcSystem(), compid) in self.autopilots
 
-    def _targets(self, target_system: int) -> list[str]:
-        if target_system == 0:
-            return [str(v) for v in self.vehicles]
-        return [str(target_system)]
+    def _targets(self, target_system: int) -> tuple[str, ...]:
+        """The vehicles a message addressed to ``target_system`` is for (0: every autopilot)."""
+        names = self.target_names.get(target_system)
+        if names is None:
+            if target_system == 0:
+                names = tuple(str(v) for v in self.vehicles)
+            else:
+                names = (str(target_system),)
+            self.target_names[target_system] = names
+        return names
 
     # -- sent to the vehicle --------------------------------------------------------------
 
