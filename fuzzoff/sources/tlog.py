@@ -176,6 +176,13 @@ class TlogSource(Source):
                 )
             raise SourceError(self.path, "no MAVLink packet found: not a tlog", "byte 0")
         info.vehicles = sorted({str(s) for s, _ in self._autopilots}, key=_vehicle_sort)
+        if not self._autopilots:
+            info.notes.append(
+                "no autopilot in the log (no HEARTBEAT or AUTOPILOT_VERSION from component 1 "
+                "or from PX4): no recorded mode; broadcast setpoints are taken for vehicle 1"
+            )
+        if info.px4_version is None:
+            info.notes.append("no AUTOPILOT_VERSION in the log: PX4 version unknown")
         info.message_count = stats.packets
         for msgid, kinds in _KIND_OF_ID.items():
             if stats.by_id.get(msgid):
