@@ -173,3 +173,14 @@ def test_ofb101_silence_in_offboard_until_the_vehicle_leaves_counts_up_to_the_sw
     (found,) = codes(lint_events(events), "OFB101")
     assert found.end_s == pytest.approx(5.7)
     assert "0.70 s" in found.message
+
+
+def test_pxs_automatic_return_after_a_loss_is_not_a_request() -> None:
+    # MAVROS-like: no commands recorded; stream stops 6.0-8.0 s, PX4 fails over to POSCTL at
+    # 7.0 s and returns to OFFBOARD by itself when the stream resumes (gate spec D9)
+    times = [t for t in every(0.0, 12.0, 0.05) if not 6.0 < t < 8.0]
+    events = [status(0.0, POSCTL), *ocm(times), status(3.0, OFFBOARD)]
+    events += [status(7.0, POSCTL), status(8.2, OFFBOARD)]
+    found = lint_events(events)
+    assert codes(found, "OFB102") == []
+    assert [f.time_s for f in codes(found, "OFB101")] == [pytest.approx(6.0)]

@@ -10,6 +10,7 @@ from fuzzoff.events import (
     Event,
     LegacyControlMode,
     MavlinkTarget,
+    VehicleStatus,
 )
 
 KEEPALIVE_EVENTS: tuple[type[Event], ...] = (*KEEPALIVE_TYPES, Dropout)
@@ -59,3 +60,36 @@ def offboard_and_flying(ctx: CheckContext) -> bool:
 
 def mode_note(ctx: CheckContext) -> str:
     return "" if ctx.state.mode_recorded else " (mode predicted by the gate model)"
+
+
+class RecordedSwitches:
+    """Tells a user's switch to OFFBOARD from PX4's automatic return, on the recorded mode alone.
+
+    Where no commands are recorded (MAVROS bags: services are not recorded) the recorded entry
+    into OFFBOARD is the request. But after a loss failsafe PX4 returns to OFFBOARD by itself
+    when the stream resumes (gate spec 5.1, D9): an entry that follows an exit made while the
+    keep-alive was older than the loss timeout (less the 10 Hz evaluation slack) is that
+    return, not a request.
+    """
+
+    SLACK_S = 0.15
+
+    def __init__(self, ctx: CheckContext) -> None:
+        self.ctx = ctx
+        self.was_offboard: bool | None = None
+        self.left_by_failsafe = False
+
+    def entered_by_request(self, event: VehicleStatus, last_keepalive: float | None) -> bool:
+        """Feed every recorded status; True when it is the user's switch to OFFBOARD."""
+        if event.nav_state is None:
+            return False
+        was, now = self.was_offboard, event.in_offboard
+        self.was_offboard = now
+        if was and not now:
+            age = None if last_keepalive is None else event.t - last_keepalive
+            self.left_by_failsafe = age is None or age >= loss_timeout(self.ctx) - self.SLACK_S
+            return False
+        if was is False and now:
+            automatic, self.left_by_failsafe = self.left_by_failsafe, False
+            return not automatic and "command" not in self.ctx.info.kinds
+        return False

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 from fuzzoff.checks._keepalive import (
     KEEPALIVE_EVENTS,
+    RecordedSwitches,
     counts_as_keepalive,
     loss_timeout,
     mode_note,
@@ -51,9 +52,7 @@ class KeepaliveRate(Check):
         self.last: float | None = None
         self.last_in_offboard = False
         self.dropout_since_last = False
-        self.was_offboard: bool | None = None
-        """Recorded mode at the previous status (None before the first: a recording may start
-        in OFFBOARD, which is not a switch)."""
+        self.switches = RecordedSwitches(ctx)
         self.recent: list[_Gap] = []
         """Gaps outside offboard, kept for ``window`` seconds in case a request follows."""
 
@@ -64,12 +63,8 @@ class KeepaliveRate(Check):
             if event.is_offboard_switch or (event.is_arm and self.ctx.state.in_offboard):
                 self._request(event.t)
         elif isinstance(event, VehicleStatus):
-            no_commands = "command" not in self.ctx.info.kinds
-            switched = event.in_offboard and self.was_offboard is False
-            if switched and no_commands:
+            if self.switches.entered_by_request(event, self.last):
                 self._request(event.t)  # no commands recorded (MAVROS): the switch itself
-            if event.nav_state is not None:
-                self.was_offboard = event.in_offboard
             if self.last_in_offboard and not offboard_and_flying(self.ctx):
                 self._left_offboard(event)
         elif counts_as_keepalive(self.ctx, event):
@@ -149,7 +144,7 @@ class StreamBeforeRequest(Check):
         self.run_start: float | None = None
         self.last: float | None = None
         self.gate_verdict: dict[int, GateTransition] = {}
-        self.was_offboard: bool | None = None
+        self.switches = RecordedSwitches(ctx)
 
     def on_event(self, event: Event) -> None:
         if isinstance(event, GateTransition):
@@ -167,12 +162,8 @@ class StreamBeforeRequest(Check):
                 self._judge(event, "arm in OFFBOARD")
             self.gate_verdict.clear()
         elif isinstance(event, VehicleStatus):
-            if event.nav_state is None:
-                return
-            switched = event.in_offboard and self.was_offboard is False
-            if switched and "command" not in self.ctx.info.kinds:
+            if self.switches.entered_by_request(event, self.last):
                 self._judge(event, "switch to OFFBOARD (recorded mode)")
-            self.was_offboard = event.in_offboard
         elif isinstance(event, Dropout):
             pass
         elif counts_as_keepalive(self.ctx, event):

@@ -17,7 +17,8 @@ READERS: dict[str, str] = {
 }
 """Format name -> reader class; imported lazily so a run loads only the libraries it needs."""
 
-RECORDING_SUFFIXES = (".tlog", ".ulg", ".mcap", ".bag", ".db3")
+RECORDING_SUFFIXES = (".tlog", ".ulg", ".mcap", ".bag", ".db3", ".active")
+"""``.active``: a ROS 1 bag whose recorder was killed (``flight.bag.active``)."""
 
 _MAGIC: tuple[tuple[bytes, str], ...] = (
     (b"ULog\x01\x12\x35", "ulog"),
