@@ -1,0 +1,183 @@
+"""``fuzzoff fuzz``: a seeded fuzz campaign against the gate model and the rules (docs/fuzz.md).
+
+Exit status: 0 every property held, 1 a counterexample was found (saved as a reproducer under
+``--save-dir``), 2 usage error or an unreadable ``--from`` recording.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import Any
+
+from fuzzoff.commands._common import parse_params, settings_from_args, write_output
+from fuzzoff.config import ConfigError
+from fuzzoff.fuzz.campaign import CampaignConfig, CampaignResult, PropertyResult, run_campaign
+from fuzzoff.fuzz.properties import PROPERTIES
+from fuzzoff.fuzz.reproducers import DEFAULT_DIR, save
+from fuzzoff.fuzz.scenario import TRANSPORTS
+from fuzzoff.profiles import ProfileError, px4_profile_for, vehicle_type_for
+from fuzzoff.sources import SourceError
+
+
+def add_parser(sub: Any) -> None:
+    parser = sub.add_parser(
+        "fuzz", help="search setpoint streams for hazards the rules miss (seeded, shrunk)"
+    )
+    parser.add_argument("--px4", metavar="VERSION", help="PX4 release or profile (default: all)")
+    parser.add_argument("--vehicle", metavar="TYPE", help="vehicle type (default: all)")
+    parser.add_argument("--transport", choices=TRANSPORTS, help="default: all")
+    size = parser.add_mutually_exclusive_group()
+    size.add_argument("--budget", type=float, metavar="SECONDS", help="time budget")
+    size.add_argument("--examples", type=int, metavar="N", help="examples per property")
+    parser.add_argument("--seed", type=int, default=0, help="the campaign's seed (default 0)")
+    parser.add_argument(
+        "--property",
+        action="append",
+        choices=sorted(PROPERTIES),
+        help="check only this property (repeatable; default all)",
+    )
+    parser.add_argument("--from", dest="from_", metavar="RECORDING", help="mutate this stream")
+    parser.add_argument(
+        "--param",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="PX4 parameter for --from (the campaign draws its own otherwise)",
+    )
+    parser.add_argument("--ignore", metavar="CODES", help="rules to switch off (fault planting)")
+    parser.add_argument(
+        "--format", choices=("terminal", "json", "junit", "sarif"), default="terminal"
+    )
+    parser.add_argument("--output", "-o", metavar="FILE", help="write the report here")
+    parser.add_argument(
+        "--save-dir",
+        metavar="DIR",
+        default=str(DEFAULT_DIR),
+        help=f"where reproducers are saved (default {DEFAULT_DIR})",
+    )
+    parser.add_argument("--no-save", action="store_true", help="do not save reproducers")
+    parser.add_argument("--quiet", "-q", action="store_true", help="no progress display")
+    parser.set_defaults(run=run)
+
+
+def _config(args: argparse.Namespace) -> CampaignConfig:
+    try:
+        px4 = px4_profile_for(args.px4) if args.px4 else None
+        vehicle = vehicle_type_for(args.vehicle) if args.vehicle else None
+    except ProfileError as exc:
+        raise ConfigError(str(exc)) from None
+    if args.examples is not None and args.examples < 1:
+        raise ConfigError("--examples must be at least 1")
+    if args.budget is not None and args.budget <= 0:
+        raise ConfigError("--budget must be positive")
+    ns = argparse.Namespace(ignore=args.ignore)
+    settings = settings_from_args(ns)
+    examples = args.examples if args.examples is not None else (None if args.budget else 100)
+    config = CampaignConfig(
+        px4=px4,
+        vehicle=vehicle,
+        transport=args.transport,
+        examples=examples,
+        budget_s=args.budget,
+        seed=args.seed,
+        properties=tuple(args.property or PROPERTIES),
+        settings=settings,
+    )
+    if args.from_:
+        from fuzzoff.fuzz.mutate import scenario_from_recording
+
+        try:
+            config.base = scenario_from_recording(
+                Path(args.from_), px4 or "1.15", vehicle or "mc", parse_params(args.param)
+            )
+        except SourceError as exc:
+            raise ConfigError(exc.line()) from None
+        except OSError as exc:
+            raise ConfigError(f"{args.from_}: {exc.strerror or exc}") from None
+    return config
+
+
+class _Progress:
+    """A rich live line: property, examples, examples/s, failures (stderr, terminals only)."""
+
+    def __init__(self, enabled: bool) -> None:
+        self.enabled = enabled and sys.stderr.isatty()
+        self.failures = 0
+        self.progress: Any = None
+        self.task: Any = None
+
+    def __enter__(self) -> _Progress:
+        if self.enabled:
+            from rich.console import Console
+            from rich.progress import Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
+
+            self.progress = Progress(
+                SpinnerColumn(),
+                TextColumn("{task.description}"),
+                TextColumn("{task.completed} examples"),
+                TextColumn("{task.fields[rate]}/s"),
+                TextColumn("failures: {task.fields[failures]}"),
+                TimeElapsedColumn(),
+                console=Console(stderr=True),
+                transient=True,
+            )
+            self.progress.__enter__()
+            self.task = self.progress.add_task("fuzz", total=None, rate="-", failures=0)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self.progress is not None:
+            self.progress.__exit__(None, None, None)
+
+    def example(self, r: PropertyResult) -> None:
+        if self.progress is None or r.examples % 5:
+            return
+        rate = f"{r.examples / r.seconds_so_far():.0f}" if r.seconds_so_far() else "-"
+        self.progress.update(
+            self.task,
+            description=r.name,
+            completed=r.examples,
+            rate=rate,
+            failures=self.failures + (1 if r.found_after else 0),
+        )
+
+    def done(self, r: PropertyResult) -> None:
+        self.failures += 1 if r.failed else 0
+
+
+def run(args: argparse.Namespace) -> int:
+    config = _config(args)
+    with _Progress(not args.quiet) as progress:
+        result = run_campaign(config, progress.example, progress.done)
+    saved = {} if args.no_save else _save_all(result, Path(args.save_dir))
+    margins = []
+    if config.base is not None:
+        from fuzzoff.fuzz.mutate import margins as find_margins
+
+        margins = find_margins(config.base)
+    write_output(_render(args.format, result, saved, margins), args.output)
+    return 1 if result.failed else 0
+
+
+def _save_all(result: CampaignResult, directory: Path) -> dict[str, Path]:
+    saved = {}
+    for r in result.results:
+        if r.failed and r.counterexample is not None:
+            saved[r.name] = save(
+                r.name, r.counterexample, r.problems, directory, cut_fraction=r.cut_fraction
+            )
+    return saved
+
+
+def _render(fmt: str, result: CampaignResult, saved: dict[str, Path], margins: list[Any]) -> str:
+    from fuzzoff.fuzz import report
+
+    if fmt == "json":
+        return report.to_json(result, saved, margins)
+    if fmt == "junit":
+        return report.to_junit(result, saved)
+    if fmt == "sarif":
+        return report.to_sarif(result, saved)
+    return report.to_terminal(result, saved, margins)

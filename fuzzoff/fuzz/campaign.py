@@ -1,0 +1,232 @@
+"""Run a campaign: one Hypothesis search per property, seeded, shrunk, timed.
+
+Determinism: the examples come from ``@seed(seed)`` with Hypothesis's example database off (the
+``ci`` profile; reproducers survive as committed files instead), so a seed and an example count
+give the same examples and the same counterexample on every machine. A time budget stops the
+search early (at the same example sequence, later or sooner depending on the machine).
+
+The search is steered with ``target()`` toward the gate's thresholds: the largest keep-alive gap
+toward the loss timeout, the keep-alive before the switch toward the documented 1 s.
+"""
+
+from __future__ import annotations
+
+import itertools
+import time
+from collections import Counter
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from hypothesis import HealthCheck, Phase, given, seed, settings, target
+from hypothesis import strategies as st
+from hypothesis.errors import Found
+
+from fuzzoff.config import Settings
+from fuzzoff.events import Command, is_keepalive
+from fuzzoff.fuzz.mutate import mutations
+from fuzzoff.fuzz.properties import PROPERTIES, FuzzContext, PropertySpec
+from fuzzoff.fuzz.scenario import Scenario, TransportName
+from fuzzoff.fuzz.streams import scenarios
+from fuzzoff.gate.params import default_params, loss_timeout
+
+PROFILE_CI = "fuzzoff-ci"
+settings.register_profile(
+    PROFILE_CI,
+    database=None,
+    deadline=None,
+    print_blob=False,
+    suppress_health_check=list(HealthCheck),
+    report_multiple_bugs=False,
+)
+
+
+class _Stop(BaseException):
+    """Raised inside the test to end the search when the budget is spent (a BaseException, so
+    Hypothesis does not take it for a failure)."""
+
+
+@dataclass(slots=True)
+class PropertyResult:
+    name: str
+    claim: str
+    examples: int = 0
+    seconds: float = 0.0
+    model_seconds: float = 0.0
+    """Time inside the property (gate model, rules, writers), the rest is generation."""
+    failed: bool = False
+    problems: list[str] = field(default_factory=list)
+    counterexample: Scenario | None = None
+    cut_fraction: float | None = None
+    found_after: int | None = None
+    """Examples (including shrinking) until the first failure."""
+    found_seconds: float | None = None
+    counts: dict[str, dict[str, int]] = field(default_factory=dict)
+    started: float = 0.0
+
+    def seconds_so_far(self) -> float:
+        return time.perf_counter() - self.started
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "property": self.name,
+            "claim": self.claim,
+            "examples": self.examples,
+            "seconds": round(self.seconds, 3),
+            "examples_per_s": round(self.examples / self.seconds, 1) if self.seconds else None,
+            "model_seconds": round(self.model_seconds, 3),
+            "failed": self.failed,
+            "problems": self.problems,
+            "found_after_examples": self.found_after,
+            "found_after_seconds": None
+            if self.found_seconds is None
+            else round(self.found_seconds, 3),
+            "counterexample": None
+            if self.counterexample is None
+            else self.counterexample.describe(),
+            "counts": self.counts,
+        }
+
+
+@dataclass(slots=True)
+class CampaignConfig:
+    px4: str | None = None
+    vehicle: str | None = None
+    transport: TransportName | None = None
+    examples: int | None = 200
+    budget_s: float | None = None
+    seed: int = 0
+    properties: tuple[str, ...] = tuple(PROPERTIES)
+    settings: Settings = field(default_factory=Settings)
+    shrink_s: float = 30.0
+    """How long shrinking a counterexample may take at most."""
+    base: Scenario | None = None
+    """``--from``: mutate this scenario (a user's recording) instead of drawing new streams."""
+
+
+def _targets(scenario: Scenario) -> None:
+    """Steer toward the thresholds: gap vs loss timeout, stream length before the switch."""
+    timeout = loss_timeout(scenario.px4, default_params(scenario.px4) | dict(scenario.params))
+    keep = [e.t for e in scenario.events if is_keepalive(e)]
+    if len(keep) >= 2:
+        gap = max(b - a for a, b in itertools.pairwise(keep))
+        target(-abs(gap - timeout), label="gap near the loss timeout")
+    switch = next(
+        (e.t for e in scenario.events if isinstance(e, Command) and e.is_offboard_switch), None
+    )
+    if switch is not None and keep:
+        before = switch - keep[0] if keep[0] <= switch else 0.0
+        target(-abs(before - 1.0), label="keep-alive before the switch near 1 s")
+
+
+def run_property(
+    spec: PropertySpec,
+    config: CampaignConfig,
+    budget_s: float | None,
+    on_example: Callable[[PropertyResult], None] | None = None,
+) -> PropertyResult:
+    result = PropertyResult(spec.name, spec.claim)
+    ctx = FuzzContext(settings=config.settings)
+    start = result.started = time.perf_counter()
+    failing: dict[str, Any] = {}
+
+    streams = (
+        scenarios(config.px4, config.vehicle, config.transport)
+        if config.base is None
+        else mutations(config.base)
+    )
+    strategy = st.tuples(streams, st.floats(0.0, 1.0))
+
+    def check(example: tuple[Scenario, float]) -> None:
+        scenario, cut = example
+        now = time.perf_counter()
+        if not failing and budget_s is not None and now - start > budget_s:
+            raise _Stop
+        if failing and now - failing["at"] > config.shrink_s:
+            raise _Stop
+        result.examples += 1
+        _targets(scenario)
+        ctx.cut_fraction = cut
+        t0 = time.perf_counter()
+        problems = spec.check(scenario, ctx)
+        result.model_seconds += time.perf_counter() - t0
+        if on_example is not None:
+            on_example(result)
+        if problems and spec.fails:
+            if not failing:
+                failing["at"] = time.perf_counter()
+                result.found_after = result.examples
+                result.found_seconds = failing["at"] - start
+            failing.update(scenario=scenario, cut=cut, problems=problems)
+            raise AssertionError("\n".join(problems))
+
+    max_examples = config.examples if config.examples is not None else 10**9
+    test = given(strategy)(check)
+    test = settings(
+        settings.get_profile(PROFILE_CI),
+        max_examples=max_examples,
+        phases=(Phase.generate, Phase.target, Phase.shrink),
+    )(test)
+    test = seed(config.seed)(test)
+    try:
+        test()
+    except _Stop:
+        pass
+    except (AssertionError, Found):
+        pass
+    finally:
+        result.seconds = time.perf_counter() - start
+        ctx.close()
+    if failing:
+        result.failed = True
+        result.problems = list(failing["problems"])
+        result.counterexample = failing["scenario"]
+        result.cut_fraction = failing["cut"] if spec.name == "truncation" else None
+    if spec.name == "docs-stricter":
+        result.counts = {
+            code: {"fired": ctx.docs_fired[code], "gate_accepted": ctx.docs_stricter[code]}
+            for code in sorted(ctx.docs_fired)
+        }
+    return result
+
+
+@dataclass(slots=True)
+class CampaignResult:
+    config: CampaignConfig
+    results: list[PropertyResult]
+
+    @property
+    def failed(self) -> bool:
+        return any(r.failed for r in self.results)
+
+    @property
+    def examples(self) -> int:
+        return sum(r.examples for r in self.results)
+
+    @property
+    def seconds(self) -> float:
+        return sum(r.seconds for r in self.results)
+
+
+def run_campaign(
+    config: CampaignConfig,
+    on_example: Callable[[PropertyResult], None] | None = None,
+    on_property: Callable[[PropertyResult], None] | None = None,
+) -> CampaignResult:
+    """Every selected property in turn, the time budget split evenly between them."""
+    share = None if config.budget_s is None else config.budget_s / len(config.properties)
+    results = []
+    for name in config.properties:
+        result = run_property(PROPERTIES[name], config, share, on_example)
+        results.append(result)
+        if on_property is not None:
+            on_property(result)
+    return CampaignResult(config, results)
+
+
+def counts_total(results: list[PropertyResult]) -> Counter[str]:
+    total: Counter[str] = Counter()
+    for r in results:
+        for code, c in r.counts.items():
+            total[code] += c["gate_accepted"]
+    return total

@@ -1,0 +1,138 @@
+"""What the gate model predicts that the stream did not intend, and which rules explain it.
+
+A *hazard* is a ``GateTransition`` of one of these kinds (gate spec section in brackets):
+
+* ``request_rejected`` / ``arm_rejected``: the stream asked for OFFBOARD or to arm in it (4.1, 4.2);
+* ``failsafe``: the loss failsafe ran (5), and ``disarmed`` by it (not by a disarm command);
+* ``setpoint_dropped``: the MAVLink receiver dropped or ignored a setpoint (6);
+* ``controller`` with a reason that lasts ``HOLD_S`` or more: another controller runs than the
+  setpoint asked for (the failsafe setpoint, the 200 ms reuse; 8-10). Shorter ones are the
+  moment between a keep-alive and its setpoint, which PX4 also sees.
+
+``EXPLAINED_BY`` names the rules whose findings explain each kind: rules about the very outcome
+(OFB201, OFB103, OFB6xx...) and about its causes (a gap, an empty control mode, a dropped
+keep-alive...).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from fuzzoff.events import Command
+from fuzzoff.gate import GateTransition
+
+HOLD_S = 0.2
+"""A controller hazard must last this long (PX4 1.16's last-valid reuse window)."""
+WAIT_S = 0.55
+"""The hold before the first setpoint after the switch must last longer than the period of the
+slowest stream the docs allow (2 Hz, plus 10 % jitter): a stream's own rate is intended."""
+NO_SETPOINT_YET = "no TrajectorySetpoint since"
+
+_DROPPED = frozenset(
+    {
+        "OFB601",
+        "OFB602",
+        "OFB603",
+        "OFB604",
+        "OFB605",
+        "OFB606",
+        "OFB607",
+        "OFB507",
+        "OFB508",
+        "OFB509",
+        "OFB803",
+        "OFB801",
+    }
+)
+_NO_SIGNAL = frozenset({"OFB101", "OFB102", "OFB103", "OFB106", "OFB301", "OFB305"}) | _DROPPED
+
+EXPLAINED_BY: dict[str, frozenset[str]] = {
+    "request_rejected": _NO_SIGNAL | {"OFB201"},
+    "arm_rejected": _NO_SIGNAL | {"OFB201"},
+    "failsafe": _NO_SIGNAL,
+    "disarmed": _NO_SIGNAL,
+    "setpoint_dropped": _DROPPED,
+    "controller": frozenset(
+        {
+            "OFB104",
+            "OFB203",
+            "OFB301",
+            "OFB302",
+            "OFB303",
+            "OFB305",
+            "OFB401",
+            "OFB402",
+            "OFB403",
+            "OFB408",
+            "OFB501",
+            "OFB502",
+            "OFB503",
+            "OFB504",
+            "OFB505",
+            "OFB506",
+            "OFB603",
+            "OFB604",
+            "OFB605",
+            "OFB803",
+        }
+    )
+    | _NO_SIGNAL,
+}
+
+OUTCOME_RULE: dict[str, str] = {
+    "request_rejected": "OFB201",
+    "arm_rejected": "OFB201",
+    "failsafe": "OFB103",
+    "disarmed": "OFB103",
+}
+"""The rule that reports the outcome itself: when the recording cannot show it (OFB002 says
+so), a warning of an explaining rule is enough (e.g. OFB102 before a rejected switch in a
+recording without acks)."""
+
+
+WHILE_ARMED = frozenset({"failsafe", "disarmed", "controller"})
+"""Kinds that are hazards only in flight: a disarmed vehicle holds nothing and flies nowhere."""
+
+
+def _armed_before(tr: GateTransition, transitions: Sequence[GateTransition]) -> bool:
+    """Was the model armed when ``tr`` happened (a loss action may disarm in ``tr`` itself)?"""
+    if tr.what == "disarmed":
+        return True
+    return bool(tr.armed)
+
+
+@dataclass(frozen=True, slots=True)
+class Hazard:
+    t: float
+    kind: str
+    message: str
+    spec: str
+    end: float
+
+    def describe(self) -> str:
+        return f"{self.kind} at {self.t:.3f} s ({self.message}; gate spec {self.spec})"
+
+
+def hazards(transitions: Sequence[GateTransition], t_end: float) -> list[Hazard]:
+    """The unintended outcomes among a vehicle's transitions, in time order."""
+    out: list[Hazard] = []
+    controllers = [tr for tr in transitions if tr.what == "controller"]
+    for tr in transitions:
+        what = tr.what
+        if what == "disarmed" and isinstance(tr.cause, Command):
+            continue
+        if what in WHILE_ARMED and not _armed_before(tr, transitions):
+            continue
+        if what == "controller":
+            if not tr.reason:
+                continue
+            idx = next(i for i, c in enumerate(controllers) if c is tr)
+            end = controllers[idx + 1].t if idx + 1 < len(controllers) else t_end
+            hold = WAIT_S if tr.reason.startswith(NO_SETPOINT_YET) else HOLD_S
+            if end - tr.t < hold:
+                continue
+            out.append(Hazard(tr.t, what, tr.message, tr.spec, end))
+        elif what in EXPLAINED_BY:
+            out.append(Hazard(tr.t, what, tr.message, tr.spec, tr.t))
+    return out

@@ -1,0 +1,182 @@
+"""``--from RECORDING``: perturb a user's real stream and find its margin.
+
+Perturbations act on the sent keep-alive (and the setpoints published with it):
+
+* ``stall``: nothing sent for ``size`` seconds from a keep-alive on (later messages shift);
+* ``drop``: ``size`` consecutive keep-alive messages lost (as on a lossy link);
+* ``jitter``: every sent message delayed by up to ``size`` seconds (deterministic pattern);
+* ``skew``: the sender's timestamps off by ``-size`` seconds (an old clock).
+
+The *margin* of a family is the smallest size that changes the gate model's outcome (the
+hazards it predicts, ``fuzz.hazards``), found by bisection at each position, and where.
+``mutations(scenario)`` is the Hypothesis strategy of perturbed scenarios the properties are
+checked on.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from hypothesis import strategies as st
+
+from fuzzoff.engine import Timeline
+from fuzzoff.events import ControlMode, Event, is_keepalive
+from fuzzoff.fuzz.hazards import hazards
+from fuzzoff.fuzz.recordings import read
+from fuzzoff.fuzz.scenario import Scenario, TransportName, run
+from fuzzoff.fuzz.streams import settle
+
+FAMILIES = ("stall", "drop", "jitter", "skew")
+MAX_SIZE = {"stall": 5.0, "drop": 50.0, "jitter": 1.0, "skew": 5.0}
+UNIT = {"stall": "s", "drop": "messages", "jitter": "s", "skew": "s"}
+
+
+def scenario_from_recording(
+    path: Path, px4: str, vehicle: str, params: dict[str, float]
+) -> Scenario:
+    """The recording's events as a scenario (transport from its events)."""
+    events = read(path)
+    transport: TransportName = "ros2"
+    if any(getattr(e, "transport", "") == "mavros" for e in events):
+        transport = "mavros"
+    elif any(e.kind.startswith("set_") or getattr(e, "transport", "") == "mavlink" for e in events):
+        transport = "mavlink"
+    return Scenario(
+        px4=px4, vehicle=vehicle, transport=transport, events=tuple(events), params=params
+    )
+
+
+@dataclass(frozen=True, slots=True)
+class Perturbation:
+    family: str
+    at: float
+    """Time of the first keep-alive affected."""
+    size: float
+
+    def describe(self) -> str:
+        size = f"{int(self.size)}" if self.family == "drop" else f"{self.size:.3f}"
+        return f"{self.family} of {size} {UNIT[self.family]} at {self.at:.3f} s"
+
+
+def apply(scenario: Scenario, p: Perturbation) -> Scenario:
+    events = list(scenario.events)
+    sent = [e for e in events if e.origin == "sent"]
+    keep = [e for e in sent if is_keepalive(e)]
+    if p.family == "stall":
+        out = [e if e.t < p.at else _shift(e, p.size) for e in events]
+    elif p.family == "drop":
+        start = next((i for i, e in enumerate(keep) if e.t >= p.at), len(keep))
+        gone = {id(e) for e in keep[start : start + int(p.size)]}
+        out = [e for e in events if id(e) not in gone]
+    elif p.family == "jitter":
+        out = [
+            _shift(e, p.size * (0.5 + 0.5 * math.sin(i * 2.39996)))
+            if e.origin == "sent" and e.t >= p.at
+            else e
+            for i, e in enumerate(events)
+        ]
+    else:  # skew
+        out = [
+            replace(e, sender_time_us=max(0, e.sender_time_us - round(p.size * 1e6)))
+            if e.origin == "sent"
+            and e.sender_time_us is not None
+            and e.t >= p.at
+            and isinstance(e, ControlMode)
+            else e
+            for e in events
+        ]
+    return replace(scenario, events=tuple(settle(out)))
+
+
+def _shift(e: Event, dt: float) -> Event:
+    return replace(e, t=e.t + dt)
+
+
+def outcome(scenario: Scenario) -> tuple[tuple[str, int], ...]:
+    """The hazards the gate model predicts, by kind and rounded time (the outcome to change)."""
+    timelines: dict[str, Timeline] = {}
+    run(scenario, timelines=timelines)
+    found = []
+    for tl in timelines.values():
+        found += [(h.kind, round(h.t * 10)) for h in hazards(tl.transitions, scenario.duration)]
+    return tuple(sorted(found))
+
+
+@dataclass(frozen=True, slots=True)
+class Margin:
+    family: str
+    perturbation: Perturbation | None
+    """The smallest perturbation that changes the outcome (None: none up to ``MAX_SIZE``)."""
+    new_hazards: tuple[tuple[str, int], ...] = ()
+
+    def to_json(self) -> dict[str, object]:
+        p = self.perturbation
+        return {
+            "family": self.family,
+            "found": p is not None,
+            "size": None if p is None else p.size,
+            "unit": UNIT[self.family],
+            "at_s": None if p is None else round(p.at, 6),
+            "max_tried": MAX_SIZE[self.family],
+            "outcome_after": [{"hazard": k, "time_s": t / 10} for k, t in self.new_hazards],
+        }
+
+
+def _positions(scenario: Scenario, count: int) -> list[float]:
+    keep = [e.t for e in scenario.events if is_keepalive(e) and e.origin == "sent"]
+    if len(keep) <= count:
+        return keep
+    step = len(keep) / count
+    return [keep[int(i * step)] for i in range(count)]
+
+
+def margins(scenario: Scenario, positions: int = 24, steps: int = 12) -> list[Margin]:
+    """Per family, the smallest perturbation (bisection per position) changing the outcome."""
+    base = outcome(scenario)
+    result = []
+    for family in FAMILIES:
+        best: Perturbation | None = None
+        best_outcome: tuple[tuple[str, int], ...] = ()
+        for at in _positions(scenario, positions):
+            hi = MAX_SIZE[family] if best is None else best.size
+            changed = outcome(apply(scenario, Perturbation(family, at, hi)))
+            if changed == base:
+                continue
+            lo, hi_outcome = 0.0, changed
+            for _ in range(steps):
+                mid = (lo + hi) / 2
+                if family == "drop":
+                    mid = float(math.floor(mid))
+                    if mid <= lo:
+                        break
+                got = outcome(apply(scenario, Perturbation(family, at, mid)))
+                if got != base:
+                    hi, hi_outcome = mid, got
+                else:
+                    lo = mid
+            if best is None or hi < best.size:
+                best, best_outcome = Perturbation(family, at, hi), hi_outcome
+        result.append(Margin(family, best, best_outcome))
+    return result
+
+
+def mutations(scenario: Scenario) -> st.SearchStrategy[Scenario]:
+    """Perturbed copies of ``scenario`` (one or two perturbations)."""
+    times = [e.t for e in scenario.events if is_keepalive(e)] or [0.0]
+    one = st.builds(
+        Perturbation,
+        family=st.sampled_from(FAMILIES),
+        at=st.sampled_from(times),
+        size=st.floats(0.0, 3.0),
+    )
+
+    def perturb(ps: Sequence[Perturbation]) -> Scenario:
+        out = scenario
+        for p in ps:
+            out = apply(out, p)
+        return out
+
+    return st.lists(one, min_size=1, max_size=2).map(perturb)

@@ -1,0 +1,62 @@
+"""Scenarios to recordings through the real writers (``fuzzoff/writers``), and back.
+
+``FORMATS_FOR`` lists the formats each transport's stream can be written to: ROS 2 direct ->
+MCAP and a rosbag2 (sqlite3) bag; MAVLink -> tlog; MAVROS -> ROS 1 bag. ULog is left out: it is
+the vehicle's own log, so its events are the vehicle's copies (``origin="vehicle"``, uORB
+names), not the sent stream, by design of the format.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from fuzzoff.events import Event
+from fuzzoff.fuzz.scenario import Scenario
+from fuzzoff.sources import open_source
+from fuzzoff.sources.px4_msgs import release_for
+
+FORMATS_FOR: dict[str, tuple[str, ...]] = {
+    "ros2": ("mcap", "rosbag2"),
+    "mavlink": ("tlog",),
+    "mavros": ("rosbag1",),
+}
+
+SUFFIX = {"mcap": ".mcap", "rosbag2": "", "tlog": ".tlog", "rosbag1": ".bag"}
+
+
+def release(scenario: Scenario) -> str:
+    """The px4_msgs release whose definitions a ROS 2 recording of the scenario embeds."""
+    return release_for(scenario.px4) or "main"
+
+
+def write(scenario: Scenario, path: Path, fmt: str) -> Path:
+    """Write the scenario's events as ``fmt`` at ``path`` (a folder for rosbag2)."""
+    events = list(scenario.events)
+    if fmt == "mcap":
+        from fuzzoff.writers.mcap import write_mcap
+
+        return write_mcap(path, events, release=release(scenario))
+    if fmt == "rosbag2":
+        from fuzzoff.writers.rosbag2 import write_rosbag2
+
+        return write_rosbag2(path, events, release=release(scenario))
+    if fmt == "tlog":
+        from fuzzoff.writers.tlog import write_tlog
+
+        return write_tlog(path, events)
+    if fmt == "rosbag1":
+        from fuzzoff.writers.rosbag1 import write_rosbag1
+
+        return write_rosbag1(path, events)
+    raise ValueError(f"no writer for {fmt!r}")
+
+
+def read(path: Path) -> list[Event]:
+    """Every event a reader gives back for ``path`` (raises ``SourceError`` if unreadable)."""
+    source = open_source(path)
+    source.open()
+    try:
+        source.probe()
+        return list(source.events())
+    finally:
+        source.close()

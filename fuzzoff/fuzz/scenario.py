@@ -1,0 +1,118 @@
+"""One fuzz example: a profile, the gate parameters, a transport and the events of the stream.
+
+A ``Scenario`` is what the strategies draw and what a reproducer stores. ``run`` lints it with
+the engine exactly as ``fuzzoff lint`` would lint the recording the scenario is written to
+(the profile and the parameters as command-line settings, see ``lint_args``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+from fuzzoff.config import Settings
+from fuzzoff.engine import Timeline, run_events
+from fuzzoff.events import Event, event_from_dict, event_to_dict
+from fuzzoff.findings import Finding
+from fuzzoff.profiles import Profile
+from fuzzoff.sources.base import RecordingInfo
+
+TransportName = Literal["ros2", "mavlink", "mavros"]
+TRANSPORTS: tuple[TransportName, ...] = ("ros2", "mavlink", "mavros")
+
+RECORDING_FORMAT: dict[str, str] = {"ros2": "mcap", "mavlink": "tlog", "mavros": "rosbag1"}
+"""The format a reproducer of each transport is saved in (task: MCAP for ROS 2, tlog for
+MAVLink; a MAVROS stream is a ROS 1 bag, since a tlog cannot say it came through MAVROS)."""
+
+
+@dataclass(frozen=True, slots=True)
+class Scenario:
+    px4: str
+    vehicle: str
+    transport: TransportName
+    events: tuple[Event, ...]
+    params: Mapping[str, float] = field(default_factory=dict)
+
+    @property
+    def profile(self) -> Profile:
+        return Profile(px4=self.px4, vehicle=self.vehicle, px4_detected=True, vehicle_detected=True)
+
+    @property
+    def duration(self) -> float:
+        return self.events[-1].t if self.events else 0.0
+
+    def settings(self, base: Settings | None = None) -> Settings:
+        """``base`` (the campaign's rule selection) with this scenario's profile and params."""
+        from dataclasses import replace
+
+        base = base or Settings()
+        return replace(base, px4=self.px4, vehicle=self.vehicle, params=dict(self.params))
+
+    def lint_args(self) -> list[str]:
+        """The ``fuzzoff lint`` arguments that judge a recording of this scenario the same way."""
+        args = ["--px4", self.px4, "--vehicle", self.vehicle]
+        for name, value in sorted(self.params.items()):
+            args += ["--param", f"{name}={value:g}"]
+        return args
+
+    def describe(self) -> str:
+        params = ", ".join(f"{k}={v:g}" for k, v in sorted(self.params.items()))
+        return (
+            f"PX4 {self.px4}, {self.vehicle}, {self.transport}, {len(self.events)} events over "
+            f"{self.duration:.2f} s" + (f", {params}" if params else "")
+        )
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "px4": self.px4,
+            "vehicle": self.vehicle,
+            "transport": self.transport,
+            "params": dict(self.params),
+            "events": [_jsonable(event_to_dict(e)) for e in self.events],
+        }
+
+    @classmethod
+    def from_json(cls, data: Mapping[str, Any]) -> Scenario:
+        events = tuple(event_from_dict(dict(e)) for e in data["events"])
+        return cls(
+            px4=str(data["px4"]),
+            vehicle=str(data["vehicle"]),
+            transport=data["transport"],
+            events=events,
+            params={str(k): float(v) for k, v in dict(data.get("params", {})).items()},
+        )
+
+
+def _jsonable(value: Any) -> Any:
+    """NaN as the string ``"nan"`` (what ``event_from_dict`` reads back), for strict JSON."""
+    if isinstance(value, float) and value != value:
+        return "nan"
+    if isinstance(value, dict):
+        return {k: _jsonable(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_jsonable(v) for v in value]
+    return value
+
+
+def info_for(events: Sequence[Event], fmt: str) -> RecordingInfo:
+    """What a reader of ``fmt`` would say about a recording holding ``events``."""
+    return RecordingInfo("fuzz", fmt, kinds={e.kind for e in events})
+
+
+def run(
+    scenario: Scenario,
+    base: Settings | None = None,
+    *,
+    events: Sequence[Event] | None = None,
+    timelines: dict[str, Timeline] | None = None,
+) -> list[Finding]:
+    """The findings ``fuzzoff lint`` gives for the scenario (or for ``events`` instead of its
+    own, judged with its profile), sorted like the lint report."""
+    stream = list(scenario.events if events is None else events)
+    info = info_for(stream, RECORDING_FORMAT[scenario.transport])
+    settings = scenario.settings(base)
+    findings, _ = run_events(stream, info, scenario.profile, settings, timelines=timelines)
+    findings = [f for f in findings if settings.enabled(f.code)]
+    findings.sort(key=lambda f: (-1e300 if f.time_s is None else f.time_s, f.vehicle, f.code))
+    return findings

@@ -1,0 +1,406 @@
+"""Hypothesis strategies, one per concept of a setpoint stream (composed in ``fuzz.streams``).
+
+Timing: ``rates``, ``jitters``, ``stalls``, ``bursts``, ``keepalive_times``, ``clock_skews``.
+Declarations: ``control_modes``. Content: ``nan_patterns``, ``trajectory_setpoints``,
+``quaternions``, ``attitude_setpoints``, ``rates_setpoints``, ``rover_setpoints``,
+``frames``, ``type_masks``, ``mavlink_setpoints``. Commands: ``command_plans``. Parameters:
+``gate_params``. Profile: ``px4_versions``, ``vehicle_types``.
+
+Values are float32-representable (``width=32``): every recording format stores setpoints as
+float32, so a stream survives the round trip through the writers unchanged.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from hypothesis import strategies as st
+
+from fuzzoff.profiles import PX4_PROFILES, VEHICLE_TYPES, at_least
+
+NAN = math.nan
+f32 = st.floats(min_value=-200.0, max_value=200.0, width=32, allow_nan=False)
+"""A finite setpoint component (metres, m/s, rad)."""
+
+# --------------------------------------------------------------------------- profile, params
+
+
+def px4_versions(transport: str | None = None) -> st.SearchStrategy[str]:
+    """Modelled PX4 profiles; ROS 2 direct needs the boolean control mode of 1.13+."""
+    if transport == "ros2":
+        return st.sampled_from([p for p in PX4_PROFILES if at_least(p, "1.13")])
+    return st.sampled_from(PX4_PROFILES)
+
+
+def vehicle_types() -> st.SearchStrategy[str]:
+    return st.sampled_from(VEHICLE_TYPES)
+
+
+LOSS_TIMEOUTS = (0.2, 0.5, 1.0, 1.5, 2.0)
+
+
+@st.composite
+def gate_params(draw: st.DrawFn, px4: str) -> dict[str, float]:
+    """``COM_OF_LOSS_T``, the loss action (``COM_OBL_RC_ACT``) and whether an RC is present."""
+    params: dict[str, float] = {}
+    if draw(st.booleans()):
+        params["COM_OF_LOSS_T"] = draw(
+            st.one_of(
+                st.sampled_from(LOSS_TIMEOUTS), st.floats(0.1, 3.0).map(lambda x: round(x, 2))
+            )
+        )
+    if draw(st.booleans()):
+        params["COM_OBL_RC_ACT"] = float(draw(st.integers(0, 7)))
+    if draw(st.booleans()):
+        params["FUZZOFF_RC_PRESENT"] = float(draw(st.integers(0, 1)))
+    del px4  # every profile reads the same names (defaults differ, gate spec 13)
+    return params
+
+
+# --------------------------------------------------------------------------- timing
+
+
+def rates() -> st.SearchStrategy[float]:
+    """Keep-alive rate in Hz: around the documented 2 Hz and the usual 10-50 Hz."""
+    return st.one_of(st.sampled_from([2.0, 5.0, 10.0, 20.0, 50.0]), st.floats(0.5, 60.0))
+
+
+def jitters() -> st.SearchStrategy[float]:
+    """Jitter as a fraction of the period (uniform +-)."""
+    return st.one_of(st.just(0.0), st.floats(0.0, 0.9))
+
+
+@dataclass(frozen=True, slots=True)
+class Stall:
+    """No message from ``at`` (seconds into the stream) for ``length`` seconds."""
+
+    at: float
+    length: float
+
+
+def stalls(loss_timeout: float) -> st.SearchStrategy[list[Stall]]:
+    """Gaps in the stream; lengths cluster around the loss timeout (the gate's threshold)."""
+    near = st.floats(-0.15, 0.15).map(lambda d: max(0.0, round(loss_timeout + d, 3)))
+    length = st.one_of(near, st.floats(0.0, 3.0))
+    return st.lists(st.builds(Stall, at=st.floats(0.0, 6.0), length=length), max_size=2)
+
+
+def bursts() -> st.SearchStrategy[list[tuple[float, int]]]:
+    """(when, how many extra messages within 1 ms)."""
+    return st.lists(st.tuples(st.floats(0.0, 6.0), st.integers(1, 5)), max_size=2)
+
+
+@st.composite
+def keepalive_times(draw: st.DrawFn, loss_timeout: float) -> list[float]:
+    """Sorted send times of the keep-alive: a rate with jitter, stalls and bursts."""
+    rate = draw(rates())
+    period = 1.0 / rate
+    duration = draw(st.floats(0.0, 6.0))
+    jitter = draw(jitters())
+    n = min(int(duration * rate) + 1, 400)
+    offsets = draw(st.lists(st.floats(-1.0, 1.0), min_size=n, max_size=n)) if jitter else [0.0] * n
+    times = [max(0.0, i * period + jitter * period * 0.5 * o) for i, o in enumerate(offsets)]
+    for stall in draw(stalls(loss_timeout)):
+        times = [t if t < stall.at else t + stall.length for t in times]
+    for at, count in draw(bursts()):
+        times += [at + 0.0002 * k for k in range(count)]
+    return sorted(round(t, 4) for t in times)
+
+
+@dataclass(frozen=True, slots=True)
+class ClockSkew:
+    """The sender's clock against the recording's: offset, drift, and swapped neighbours."""
+
+    offset_s: float
+    drift: float
+    swaps: tuple[int, ...]
+
+    def stamp(self, times: Sequence[float]) -> list[int]:
+        stamps = [max(0, round((t + self.offset_s + t * self.drift) * 1e6)) for t in times]
+        for i in self.swaps:
+            if i + 1 < len(stamps):
+                stamps[i], stamps[i + 1] = stamps[i + 1], stamps[i]
+        return stamps
+
+
+def clock_skews() -> st.SearchStrategy[ClockSkew]:
+    """Mostly none; else an offset (negative = old timestamps), drift and reordering."""
+    return st.one_of(
+        st.just(ClockSkew(0.0, 0.0, ())),
+        st.builds(
+            ClockSkew,
+            offset_s=st.one_of(st.floats(-3.0, 3.0), st.sampled_from([-1.0, 0.5, 5.0])),
+            drift=st.floats(-0.2, 0.2),
+            swaps=st.lists(st.integers(0, 40), max_size=3).map(tuple),
+        ),
+    )
+
+
+# --------------------------------------------------------------------------- declarations
+
+OCM_FLAGS_BEFORE_115 = ("position", "velocity", "acceleration", "attitude", "body_rate", "actuator")
+OCM_FLAGS_115 = (
+    "position",
+    "velocity",
+    "acceleration",
+    "attitude",
+    "body_rate",
+    "thrust_and_torque",
+    "direct_actuator",
+)
+
+
+@st.composite
+def control_modes(draw: st.DrawFn, px4: str) -> dict[str, Any]:
+    """``OffboardControlMode`` flags of the release's layout: usually one flag, sometimes a
+    mix, sometimes none (OFB301)."""
+    names = OCM_FLAGS_115 if at_least(px4, "1.15") else OCM_FLAGS_BEFORE_115
+    layout = "thrust_and_torque" if at_least(px4, "1.15") else "actuator"
+    chosen = draw(
+        st.one_of(
+            st.sampled_from(names).map(lambda n: {n}),
+            st.sets(st.sampled_from(names), max_size=3),
+        )
+    )
+    flags: dict[str, Any] = {name: True for name in chosen}
+    flags["layout"] = layout
+    return flags
+
+
+# --------------------------------------------------------------------------- setpoint content
+
+
+@dataclass(frozen=True, slots=True)
+class NanPattern:
+    """Which components are set (True) per vector: position, velocity, acceleration; yaw."""
+
+    position: tuple[bool, bool, bool]
+    velocity: tuple[bool, bool, bool]
+    acceleration: tuple[bool, bool, bool]
+    yaw: bool
+
+
+_TRIPLE = st.tuples(st.booleans(), st.booleans(), st.booleans())
+_COMMON_TRIPLES = st.sampled_from([(True, True, True), (False, False, False)])
+
+
+def nan_patterns() -> st.SearchStrategy[NanPattern]:
+    """Per-axis NaN patterns: the documented whole-vector ones and arbitrary per-axis mixes."""
+    triple = st.one_of(_COMMON_TRIPLES, _TRIPLE)
+    return st.builds(NanPattern, triple, triple, triple, st.booleans())
+
+
+def _vec(draw: st.DrawFn, mask: tuple[bool, bool, bool]) -> tuple[float, float, float]:
+    x, y, z = (draw(f32) if m else NAN for m in mask)
+    return (x, y, z)
+
+
+@st.composite
+def trajectory_values(draw: st.DrawFn, pattern: NanPattern) -> dict[str, Any]:
+    """Field values of a ``TrajectorySetpoint`` following ``pattern``."""
+    return {
+        "position": _vec(draw, pattern.position),
+        "velocity": _vec(draw, pattern.velocity),
+        "acceleration": _vec(draw, pattern.acceleration),
+        "yaw": draw(f32) if pattern.yaw else NAN,
+    }
+
+
+def trajectory_setpoints() -> st.SearchStrategy[dict[str, Any]]:
+    return nan_patterns().flatmap(trajectory_values)
+
+
+def _f32(x: float) -> float:
+    import struct
+
+    return float(struct.unpack("<f", struct.pack("<f", x))[0])
+
+
+def quaternions() -> st.SearchStrategy[tuple[float, float, float, float]]:
+    """Unit quaternions (w, x, y, z), and some that are not (zero, scaled, NaN)."""
+
+    def unit(v: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
+        n = math.sqrt(sum(c * c for c in v))
+        if n < 1e-3:
+            return (1.0, 0.0, 0.0, 0.0)
+        w, x, y, z = (_f32(c / n) for c in v)
+        return (w, x, y, z)
+
+    comp = st.floats(-1.0, 1.0, width=32)
+    raw = st.tuples(comp, comp, comp, comp)
+    return st.one_of(
+        raw.map(unit),
+        raw,
+        st.just((NAN, NAN, NAN, NAN)),
+        st.just((0.0, 0.0, 0.0, 0.0)),
+    )
+
+
+def thrusts() -> st.SearchStrategy[float]:
+    """Normalised thrust, sometimes out of [-1, 1] or NaN."""
+    return st.one_of(st.floats(-1.0, 1.0, width=32), st.floats(-3.0, 3.0, width=32), st.just(NAN))
+
+
+@st.composite
+def attitude_setpoints(draw: st.DrawFn) -> dict[str, Any]:
+    return {"q_d": draw(quaternions()), "thrust_body": (0.0, 0.0, draw(thrusts()))}
+
+
+@st.composite
+def rates_setpoints(draw: st.DrawFn) -> dict[str, Any]:
+    rate = st.one_of(st.floats(-5.0, 5.0, width=32), st.just(NAN))
+    return {
+        "roll": draw(rate),
+        "pitch": draw(rate),
+        "yaw": draw(rate),
+        "thrust_body": (0.0, 0.0, draw(thrusts())),
+    }
+
+
+ROVER_KINDS = (
+    "rover_position",
+    "rover_speed",
+    "rover_attitude",
+    "rover_rate",
+    "rover_throttle",
+    "rover_steering",
+)
+
+
+@st.composite
+def rover_setpoints(draw: st.DrawFn, kind: str | None = None) -> tuple[str, dict[str, Any]]:
+    """(kind, values) of one rover setpoint topic; NaN where the docs require it, or not."""
+    kind = kind or draw(st.sampled_from(ROVER_KINDS))
+    value = st.one_of(st.floats(-2.0, 2.0, width=32), st.just(NAN))
+    if kind == "rover_position":
+        return kind, {"position_ned": (draw(f32), draw(f32)), "yaw": draw(value)}
+    if kind == "rover_speed":
+        return kind, {"speed_body_x": draw(value), "speed_body_y": draw(value)}
+    if kind == "rover_attitude":
+        return kind, {"yaw_setpoint": draw(value)}
+    if kind == "rover_rate":
+        return kind, {"yaw_rate_setpoint": draw(value)}
+    if kind == "rover_throttle":
+        return kind, {"throttle_body_x": draw(value), "throttle_body_y": draw(value)}
+    return kind, {"normalized_steering_angle": draw(value), "normalized_speed_diff": draw(value)}
+
+
+# --------------------------------------------------------------------------- MAVLink content
+
+LOCAL_FRAMES = (1, 7, 8, 9, 20, 21)
+GLOBAL_FRAMES = (5, 6, 11, 0, 3, 10)
+COMMON_TYPE_MASKS = (
+    0b110111111000,  # position
+    0b110111000111,  # velocity
+    0b110000111111,  # acceleration
+    0b100111111000,  # position + yaw rate
+    0b000111111000,  # position + yaw + yaw rate
+    0b110000000000,  # position, velocity, acceleration
+    0b0001000000000000 | 0b110111111000,  # fixed-wing takeoff bit
+    3576,
+    0,
+)
+
+
+def frames(kind: str) -> st.SearchStrategy[int]:
+    """Coordinate frames: the supported ones, neighbours the receiver drops, and any value."""
+    usual = LOCAL_FRAMES if kind == "local" else GLOBAL_FRAMES
+    return st.one_of(st.sampled_from(usual), st.integers(0, 21))
+
+
+def type_masks() -> st.SearchStrategy[int]:
+    return st.one_of(st.sampled_from(COMMON_TYPE_MASKS), st.integers(0, 0xFFFF))
+
+
+@st.composite
+def mavlink_setpoints(draw: st.DrawFn) -> tuple[str, dict[str, Any]]:
+    """(kind, fields) of one SET_POSITION_TARGET_* / SET_ATTITUDE_TARGET message."""
+    kind = draw(st.sampled_from(("local", "local", "global", "attitude")))
+    if kind == "attitude":
+        mask = draw(st.one_of(st.sampled_from((0, 7, 0b10000111, 128, 64)), st.integers(0, 255)))
+        return "set_attitude_target", {
+            "type_mask": mask,
+            "q": draw(quaternions()),
+            "body_roll_rate": draw(st.floats(-3.0, 3.0, width=32)),
+            "body_pitch_rate": draw(st.floats(-3.0, 3.0, width=32)),
+            "body_yaw_rate": draw(st.floats(-3.0, 3.0, width=32)),
+            "thrust": draw(thrusts()),
+        }
+    vec = st.tuples(f32, f32, f32)
+    common = {
+        "type_mask": draw(type_masks()),
+        "velocity": draw(vec),
+        "acceleration": draw(vec),
+        "yaw": draw(st.floats(-3.0, 3.0, width=32)),
+        "yaw_rate": draw(st.floats(-3.0, 3.0, width=32)),
+    }
+    if kind == "local":
+        return "set_position_target_local_ned", {
+            **common,
+            "coordinate_frame": draw(frames("local")),
+            "position": draw(vec),
+        }
+    return "set_position_target_global_int", {
+        **common,
+        "coordinate_frame": draw(frames("global")),
+        "lat_int": draw(st.integers(-900_000_000, 900_000_000)),
+        "lon_int": draw(st.integers(-1_800_000_000, 1_800_000_000)),
+        "alt": draw(st.floats(-100.0, 500.0, width=32)),
+    }
+
+
+# --------------------------------------------------------------------------- commands
+
+
+@dataclass(frozen=True, slots=True)
+class CommandPlan:
+    """When the stream's operator arms, switches to OFFBOARD, leaves it and disarms (None =
+    never); ``set_nav_state`` uses ROS 2's VEHICLE_CMD_SET_NAV_STATE instead of DO_SET_MODE."""
+
+    arm: float | None
+    switch: float | None
+    leave: float | None
+    disarm: float | None
+    set_nav_state: bool = False
+    acks: bool = True
+
+
+def _moment(duration: float) -> st.SearchStrategy[float | None]:
+    return st.one_of(st.none(), st.floats(0.0, max(duration, 0.01)).map(lambda x: round(x, 3)))
+
+
+@st.composite
+def command_plans(draw: st.DrawFn, duration: float, ros2_nav_state: bool) -> CommandPlan:
+    """Arm before or after the switch, the switch anywhere in the stream (often early, near
+    the 1 s the docs ask for), maybe leave OFFBOARD and disarm later."""
+    early = st.floats(0.0, 1.5).map(lambda x: round(x, 3))
+    switch = draw(st.one_of(early, _moment(duration)))
+    arm = draw(st.one_of(early, _moment(duration)))
+    leave = draw(st.one_of(st.none(), _moment(duration + 1.0)))
+    disarm = draw(st.one_of(st.none(), _moment(duration + 1.0)))
+    return CommandPlan(
+        arm=arm,
+        switch=switch,
+        leave=leave,
+        disarm=disarm,
+        set_nav_state=ros2_nav_state and draw(st.booleans()),
+        acks=draw(st.booleans()),
+    )
+
+
+# --------------------------------------------------------------------------- helpers
+
+
+def frozen_or_moving(values: dict[str, Any]) -> Callable[[int], dict[str, Any]]:
+    """The i-th message's values: a frozen setpoint repeats them, a moving one shifts x."""
+
+    def nth(i: int) -> dict[str, Any]:
+        pos = values.get("position")
+        if isinstance(pos, tuple) and math.isfinite(pos[0]):
+            return {**values, "position": (_f32(pos[0] + 0.01 * i), pos[1], pos[2])}
+        return values
+
+    return nth

@@ -1,0 +1,321 @@
+"""Compose the concept strategies into whole streams (``scenarios``), per transport.
+
+* ``ros2``: ``ControlMode`` keep-alive + PX4 setpoint topics + ``VehicleCommand`` (and the
+  vehicle's ``VehicleCommandAck``), as ``/fmu/in`` and ``/fmu/out`` of an MCAP recording;
+* ``mavlink``: SET_POSITION_TARGET_* / SET_ATTITUDE_TARGET from the companion (they are the
+  keep-alive), COMMAND_LONG and the autopilot's COMMAND_ACK, as in a tlog;
+* ``mavros``: the same MAVLink setpoints with ``transport="mavros"`` and ``/mavros/state`` (a
+  MAVROS bag has no commands: mode changes are service calls, only the state shows them).
+
+The vehicle's side (acks, MAVROS state) is what the gate model predicts for the sent side
+(``echo``): a recording of a vehicle that behaves as the model says. Events are built exactly as
+the readers give them back (sender ids, ``from_external``, sender timestamps), so the round trip
+through a writer and a reader can be compared field by field.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import replace
+from typing import Any
+
+from hypothesis import strategies as st
+
+from fuzzoff import events as ev
+from fuzzoff.fuzz import strategies as fs
+from fuzzoff.fuzz.scenario import TRANSPORTS, Scenario, TransportName
+from fuzzoff.gate import GateModel
+from fuzzoff.gate.params import default_params, loss_timeout
+from fuzzoff.modes import mavros_mode_to_nav_state, nav_state_to_mavros_mode
+from fuzzoff.profiles import Profile, at_least, is_rover
+
+MIN_STEP = 0.0001
+"""Distinct receive times: events never share a timestamp (the readers' order for equal
+timestamps is the file's, which a writer need not keep)."""
+
+COMPANION = (1, 191)
+MODE_POSCTL = (1.0, 3.0)
+"""DO_SET_MODE params for POSCTL (custom main mode 3)."""
+
+
+def _cmd(t: float, command: int, params: Sequence[float], transport: TransportName) -> ev.Command:
+    p = (list(params) + [0.0] * 7)[:7]
+    full = (p[0], p[1], p[2], p[3], p[4], p[5], p[6])
+    if transport == "ros2":
+        return ev.Command(
+            t=t,
+            command=command,
+            params=full,
+            sender_time_us=round(t * 1e6),
+            source_system=0,
+            source_component=0,
+            from_external=True,
+            transport="ros2",
+        )
+    return ev.Command(
+        t=t,
+        vehicle="1",
+        command=command,
+        params=full,
+        source_system=COMPANION[0],
+        source_component=COMPANION[1],
+        from_external=True,
+        transport="mavlink",
+    )
+
+
+def commands(plan: fs.CommandPlan, transport: TransportName) -> list[ev.Command]:
+    """The plan's commands (none for MAVROS: its mode changes are service calls)."""
+    out: list[ev.Command] = []
+    if plan.arm is not None:
+        out.append(_cmd(plan.arm, ev.MAV_CMD_COMPONENT_ARM_DISARM, (1.0,), transport))
+    if plan.switch is not None:
+        if plan.set_nav_state:
+            out.append(_cmd(plan.switch, ev.VEHICLE_CMD_SET_NAV_STATE, (14.0,), transport))
+        else:
+            out.append(_cmd(plan.switch, ev.MAV_CMD_DO_SET_MODE, (1.0, 6.0), transport))
+    if plan.leave is not None:
+        out.append(_cmd(plan.leave, ev.MAV_CMD_DO_SET_MODE, MODE_POSCTL, transport))
+    if plan.disarm is not None:
+        out.append(_cmd(plan.disarm, ev.MAV_CMD_COMPONENT_ARM_DISARM, (0.0,), transport))
+    return out
+
+
+def settle(events: Sequence[ev.Event]) -> list[ev.Event]:
+    """Sorted, starting at 0 (a recording's clock starts at its first message), 0.1 ms
+    resolution, strictly increasing."""
+    ordered = sorted(events, key=lambda e: e.t)
+    if not ordered:
+        return []
+    t0 = ordered[0].t
+    out: list[ev.Event] = []
+    last = -1.0
+    for e in ordered:
+        t = round(max(e.t - t0, last + MIN_STEP), 4)
+        if t != e.t:
+            e = _retime(e, t)
+        out.append(e)
+        last = t
+    return out
+
+
+def _retime(e: ev.Event, t: float) -> ev.Event:
+    """Move ``e`` to ``t``; a sender stamp that tracked the send time moves with it."""
+    if e.sender_time_us is not None and e.sender_time_us == round(e.t * 1e6):
+        if e.kind.startswith("set_"):  # MAVLink time_boot_ms: millisecond resolution
+            return replace(e, t=t, sender_time_us=round(t * 1e3) * 1000)
+        return replace(e, t=t, sender_time_us=round(t * 1e6))
+    return replace(e, t=t)
+
+
+# ----------------------------------------------------------------------------- the vehicle
+
+ACCEPT = {"request_accepted", "arm_accepted", "disarmed", "mode"}
+REJECT = {"request_rejected", "arm_rejected"}
+
+
+def echo(
+    sent: Sequence[ev.Event],
+    px4: str,
+    vehicle: str,
+    params: dict[str, float],
+    *,
+    acks: bool,
+    status: bool,
+    transport: TransportName,
+) -> list[ev.Event]:
+    """The vehicle's answers the gate model predicts: a COMMAND_ACK per command (two for a
+    MAVLink mode switch on 1.16/1.17, gate spec 4.3), and for MAVROS the state at 1 Hz and at
+    each change."""
+    profile = Profile(px4=px4, vehicle=vehicle, px4_detected=True, vehicle_detected=True)
+    vid = "1" if transport == "mavlink" else ""
+    model = GateModel(profile, params, vid)
+    out: list[ev.Event] = []
+    last_state: tuple[int | None, bool] | None = None
+    next_beat = 0.0
+    for event in sent:
+        if status:
+            while next_beat <= event.t:
+                model.feed(ev.Dropout(t=next_beat, vehicle=vid))  # advance the clock only
+                out.append(_status(next_beat + 0.0002, model, vid))
+                last_state = (model.nav_state, model.armed)
+                next_beat += 1.0
+        transitions = model.feed(event)
+        if isinstance(event, ev.Command) and acks:
+            out += _acks(event, transitions, px4, transport, vid)
+        if status and (model.nav_state, model.armed) != last_state:
+            last_state = (model.nav_state, model.armed)
+            out.append(_status(event.t + 0.003, model, vid))
+    if status and sent:
+        model.finish(sent[-1].t)
+    return out
+
+
+def _status(t: float, model: GateModel, vid: str) -> ev.VehicleStatus:
+    nav = model.nav_state if model.nav_state is not None else 2
+    # /mavros/state names a mode; the writer knows no name for some (TERMINATION, DESCEND):
+    # the state shows what the name reads back as.
+    nav = mavros_mode_to_nav_state(nav_state_to_mavros_mode(nav)) or 0
+    return ev.VehicleStatus(
+        t=t, vehicle=vid, nav_state=nav, mode=nav_state_to_mavros_mode(nav), armed=model.armed
+    )
+
+
+def _acks(
+    cmd: ev.Command,
+    transitions: Sequence[Any],
+    px4: str,
+    transport: TransportName,
+    vid: str,
+) -> list[ev.Event]:
+    ours = [tr for tr in transitions if tr.cause is cmd]
+    rejected = any(tr.what in REJECT or (tr.what == "mode" and tr.reason) for tr in ours)
+    result = 1 if rejected else 0
+    out: list[ev.Event] = []
+    stamp = transport == "ros2"
+
+    def ack(t: float, res: int) -> ev.CommandAck:
+        return ev.CommandAck(
+            t=t,
+            vehicle=vid,
+            command=cmd.command,
+            result=res,
+            target_system=0 if stamp else COMPANION[0],
+            target_component=0 if stamp else COMPANION[1],
+            sender_time_us=round(t * 1e6) if stamp else None,
+        )
+
+    if transport == "mavlink" and cmd.is_mode_switch and px4 in ("1.16", "1.17"):
+        out.append(ack(cmd.t + 0.002, 0))
+    out.append(ack(cmd.t + 0.008, result))
+    return out
+
+
+# ----------------------------------------------------------------------------- per transport
+
+
+def _ros2_setpoint_kinds(vehicle: str, px4: str) -> list[str]:
+    kinds = ["trajectory", "trajectory", "attitude", "rates", "none"]
+    if is_rover(vehicle) and at_least(px4, "1.16"):
+        kinds += list(fs.ROVER_KINDS) * 2
+    return kinds
+
+
+_ROS2_BUILD: dict[str, Callable[..., ev.Event]] = {
+    "trajectory": ev.TrajectorySetpoint,
+    "attitude": ev.AttitudeSetpoint,
+    "rates": ev.RatesSetpoint,
+    "rover_position": ev.RoverPositionSetpoint,
+    "rover_speed": ev.RoverSpeedSetpoint,
+    "rover_attitude": ev.RoverAttitudeSetpoint,
+    "rover_rate": ev.RoverRateSetpoint,
+    "rover_throttle": ev.RoverThrottleSetpoint,
+    "rover_steering": ev.RoverSteeringSetpoint,
+}
+
+
+@st.composite
+def ros2_sent(draw: st.DrawFn, px4: str, vehicle: str, times: list[float]) -> list[ev.Event]:
+    """Keep-alive and setpoints of a ROS 2 companion (``/fmu/in``)."""
+    flags = draw(fs.control_modes(px4))
+    skew = draw(fs.clock_skews())
+    stamps = skew.stamp(times)
+    out: list[ev.Event] = [
+        ev.ControlMode(t=t, sender_time_us=s, **flags) for t, s in zip(times, stamps, strict=True)
+    ]
+    kind = draw(st.sampled_from(_ros2_setpoint_kinds(vehicle, px4)))
+    if kind == "none" or not times:
+        return out
+    if kind == "trajectory":
+        values = draw(fs.trajectory_setpoints())
+    elif kind == "attitude":
+        values = draw(fs.attitude_setpoints())
+    elif kind == "rates":
+        values = draw(fs.rates_setpoints())
+    else:
+        _, values = draw(fs.rover_setpoints(kind))
+    nth = fs.frozen_or_moving(values) if draw(st.booleans()) else (lambda i: values)
+    # Setpoints follow each keep-alive by 1 ms, from the first one or later, until the last or
+    # earlier (stale setpoints under a live keep-alive: OFB104).
+    start = draw(st.integers(0, len(times) - 1)) if draw(st.booleans()) else 0
+    stop = len(times) if draw(st.booleans()) else draw(st.integers(start, len(times)))
+    build = _ROS2_BUILD[kind]
+    for i in range(start, stop):
+        t = times[i] + 0.001
+        out.append(build(t=t, sender_time_us=round(t * 1e6), **nth(i)))
+    return out
+
+
+_MAV_BUILD: dict[str, type[ev.MavlinkTarget]] = {
+    "set_position_target_local_ned": ev.SetPositionTargetLocal,
+    "set_position_target_global_int": ev.SetPositionTargetGlobal,
+    "set_attitude_target": ev.SetAttitudeTarget,
+}
+
+
+@st.composite
+def mavlink_sent(draw: st.DrawFn, times: list[float], transport: TransportName) -> list[ev.Event]:
+    """MAVLink setpoints (each one a keep-alive) from the companion."""
+    kind, values = draw(fs.mavlink_setpoints())
+    if transport == "mavros" and "thrust" in values:
+        # MAVROS clamps thrust to [0, 1] before it is sent (writers/rosbag1.py): what PX4 gets.
+        thrust = float(values["thrust"])
+        values["thrust"] = min(max(thrust, 0.0), 1.0) if thrust == thrust else 0.0
+    skew = draw(fs.clock_skews()) if transport == "mavlink" else fs.ClockSkew(0.0, 0.0, ())
+    stamps = [s // 1000 * 1000 for s in skew.stamp(times)]
+    nth = fs.frozen_or_moving(values) if draw(st.booleans()) else (lambda i: values)
+    build = _MAV_BUILD[kind]
+    out: list[ev.Event] = []
+    for i, t in enumerate(times):
+        extra: dict[str, Any]
+        if transport == "mavlink":
+            extra = {"source_system": COMPANION[0], "source_component": COMPANION[1]}
+            extra["sender_time_us"] = stamps[i] % (2**32 * 1000)
+            extra["vehicle"] = "1"
+        else:  # MAVROS addresses its target (tgt_system 1, tgt_component 1); ROS namespace ""
+            extra = {"target_system": 1, "target_component": 1, "vehicle": ""}
+        out.append(build(t=t, transport=transport, **extra, **nth(i)))
+    return out
+
+
+@st.composite
+def scenarios(
+    draw: st.DrawFn,
+    px4: str | None = None,
+    vehicle: str | None = None,
+    transport: TransportName | None = None,
+) -> Scenario:
+    """A whole stream: profile, parameters, keep-alive timing, content, commands, answers."""
+    chosen: TransportName = (
+        transport if transport is not None else draw(st.sampled_from(TRANSPORTS))
+    )
+    px4 = px4 or draw(fs.px4_versions(chosen))
+    if chosen == "ros2" and not at_least(px4, "1.13"):
+        chosen = "mavlink"  # the ROS 2 control mode does not exist before 1.13
+    vehicle = vehicle or draw(fs.vehicle_types())
+    params = draw(fs.gate_params(px4))
+    timeout = loss_timeout(px4, default_params(px4) | params)
+    times = draw(fs.keepalive_times(timeout))
+    duration = times[-1] if times else 0.0
+    if chosen == "ros2":
+        sent = draw(ros2_sent(px4, vehicle, times))
+    else:
+        sent = draw(mavlink_sent(times, chosen))
+    plan = draw(fs.command_plans(duration, chosen == "ros2" and at_least(px4, "1.15")))
+    if chosen == "mavros":
+        plan = replace(plan, acks=False)
+    sent = settle([*sent, *commands(plan, chosen)])
+    answers = echo(
+        sent,
+        px4,
+        vehicle,
+        params,
+        acks=plan.acks,
+        status=chosen == "mavros",
+        transport=chosen,
+    )
+    stream = settle([*sent, *answers])
+    if chosen == "mavros":
+        stream = [e for e in stream if not isinstance(e, ev.Command)]
+        stream = settle(stream)
+    return Scenario(px4=px4, vehicle=vehicle, transport=chosen, events=tuple(stream), params=params)
