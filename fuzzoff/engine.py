@@ -109,13 +109,20 @@ class VehicleRun:
             self._dispatch(tr)
 
     def feed(self, event: Event) -> None:
+        """The hot path: runs once per event of a recording, so it is kept flat."""
         self.last_t = event.t
         self.state.update(event)
-        self._transitions(self.gate.feed(event))
+        transitions = self.gate.feed(event)
+        if transitions:
+            self._transitions(transitions)
         self.state.set_predicted(self.gate.in_offboard, event.t)
         if self.timeline is not None:
             self._record(event)
-        self._dispatch(event)
+        handlers = self.handlers.get(type(event))
+        if handlers is None:
+            handlers = self._handlers_for(type(event))
+        for handler in handlers:
+            handler(event)
 
     def _record(self, event: Event) -> None:
         assert self.timeline is not None
