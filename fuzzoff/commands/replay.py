@@ -1,0 +1,139 @@
+"""``fuzzoff replay REPRODUCER``: re-check a saved reproducer, or stream it to a live PX4.
+
+Without ``--to``: lint the recording with the reproducer's arguments and compare with its
+expected findings (the corpus rule: same codes and severities, times within 0.05 s), then run
+the property it broke again. Exit 0 when the findings match and the property holds now (the bug
+is fixed), 1 when the findings differ or the property still fails, 2 when the reproducer cannot
+be read.
+
+With ``--to udp:HOST:PORT``: send the recording's MAVLink stream (a tlog) to that endpoint at
+its recorded timing (``--speed`` to scale), e.g. to a PX4 SITL's offboard port.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+from fuzzoff.commands._common import write_output
+from fuzzoff.config import ConfigError
+from fuzzoff.fuzz.reproducers import ReproducerError, load, recheck
+from fuzzoff.report.sanitize import printable
+
+TIME_TOLERANCE_S = 0.05
+
+
+def add_parser(sub: Any) -> None:
+    parser = sub.add_parser(
+        "replay", help="re-check a fuzz reproducer, or stream it to a live PX4 (--to udp:...)"
+    )
+    parser.add_argument("path", metavar="REPRODUCER", help="NAME.expected.json or its recording")
+    parser.add_argument("--to", metavar="udp:HOST:PORT", help="stream the MAVLink packets there")
+    parser.add_argument("--speed", type=float, default=1.0, help="time scale for --to (2 = 2x)")
+    parser.add_argument("--format", choices=("terminal", "json"), default="terminal")
+    parser.add_argument("--output", "-o", metavar="FILE")
+    parser.set_defaults(run=run)
+
+
+def _key(f: dict[str, Any]) -> tuple[str, str, str]:
+    return (str(f["code"]), str(f["severity"]), str(f.get("vehicle", "")))
+
+
+def compare(expected: list[dict[str, Any]], actual: list[dict[str, Any]]) -> list[str]:
+    """Missing and unexpected findings (the corpus matching of tests/test_corpora.py)."""
+    remaining = list(actual)
+    problems = []
+    for want in expected:
+        hit = None
+        for got in remaining:
+            if _key(got)[:2] != _key(want)[:2]:
+                continue
+            if "vehicle" in want and want["vehicle"] != got.get("vehicle", ""):
+                continue
+            wt, gt = want.get("time_s"), got.get("time_s")
+            if (wt is None) != (gt is None):
+                continue
+            if wt is None or abs(float(wt) - float(gt)) <= TIME_TOLERANCE_S:
+                hit = got
+                break
+        if hit is None:
+            problems.append(f"missing {want['code']} {want['severity']} at {want.get('time_s')}")
+        else:
+            remaining.remove(hit)
+    problems += [f"unexpected {f['code']} {f['severity']} at {f['time_s']}" for f in remaining]
+    return problems
+
+
+def run(args: argparse.Namespace) -> int:
+    try:
+        spec, recording = load(Path(args.path))
+    except ReproducerError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    if not recording.exists():
+        print(f"error: {recording}: the reproducer's recording is missing", file=sys.stderr)
+        return 2
+    if args.to:
+        return _stream(recording, args)
+    from fuzzoff.engine import lint_file
+    from fuzzoff.fuzz.reproducers import expected_findings
+    from fuzzoff.fuzz.scenario import Scenario
+
+    info = spec.get("scenario") or {}
+    scenario = Scenario(
+        px4=str(info.get("px4", "1.15")),
+        vehicle=str(info.get("vehicle", "mc")),
+        transport=info.get("transport", "ros2"),
+        events=(),
+        params={str(k): float(v) for k, v in dict(info.get("params", {})).items()},
+    )
+    report = lint_file(recording, scenario.settings())
+    differ = compare(list(spec.get("findings", [])), expected_findings(report))
+    still = recheck(spec, recording)
+    prop = spec.get("property")
+    data = {
+        "reproducer": str(args.path),
+        "recording": str(recording),
+        "property": prop,
+        "findings_match": not differ,
+        "finding_differences": differ,
+        "property_still_fails": bool(still),
+        "problems": still,
+    }
+    if args.format == "json":
+        text = json.dumps(data, indent=2) + "\n"
+    else:
+        lines = [f"{printable(str(recording))}:"]
+        lines.append("  findings: " + ("as expected" if not differ else "DIFFER"))
+        lines += [f"    {d}" for d in differ]
+        if prop:
+            verdict = "still fails" if still else "holds now (fixed?)"
+            lines.append(f"  property {prop}: {verdict}")
+            lines += [f"    {printable(p, 300)}" for p in still]
+        text = "\n".join(lines) + "\n"
+    write_output(text, args.output)
+    return 1 if differ or still else 0
+
+
+def _stream(recording: Path, args: argparse.Namespace) -> int:
+    from fuzzoff.fuzz.udp import TargetError, parse_target, sent_packets, stream
+
+    try:
+        host, port = parse_target(args.to)
+    except TargetError as exc:
+        raise ConfigError(str(exc)) from None
+    if args.speed <= 0:
+        raise ConfigError("--speed must be positive")
+    if recording.suffix != ".tlog":
+        raise ConfigError(f"{recording}: --to streams MAVLink: only a .tlog reproducer")
+    try:
+        packets = sent_packets(recording)
+    except (OSError, ValueError) as exc:
+        print(f"error: {recording}: not a readable tlog: {exc}", file=sys.stderr)
+        return 2
+    count = stream(packets, host, port, speed=args.speed)
+    print(f"sent {count} packets to {host}:{port} over {packets[-1].t if packets else 0:.2f} s")
+    return 0
