@@ -460,3 +460,14 @@ def test_ofb107_not_while_disarmed() -> None:
         *_repeat(0.0, 5.0, 20.0, position=(0.0, 0.0, -2.0)),
     ]
     assert codes(lint_events(events), "OFB107") == []
+
+
+def test_ofb107_an_all_nan_rover_setpoint_published_on_purpose_is_not_frozen() -> None:
+    """Seed 000: Speed + Rate needs RoverAttitudeSetpoint published as NaN, unchanging."""
+    from fuzzoff.events import ControlMode, RoverAttitudeSetpoint, VehicleStatus
+    from tests.streams import codes, every, lint_events
+
+    events = [VehicleStatus(t=0.0, nav_state=14, armed=True)]
+    events += [ControlMode(t=t, velocity=True) for t in every(0.0, 8.0, 0.1)]
+    events += [RoverAttitudeSetpoint(t=t + 0.01) for t in every(0.0, 8.0, 0.05)]
+    assert codes(lint_events(events, px4="1.17", vehicle="rover-differential"), "OFB107") == []

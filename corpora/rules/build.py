@@ -201,9 +201,29 @@ def mcap_cases() -> list[Case]:
     )
 
     # OFB106: the companion's clock stops at 3.0 s; the first message lagging by more than
-    # COM_OF_LOSS_T (1.0 s) is at 4.1 s. PX4 1.15 would take the stream for lost (warning).
-    frozen_clock = Flight(POSITION, climb, ocm_stamp=lambda t: stamp(min(t, 3.0))).events()
-    cases.append(Case("ofb106_clock_stops", frozen_clock, [("OFB106", "warning", 4.1)], []))
+    # COM_OF_LOSS_T (1.0 s) is at 4.1 s. PX4 1.15 takes the stream for lost (warning): it judges
+    # the keep-alive's age by its rewritten timestamp (gate spec 2.1.1), so at the 10 Hz check
+    # after 4.0 s it fails over to POSCTL (OFB103 at 4.01 s), which the recorded status shows
+    # from 4.1 s with its failsafe flag.
+    frozen_clock = [
+        e
+        for e in Flight(POSITION, climb, ocm_stamp=lambda t: stamp(min(t, 3.0))).events()
+        if not (isinstance(e, VehicleStatus) and e.t >= 4.1)
+    ]
+    frozen_clock += [
+        VehicleStatus(t=t, nav_state=POSCTL, armed=True, failsafe=True)
+        for t in [4.1, *ticks(4.2, END_T, STATUS_PERIOD)]
+    ]
+    frozen_clock.sort(key=lambda e: e.t)
+    cases.append(
+        Case(
+            "ofb106_clock_stops",
+            frozen_clock,
+            # ...and the companion keeps publishing TrajectorySetpoint in POSCTL (OFB203).
+            [("OFB106", "warning", 4.1), ("OFB103", "error", 4.01), ("OFB203", "error", 4.15)],
+            ["OFB202"],
+        )
+    )
 
     # OFB107: at 2.5 s the planner dies; the library re-sends its last setpoint for 3.45 s.
     def dead_planner(t: float) -> list[Event]:

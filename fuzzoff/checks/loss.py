@@ -27,6 +27,12 @@ RECORDED_ANSWER_WINDOW_S = 2.5
 (PX4's HEARTBEAT is 1 Hz and the loss is evaluated at 10 Hz)."""
 
 
+def _inner(message: str) -> str:
+    """``offboard signal lost (why)`` -> ``why``."""
+    _head, sep, rest = message.partition("(")
+    return rest[:-1] if sep and rest.endswith(")") else message
+
+
 @dataclass(slots=True)
 class _Pending:
     t: float
@@ -45,6 +51,8 @@ class OffboardLoss(Check):
         self.last_where = Where("keep-alive")
         self.last_flying = False
         self.pending: _Pending | None = None
+        self.lost: GateTransition | None = None
+        """The gate's latest ``signal_lost`` (its message says why: silence, an old stamp...)."""
         self.reported_until: float = -1.0
         """Keep-alive time up to which a loss has been reported (one finding per gap)."""
 
@@ -52,7 +60,9 @@ class OffboardLoss(Check):
         if self.pending is not None and event.t - self.pending.t > RECORDED_ANSWER_WINDOW_S:
             self._flush(None)
         if isinstance(event, GateTransition):
-            if event.what == "failsafe":
+            if event.what == "signal_lost":
+                self.lost = event
+            elif event.what == "failsafe":
                 self._from_gate(event)
         elif isinstance(event, VehicleStatus):
             if self.pending is not None and event.nav_state is not None and not event.in_offboard:
@@ -70,11 +80,13 @@ class OffboardLoss(Check):
 
     def _from_gate(self, tr: GateTransition) -> None:
         timeout = loss_timeout(self.ctx)
-        stopped = (
-            f"the keep-alive stopped at {self.last:.2f} s"
-            if self.last is not None
-            else ("no keep-alive")
-        )
+        if self.last is None:
+            stopped = "no keep-alive"
+        elif tr.t - self.last < timeout and self.lost is not None:
+            why = self.lost.reason or _inner(self.lost.message)
+            stopped = f"the keep-alive kept arriving but PX4 no longer counts it ({why})"
+        else:
+            stopped = f"the keep-alive stopped at {self.last:.2f} s"
         action = tr.action or "its failsafe"
         message = (
             f"{stopped} while in OFFBOARD; {px4_label(self.ctx)} declares the offboard signal lost "
