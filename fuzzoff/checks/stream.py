@@ -52,6 +52,7 @@ class KeepaliveRate(Check):
         self.last: float | None = None
         self.last_in_offboard = False
         self.dropout_since_last = False
+        self.last_where = Where("keep-alive")
         self.switches = RecordedSwitches(ctx)
         self.recent: list[_Gap] = []
         """Gaps outside offboard, kept for ``window`` seconds in case a request follows."""
@@ -77,7 +78,7 @@ class KeepaliveRate(Check):
                         self._report(found, "in OFFBOARD")
                     else:
                         self.recent.append(found)
-            self.last = event.t
+            self.last, self.last_where = event.t, event.where
             self.last_in_offboard = offboard_and_flying(self.ctx)
             self.dropout_since_last = False
         if self.recent:
@@ -92,7 +93,9 @@ class KeepaliveRate(Check):
             return
         gap = proven_gap(self.ctx, event, event.t - self.last)
         if gap >= self.max_gap:
-            self._report(_Gap(self.last, event.t, gap, event.where), "in OFFBOARD (until it left)")
+            self._report(
+                _Gap(self.last, event.t, gap, self.last_where), "in OFFBOARD (until it left)"
+            )
 
     def _request(self, t: float) -> None:
         for found in self.recent:
@@ -123,12 +126,9 @@ class KeepaliveRate(Check):
     def finish(self, t_end: float) -> None:
         if self.last is not None and self.last_in_offboard and t_end - self.last >= self.max_gap:
             self._report(
-                _Gap(self.last, t_end, t_end - self.last, self._where()),
+                _Gap(self.last, t_end, t_end - self.last, self.last_where),
                 "in OFFBOARD (stream stopped, recording ends)",
             )
-
-    def _where(self) -> Where:
-        return Where("keep-alive")
 
 
 class StreamBeforeRequest(Check):
