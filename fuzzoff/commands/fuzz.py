@@ -14,6 +14,7 @@ from typing import Any
 from fuzzoff.commands._common import parse_params, settings_from_args, write_output
 from fuzzoff.config import ConfigError
 from fuzzoff.fuzz.campaign import CampaignConfig, CampaignResult, PropertyResult, run_campaign
+from fuzzoff.fuzz.known import KNOWN
 from fuzzoff.fuzz.properties import PROPERTIES
 from fuzzoff.fuzz.reproducers import DEFAULT_DIR, save
 from fuzzoff.fuzz.scenario import TRANSPORTS
@@ -47,6 +48,11 @@ def add_parser(sub: Any) -> None:
         help="PX4 parameter for --from (the campaign draws its own otherwise)",
     )
     parser.add_argument("--ignore", metavar="CODES", help="rules to switch off (fault planting)")
+    parser.add_argument(
+        "--known",
+        action="store_true",
+        help="leave out the known problems listed in fuzzoff/fuzz/known.py (as CI does)",
+    )
     parser.add_argument(
         "--format", choices=("terminal", "json", "junit", "sarif"), default="terminal"
     )
@@ -84,6 +90,7 @@ def _config(args: argparse.Namespace) -> CampaignConfig:
         seed=args.seed,
         properties=tuple(args.property or PROPERTIES),
         settings=settings,
+        known=tuple(KNOWN) if args.known else (),
     )
     if args.from_:
         from fuzzoff.fuzz.mutate import scenario_from_recording
@@ -166,7 +173,12 @@ def _save_all(result: CampaignResult, directory: Path) -> dict[str, Path]:
     for r in result.results:
         if r.failed and r.counterexample is not None:
             saved[r.name] = save(
-                r.name, r.counterexample, r.problems, directory, cut_fraction=r.cut_fraction
+                r.name,
+                r.counterexample,
+                r.problems,
+                directory,
+                cut_fraction=r.cut_fraction,
+                base=result.config.settings,
             )
     return saved
 

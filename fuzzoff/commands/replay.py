@@ -56,7 +56,7 @@ def compare(expected: list[dict[str, Any]], actual: list[dict[str, Any]]) -> lis
             wt, gt = want.get("time_s"), got.get("time_s")
             if (wt is None) != (gt is None):
                 continue
-            if wt is None or abs(float(wt) - float(gt)) <= TIME_TOLERANCE_S:
+            if wt is None or gt is None or abs(float(wt) - float(gt)) <= TIME_TOLERANCE_S:
                 hit = got
                 break
         if hit is None:

@@ -105,7 +105,10 @@ def every_unintended_outcome_is_explained(scenario: Scenario, ctx: FuzzContext) 
         mine = [f for f in findings if f.vehicle == vehicle or f.time_s is None]
         for hazard in hazards(timeline.transitions, scenario.duration):
             if not explains(hazard, mine, blind):
-                problems.append(f"silent hazard: {hazard.describe()}, no finding explains it")
+                problems.append(
+                    f"silent hazard ({scenario.transport}, PX4 {scenario.px4}): "
+                    f"{hazard.describe()}, no finding explains it"
+                )
     return problems
 
 

@@ -62,23 +62,29 @@ def save(
     directory: Path,
     *,
     cut_fraction: float | None = None,
+    base: Settings | None = None,
 ) -> Path:
-    """Write the reproducer; returns the path of its ``expected.json``."""
+    """Write the reproducer; returns the path of its ``expected.json``. ``base``: the
+    campaign's rule selection (``--ignore``), kept in the reproducer's arguments."""
     directory.mkdir(parents=True, exist_ok=True)
     name = name_for(prop, scenario)
     fmt = RECORDING_FORMAT[scenario.transport]
     recording = directory / f"{name}{recordings.SUFFIX[fmt]}"
     recordings.write(scenario, recording, fmt)
-    settings = scenario.settings()
+    settings = scenario.settings(base)
     report = lint_file(recording, settings)
+    args = scenario.lint_args()
+    if settings.ignore:
+        args += ["--ignore", ",".join(sorted(settings.ignore))]
     spec: dict[str, Any] = {
         "recording": recording.name,
-        "args": scenario.lint_args(),
+        "args": args,
         "exit_status": exit_status(report, settings),
         "complete": report.complete,
         "property": prop,
         "problems": problems,
-        "scenario": {k: v for k, v in scenario.to_json().items() if k != "events"},
+        "scenario": {k: v for k, v in scenario.to_json().items() if k != "events"}
+        | {"ignore": sorted(settings.ignore)},
         "findings": expected_findings(report),
     }
     if cut_fraction is not None:
@@ -122,7 +128,7 @@ def recheck(spec: dict[str, Any], recording: Path) -> list[str]:
         str(info["vehicle"]),
         {str(k): float(v) for k, v in dict(info.get("params", {})).items()},
     )
-    ctx = FuzzContext()
+    ctx = FuzzContext(settings=Settings(ignore=frozenset(info.get("ignore", []))))
     try:
         if "cut_fraction" in spec:
             ctx.cut_fraction = float(spec["cut_fraction"])

@@ -35,6 +35,8 @@ timestamps is the file's, which a writer need not keep)."""
 
 COMPANION = (1, 191)
 MODE_POSCTL = (1.0, 3.0)
+STATUS_STEP = 0.05
+"""How often the MAVROS state echo looks at the model between messages."""
 """DO_SET_MODE params for POSCTL (custom main mode 3)."""
 
 
@@ -133,21 +135,30 @@ def echo(
     out: list[ev.Event] = []
     last_state: tuple[int | None, bool] | None = None
     next_beat = 0.0
+    clock = 0.0
+
+    def note(t: float) -> None:
+        nonlocal last_state
+        if (model.nav_state, model.armed) != last_state:
+            last_state = (model.nav_state, model.armed)
+            out.append(_status(t + 0.003, model, vid))
+
     for event in sent:
         if status:
-            while next_beat <= event.t:
-                model.feed(ev.Dropout(t=next_beat, vehicle=vid))  # advance the clock only
-                out.append(_status(next_beat + 0.0002, model, vid))
-                last_state = (model.nav_state, model.armed)
-                next_beat += 1.0
+            # The state changes between messages too (a loss failsafe): look at 20 Hz.
+            while clock + STATUS_STEP < event.t:
+                clock += STATUS_STEP
+                model.feed(ev.Dropout(t=clock, vehicle=vid))  # advances the clock only
+                note(clock)
+                if clock >= next_beat:
+                    out.append(_status(clock + 0.0002, model, vid))
+                    next_beat += 1.0
         transitions = model.feed(event)
+        clock = max(clock, event.t)
         if isinstance(event, ev.Command) and acks:
             out += _acks(event, transitions, px4, transport, vid)
-        if status and (model.nav_state, model.armed) != last_state:
-            last_state = (model.nav_state, model.armed)
-            out.append(_status(event.t + 0.003, model, vid))
-    if status and sent:
-        model.finish(sent[-1].t)
+        if status:
+            note(event.t)
     return out
 
 

@@ -71,7 +71,7 @@ def stream(
     speed: float = 1.0,
     on_packet: Callable[[Packet], None] | None = None,
 ) -> int:
-    """Send ``packets`` to ``host:port`` over UDP at their times (``speed`` x); returns the count."""
+    """Send ``packets`` to ``host:port`` over UDP at their times (``speed`` x); the count."""
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
         start = time.monotonic()
         for packet in packets:
