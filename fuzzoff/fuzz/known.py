@@ -2,34 +2,40 @@
 
 CI campaigns (tests/test_fuzz_campaigns.py) leave these out so the search goes on for new ones;
 ``fuzzoff fuzz --known`` does the same. Each entry: a regular expression matched against a
-property's problem text, and why it is known. Remove an entry when its reproducer under
+property's problem text -> what it is. Remove an entry when its reproducer under
 ``corpora/fuzz/`` replays as fixed (``fuzzoff replay`` exits 0).
 """
 
 from __future__ import annotations
 
-KNOWN: dict[str, str] = {}
-"""pattern -> explanation (filled below)."""
+_MAV = r"silent hazard \((mavlink|mavros), "
 
-KNOWN.update(
-    {
-        r"silent hazard \((mavlink|mavros), .*controller .*no TrajectorySetpoint since": "PX4 "
-        "forwards MAVLink setpoints only in OFFBOARD, so after the switch the vehicle holds "
-        "until the next one arrives; no rule reports a long hold after the switch for a MAVLink "
-        "stream (OFB303 covers ROS 2 only)",
-        r"silent hazard .*arm_rejected": "OFB201 registers an arm request in OFFBOARD only when "
-        "the recording shows the mode (vehicle_status); without it, a rejected arm in the "
-        "predicted OFFBOARD is not reported even with the rejecting ack recorded",
-        r"timeline out of order": "gate model: the loss failsafe is emitted one Commander "
-        "iteration ahead (t + 10 ms) before the keep-alive at t that ends the loss is applied "
-        "(a gap of exactly COM_OF_LOSS_T); see invariant 0",
-        r"silent hazard \((mavlink|mavros), PX4 (legacy|1\.11)\): setpoint_dropped": "legacy/1.11 MAVLink receiver drops (GLOBAL_INT not "
-        "handled, non-finite fields, FORCE bit, takeoff bit as loiter): no legacy rule covers "
-        "them (OFB6xx apply from 1.13)",
-        r"setpoint_dropped .*no position, velocity or acceleration": "SET_POSITION_TARGET_LOCAL_NED "
-        "in MAV_FRAME_BODY_NED with only position set: the receiver drops it (gate spec 6.2, "
-        "D17) but OFB601/OFB602 are silent",
-        r"invariant 0: .*goes back in time": "gate model: the loss failsafe is emitted one "
-        "Commander iteration ahead (t + 10 ms) before the event at t is applied",
-    }
-)
+KNOWN: dict[str, str] = {
+    _MAV + r".*controller .*no TrajectorySetpoint since": (
+        "PX4 forwards MAVLink setpoints only in OFFBOARD, so after the switch the vehicle holds "
+        "until the next one arrives; no rule reports a long hold after the switch for a "
+        "MAVLink stream (OFB303 covers ROS 2 only)"
+    ),
+    r"silent hazard .*arm_rejected": (
+        "OFB201 registers an arm request in OFFBOARD only when the recording shows the mode "
+        "(vehicle_status); without it, a rejected arm in the predicted OFFBOARD is not "
+        "reported even with the rejecting ack recorded"
+    ),
+    r"timeline out of order": (
+        "gate model: the loss failsafe is emitted one Commander iteration ahead (t + 10 ms) "
+        "before the keep-alive at t that ends the loss is applied (a gap of exactly "
+        "COM_OF_LOSS_T); see invariant 0"
+    ),
+    r"invariant 0: .*goes back in time": (
+        "gate model: the loss failsafe is emitted one Commander iteration ahead (t + 10 ms) "
+        "before the event at t is applied"
+    ),
+    _MAV + r"PX4 (legacy|1\.11)\): setpoint_dropped": (
+        "legacy/1.11 MAVLink receiver drops (GLOBAL_INT not handled, non-finite fields, FORCE "
+        "bit, takeoff bit as loiter): no legacy rule covers them (OFB6xx apply from 1.13)"
+    ),
+    r"setpoint_dropped .*no position, velocity or acceleration": (
+        "SET_POSITION_TARGET_LOCAL_NED in MAV_FRAME_BODY_NED with only position set: the "
+        "receiver drops it (gate spec 6.2, D17) but OFB601/OFB602 are silent"
+    ),
+}
