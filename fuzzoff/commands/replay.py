@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from fuzzoff.commands._common import write_output
-from fuzzoff.config import ConfigError
+from fuzzoff.config import ConfigError, Settings
 from fuzzoff.fuzz.reproducers import ReproducerError, load, recheck
 from fuzzoff.report.sanitize import printable
 
@@ -90,7 +90,8 @@ def run(args: argparse.Namespace) -> int:
         events=(),
         params={str(k): float(v) for k, v in dict(info.get("params", {})).items()},
     )
-    report = lint_file(recording, scenario.settings())
+    ignore = frozenset(str(c) for c in info.get("ignore", []))
+    report = lint_file(recording, scenario.settings(Settings(ignore=ignore)))
     differ = compare(list(spec.get("findings", [])), expected_findings(report))
     still = recheck(spec, recording)
     prop = spec.get("property")

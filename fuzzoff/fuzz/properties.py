@@ -98,17 +98,24 @@ def explains(hazard: Hazard, findings: Sequence[Finding], blind: set[str]) -> bo
 
 
 def every_unintended_outcome_is_explained(scenario: Scenario, ctx: FuzzContext) -> list[str]:
+    """Only the first silent hazard of a vehicle is reported (later ones are counted): they are
+    often its consequences (a dropped keep-alive, then a rejected switch)."""
     findings, timelines = _timelines(scenario, ctx)
     blind = _not_checkable(findings, scenario)
     problems = []
     for vehicle, timeline in sorted(timelines.items()):
         mine = [f for f in findings if f.vehicle == vehicle or f.time_s is None]
-        for hazard in hazards(timeline.transitions, scenario.duration):
-            if not explains(hazard, mine, blind):
-                problems.append(
-                    f"silent hazard ({scenario.transport}, PX4 {scenario.px4}): "
-                    f"{hazard.describe()}, no finding explains it"
-                )
+        silent = [
+            h
+            for h in hazards(timeline.transitions, scenario.duration)
+            if not explains(h, mine, blind)
+        ]
+        if silent:
+            more = f" ({len(silent) - 1} later ones too)" if len(silent) > 1 else ""
+            problems.append(
+                f"silent hazard ({scenario.transport}, PX4 {scenario.px4}): "
+                f"{silent[0].describe()}, no finding explains it{more}"
+            )
     return problems
 
 

@@ -1,0 +1,263 @@
+"""Short seeded fuzz campaigns (per PX4 profile, per transport), the fuzz and replay commands.
+
+Known problems (fuzzoff/fuzz/known.py, each with a reproducer under corpora/fuzz/) are left out
+of the CI campaigns so that they look for new ones.
+"""
+
+from __future__ import annotations
+
+import json
+import threading
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import pytest
+
+from fuzzoff.config import Settings
+from fuzzoff.events import (
+    Command,
+    ControlMode,
+    Event,
+    SetPositionTargetLocal,
+    TrajectorySetpoint,
+)
+from fuzzoff.fuzz.campaign import CampaignConfig, run_campaign
+from fuzzoff.fuzz.known import KNOWN
+from fuzzoff.fuzz.properties import FuzzContext, every_unintended_outcome_is_explained
+from fuzzoff.fuzz.reproducers import save
+from fuzzoff.fuzz.scenario import Scenario
+from fuzzoff.profiles import PX4_PROFILES
+from fuzzoff.writers.mcap import write_mcap
+from tests.helpers import run_cli
+
+SEED = 20261122
+
+
+def _explain(result: object) -> str:
+    lines = []
+    for r in result.results:  # type: ignore[attr-defined]
+        if r.failed:
+            lines += [f"{r.name}: {p}" for p in r.problems]
+            lines.append(f"  counterexample: {r.counterexample.describe()}")
+            for e in r.counterexample.events[:40]:
+                lines.append(f"    {e}")
+    return "\n".join(lines)
+
+
+@pytest.mark.parametrize("px4", PX4_PROFILES)
+def test_campaign_finds_no_new_hazard_or_invariant_break(px4: str) -> None:
+    config = CampaignConfig(
+        px4=px4,
+        examples=60,
+        seed=SEED,
+        properties=("explained", "invariants"),
+        known=tuple(KNOWN),
+        shrink_s=5.0,
+    )
+    result = run_campaign(config)
+    assert not result.failed, _explain(result)
+    assert all(r.examples >= 60 for r in result.results)
+
+
+@pytest.mark.parametrize("transport", ["ros2", "mavlink", "mavros"])
+def test_writers_round_trip_and_cut_recordings_give_a_prefix(transport: str) -> None:
+    config = CampaignConfig(
+        transport=transport,  # type: ignore[arg-type]
+        examples=12,
+        seed=SEED,
+        properties=("round-trip", "truncation"),
+        shrink_s=5.0,
+    )
+    result = run_campaign(config)
+    assert not result.failed, _explain(result)
+
+
+def _planted(seed: int = 7) -> CampaignConfig:
+    """A fault planted in a copy of the rules: the loss rules switched off."""
+    return CampaignConfig(
+        px4="1.15",
+        vehicle="mc",
+        transport="ros2",
+        examples=300,
+        seed=seed,
+        properties=("explained",),
+        settings=Settings(ignore=frozenset({"OFB103", "OFB101"})),
+        known=tuple(KNOWN),
+        shrink_s=10.0,
+    )
+
+
+def test_planted_fault_is_found_shrunk_and_the_same_for_a_seed() -> None:
+    first = run_campaign(_planted()).results[0]
+    second = run_campaign(_planted()).results[0]
+    assert first.failed, "switching off OFB103 and OFB101 must leave a loss failsafe unexplained"
+    assert "failsafe" in first.problems[0]
+    assert first.counterexample is not None and second.counterexample is not None
+    assert first.counterexample.to_json() == second.counterexample.to_json()
+    assert len(first.counterexample.events) < 40, "the counterexample is shrunk"
+
+
+def test_reproducer_replays_through_lint_and_replay(tmp_path: Path) -> None:
+    result = run_campaign(_planted()).results[0]
+    assert result.counterexample is not None
+    config = _planted()
+    path = save("explained", result.counterexample, result.problems, tmp_path, base=config.settings)
+    spec = json.loads(path.read_text())
+    assert spec["property"] == "explained"
+    assert (tmp_path / spec["recording"]).suffix == ".mcap"
+    assert "--ignore" in spec["args"]
+    lint = run_cli(["lint", str(tmp_path / spec["recording"]), "--format", "json", *spec["args"]])
+    assert lint.returncode == spec["exit_status"]
+    codes = [f["code"] for f in json.loads(lint.stdout)["files"][0]["findings"]]
+    assert codes == [f["code"] for f in spec["findings"]]
+    replay = run_cli(["replay", str(path), "--format", "json"])
+    assert replay.returncode == 1, replay.stderr
+    data = json.loads(replay.stdout)
+    assert data["findings_match"] is True
+    assert data["property_still_fails"] is True
+
+
+def test_fuzz_command_reports_json_junit_and_sarif(tmp_path: Path) -> None:
+    args = ["fuzz", "--px4", "1.15", "--vehicle", "mc", "--examples", "5", "--seed", "1", "-q"]
+    args += ["--property", "invariants", "--property", "docs-stricter", "--no-save"]
+    out = run_cli([*args, "--format", "json"])
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    assert [p["property"] for p in data["properties"]] == ["invariants", "docs-stricter"]
+    assert data["failed"] is False and data["campaign"]["seed"] == 1
+    junit = run_cli([*args, "--format", "junit"])
+    cases = ET.fromstring(junit.stdout).findall(".//testcase")
+    assert [c.get("name") for c in cases] == ["invariants", "docs-stricter"]
+    sarif = json.loads(run_cli([*args, "--format", "sarif"]).stdout)
+    assert sarif["version"] == "2.1.0"
+    assert sarif["runs"][0]["results"] == []
+
+
+def test_fuzz_command_exits_1_and_saves_a_reproducer(tmp_path: Path) -> None:
+    args = ["fuzz", "--px4", "1.15", "--vehicle", "mc", "--transport", "ros2"]
+    args += ["--examples", "300", "--seed", "7", "--property", "explained"]
+    args += ["--ignore", "OFB103,OFB101", "--known"]
+    out = run_cli([*args, "--save-dir", str(tmp_path), "--format", "sarif", "-q"])
+    assert out.returncode == 1, out.stderr
+    sarif = json.loads(out.stdout)
+    (result,) = sarif["runs"][0]["results"]
+    assert result["ruleId"] == "fuzz/explained"
+    uri = result["locations"][0]["physicalLocation"]["artifactLocation"]["uri"]
+    assert Path(uri).exists() and uri.endswith(".expected.json")
+
+
+def test_fuzz_rejects_bad_usage() -> None:
+    assert run_cli(["fuzz", "--px4", "abc", "--examples", "1"]).returncode == 2
+    assert run_cli(["fuzz", "--examples", "0"]).returncode == 2
+    assert run_cli(["fuzz", "--from", "/nonexistent.mcap", "--examples", "1"]).returncode == 2
+
+
+def _good_stream() -> list[object]:
+    events: list[object] = []
+    for i in range(60):
+        t = round(i * 0.05, 4)
+        events.append(ControlMode(t=t, position=True, sender_time_us=round(t * 1e6)))
+        events.append(
+            TrajectorySetpoint(
+                t=t + 0.001, position=(0.0, 0.0, -2.0), sender_time_us=round((t + 0.001) * 1e6)
+            )
+        )
+    for t, cmd, params in ((1.2, 400, (1.0,)), (1.3, 176, (1.0, 6.0))):
+        p = (*params, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)[:7]
+        events.append(
+            Command(
+                t=t,
+                command=cmd,
+                params=p,
+                sender_time_us=round(t * 1e6),
+                transport="ros2",
+            )
+        )
+    return sorted(events, key=lambda e: e.t)  # type: ignore[attr-defined]
+
+
+def test_from_recording_reports_the_stall_margin(tmp_path: Path) -> None:
+    path = write_mcap(tmp_path / "good.mcap", _good_stream(), release="1.15")  # type: ignore[arg-type]
+    args = ["fuzz", "--from", str(path), "--px4", "1.15", "--vehicle", "mc", "--examples", "3"]
+    out = run_cli([*args, "--property", "invariants", "--format", "json", "--no-save", "-q"])
+    assert out.returncode == 0, out.stderr
+    margins = {m["family"]: m for m in json.loads(out.stdout)["margins"]}
+    stall = margins["stall"]
+    assert stall["found"]
+    # 20 Hz stream, COM_OF_LOSS_T 1 s checked at 10 Hz: a stall of about 0.95 s loses it.
+    assert 0.8 <= stall["size"] <= 1.05
+    assert any(o["hazard"] == "failsafe" for o in stall["outcome_after"])
+
+
+def test_explained_property_accepts_an_explained_loss() -> None:
+    events: list[Event] = []
+    for i in range(40):
+        t = round(i * 0.1, 4)
+        if 1.5 <= t < 3.0:
+            continue
+        events.append(ControlMode(t=t, position=True, sender_time_us=round(t * 1e6)))
+        events.append(TrajectorySetpoint(t=t + 0.001, position=(0.0, 0.0, -2.0), sender_time_us=0))
+    events += [
+        Command(t=1.0, command=400, params=(1.0,) + (0.0,) * 6, transport="ros2"),
+        Command(t=1.1, command=176, params=(1.0, 6.0) + (0.0,) * 5, transport="ros2"),
+    ]
+    scenario = Scenario("1.15", "mc", "ros2", tuple(sorted(events, key=lambda e: e.t)))
+    assert every_unintended_outcome_is_explained(scenario, FuzzContext()) == []
+    blind = FuzzContext(settings=Settings(ignore=frozenset({"OFB103", "OFB101"})))
+    (problem,) = every_unintended_outcome_is_explained(scenario, blind)
+    assert "failsafe" in problem
+
+
+def _listen(port_box: list[int], got: list[tuple[float, str]], ready: threading.Event) -> None:
+    import time
+
+    from pymavlink import mavutil
+
+    conn = mavutil.mavlink_connection("udpin:127.0.0.1:0")
+    port_box.append(conn.port.getsockname()[1])
+    ready.set()
+    deadline = time.monotonic() + 10.0
+    while time.monotonic() < deadline and len(got) < 5:
+        msg = conn.recv_match(blocking=True, timeout=0.5)
+        if msg is not None and msg.get_type() != "BAD_DATA":
+            got.append((time.monotonic(), msg.get_type()))
+    conn.close()
+
+
+def test_replay_streams_a_tlog_reproducer_to_udp(tmp_path: Path) -> None:
+    sp = dict(vehicle="1", type_mask=3576, source_system=1, source_component=191)
+    events = [
+        SetPositionTargetLocal(t=0.0, **sp),  # type: ignore[arg-type]
+        SetPositionTargetLocal(t=0.1, **sp),  # type: ignore[arg-type]
+        Command(t=0.15, vehicle="1", command=176, params=(1.0, 6.0) + (0.0,) * 5),
+        SetPositionTargetLocal(t=0.45, **sp),  # type: ignore[arg-type]
+    ]
+    scenario = Scenario("1.15", "mc", "mavlink", tuple(events))
+    spec_path = save("explained", scenario, ["example"], tmp_path)
+    port: list[int] = []
+    got: list[tuple[float, str]] = []
+    ready = threading.Event()
+    listener = threading.Thread(target=_listen, args=(port, got, ready))
+    listener.start()
+    ready.wait(5.0)
+    out = run_cli(["replay", str(spec_path), "--to", f"udp:127.0.0.1:{port[0]}"])
+    listener.join(12.0)
+    assert out.returncode == 0, out.stderr
+    kinds = [k for _, k in got]
+    # The GCS heartbeat the tlog starts with, then the companion's stream in order.
+    assert kinds == [
+        "HEARTBEAT",
+        "SET_POSITION_TARGET_LOCAL_NED",
+        "SET_POSITION_TARGET_LOCAL_NED",
+        "COMMAND_LONG",
+        "SET_POSITION_TARGET_LOCAL_NED",
+    ]
+    # Recorded timing: the 0.3 s pause before the last setpoint is kept (never shorter).
+    assert got[4][0] - got[3][0] >= 0.25
+
+
+def test_replay_rejects_a_bad_target_and_a_missing_file(tmp_path: Path) -> None:
+    assert run_cli(["replay", str(tmp_path / "none.expected.json")]).returncode == 2
+    bad = tmp_path / "x.expected.json"
+    bad.write_text("{not json")
+    assert run_cli(["replay", str(bad)]).returncode == 2
