@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import struct
 from dataclasses import dataclass, field
+from functools import cache
 from typing import Any
 
 from rosbags.typesys import get_types_from_idl
@@ -91,11 +92,23 @@ def _idl_store(typename: str, text: str) -> Typestore:
     return store
 
 
+@cache
 def bundled(message: str, release: str) -> Definition | None:
+    """A bundled definition, compiled once per process."""
     text = px4_msgs.definition(release, message)
     if text is None:
         return None
     return Definition.make(px4_msgs.type_name(message), text, f"bundled {release}")
+
+
+@cache
+def bundled_layout(message: str, release: str) -> tuple[Any, ...] | None:
+    """The field layout of a bundled definition (no code generation: cheap to compare)."""
+    text = px4_msgs.definition(release, message)
+    if text is None:
+        return None
+    typename = px4_msgs.type_name(message)
+    return tuple(px4_msgs.typestore_for(typename, text).fielddefs[typename][1])
 
 
 def message_of(topic: str, msgtype: str) -> tuple[str | None, TopicRef | None]:
@@ -226,7 +239,7 @@ class Ros2Decoding:
         fits = {
             r
             for r in px4_msgs.releases_with(message)
-            if (b := bundled(message, r)) is not None and b.layout == definition.layout
+            if bundled_layout(message, r) == definition.layout
         }
         self.evidence = fits if self.evidence is None else self.evidence & fits
 

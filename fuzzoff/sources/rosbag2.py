@@ -31,6 +31,9 @@ from fuzzoff.sources.ros2_decode import Decoder, Ros2Decoding, TopicDecoder
 from fuzzoff.sources.ros2_order import ChunkOrder
 
 DATA_SUFFIXES = (".db3", ".mcap")
+STATUS_WINDOW_NS = 10_000_000_000
+"""The vehicle type is looked up in the first VehicleStatus of the first 10 s (PX4 sends it
+at 1-2 Hz and on every change)."""
 _FORMATS = {MessageDefinitionFormat.MSG: "msg", MessageDefinitionFormat.IDL: "idl"}
 
 
@@ -168,9 +171,11 @@ class Rosbag2Source(Source):
                 continue
             if not conn.msgcount:
                 continue
+            # Only the first seconds: a time-bounded query stays cheap on a large sqlite bag.
+            window = reader.start_time + STATUS_WINDOW_NS
             try:
-                _, _, raw = next(iter(reader.messages(connections=[conn])))
-            except Exception:  # the main pass reports damage
+                _, _, raw = next(iter(reader.messages(connections=[conn], stop=window)))
+            except Exception:  # none in the window, or damage the main pass reports
                 continue
             self._vehicle = self.decoding.vehicle_from(decoder, raw)
             if self._vehicle:
