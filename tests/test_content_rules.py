@@ -7,6 +7,8 @@ from collections.abc import Sequence
 from typing import Any
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from fuzzoff.config import Settings
 from fuzzoff.events import (
@@ -471,3 +473,31 @@ def test_ofb107_an_all_nan_rover_setpoint_published_on_purpose_is_not_frozen() -
     events += [ControlMode(t=t, velocity=True) for t in every(0.0, 8.0, 0.1)]
     events += [RoverAttitudeSetpoint(t=t + 0.01) for t in every(0.0, 8.0, 0.05)]
     assert codes(lint_events(events, px4="1.17", vehicle="rover-differential"), "OFB107") == []
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.lists(st.tuples(st.integers(1, 3), st.integers(1, 90)), min_size=1, max_size=8),
+    st.sampled_from([0.02, 0.05]),
+)
+def test_ofb107_sampled_comparison_finds_the_same_runs_as_comparing_every_message(
+    segments: list[tuple[int, int]], period: float
+) -> None:
+    """OFB107 compares content at 10 Hz; its runs must still start and end on the exact
+    messages a message-by-message comparison gives."""
+    values: list[int] = [v for v, n in segments for _ in range(n)]
+    times = [round(i * period, 6) for i in range(len(values))]
+    events: list[Event] = [status(0.0, OFFBOARD), *ocm(every(0.0, times[-1] + 0.1, 0.1))]
+    events += [
+        TrajectorySetpoint(t=t, velocity=(float(v), 0.0, 0.0))
+        for t, v in zip(times, values, strict=True)
+    ]
+    expected = []
+    start = 0
+    for i in range(1, len(values) + 1):
+        if i == len(values) or values[i] != values[start]:
+            if times[i - 1] - times[start] > 3.0:
+                expected.append((times[start], times[i - 1]))
+            start = i
+    found = [(f.time_s, f.end_s) for f in codes(lint_events(events), "OFB107")]
+    assert found == [(pytest.approx(a), pytest.approx(b)) for a, b in expected]

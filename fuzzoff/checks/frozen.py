@@ -113,10 +113,41 @@ class SetpointFrozen(Check):
                 run.pending.clear()
                 run.last = run.compared = event.t
                 return
+            if run.pending:
+                self._restart_within(run, event, content)
+                return
         else:
             content = content_of(event)
         self._close(event.kind)
         self.runs[event.kind] = _Run(content, event.t, event.t, event.where, compared=event.t)
+
+    def _restart_within(self, run: _Run, event: Event, content: str) -> None:
+        """The content changed somewhere among the uncompared messages: end the run at the last
+        one that matches and start the next run at the first one that does not (exact edges)."""
+        pending, run.pending = run.pending, []
+        matched = 0
+        for t, raw in pending:
+            if repr(raw) != run.content:
+                break
+            run.last, matched = t, matched + 1
+        run.count += matched
+        self.runs[event.kind] = run
+        self._close(event.kind)
+        rest = pending[matched:]
+        if not rest:  # every pending message matched: the change is this message
+            self.runs[event.kind] = _Run(content, event.t, event.t, event.where, compared=event.t)
+            return
+        t0, raw0 = rest[0]
+        new = _Run(repr(raw0), t0, t0, event.where, compared=event.t)
+        for t, raw in [*rest[1:], (event.t, None)]:
+            text = content if raw is None else repr(raw)
+            if text != new.content:
+                self.runs[event.kind] = new
+                self._close(event.kind)
+                new = _Run(text, t, t, event.where, compared=event.t)
+            else:
+                new.last, new.count = t, new.count + 1
+        self.runs[event.kind] = new
 
     def _close(self, kind: str) -> None:
         run = self.runs.pop(kind, None)
