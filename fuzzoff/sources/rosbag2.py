@@ -10,10 +10,7 @@ by row; a cut ``.mcap`` -> fuzzoff's streaming MCAP reader. Every salvage is a p
 from __future__ import annotations
 
 import re
-import shutil
 import sqlite3
-import struct
-import tempfile
 from collections.abc import Iterator
 from contextlib import suppress
 from pathlib import Path
@@ -29,6 +26,8 @@ from fuzzoff.sources.base import RecordingInfo, Source, SourceError, SourceProbl
 from fuzzoff.sources.mcap_stream import McapStream
 from fuzzoff.sources.ros2_decode import Decoder, Ros2Decoding, TopicDecoder
 from fuzzoff.sources.ros2_order import ChunkOrder
+from fuzzoff.sources.rosbag2_sqlite import SalvageCopies
+from fuzzoff.sources.rosbag2_sqlite import topics as sqlite_topics
 
 DATA_SUFFIXES = (".db3", ".mcap")
 STATUS_WINDOW_NS = 10_000_000_000
@@ -61,7 +60,7 @@ class Rosbag2Source(Source):
         self._done = 0
         self._notes: list[str] = []
         self._vehicle: str | None = None
-        self._tmp: tempfile.TemporaryDirectory[str] | None = None
+        self._copies = SalvageCopies()
         self._last_ns = -1
 
     # -- opening -----------------------------------------------------------------------------
@@ -205,7 +204,7 @@ class Rosbag2Source(Source):
     def _probe_salvage(self, path: Path) -> int | None:
         """Topics, definitions and start time of a database rosbags cannot open."""
         try:
-            db = self._salvage_db(path)
+            db = self._copies.connect(path)
         except (sqlite3.Error, OSError):
             return None
         try:
@@ -222,15 +221,6 @@ class Rosbag2Source(Source):
             return None
         finally:
             db.close()
-
-    def _salvage_db(self, path: Path) -> sqlite3.Connection:
-        """A read-only connection to a header-fixed copy (made once per file, see close())."""
-        if self._tmp is None:
-            self._tmp = tempfile.TemporaryDirectory(prefix="fuzzoff-")
-        copy = Path(self._tmp.name) / path.name
-        if not copy.exists():
-            _readable_copy(path, Path(self._tmp.name))
-        return sqlite3.connect(f"file:{copy}?mode=ro", uri=True)
 
     def _decoder(self, topic: str, msgtype: str, msgdef: Any) -> Decoder | None:
         text = msgdef.data if msgdef is not None and msgdef.format in _FORMATS else None
@@ -331,7 +321,7 @@ class Rosbag2Source(Source):
     def _salvage_sqlite(self, path: Path, exc: BaseException) -> Iterator[Event]:
         """Row by row with Python's sqlite3, in row order, until the damage (formats.md 5)."""
         try:
-            db = self._salvage_db(path)
+            db = self._copies.connect(path)
         except (sqlite3.Error, OSError) as err:
             what = f"cannot open the database: {_why(err)}"
             self.problems.append(SourceProblem(what, path.name))
@@ -381,16 +371,8 @@ class Rosbag2Source(Source):
             db.close()
 
     def _sqlite_topics(self, db: sqlite3.Connection) -> dict[int, Decoder]:
-        definitions: dict[str, tuple[str, str]] = {}
-        with suppress(sqlite3.Error):
-            for name, encoding, text in db.execute(
-                "SELECT topic_type, encoding, encoded_message_definition FROM message_definitions"
-            ):
-                if encoding in ("ros2msg", "ros2idl") and text:
-                    definitions[name] = (text, "idl" if encoding == "ros2idl" else "msg")
         out: dict[int, Decoder] = {}
-        for topic_id, name, msgtype in db.execute("SELECT id, name, type FROM topics"):
-            text, fmt = definitions.get(msgtype, (None, "msg"))
+        for topic_id, name, msgtype, text, fmt in sqlite_topics(db):
             decoder = self._connect(name, msgtype, text, fmt)
             if decoder is not None:
                 out[topic_id] = decoder
@@ -408,9 +390,7 @@ class Rosbag2Source(Source):
             self._reader = None
 
     def close(self) -> None:
-        if self._tmp is not None:
-            self._tmp.cleanup()
-            self._tmp = None
+        self._copies.close()
         if self._reader is not None:
             with suppress(Exception):
                 self._reader.close()
@@ -424,27 +404,3 @@ class Rosbag2Source(Source):
             return None
         fraction = (self._last_ns - self._t0) / float(reader.duration)
         return min(1.0, max(0.0, fraction))
-
-
-def _readable_copy(path: Path, folder: Path) -> Path:
-    """A copy of a cut database whose header no longer claims the missing pages.
-
-    SQLite trusts the page count in the header of a cleanly closed file, so a byte-truncated
-    database fails on its first query, even for pages that are all there. The copy's header
-    states the pages the file really has (and rollback-journal mode, so no -wal is needed).
-    """
-    copy = folder / path.name
-    shutil.copyfile(path, copy)
-    with copy.open("r+b") as fh:
-        header = fh.read(100)
-        if len(header) < 100 or not header.startswith(b"SQLite format 3\x00"):
-            return copy
-        page_size = struct.unpack(">H", header[16:18])[0]
-        page_size = 65536 if page_size == 1 else page_size
-        pages = copy.stat().st_size // max(page_size, 512)
-        if struct.unpack(">I", header[28:32])[0] > pages:
-            fh.seek(28)
-            fh.write(struct.pack(">I", pages))
-        fh.seek(18)
-        fh.write(b"\x01\x01")
-    return copy

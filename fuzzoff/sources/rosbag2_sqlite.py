@@ -1,0 +1,78 @@
+"""Reading a ``.db3`` that rosbags cannot open, with Python's ``sqlite3`` (formats.md 5).
+
+The salvage works on a copy in a temporary folder (the user's file is never written): a
+byte-truncated database has a header that still claims the missing pages, and SQLite refuses
+every query on it, so the copy's header is corrected first. Rows are then read in row order
+until the damage.
+"""
+
+from __future__ import annotations
+
+import shutil
+import sqlite3
+import struct
+import tempfile
+from contextlib import suppress
+from pathlib import Path
+
+ENCODINGS = {"ros2msg": "msg", "ros2idl": "idl"}
+
+
+class SalvageCopies:
+    """Header-fixed read-only copies of damaged databases, one per file, removed on close."""
+
+    def __init__(self) -> None:
+        self._tmp: tempfile.TemporaryDirectory[str] | None = None
+
+    def connect(self, path: Path) -> sqlite3.Connection:
+        if self._tmp is None:
+            self._tmp = tempfile.TemporaryDirectory(prefix="fuzzoff-")
+        copy = Path(self._tmp.name) / path.name
+        if not copy.exists():
+            readable_copy(path, Path(self._tmp.name))
+        return sqlite3.connect(f"file:{copy}?mode=ro", uri=True)
+
+    def close(self) -> None:
+        if self._tmp is not None:
+            self._tmp.cleanup()
+            self._tmp = None
+
+
+def topics(db: sqlite3.Connection) -> list[tuple[int, str, str, str | None, str]]:
+    """(topic id, name, type, embedded definition or None, its format) of every topic."""
+    definitions: dict[str, tuple[str, str]] = {}
+    with suppress(sqlite3.Error):  # schema 3 and older have no message_definitions
+        for name, encoding, text in db.execute(
+            "SELECT topic_type, encoding, encoded_message_definition FROM message_definitions"
+        ):
+            if encoding in ENCODINGS and text:
+                definitions[name] = (text, ENCODINGS[encoding])
+    out = []
+    for topic_id, name, msgtype in db.execute("SELECT id, name, type FROM topics"):
+        text, fmt = definitions.get(msgtype, (None, "msg"))
+        out.append((topic_id, name, msgtype, text, fmt))
+    return out
+
+
+def readable_copy(path: Path, folder: Path) -> Path:
+    """A copy of a cut database whose header no longer claims the missing pages.
+
+    SQLite trusts the page count in the header of a cleanly closed file, so a byte-truncated
+    database fails on its first query, even for pages that are all there. The copy's header
+    states the pages the file really has (and rollback-journal mode, so no -wal is needed).
+    """
+    copy = folder / path.name
+    shutil.copyfile(path, copy)
+    with copy.open("r+b") as fh:
+        header = fh.read(100)
+        if len(header) < 100 or not header.startswith(b"SQLite format 3\x00"):
+            return copy
+        page_size = struct.unpack(">H", header[16:18])[0]
+        page_size = 65536 if page_size == 1 else page_size
+        pages = copy.stat().st_size // max(page_size, 512)
+        if struct.unpack(">I", header[28:32])[0] > pages:
+            fh.seek(28)
+            fh.write(struct.pack(">I", pages))
+        fh.seek(18)
+        fh.write(b"\x01\x01")
+    return copy
