@@ -128,17 +128,20 @@ def hazards(transitions: Sequence[GateTransition], t_end: float) -> list[Hazard]
         what = tr.what
         if what == "disarmed" and isinstance(tr.cause, Command):
             continue
-        if what in WHILE_ARMED and not _armed_before(tr, transitions):
-            continue
         if what == "controller":
             if not tr.reason:
                 continue
             idx = next(i for i, c in enumerate(controllers) if c is tr)
             end = controllers[idx + 1].t if idx + 1 < len(controllers) else t_end
+            # Armed at some moment while it runs (arming after the switch changes no controller).
+            if not (tr.armed or any(x.armed for x in transitions if tr.t <= x.t < end)):
+                continue
             hold = WAIT_S if tr.reason.startswith(NO_SETPOINT_YET) else HOLD_S
             if end - tr.t < hold:
                 continue
             out.append(Hazard(tr.t, what, tr.message, tr.spec, end))
+        elif what in WHILE_ARMED and not _armed_before(tr, transitions):
+            continue
         elif what in EXPLAINED_BY:
             message = tr.message
             if _undone_earlier(tr, transitions):

@@ -62,6 +62,8 @@ class FuzzContext:
     docs_stricter: Counter[str] = field(default_factory=Counter)
     cut_fraction: float = 1.0
     """Where ``truncated_recordings_give_a_prefix`` cuts (drawn per example)."""
+    first_only: bool = True
+    """``every_unintended_outcome_is_explained`` reports the first silent hazard only."""
 
     def close(self) -> None:
         shutil.rmtree(self.workdir, ignore_errors=True)
@@ -110,12 +112,12 @@ def every_unintended_outcome_is_explained(scenario: Scenario, ctx: FuzzContext) 
             for h in hazards(timeline.transitions, scenario.duration)
             if not explains(h, mine, blind)
         ]
-        if silent:
+        head = f"silent hazard ({scenario.transport}, PX4 {scenario.px4})"
+        if silent and ctx.first_only:
             more = f" ({len(silent) - 1} later ones too)" if len(silent) > 1 else ""
-            problems.append(
-                f"silent hazard ({scenario.transport}, PX4 {scenario.px4}): "
-                f"{silent[0].describe()}, no finding explains it{more}"
-            )
+            problems.append(f"{head}: {silent[0].describe()}, no finding explains it{more}")
+        elif silent:
+            problems += [f"{head}: {h.describe()}, no finding explains it" for h in silent]
     return problems
 
 

@@ -28,6 +28,8 @@ from fuzzoff.gate import GateModel
 from fuzzoff.gate.params import default_params, loss_timeout
 from fuzzoff.modes import mavros_mode_to_nav_state, nav_state_to_mavros_mode
 from fuzzoff.profiles import Profile, at_least, is_rover
+from fuzzoff.sources import px4_msgs
+from fuzzoff.sources.px4_msgs import release_for
 
 MIN_STEP = 0.0001
 """Distinct receive times: events never share a timestamp (the readers' order for equal
@@ -205,10 +207,28 @@ def _acks(
 # ----------------------------------------------------------------------------- per transport
 
 
+_MESSAGE = {
+    "trajectory": "TrajectorySetpoint",
+    "attitude": "VehicleAttitudeSetpoint",
+    "rates": "VehicleRatesSetpoint",
+    "rover_position": "RoverPositionSetpoint",
+    "rover_speed": "RoverSpeedSetpoint",
+    "rover_attitude": "RoverAttitudeSetpoint",
+    "rover_rate": "RoverRateSetpoint",
+    "rover_throttle": "RoverThrottleSetpoint",
+    "rover_steering": "RoverSteeringSetpoint",
+}
+
+
+def _published(kind: str, px4: str) -> bool:
+    """Does the release's px4_msgs have this setpoint's message (rover topics vary)?"""
+    return px4_msgs.definition(release_for(px4) or "main", _MESSAGE[kind]) is not None
+
+
 def _ros2_setpoint_kinds(vehicle: str, px4: str) -> list[str]:
     kinds = ["trajectory", "trajectory", "attitude", "rates", "none"]
     if is_rover(vehicle) and at_least(px4, "1.16"):
-        kinds += list(fs.ROVER_KINDS) * 2
+        kinds += [k for k in fs.ROVER_KINDS if _published(k, px4)] * 2
     return kinds
 
 
@@ -234,9 +254,28 @@ def ros2_sent(draw: st.DrawFn, px4: str, vehicle: str, times: list[float]) -> li
     out: list[ev.Event] = [
         ev.ControlMode(t=t, sender_time_us=s, **flags) for t, s in zip(times, stamps, strict=True)
     ]
-    kind = draw(st.sampled_from(_ros2_setpoint_kinds(vehicle, px4)))
-    if kind == "none" or not times:
+    choices = _ros2_setpoint_kinds(vehicle, px4)
+    # A rover program publishes a combination of rover setpoints (OFB502, OFB504).
+    most = 3 if is_rover(vehicle) else 1
+    any_kinds = st.lists(st.sampled_from(choices), min_size=1, max_size=most, unique=True)
+    if is_rover(vehicle) and at_least(px4, "1.16"):
+        combos = [c for c in fs.ROVER_COMBINATIONS if all(_published(k, px4) for k in c)]
+        kinds = draw(
+            st.one_of(any_kinds, st.sampled_from(combos).map(list)) if combos else any_kinds
+        )
+    else:
+        kinds = draw(any_kinds)
+    if not times:
         return out
+    for offset, kind in enumerate(k for k in kinds if k != "none"):
+        out += draw(_setpoint_series(kind, times, 0.001 * (offset + 1)))
+    return out
+
+
+@st.composite
+def _setpoint_series(draw: st.DrawFn, kind: str, times: list[float], lag: float) -> list[ev.Event]:
+    """One setpoint topic following the keep-alive by ``lag``, maybe starting late or stopping
+    early (stale setpoints under a live keep-alive: OFB104), frozen or moving."""
     if kind == "trajectory":
         values = draw(fs.trajectory_setpoints())
     elif kind == "attitude":
@@ -246,13 +285,13 @@ def ros2_sent(draw: st.DrawFn, px4: str, vehicle: str, times: list[float]) -> li
     else:
         _, values = draw(fs.rover_setpoints(kind))
     nth = fs.frozen_or_moving(values) if draw(st.booleans()) else (lambda i: values)
-    # Setpoints follow each keep-alive by 1 ms, from the first one or later, until the last or
-    # earlier (stale setpoints under a live keep-alive: OFB104).
-    start = draw(st.integers(0, len(times) - 1)) if draw(st.booleans()) else 0
-    stop = len(times) if draw(st.booleans()) else draw(st.integers(start, len(times)))
+    whole = draw(st.sampled_from(["whole", "whole", "late", "early"]))
+    start = draw(st.integers(0, len(times) - 1)) if whole == "late" else 0
+    stop = draw(st.integers(start, len(times))) if whole == "early" else len(times)
     build = _ROS2_BUILD[kind]
+    out: list[ev.Event] = []
     for i in range(start, stop):
-        t = times[i] + 0.001
+        t = times[i] + lag
         out.append(build(t=t, sender_time_us=round(t * 1e6), **nth(i)))
     return out
 
