@@ -224,6 +224,7 @@ def lint_file(
     unreadable = get_rule("OFB001")
     try:
         source = open_source(path)
+        source.px4_hint = settings.px4
         source.open()
     except SourceError as exc:
         report = FileReport(

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.helpers import run_cli, run_cli_process
+from tests.helpers import CORPORA, run_cli, run_cli_process
 
 
 def test_unknown_rule_selector_is_a_usage_error(tmp_path: Path) -> None:
@@ -104,3 +104,25 @@ def test_the_installed_command_runs_as_a_process(tmp_path: Path) -> None:
     result = run_cli_process(["lint", str(path)])
     assert result.returncode == 2
     assert "Traceback" not in result.stderr
+
+
+def test_px4_option_steers_the_bundled_definitions_of_a_bag_without_them() -> None:
+    bag = CORPORA / "rosbag2" / "humble_no_definitions"
+    right = json.loads(run_cli(["lint", str(bag), "--format", "json", "--px4", "1.14"]).stdout)
+    assert right["files"][0]["complete"] is True
+    wrong = run_cli(["lint", str(bag), "--format", "json", "--px4", "1.16"])
+    assert wrong.returncode == 2
+    (report,) = json.loads(wrong.stdout)["files"]
+    assert report["complete"] is False
+    assert any("bundled 1.16 definition" in f["message"] for f in report["findings"])
+
+
+def test_a_bag_folder_without_metadata_is_linted_as_one_bag(tmp_path: Path) -> None:
+    import shutil
+
+    bag = tmp_path / "flight"
+    bag.mkdir()
+    shutil.copy(CORPORA / "rosbag2" / "two_vehicles" / "two_vehicles.db3", bag / "flight_0.db3")
+    data = json.loads(run_cli(["lint", str(tmp_path), "--format", "json"]).stdout)
+    assert [f["path"] for f in data["files"]] == [str(bag)]
+    assert data["files"][0]["format"] == "rosbag2-sqlite3"

@@ -184,3 +184,10 @@ def test_pxs_automatic_return_after_a_loss_is_not_a_request() -> None:
     found = lint_events(events)
     assert codes(found, "OFB102") == []
     assert [f.time_s for f in codes(found, "OFB101")] == [pytest.approx(6.0)]
+
+
+def test_ofb104_not_when_the_keepalive_stopped_with_the_setpoints() -> None:
+    times = [t for t in every(0.0, 10.0, 0.1) if not 4.0 < t < 6.0]
+    sp = [TrajectorySetpoint(t=t + 0.01, position=(0.0, 0.0, -2.0)) for t in times]
+    events = [status(0.0, OFFBOARD), *ocm(times), *sp]
+    assert codes(lint_events(events, fmt="mcap"), "OFB104") == []

@@ -31,6 +31,9 @@ class StaleSetpoints(Check):
                 "subsampled copies",
             )
         self.last_sent: dict[str, float] = {}
+        self.last_ocm: float | None = None
+        self.ocm_since = 0.0
+        """Start of the keep-alive's current unbroken run."""
         self.episode: tuple[str, float, Where] | None = None
         """(what went stale, since when, where) while a stale stretch is open."""
 
@@ -42,6 +45,9 @@ class StaleSetpoints(Check):
             return
         if not isinstance(event, ControlMode):
             return
+        if self.last_ocm is None or event.t - self.last_ocm > self.stale:
+            self.ocm_since = event.t  # the keep-alive itself paused: not "kept coming"
+        self.last_ocm = event.t
         flying = offboard_and_flying(self.ctx)
         if not flying:
             self._close(event.t)
@@ -56,6 +62,7 @@ class StaleSetpoints(Check):
             if len(quiet) < len(published):
                 continue  # never published in full: OFB303's finding, not a stale one
             oldest, kind = min(quiet)
+            oldest = max(oldest, self.ocm_since)  # quiet only counts under a live keep-alive
             if event.t - oldest <= self.stale:
                 self._close(event.t)  # one alternative is being served
                 return

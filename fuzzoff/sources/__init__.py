@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import importlib
+import re
 from pathlib import Path
 
 from fuzzoff.sources.base import RecordingInfo, Source, SourceError, SourceProblem
@@ -60,6 +61,23 @@ def _detect_bag_folder(path: Path) -> str:
     raise SourceError(path, "a folder without metadata.yaml or .db3/.mcap files is not a ROS 2 bag")
 
 
+_BAG_PART = re.compile(r"^(?P<stem>.+)_(?P<n>\d+)\.(?:db3|mcap)$")
+
+
+def _is_bag_without_metadata(path: Path) -> bool:
+    """A rosbag2 folder whose metadata.yaml was never written (the recorder crashed): rosbag2
+    names its data files ``<folder>_<n>.db3|mcap``. Such a folder is one bag, not one
+    recording per file; a folder of independent recordings does not follow that naming."""
+    parts = [p for p in path.iterdir() if p.suffix in RECORDING_SUFFIXES]
+    if not parts:
+        return False
+    for part in parts:
+        match = _BAG_PART.match(part.name)
+        if match is None or match.group("stem") != path.name:
+            return False
+    return True
+
+
 def open_source(path: Path, fmt: str | None = None) -> Source:
     """A reader for ``path`` (not yet opened)."""
     fmt = fmt or detect_format(path)
@@ -80,7 +98,7 @@ def find_recordings(path: Path) -> list[Path]:
     """The recordings in a folder, searched recursively; a ROS 2 bag folder counts as one."""
     if not path.is_dir():
         return [path]
-    if (path / "metadata.yaml").is_file():
+    if (path / "metadata.yaml").is_file() or _is_bag_without_metadata(path):
         return [path]
     found: list[Path] = []
     for child in sorted(path.iterdir()):

@@ -77,6 +77,9 @@ class Source(abc.ABC):
         self.path = path
         self.problems: list[SourceProblem] = []
         self.stats: dict[str, Any] = {}
+        self.px4_hint: str | None = None
+        """The user's ``--px4`` profile, set before ``open()``: readers that must choose message
+        definitions the recording does not carry (Humble-era ROS 2 bags) start from it."""
 
     def __enter__(self) -> Source:
         self.open()

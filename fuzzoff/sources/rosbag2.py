@@ -49,7 +49,6 @@ class Rosbag2Source(Source):
 
     def __init__(self, path: Path) -> None:
         super().__init__(path)
-        self.px4_hint: str | None = None
         self.decoding = Ros2Decoding()
         self._decoders: dict[tuple[str, str], Decoder | None] = {}
         self._reader: Any = None
