@@ -15,13 +15,11 @@ first run; ``python -m bench ros2`` runs only this benchmark.
 
 from __future__ import annotations
 
-import os
 import subprocess
 import sys
-import tempfile
-import time
-from dataclasses import dataclass
 from pathlib import Path
+
+from bench.measure import Run, measure
 
 DATA = Path(__file__).resolve().parent / "data"
 ROOT = DATA.parent.parent
@@ -84,33 +82,12 @@ print(len(report.findings), time.process_time() - start)
 """
 
 
-@dataclass
-class Run:
-    wall_s: float
-    cpu_s: float
-    rss_mb: float
-    output: str
-
-    @property
-    def work_s(self) -> float:
-        """CPU time after start-up and imports, as the child measured it."""
-        try:
-            return float(self.output.split()[-1])
-        except (IndexError, ValueError):
-            return float("nan")
-
-
-def measure(args: list[str]) -> Run:
-    """Run ``args``; wall time, CPU time and this child's own peak RSS."""
-    env = {**os.environ, "NO_COLOR": "1"}
-    with tempfile.TemporaryFile() as out:
-        start = time.perf_counter()
-        proc = subprocess.Popen(args, stdout=out, stderr=subprocess.DEVNULL, cwd=ROOT, env=env)
-        _, _status, usage = os.wait4(proc.pid, 0)
-        wall = time.perf_counter() - start
-        out.seek(0)
-        text = out.read().decode(errors="replace")
-    return Run(wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024, text)
+def work_s(run: Run) -> float:
+    """CPU time after start-up and imports, as the child measured it."""
+    try:
+        return float(run.output.split()[-1])
+    except (IndexError, ValueError):
+        return float("nan")
 
 
 def lint(path: Path) -> Run:
@@ -124,9 +101,9 @@ def lint_work(path: Path) -> Run:
 
 
 def _row(name: str, what: str, messages: int, run: Run) -> None:
-    rate = messages / run.work_s if run.work_s else 0.0
+    rate = messages / work_s(run) if work_s(run) else 0.0
     print(
-        f"{name:<22} {what:<34} {run.wall_s:7.2f} s {run.cpu_s:7.2f} s {run.work_s:7.2f} s "
+        f"{name:<22} {what:<34} {run.wall_s:7.2f} s {run.cpu_s:7.2f} s {work_s(run):7.2f} s "
         f"{rate:10,.0f} msg/s {run.rss_mb:7.1f} MB",
         flush=True,
     )
@@ -202,7 +179,7 @@ def _verdicts(kind: str, results: dict[str, dict[str, Run]]) -> list[str]:
     out = []
 
     def cpu(name: str, what: str) -> float:
-        return results[f"{tag} {name}"][what].work_s
+        return work_s(results[f"{tag} {name}"][what])
 
     for size in ("100k", "1M"):
         r = cpu(size, "fuzzoff lint") / cpu(size, "rosbags, PX4 topics")

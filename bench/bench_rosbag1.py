@@ -12,14 +12,10 @@ the first run; ``python -m bench rosbag1`` runs only this benchmark.
 
 from __future__ import annotations
 
-import os
-import subprocess
 import sys
-import tempfile
-import time
-from dataclasses import dataclass
 from pathlib import Path
 
+from bench.measure import Run, measure
 from bench.rosbag1_data import generate
 
 DATA = Path(__file__).resolve().parent / "data"
@@ -50,27 +46,6 @@ with source:
     source.probe()
     print(sum(1 for _ in source.events()))
 """
-
-
-@dataclass
-class Run:
-    wall_s: float
-    cpu_s: float
-    rss_mb: float
-    output: str
-
-
-def measure(args: list[str]) -> Run:
-    """Run ``args``; wall time, CPU time and this child's own peak RSS."""
-    env = {**os.environ, "NO_COLOR": "1"}
-    with tempfile.TemporaryFile() as out:
-        start = time.perf_counter()
-        proc = subprocess.Popen(args, stdout=out, stderr=subprocess.DEVNULL, cwd=ROOT, env=env)
-        _, _status, usage = os.wait4(proc.pid, 0)
-        wall = time.perf_counter() - start
-        out.seek(0)
-        text = out.read().decode(errors="replace")
-    return Run(wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024, text)
 
 
 def lint(path: Path) -> Run:

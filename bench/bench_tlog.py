@@ -15,15 +15,12 @@ from __future__ import annotations
 
 import os
 import shutil
-import subprocess
 import sys
-import tempfile
-import time
 from collections.abc import Callable
-from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
 
+from bench.measure import Run, measure
 from bench.tlog_data import generate
 
 REPEATS = {"100k": 3, "1M": 1, "mixed-500k": 3}
@@ -57,28 +54,6 @@ with source:
     source.probe()
     print(sum(1 for _ in source.events()))
 """
-
-
-@dataclass
-class Run:
-    wall_s: float
-    rss_mb: float
-    cpu_s: float
-    output: str
-
-
-def measure(args: list[str]) -> Run:
-    """Run ``args``; wall time and this child's own peak RSS (not the max over all children)."""
-    env = {**os.environ, "MAVLINK20": "1", "NO_COLOR": "1"}
-    with tempfile.TemporaryFile() as out:
-        start = time.perf_counter()
-        proc = subprocess.Popen(args, stdout=out, stderr=subprocess.DEVNULL, cwd=ROOT, env=env)
-        _, status, usage = os.wait4(proc.pid, 0)
-        wall = time.perf_counter() - start
-        proc.returncode = os.waitstatus_to_exitcode(status)
-        out.seek(0)
-        text = out.read().decode(errors="replace")
-    return Run(wall, usage.ru_maxrss / 1024, usage.ru_utime + usage.ru_stime, text)
 
 
 def lint(paths: list[Path], jobs: int = 1) -> Run:
