@@ -1,0 +1,83 @@
+"""Rebuild the reproducers of the known problems (fuzzoff/fuzz/known.py) from seeded campaigns.
+
+Run as ``.venv/bin/python corpora/fuzz/build.py``. Each entry is a campaign (property, profile,
+transport, seed) that finds the problem; the shrunk counterexample is saved here as a recording
+plus ``NAME.expected.json`` (what ``fuzzoff lint`` says about it, the property and the problem).
+``make test`` replays the findings; ``fuzzoff replay NAME.expected.json`` re-checks the property
+(exit 0 once the problem is fixed: then drop the entry here and in known.py).
+"""
+
+from __future__ import annotations
+
+import re
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+
+from fuzzoff.fuzz.campaign import CampaignConfig, run_campaign  # noqa: E402
+from fuzzoff.fuzz.known import KNOWN  # noqa: E402
+from fuzzoff.fuzz.reproducers import save  # noqa: E402
+from fuzzoff.fuzz.scenario import TransportName  # noqa: E402
+
+HERE = Path(__file__).resolve().parent
+
+
+@dataclass(frozen=True, slots=True)
+class Entry:
+    pattern: str
+    """The known.py key the reproducer shows."""
+    prop: str
+    px4: str
+    transport: TransportName
+    seed: int
+    vehicle: str = "mc"
+
+
+_MAV = r"silent hazard \((mavlink|mavros), "
+ENTRIES = (
+    Entry(_MAV + r"PX4 (legacy|1\.11)\): setpoint_dropped", "explained", "legacy", "mavlink", 1),
+    Entry(
+        r"setpoint_dropped .*no position, velocity or acceleration",
+        "explained",
+        "1.16",
+        "mavlink",
+        5,
+    ),
+    Entry(_MAV + r".*controller .*no TrajectorySetpoint since", "explained", "1.15", "mavlink", 0),
+    Entry(r"silent hazard .*arm_rejected", "explained", "1.15", "ros2", 2),
+    Entry(r"invariant 0: .*goes back in time", "invariants", "main", "ros2", 4),
+)
+
+
+def build(entry: Entry) -> Path:
+    others = tuple(k for k in KNOWN if k != entry.pattern)
+    config = CampaignConfig(
+        px4=entry.px4,
+        vehicle=entry.vehicle,
+        transport=entry.transport,
+        examples=2000,
+        seed=entry.seed,
+        properties=(entry.prop,),
+        known=others,
+        shrink_s=60.0,
+    )
+    (result,) = run_campaign(config).results
+    if not result.failed or result.counterexample is None:
+        raise SystemExit(f"{entry}: the campaign found nothing")
+    if not any(re.search(entry.pattern, p) for p in result.problems):
+        raise SystemExit(f"{entry}: found something else: {result.problems}")
+    return save(entry.prop, result.counterexample, result.problems, HERE)
+
+
+def main() -> None:
+    for old in HERE.glob("*"):
+        if old.name != "build.py" and old.is_file():
+            old.unlink()
+    for entry in ENTRIES:
+        print(build(entry).relative_to(HERE.parent.parent))
+
+
+if __name__ == "__main__":
+    main()
