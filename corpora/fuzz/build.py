@@ -10,16 +10,13 @@ plus ``NAME.expected.json`` (what ``fuzzoff lint`` says about it, the property a
 from __future__ import annotations
 
 import re
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
-
-from fuzzoff.fuzz.campaign import CampaignConfig, run_campaign  # noqa: E402
-from fuzzoff.fuzz.known import KNOWN  # noqa: E402
-from fuzzoff.fuzz.reproducers import save  # noqa: E402
-from fuzzoff.fuzz.scenario import TransportName  # noqa: E402
+from fuzzoff.fuzz.campaign import CampaignConfig, run_campaign
+from fuzzoff.fuzz.known import KNOWN
+from fuzzoff.fuzz.reproducers import save
+from fuzzoff.fuzz.scenario import TransportName
 
 HERE = Path(__file__).resolve().parent
 
