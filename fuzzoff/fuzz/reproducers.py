@@ -22,7 +22,7 @@ from typing import Any
 
 from fuzzoff.config import Settings
 from fuzzoff.engine import lint_file
-from fuzzoff.findings import FileReport, Severity
+from fuzzoff.findings import FileReport
 from fuzzoff.fuzz import recordings
 from fuzzoff.fuzz.properties import PROPERTIES, FuzzContext
 from fuzzoff.fuzz.scenario import RECORDING_FORMAT, Scenario
@@ -135,7 +135,3 @@ def recheck(spec: dict[str, Any], recording: Path) -> list[str]:
         return PROPERTIES[str(prop)].check(scenario, ctx)
     finally:
         ctx.close()
-
-
-def severity_label(severity: Severity) -> str:
-    return severity.label
