@@ -4,6 +4,8 @@ A *hazard* is a ``GateTransition`` of one of these kinds (gate spec section in b
 
 * ``request_rejected`` / ``arm_rejected``: the stream asked for OFFBOARD or to arm in it (4.1, 4.2);
 * ``failsafe``: the loss failsafe ran (5), and ``disarmed`` by it (not by a disarm command);
+  not a failsafe the model ends within one Commander iteration (a tie at the threshold, which
+  changes nothing; the invariants check the model's timeline itself);
 * ``setpoint_dropped``: the MAVLink receiver dropped or ignored a setpoint (6);
 * ``controller`` with a reason that lasts ``HOLD_S`` or more: another controller runs than the
   setpoint asked for (the failsafe setpoint, the 200 ms reuse; 8-10). Shorter ones are the
@@ -102,6 +104,21 @@ def _armed_before(tr: GateTransition, transitions: Sequence[GateTransition]) -> 
     return bool(tr.armed)
 
 
+BLIP_S = 0.0105
+"""A failsafe the model ends within one Commander iteration (the keep-alive that ends the loss
+arrives at the loss time itself: a tie at the threshold) changes nothing the vehicle does."""
+
+
+def _blip(tr: GateTransition, transitions: Sequence[GateTransition]) -> bool:
+    idx = next(i for i, x in enumerate(transitions) if x is tr)
+    for x in transitions[idx + 1 :]:
+        if x.what == "offboard_resumed":
+            return abs(x.t - tr.t) <= BLIP_S
+        if x.what == "failsafe" or x.t > tr.t + BLIP_S:
+            return False
+    return False
+
+
 def _undone_earlier(tr: GateTransition, transitions: Sequence[GateTransition]) -> bool:
     """A transition listed after ``tr`` but timed before it (the model bug in fuzz.known)."""
     idx = next(i for i, x in enumerate(transitions) if x is tr)
@@ -140,7 +157,9 @@ def hazards(transitions: Sequence[GateTransition], t_end: float) -> list[Hazard]
             if end - tr.t < hold:
                 continue
             out.append(Hazard(tr.t, what, tr.message, tr.spec, end))
-        elif what in WHILE_ARMED and not _armed_before(tr, transitions):
+        elif (what in WHILE_ARMED and not _armed_before(tr, transitions)) or (
+            what == "failsafe" and _blip(tr, transitions)
+        ):
             continue
         elif what in EXPLAINED_BY:
             message = tr.message
