@@ -261,3 +261,20 @@ def test_replay_rejects_a_bad_target_and_a_missing_file(tmp_path: Path) -> None:
     bad = tmp_path / "x.expected.json"
     bad.write_text("{not json")
     assert run_cli(["replay", str(bad)]).returncode == 2
+
+
+def test_stateful_sessions_keep_the_gate_invariants() -> None:
+    from hypothesis import HealthCheck, settings
+
+    from fuzzoff.fuzz.stateful import OffboardSession
+
+    case = OffboardSession.TestCase
+    case.settings = settings(
+        max_examples=40,
+        stateful_step_count=10,
+        database=None,
+        deadline=None,
+        derandomize=True,
+        suppress_health_check=list(HealthCheck),
+    )
+    case().runTest()
