@@ -26,10 +26,10 @@ class Entry:
     pattern: str
     """The known.py key the reproducer shows."""
     prop: str
-    px4: str
-    transport: TransportName
+    px4: str | None
+    transport: TransportName | None
     seed: int
-    vehicle: str = "mc"
+    vehicle: str | None = "mc"
 
 
 _MAV = r"silent hazard \((mavlink|mavros), "
@@ -45,6 +45,7 @@ ENTRIES = (
     Entry(_MAV + r".*controller .*no TrajectorySetpoint since", "explained", "1.15", "mavlink", 0),
     Entry(r"silent hazard .*arm_rejected", "explained", "1.15", "ros2", 2),
     Entry(r"invariant 0: .*goes back in time", "invariants", "main", "ros2", 4),
+    Entry(r"silent hazard \(ros2, [^)]*\): request_rejected", "explained", None, None, 21, None),
 )
 
 

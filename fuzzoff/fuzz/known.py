@@ -21,6 +21,11 @@ KNOWN: dict[str, str] = {
         "(vehicle_status); without it, a rejected arm in the predicted OFFBOARD is not "
         "reported even with the rejecting ack recorded"
     ),
+    r"silent hazard \(ros2, [^)]*\): request_rejected": (
+        "OFB101/OFB102 judge gaps by the docs' 0.5 s: with COM_OF_LOSS_T lowered below it, a "
+        "gap shorter than 0.5 s before the switch loses the signal and the switch is rejected, "
+        "and no rule says so (OFB201 needs the acks)"
+    ),
     r"timeline out of order": (
         "gate model: the loss failsafe is emitted one Commander iteration ahead (t + 10 ms) "
         "before the keep-alive at t that ends the loss is applied (a gap of exactly "
