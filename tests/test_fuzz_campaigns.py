@@ -115,6 +115,8 @@ def test_reproducer_replays_through_lint_and_replay(tmp_path: Path) -> None:
     data = json.loads(replay.stdout)
     assert data["findings_match"] is True
     assert data["property_still_fails"] is True
+    by_recording = run_cli(["replay", str(tmp_path / spec["recording"]), "--format", "json"])
+    assert json.loads(by_recording.stdout)["property"] == "explained"
 
 
 def test_fuzz_command_reports_json_junit_and_sarif(tmp_path: Path) -> None:

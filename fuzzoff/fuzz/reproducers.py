@@ -101,10 +101,10 @@ class ReproducerError(ValueError):
 def load(path: Path) -> tuple[dict[str, Any], Path]:
     """(the expected.json contents, the recording's path) for a reproducer given by either."""
     if not path.name.endswith(".expected.json"):
-        candidates = sorted(path.parent.glob(f"{path.name.split('.')[0]}*.expected.json"))
-        if not candidates:
-            raise ReproducerError(f"{path}: no NAME.expected.json beside it")
-        path = candidates[0]
+        stem = path.name[: -len(path.suffix)] if path.suffix else path.name
+        path = path.parent / f"{stem}.expected.json"
+        if not path.exists():
+            raise ReproducerError(f"{path}: no such file beside the recording")
     try:
         spec = json.loads(path.read_text())
     except (OSError, json.JSONDecodeError) as exc:
