@@ -97,7 +97,7 @@ def _config(args: argparse.Namespace) -> CampaignConfig:
 
         try:
             config.base = scenario_from_recording(
-                Path(args.from_), px4 or "1.15", vehicle or "mc", parse_params(args.param)
+                Path(args.from_), px4, vehicle, parse_params(args.param)
             )
         except SourceError as exc:
             raise ConfigError(exc.line()) from None

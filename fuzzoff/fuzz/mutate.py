@@ -25,9 +25,10 @@ from hypothesis import strategies as st
 from fuzzoff.engine import Timeline
 from fuzzoff.events import ControlMode, Event, is_keepalive
 from fuzzoff.fuzz.hazards import hazards
-from fuzzoff.fuzz.recordings import read
+from fuzzoff.fuzz.recordings import read_with_info
 from fuzzoff.fuzz.scenario import Scenario, TransportName, run
 from fuzzoff.fuzz.streams import settle
+from fuzzoff.profiles import DEFAULT_PX4, DEFAULT_VEHICLE, ProfileError, px4_profile_for
 
 FAMILIES = ("stall", "drop", "jitter", "skew")
 MAX_SIZE = {"stall": 5.0, "drop": 50.0, "jitter": 1.0, "skew": 5.0}
@@ -35,10 +36,17 @@ UNIT = {"stall": "s", "drop": "messages", "jitter": "s", "skew": "s"}
 
 
 def scenario_from_recording(
-    path: Path, px4: str, vehicle: str, params: dict[str, float]
+    path: Path, px4: str | None, vehicle: str | None, params: dict[str, float]
 ) -> Scenario:
-    """The recording's events as a scenario (transport from its events)."""
-    events = read(path)
+    """The recording's events as a scenario (transport from its events; profile as given, else
+    as the recording says, else PX4 1.15 multicopter like ``fuzzoff lint``)."""
+    events, info = read_with_info(path)
+    if px4 is None:
+        try:
+            px4 = px4_profile_for(info.px4_version) if info.px4_version else DEFAULT_PX4
+        except ProfileError:
+            px4 = DEFAULT_PX4
+    vehicle = vehicle or info.vehicle_type or DEFAULT_VEHICLE
     transport: TransportName = "ros2"
     if any(getattr(e, "transport", "") == "mavros" for e in events):
         transport = "mavros"

@@ -13,6 +13,7 @@ from pathlib import Path
 from fuzzoff.events import Event
 from fuzzoff.fuzz.scenario import Scenario
 from fuzzoff.sources import open_source
+from fuzzoff.sources.base import RecordingInfo
 from fuzzoff.sources.px4_msgs import release_for
 
 FORMATS_FOR: dict[str, tuple[str, ...]] = {
@@ -53,10 +54,15 @@ def write(scenario: Scenario, path: Path, fmt: str) -> Path:
 
 def read(path: Path) -> list[Event]:
     """Every event a reader gives back for ``path`` (raises ``SourceError`` if unreadable)."""
+    return read_with_info(path)[0]
+
+
+def read_with_info(path: Path) -> tuple[list[Event], RecordingInfo]:
+    """The events and what the reader says about the recording (PX4 version, vehicle type)."""
     source = open_source(path)
     source.open()
     try:
-        source.probe()
-        return list(source.events())
+        info = source.probe()
+        return list(source.events()), info
     finally:
         source.close()
