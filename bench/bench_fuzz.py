@@ -122,7 +122,7 @@ CLASSES: tuple[HazardClass, ...] = (
         "rover combination without its NaN setpoint",
         "target",
         rule="OFB504",
-        px4="1.16",
+        px4="1.17",
         vehicle="rover-differential",
         transport="ros2",
     ),
