@@ -32,7 +32,7 @@ class _Request:
 
 class RequestRejected(Check):
     codes = ("OFB201",)
-    wants = (Event,)
+    wants = (Command, CommandAck, GateTransition)
 
     def __init__(self, ctx: CheckContext) -> None:
         super().__init__(ctx)
