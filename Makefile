@@ -41,8 +41,9 @@ check: $(STAMP)
 bench: $(STAMP)
 	$(BIN)/python -m bench
 
+# A longer campaign than the short seeded ones `make test` runs; SEED=n picks another seed.
 fuzz: $(STAMP)
-	$(BIN)/fuzzoff fuzz --budget 300 --seed 1
+	$(BIN)/fuzzoff fuzz --budget 600 --seed $${SEED:-1} --known --format junit --output build/fuzz-junit.xml
 
 clean:
 	rm -rf $(VENV) build .pytest_cache .mypy_cache .hypothesis
