@@ -191,3 +191,27 @@ def test_ofb104_not_when_the_keepalive_stopped_with_the_setpoints() -> None:
     sp = [TrajectorySetpoint(t=t + 0.01, position=(0.0, 0.0, -2.0)) for t in times]
     events = [status(0.0, OFFBOARD), *ocm(times), *sp]
     assert codes(lint_events(events, fmt="mcap"), "OFB104") == []
+
+
+def test_ofb201_reports_the_models_rejection_when_the_recording_has_no_acks() -> None:
+    # no keep-alive at all, armed: PX4 1.15 rejects the switch; no ack recorded
+    found = lint_events([status(0.0, POSCTL), switch(1.0)])
+    (rejected,) = codes(found, "OFB201")
+    assert "would reject it" in rejected.message and "no offboard signal" in rejected.message
+    assert not [f for f in codes(found, "OFB002") if "OFB201" in f.message]
+
+
+def test_ofb201_no_acks_and_an_accepted_switch_is_not_checkable() -> None:
+    found = lint_events([status(0.0, POSCTL), *ocm(every(0.0, 1.5, 0.1)), switch(1.5)])
+    assert codes(found, "OFB201") == []
+    assert [f for f in codes(found, "OFB002") if "OFB201" in f.message]
+
+
+def test_ofb201_arm_in_predicted_offboard_without_a_recorded_mode() -> None:
+    from fuzzoff.events import Command
+
+    arm = Command(t=2.0, command=400, params=(1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
+    # disarmed switch without a stream is accepted on 1.15; the arm is rejected (gate spec 4.2)
+    events = [switch(1.0), ack(1.01, 0), arm, ack(2.01, 1, command=400)]
+    (found,) = codes(lint_events(events), "OFB201")
+    assert "arm in OFFBOARD" in found.message

@@ -43,9 +43,7 @@ ENTRIES = (
         5,
     ),
     Entry(_MAV + r".*controller .*no TrajectorySetpoint since", "explained", "1.15", "mavlink", 0),
-    Entry(r"silent hazard .*arm_rejected", "explained", "1.15", "ros2", 2),
     Entry(r"invariant 0: .*goes back in time", "invariants", "main", "ros2", 4),
-    Entry(r"silent hazard \(ros2, [^)]*\): request_rejected", "explained", None, None, 21, None),
 )
 
 

@@ -12,7 +12,6 @@ from dataclasses import dataclass
 from fuzzoff.checks._keepalive import px4_label
 from fuzzoff.checks.base import Check, CheckContext
 from fuzzoff.events import (
-    MAV_CMD_COMPONENT_ARM_DISARM,
     NAV_STATE_OFFBOARD,
     Command,
     CommandAck,
@@ -39,6 +38,8 @@ class RequestRejected(Check):
         self.requests: dict[int, _Request] = {}
         """Open offboard requests by MAVLink command id (one outstanding per command)."""
         self.seen_ack = False
+        self.unconfirmed = False
+        """A request the model accepts could not be confirmed: there are no acks."""
         self.verdicts: dict[int, GateTransition] = {}
         """The gate's answer to a command, keyed by the command's id: the engine dispatches the
         gate's transitions before the event that caused them."""
@@ -51,17 +52,55 @@ class RequestRejected(Check):
         elif isinstance(event, Command):
             verdict = self.verdicts.pop(id(event), None)
             self.verdicts.clear()
+            request = None
             if event.is_offboard_switch:
-                self.requests[event.command] = _Request(event, "switch to OFFBOARD", verdict)
-            elif event.is_arm and self.ctx.state.nav_state == NAV_STATE_OFFBOARD:
-                self.requests[event.command] = _Request(event, "arm in OFFBOARD", verdict)
-            elif event.is_mode_switch or event.command == MAV_CMD_COMPONENT_ARM_DISARM:
-                self.requests.pop(event.command, None)  # another request supersedes it
+                request = _Request(event, "switch to OFFBOARD", verdict)
+            elif event.is_arm and self._offboard_selected():
+                request = _Request(event, "arm in OFFBOARD", verdict)
+            if request is not None or event.is_mode_switch or event.is_arm or event.is_disarm:
+                self._supersede(event.command)
+            if request is not None:
+                self.requests[event.command] = request
         elif isinstance(event, CommandAck):
             self.seen_ack = True
             request = self.requests.get(event.command)
             if request is not None:
                 request.ack = event  # a later ack within the window replaces an earlier one
+
+    def _offboard_selected(self) -> bool:
+        """OFFBOARD is the selected mode: as recorded, else as the gate model has it."""
+        state = self.ctx.state
+        if state.mode_recorded:
+            return state.nav_state == NAV_STATE_OFFBOARD
+        return self.ctx.gate.user_intention == NAV_STATE_OFFBOARD
+
+    def _supersede(self, command: int) -> None:
+        """A new request of the same command: the open one is judged as it stands."""
+        request = self.requests.pop(command, None)
+        if request is None:
+            return
+        if request.ack is not None:
+            self._judge(request)
+        else:
+            self._predict(request)
+
+    def _predict(self, request: _Request) -> None:
+        """No ack for this request and none anywhere in the recording: the rule reports the gate
+        model's rejection itself (the consequence the docs' rules lead to, rules.md)."""
+        if self.ctx.has("command_ack"):
+            return
+        verdict = request.verdict
+        if verdict is None or not verdict.what.endswith("rejected"):
+            self.unconfirmed = True
+            return
+        self.ctx.report(
+            "OFB201",
+            f"{request.what} at {request.command.t:.2f} s: {px4_label(self.ctx)} would reject it "
+            f"({verdict.reason or verdict.message}, gate spec {verdict.spec}); the recording "
+            "has no command acks to show the vehicle's answer",
+            request.command.t,
+            request.command.where,
+        )
 
     def _settle(self, now: float) -> None:
         if not self.requests:
@@ -96,7 +135,11 @@ class RequestRejected(Check):
 
     def finish(self, t_end: float) -> None:
         self._settle(float("inf"))
-        if self.requests and not self.seen_ack and not self.ctx.has("command_ack"):
+        for command in list(self.requests):
+            self._supersede(command)
+        if self.unconfirmed:
             self.ctx.cannot_check(
-                "OFB201", "needs the vehicle's command acks (COMMAND_ACK / vehicle_command_ack)"
+                "OFB201",
+                "needs the vehicle's command acks (COMMAND_ACK / vehicle_command_ack) to confirm "
+                "requests the gate model expects PX4 to accept",
             )

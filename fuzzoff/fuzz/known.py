@@ -16,16 +16,6 @@ KNOWN: dict[str, str] = {
         "until the next one arrives; no rule reports a long hold after the switch for a "
         "MAVLink stream (OFB303 covers ROS 2 only)"
     ),
-    r"silent hazard .*arm_rejected": (
-        "OFB201 registers an arm request in OFFBOARD only when the recording shows the mode "
-        "(vehicle_status); without it, a rejected arm in the predicted OFFBOARD is not "
-        "reported even with the rejecting ack recorded"
-    ),
-    r"silent hazard \(ros2, [^)]*\): request_rejected": (
-        "OFB101/OFB102 judge gaps by the docs' 0.5 s: with COM_OF_LOSS_T lowered below it, a "
-        "gap shorter than 0.5 s before the switch loses the signal and the switch is rejected, "
-        "and no rule says so (OFB201 needs the acks)"
-    ),
     r"timeline out of order": (
         "gate model: the loss failsafe is emitted one Commander iteration ahead (t + 10 ms) "
         "before the keep-alive at t that ends the loss is applied (a gap of exactly "
