@@ -43,7 +43,6 @@ ENTRIES = (
         5,
     ),
     Entry(_MAV + r".*controller .*no TrajectorySetpoint since", "explained", "1.15", "mavlink", 0),
-    Entry(r"invariant 0: .*goes back in time", "invariants", "main", "ros2", 4),
 )
 
 

@@ -16,15 +16,6 @@ KNOWN: dict[str, str] = {
         "until the next one arrives; no rule reports a long hold after the switch for a "
         "MAVLink stream (OFB303 covers ROS 2 only)"
     ),
-    r"timeline out of order": (
-        "gate model: the loss failsafe is emitted one Commander iteration ahead (t + 10 ms) "
-        "before the keep-alive at t that ends the loss is applied (a gap of exactly "
-        "COM_OF_LOSS_T); see invariant 0"
-    ),
-    r"invariant 0: .*goes back in time": (
-        "gate model: the loss failsafe is emitted one Commander iteration ahead (t + 10 ms) "
-        "before the event at t is applied"
-    ),
     _MAV + r"PX4 (legacy|1\.11)\): setpoint_dropped": (
         "legacy/1.11 MAVLink receiver drops (GLOBAL_INT not handled, non-finite fields, FORCE "
         "bit, takeoff bit as loiter): no legacy rule covers them (OFB6xx apply from 1.13)"

@@ -86,6 +86,10 @@ class GateModel:
         self._sampled = False
         self.ctl = ControllerTracker(self.px4, self.vehicle_type, self.est)
         self._deadline = INF
+        self._clock = -INF
+        """The newest event time fed: nothing is emitted earlier (the timeline never goes back)."""
+        self._failsafe_due = INF
+        """1.14+: the Commander iteration that will run the loss failsafe (2.1.3), inf if none."""
         self._dirty = False
         self._stamp_offset: float | None = None
         self.compare = Comparator(slack(self.px4) + LOOP_PERIOD)
@@ -143,6 +147,8 @@ class GateModel:
         if t >= self._deadline:
             self._advance(t)
             self._deadline = self._now_deadline
+        if t > self._clock:
+            self._clock = t
         handler = self._handlers.get(type(event))
         if handler is not None:
             self._cause = event
@@ -201,25 +207,33 @@ class GateModel:
             self.signal.timeout_at(),
             self.ctl.reuse_due,
             self.compare.due(),
+            self._failsafe_due,
         )
 
     def _advance(self, t: float) -> None:
         while True:
             lost = self.signal.lost_at()
             timeout = self.signal.timeout_at()
-            due = min(lost, timeout, self.ctl.reuse_due, self.compare.due())
+            failsafe = self._failsafe_due
+            due = min(lost, timeout, self.ctl.reuse_due, self.compare.due(), failsafe)
             if due > t:
                 return
-            if lost == due:
-                self._signal_lost(lost)
+            # Due before an event already applied (a deadline that moved earlier): PX4 acts at
+            # the next pass it runs, never in the past.
+            at = max(due, self._clock)
+            if failsafe == due:
+                self._failsafe_due = INF
+                self._refresh(at, cause=None)
+            elif lost == due:
+                self._signal_lost(at)
             elif timeout == due:
                 self.signal.timed_out = True  # type: ignore[attr-defined]
-                self._refresh(timeout)
+                self._refresh(at)
             elif self.ctl.reuse_due == due:
                 self.ctl.reuse_due = INF
-                self._update_controller(due)
+                self._update_controller(at)
             else:
-                self._confirm(due)
+                self._confirm(at)
 
     # ------------------------------------------------------------------ proof of life
 
@@ -241,8 +255,15 @@ class GateModel:
         )
         if self.signal.timeout_at() <= t:  # legacy: COM_OF_LOSS_T 0 = both stages at once
             self.signal.timed_out = True  # type: ignore[attr-defined]
-        # 1.14+: the failsafe reacts one Commander iteration after the check pass (2.1.3).
-        self._refresh(t + (LOOP_PERIOD if self.tick_based else 0.0), cause=None)
+        if self.tick_based:
+            # 1.14+ (2.1.3): Commander's iteration runs handleModeIntentionAndFailsafe() before
+            # the check block, so the failsafe reacts one iteration (10 ms) after the check pass
+            # that saw the loss. Until then nothing changes the mode, and a keep-alive that
+            # arrives in between cancels it (the forced check pass clears the flag). Emitting
+            # it only when that iteration is reached keeps the timeline in time order.
+            self._failsafe_due = t + LOOP_PERIOD
+        else:
+            self._refresh(t, cause=None)
 
     def _keepalive(self, t: float, mask: int, event: Event, stamp: float | None = None) -> None:
         changed = mask != self.ocm_mask
@@ -253,10 +274,12 @@ class GateModel:
             self._sampled = True
             self.compare.sampled_keepalive()
         became = self.signal.keepalive(t, self._good, stamp)
-        # A good keep-alive while available only moves the loss later: the cached deadline
-        # stays a valid lower bound (feed() recomputes it when it is reached).
-        self._dirty = became or not self._good or changed
+        # A good keep-alive received now while available only moves the loss later: the cached
+        # deadline stays a valid lower bound (feed() recomputes it when it is reached). One with
+        # its own timestamp (2.1.1) may lag and move the loss earlier.
+        self._dirty = became or not self._good or changed or stamp is not None
         if became:
+            self._failsafe_due = INF
             self._emit(
                 t,
                 "signal_available",
@@ -363,6 +386,8 @@ class GateModel:
     def _needs_failsafe(self) -> bool:
         if self.user_intention != NAV_STATE_OFFBOARD or self.signal.available:
             return False
+        if self._failsafe_due != INF:
+            return False  # lost at the last check pass; the failsafe iteration is still ahead
         if self.tick_based:
             return self.armed
         return True  # 1.13 and older: recomputed even when disarmed (4.1)
@@ -551,6 +576,16 @@ class GateModel:
             self._start(status)
             return
         self.compare.remember(status)
+        if (
+            self._failsafe_due != INF
+            and status.nav_state is not None
+            and status.nav_state != NAV_STATE_OFFBOARD
+        ):
+            # The recording already shows the vehicle out of OFFBOARD between the check pass
+            # that saw the loss and the model's failsafe iteration: PX4's loop phase is not the
+            # model's grid (2.1.3), this is the failsafe. Run it now (never back in time).
+            self._failsafe_due = INF
+            self._refresh(status.t, cause=None)
         armed, intention = self._unseen_inputs(status)
         if armed or intention is not None:
             self._adopt(status.t, status, intention, silent=True)

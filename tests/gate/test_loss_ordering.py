@@ -1,0 +1,161 @@
+"""The loss failsafe's place in time on 1.14+ (gate spec 2.1.3) and the timeline's order.
+
+Facts used (spec 2.1.3, Commander::run): the loss is detected at a ~10 Hz check pass; the
+failsafe reacts one Commander iteration (10 ms) later, because handleModeIntentionAndFailsafe()
+runs before the check block. A keep-alive that arrives after the check pass but before that
+iteration clears the flag first (offboardControlCheck forces a check pass), so no failsafe is
+run. Whatever the events, ``feed`` never returns a transition earlier than one it returned
+before.
+"""
+
+from __future__ import annotations
+
+import json
+import random
+from pathlib import Path
+
+import pytest
+
+from fuzzoff.events import ControlMode, Event, TrajectorySetpoint, VehicleStatus
+from fuzzoff.gate import GateModel, GateTransition
+from fuzzoff.profiles import Profile
+from fuzzoff.writers.mcap import write_mcap
+from tests.gate.streams import (
+    ALL,
+    OFFBOARD,
+    POSCTL,
+    TICK,
+    arm,
+    in_offboard,
+    ocm,
+    of,
+    status,
+    stream,
+    switch_offboard,
+)
+from tests.helpers import run_cli
+
+ITERATION = 0.01
+
+
+def _feed(px4: str, events: list[Event], t_end: float, **params: float) -> list[GateTransition]:
+    """Feed in time order and check, call by call, that the timeline never goes back."""
+    gate = GateModel(Profile(px4=px4, vehicle="mc"), params, "1")
+    out: list[GateTransition] = []
+    for event in sorted(events, key=lambda e: e.t):
+        for tr in gate.feed(event):
+            assert not out or tr.t >= out[-1].t - 1e-12, (out[-1], tr)
+            out.append(tr)
+    for tr in gate.finish(t_end):
+        assert not out or tr.t >= out[-1].t - 1e-12, (out[-1], tr)
+        out.append(tr)
+    return out
+
+
+@pytest.mark.parametrize("px4", TICK)
+def test_keepalive_at_the_check_pass_prevents_the_failsafe(px4: str) -> None:
+    """Keep-alives exactly COM_OF_LOSS_T apart (the fuzz reproducer: 0.2 s): each check pass
+    that lands on a gap's end sees the loss, the keep-alive at that instant clears it before
+    the failsafe iteration: no failsafe, the vehicle stays in OFFBOARD."""
+    events: list[Event] = [in_offboard(), *stream(0.0, 1.0, period=0.2)]
+    trs = _feed(px4, events, 1.05, COM_OF_LOSS_T=0.2)
+    assert of("signal_lost", trs)  # the model sees the exact-timeout gaps (2.1: >=)
+    assert of("failsafe", trs) == []
+    assert {tr.nav_state for tr in trs} <= {OFFBOARD, None}
+
+
+@pytest.mark.parametrize("px4", TICK)
+@pytest.mark.parametrize("late", [0.0, 0.004, 0.0099])
+def test_keepalive_before_the_failsafe_iteration_prevents_it(px4: str, late: float) -> None:
+    """Lost at the check pass at 2.0 s (newest keep-alive 1.0 s, COM_OF_LOSS_T 1 s); a
+    keep-alive at 2.0 s + ``late`` (< 10 ms) arrives before the failsafe iteration."""
+    events: list[Event] = [in_offboard(), *stream(0.0, 1.0), ocm(round(2.0 + late, 6))]
+    trs = _feed(px4, events, 2.5)
+    assert [tr.t for tr in of("signal_lost", trs)] == [pytest.approx(2.0)]
+    assert [tr.t for tr in of("signal_available", trs)][-1] == pytest.approx(2.0 + late)
+    assert of("failsafe", trs) == []
+    assert of("offboard_resumed", trs) == []
+
+
+@pytest.mark.parametrize("px4", TICK)
+@pytest.mark.parametrize("late", [ITERATION, 0.05])
+def test_keepalive_after_the_failsafe_iteration_comes_too_late(px4: str, late: float) -> None:
+    """A keep-alive at or after the failsafe iteration (check pass + 10 ms): the failsafe ran
+    (5.1: POSCTL by default) and the vehicle returns to OFFBOARD at the keep-alive."""
+    events: list[Event] = [in_offboard(), *stream(0.0, 1.0), ocm(round(2.0 + late, 6))]
+    trs = _feed(px4, events, 2.5)
+    (failsafe,) = of("failsafe", trs)
+    assert failsafe.t == pytest.approx(2.0 + ITERATION)
+    assert failsafe.nav_state == POSCTL
+    (resumed,) = of("offboard_resumed", trs)
+    assert resumed.t == pytest.approx(2.0 + late)
+    assert resumed.t >= failsafe.t
+
+
+@pytest.mark.parametrize("px4", TICK)
+def test_other_events_in_the_window_do_not_run_the_failsafe_early(px4: str) -> None:
+    """A setpoint and a recorded status between the check pass and the failsafe iteration
+    change nothing: the failsafe still comes at the iteration, not at those events."""
+    events: list[Event] = [
+        in_offboard(),
+        *stream(0.0, 1.0),
+        TrajectorySetpoint(t=2.003, position=(0.0, 0.0, -2.0)),
+        status(2.005, OFFBOARD, True, OFFBOARD),
+    ]
+    trs = _feed(px4, events, 3.0)
+    (failsafe,) = of("failsafe", trs)
+    assert failsafe.t == pytest.approx(2.0 + ITERATION)
+
+
+@pytest.mark.parametrize("px4", TICK)
+def test_recording_ending_inside_the_window_runs_no_failsafe(px4: str) -> None:
+    """Nothing after the recording's end: a loss seen in its last 10 ms has no failsafe yet."""
+    trs = _feed(px4, [in_offboard(), *stream(0.0, 1.0)], 2.005)
+    assert len(of("signal_lost", trs)) == 1
+    assert of("failsafe", trs) == []
+
+
+def _random_session(rng: random.Random) -> list[Event]:
+    events: list[Event] = [status(0.0, POSCTL, False, POSCTL)]
+    t = 0.0
+    while t < 6.0:
+        t = round(t + rng.choice([0.05, 0.1, 0.2, 0.3, 0.5, 0.9, 1.0, 1.1, 1.3]), 3)
+        events.append(ocm(t))
+        if rng.random() < 0.05:
+            events.append(switch_offboard(round(t + rng.choice([0.0, 0.005, 0.01]), 3)))
+        if rng.random() < 0.05:
+            events.append(arm(round(t + rng.choice([0.0, 0.005, 0.01]), 3)))
+        if rng.random() < 0.1:
+            nav = rng.choice([OFFBOARD, POSCTL])
+            events.append(status(round(t + 0.007, 3), nav, True, None))
+    return events
+
+
+@pytest.mark.parametrize("px4", ALL)
+@pytest.mark.parametrize("seed", range(12))
+@pytest.mark.parametrize("timeout", [0.2, 0.5, 1.0])
+def test_feed_never_goes_back_in_time(px4: str, seed: int, timeout: float) -> None:
+    """Keep-alive gaps around COM_OF_LOSS_T, switches, arms and recorded statuses at and just
+    after check passes: every profile's timeline stays in time order."""
+    events = _random_session(random.Random(seed))
+    _feed(px4, events, 7.0, COM_OF_LOSS_T=timeout)
+
+
+def test_gate_command_output_is_in_time_order(tmp_path: Path) -> None:
+    """``fuzzoff gate`` on a ROS 2 recording with keep-alives exactly COM_OF_LOSS_T apart:
+    rows in time order and no failsafe PX4 would not run."""
+    events: list[Event] = [
+        VehicleStatus(t=0.0, vehicle="1", nav_state=OFFBOARD, armed=True, user_intention=14),
+    ]
+    events += [
+        ControlMode(t=round(0.2 * k, 3), vehicle="1", position=True, origin="sent")
+        for k in range(11)
+    ]
+    path = write_mcap(tmp_path / "exact.mcap", events, release="1.16")
+    args = ["gate", str(path), "--px4", "1.16", "--vehicle", "mc", "--param", "COM_OF_LOSS_T=0.2"]
+    result = run_cli([*args, "--format", "json"])
+    assert result.returncode == 0, result.stdout + result.stderr
+    rows = json.loads(result.stdout)["files"][0]["vehicles"][0]["timeline"]
+    times = [r["time_s"] for r in rows]
+    assert times == sorted(times)
+    assert not [r for r in rows if r["what"] == "failsafe"]
