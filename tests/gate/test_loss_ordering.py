@@ -159,3 +159,22 @@ def test_gate_command_output_is_in_time_order(tmp_path: Path) -> None:
     times = [r["time_s"] for r in rows]
     assert times == sorted(times)
     assert not [r for r in rows if r["what"] == "failsafe"]
+
+
+@pytest.mark.parametrize("px4", TICK)
+def test_lagging_timestamp_brings_the_loss_forward(px4: str) -> None:
+    """2.1.1: a ROS 2 keep-alive whose own timestamp lags makes PX4 see an older sample. The
+    first stamped keep-alive (1.0 s) sets the clock offset; one received at 1.95 s stamped
+    1.55 s expires at 2.05 s, seen at the 2.1 s check pass, even though an earlier unstamped
+    keep-alive (1.9 s) would have lasted until 2.4 s. The next keep-alive (2.2 s) ends it."""
+
+    def sent(t: float, stamp_s: float) -> ControlMode:
+        return ControlMode(t=t, position=True, origin="sent", sender_time_us=round(stamp_s * 1e6))
+
+    events: list[Event] = [in_offboard(), *stream(0.0, 0.9)]
+    events += [sent(1.0, 1.0), ocm(1.3), ocm(1.6), ocm(1.9), sent(1.95, 1.55), sent(2.2, 0.0)]
+    trs = _feed(px4, events, 2.5, COM_OF_LOSS_T=0.5)
+    assert [tr.t for tr in of("signal_lost", trs)] == [pytest.approx(2.1)]
+    (failsafe,) = of("failsafe", trs)
+    assert failsafe.t == pytest.approx(2.1 + ITERATION)
+    assert [tr.t for tr in of("signal_available", trs)][-1] == pytest.approx(2.2)
