@@ -31,6 +31,7 @@ from fuzzoff.events import (
     FailsafeFlags,
     LegacyControlMode,
     Parameter,
+    PositionSetpointTriplet,
     SetAttitudeTarget,
     SetPositionTargetGlobal,
     SetPositionTargetLocal,
@@ -111,6 +112,7 @@ class GateModel:
             SetPositionTargetGlobal: self._on_mavlink,
             SetAttitudeTarget: self._on_mavlink,
             TrajectorySetpoint: self._on_trajectory,
+            PositionSetpointTriplet: self._on_triplet,
             VehicleStatus: self._on_status,
             FailsafeFlags: self._on_failsafe_flags,
             Command: self._on_command,
@@ -354,9 +356,17 @@ class GateModel:
             dirty = self._dirty
             self._trajectory(event.t, axes)
             self._dirty = self._dirty or dirty
+        elif axes and self.ctl.legacy:
+            self.ctl.setpoint(event.t)  # legacy: counted once offboard runs (section 8)
 
     def _on_trajectory(self, event: TrajectorySetpoint) -> None:
         self._trajectory(event.t, controllers.axes_of(event))
+
+    def _on_triplet(self, event: PositionSetpointTriplet) -> None:
+        """legacy/1.11: the offboard setpoint as mc_pos_control sees it (section 8)."""
+        self._dirty = False
+        if self.ctl.legacy and event.current_valid and self.ctl.setpoint(event.t):
+            self._update_controller(event.t)
 
     def _on_failsafe_flags(self, event: FailsafeFlags) -> None:
         if self.est.update(event):

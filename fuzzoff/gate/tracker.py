@@ -46,6 +46,11 @@ class ControllerTracker:
         self.reuse_due = INF
         """1.16+: when a reused last valid setpoint expires (section 8)."""
         self.kind = "none"
+        self.legacy = px4 in ("legacy", "1.11")
+        """legacy/1.11: the offboard setpoint reaches mc_pos_control as
+        ``position_setpoint_triplet`` (section 8 legacy note: details not modelled)."""
+        self.setpoint_t = -INF
+        """legacy/1.11: the newest offboard setpoint (triplet, MAVLink or trajectory setpoint)."""
         self._memo: dict[int, str | None] = {}
         self.land_speed = 0.7
 
@@ -58,9 +63,19 @@ class ControllerTracker:
     def entered_offboard(self, t: float) -> None:
         self.offboard_since = t
 
+    def setpoint(self, t: float) -> bool:
+        """legacy/1.11: an offboard setpoint (a valid ``position_setpoint_triplet`` or a MAVLink
+        setpoint); True when what runs may have changed (the first one)."""
+        first = self.setpoint_t == -INF
+        self.setpoint_t = t
+        return first
+
     def trajectory(self, t: float, axes: int, in_offboard: bool) -> bool:
         """A trajectory setpoint; True when what runs may have changed (call ``update``)."""
         self.traj_t = t
+        if self.legacy:
+            self.traj_axes = axes
+            return self.setpoint(t)
         if not in_offboard or not self.position_control:
             if axes != self.traj_axes:
                 self.traj_axes = axes
@@ -104,6 +119,8 @@ class ControllerTracker:
         return self._multicopter(t)
 
     def _multicopter(self, t: float) -> Change | None:
+        if self.legacy:
+            return self._legacy_multicopter()
         mask, axes = self.mask, self.traj_axes
         invalid: str | None = None
         if self.traj_t < self.offboard_since:
@@ -138,6 +155,24 @@ class ControllerTracker:
             why = "no TrajectorySetpoint since position control was enabled"
             return Change(f"{head}: {hold} ({why})", "8", why, unverified)
         return Change(f"{head}: {hold} ({invalid})", "8", invalid, unverified)
+
+    def _legacy_multicopter(self) -> Change | None:
+        """legacy/1.11: mc_pos_control flies ``position_setpoint_triplet`` with its ``*_valid``
+        flags (section 8 legacy note): not modelled per axis, so no hold is claimed."""
+        seen = self.setpoint_t > -INF
+        key = (self.mask, "legacy", seen)
+        self.kind = "legacy"
+        if key == self.key:
+            return None
+        self.key = key
+        flags = ", ".join(controllers.control_flags(self.px4, self.mask))
+        head = f"multicopter offboard {ocm.names(ocm.first_flag(self.mask))} ({flags})"
+        if seen:
+            text = f"{head}: setpoint from position_setpoint_triplet (not modelled per axis)"
+            return Change(text, "8", None, True)
+        why = "no offboard setpoint recorded yet"
+        text = f"{head}: {why} (what legacy mc_pos_control flies then: not modelled)"
+        return Change(text, "8", why, True)
 
     def _fw_state(self) -> str:
         if self.vehicle_type != "fw" or ocm.first_flag(self.mask) != ocm.POSITION:
