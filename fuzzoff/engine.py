@@ -74,7 +74,10 @@ class VehicleRun:
         info: RecordingInfo,
         timeline: Timeline | None,
     ) -> None:
-        self.state = VehicleState(mode_recorded="vehicle_status" in info.kinds)
+        self.state = VehicleState(
+            mode_recorded="vehicle_status" in info.kinds,
+            own_system=int(vehicle) if vehicle.isdecimal() else None,
+        )
         self.gate = GateModel(profile, settings.params, vehicle)
         self.ctx = CheckContext(
             profile=profile,

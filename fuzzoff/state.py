@@ -8,9 +8,11 @@ mode at all, the gate model's prediction is used and ``mode_source`` says so.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from fuzzoff.events import (
+    KEEPALIVE_ROS,
     MAV_CMD_DO_SET_MODE,
     NAV_STATE_OFFBOARD,
     VEHICLE_CMD_SET_NAV_STATE,
@@ -20,6 +22,7 @@ from fuzzoff.events import (
     Event,
     FailsafeFlags,
     LegacyControlMode,
+    MavlinkTarget,
     Parameter,
     VehicleStatus,
 )
@@ -53,6 +56,16 @@ class VehicleState:
     in_offboard: bool = False
     """Recorded mode (acks applied), or the gate's prediction when no mode is recorded; kept as
     a plain attribute because every check asks on every message."""
+    flying: bool = False
+    """``in_offboard`` and not known to be disarmed (a disarmed vehicle parked in OFFBOARD is
+    idle): what most stream rules ask on every keep-alive, so it is kept up to date here."""
+    own_system: int | None = None
+    """This vehicle's MAVLink system id (None where its name is not one: ROS namespaces)."""
+    keepalive: Event | None = None
+    """The current event when it counts as this vehicle's keep-alive (the docs' keep-alive: an
+    OCM, or a MAVLink setpoint addressed to this vehicle or to all), else None. Set by
+    ``update`` once per event so that the stream rules need not each work it out again; compare
+    with ``is`` (a gate transition dispatched meanwhile is never the current event)."""
     _pending: dict[int, _PendingSwitch] = field(default_factory=dict)
 
     def _now_in_offboard(self) -> bool:
@@ -72,37 +85,68 @@ class VehicleState:
         self.predicted_offboard = in_offboard
         if not self.mode_recorded:
             self.in_offboard = in_offboard
+            self.flying = in_offboard and self.armed is not False
             self.offboard_since = t if in_offboard else None
 
     def update(self, event: Event) -> None:
+        updater = _UPDATER_BY_TYPE.get(type(event))
+        if updater is None:
+            updater = _UPDATER_BY_TYPE[type(event)] = _updater_for(type(event))
         was = self.in_offboard
-        if isinstance(event, VehicleStatus):
-            if event.nav_state is not None:
-                self.nav_state = event.nav_state
-            if event.armed is not None:
-                self.armed = event.armed
-        elif isinstance(event, ControlMode):
-            self.control_mode = event
-            self.declared_flag = event.first_flag()
-        elif isinstance(event, LegacyControlMode):
-            self.control_mode = event
-            self.declared_flag = None
-        elif isinstance(event, Parameter):
-            self.params[event.name] = event.value
-        elif isinstance(event, FailsafeFlags):
-            self.failsafe_flags = event
-        elif isinstance(event, Command) and event.is_mode_switch:
-            self._pending[event.command] = _PendingSwitch(event.t, event.is_offboard_switch)
-        elif isinstance(event, CommandAck) and event.command in (
-            MAV_CMD_DO_SET_MODE,
-            VEHICLE_CMD_SET_NAV_STATE,
-        ):
-            self._ack(event)
+        self.keepalive = None
+        updater(self, event)
         now = self.in_offboard = self._now_in_offboard()
+        self.flying = now and self.armed is not False
         if now and not was:
             self.offboard_since = event.t
         elif was and not now:
             self.offboard_since = None
+
+    def _status(self, event: Event) -> None:
+        assert isinstance(event, VehicleStatus)
+        if event.nav_state is not None:
+            self.nav_state = event.nav_state
+        if event.armed is not None:
+            self.armed = event.armed
+
+    def _control_mode(self, event: Event) -> None:
+        assert isinstance(event, ControlMode)
+        self.keepalive = event
+        self.control_mode = event
+        self.declared_flag = event.first_flag()
+
+    def _legacy_control_mode(self, event: Event) -> None:
+        assert isinstance(event, LegacyControlMode)
+        self.keepalive = event
+        self.control_mode = event
+        self.declared_flag = None
+
+    def _mavlink_setpoint(self, event: Event) -> None:
+        assert isinstance(event, MavlinkTarget)
+        target = event.target_system
+        if target == 0 or self.own_system is None or target == self.own_system:
+            self.keepalive = event
+
+    def _parameter(self, event: Event) -> None:
+        assert isinstance(event, Parameter)
+        self.params[event.name] = event.value
+
+    def _failsafe_flags(self, event: Event) -> None:
+        assert isinstance(event, FailsafeFlags)
+        self.failsafe_flags = event
+
+    def _command(self, event: Event) -> None:
+        assert isinstance(event, Command)
+        if event.is_mode_switch:
+            self._pending[event.command] = _PendingSwitch(event.t, event.is_offboard_switch)
+
+    def _command_ack(self, event: Event) -> None:
+        assert isinstance(event, CommandAck)
+        if event.command in (MAV_CMD_DO_SET_MODE, VEHICLE_CMD_SET_NAV_STATE):
+            self._ack(event)
+
+    def _other(self, event: Event) -> None:
+        """Setpoints, status texts...: nothing the shared state keeps."""
 
     def _ack(self, ack: CommandAck) -> None:
         pending = self._pending.get(ack.command)
@@ -119,3 +163,31 @@ class VehicleState:
                 self.nav_state = NAV_STATE_OFFBOARD
             elif self.nav_state == NAV_STATE_OFFBOARD:
                 self.nav_state = None  # left offboard for a mode the status will name
+
+
+_UPDATERS: tuple[tuple[type, Callable[[VehicleState, Event], None]], ...] = (
+    (VehicleStatus, VehicleState._status),
+    (ControlMode, VehicleState._control_mode),
+    (LegacyControlMode, VehicleState._legacy_control_mode),
+    (Parameter, VehicleState._parameter),
+    (FailsafeFlags, VehicleState._failsafe_flags),
+    (Command, VehicleState._command),
+    (CommandAck, VehicleState._command_ack),
+    (MavlinkTarget, VehicleState._mavlink_setpoint),
+)
+"""In the order ``update`` used to test them with ``isinstance``; looked up once per event type
+instead of walking the chain on every message (about 0.3 µs a setpoint on a tlog)."""
+
+
+_UPDATER_BY_TYPE: dict[type, Callable[[VehicleState, Event], None]] = {}
+"""Event type -> its entry of ``_UPDATERS`` (``_other`` for none), filled as types appear."""
+
+
+def _updater_for(cls: type) -> Callable[[VehicleState, Event], None]:
+    for base, updater in _UPDATERS:
+        if issubclass(cls, base):
+            return updater
+    return VehicleState._other
+
+
+assert {ControlMode, LegacyControlMode} == set(KEEPALIVE_ROS)  # _UPDATERS marks both keep-alive

@@ -13,7 +13,6 @@ from dataclasses import dataclass
 from fuzzoff.checks.base import CheckContext
 from fuzzoff.events import Event, Where
 from fuzzoff.findings import Severity
-from fuzzoff.tables.control_mode import row_for
 
 
 def mode_note(ctx: CheckContext) -> str:
@@ -32,7 +31,7 @@ def from_external(ctx: CheckContext, event: Event) -> bool:
         return True
     if event.origin != "vehicle" or not ctx.state.in_offboard:
         return False
-    row = row_for(ctx.profile, declared_flag(ctx))
+    row = ctx.row_for(ctx.state.declared_flag)
     return row is not None and event.kind in row.allowed
 
 
@@ -84,8 +83,9 @@ class Episodes:
             self._report(episode)
 
     def close_all(self) -> None:
-        for key in list(self.open):
-            self.good(key)
+        if self.open:  # usually nothing is open: skip the copy of the keys
+            for key in list(self.open):
+                self.good(key)
 
     def _report(self, episode: Episode) -> None:
         message = episode.message

@@ -20,6 +20,7 @@ from fuzzoff.gate import GateModel
 from fuzzoff.profiles import Profile
 from fuzzoff.sources.base import RecordingInfo
 from fuzzoff.state import VehicleState
+from fuzzoff.tables.control_mode import FlagRow, row_for
 
 REGISTRY: list[type[Check]] = []
 
@@ -37,6 +38,16 @@ class CheckContext:
     findings: list[Finding] = field(default_factory=list)
     not_checkable: dict[str, str] = field(default_factory=dict)
     """code -> what the recording would need (becomes one OFB002 finding per code)."""
+    _rows: dict[str | None, FlagRow | None] = field(default_factory=dict)
+
+    def row_for(self, first_flag: str | None) -> FlagRow | None:
+        """``tables.control_mode.row_for`` for this profile, remembered per flag: the content
+        rules ask on every setpoint, and the table lookup compares version strings (~1 µs)."""
+        try:
+            return self._rows[first_flag]
+        except KeyError:
+            row = self._rows[first_flag] = row_for(self.profile, first_flag)
+            return row
 
     def enabled(self, code: str) -> bool:
         try:

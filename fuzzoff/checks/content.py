@@ -39,9 +39,12 @@ MAVLINK_THRUST_RANGE: dict[str, tuple[float, float]] = {"mc": (0.0, 1.0), "vtol"
 def finiteness(sp: TrajectorySetpoint) -> tuple[tuple[bool, bool, bool], ...]:
     """Which components of position, velocity and acceleration are finite (computed once)."""
     isf = math.isfinite
-    return tuple(
-        (isf(vec[0]), isf(vec[1]), isf(vec[2]))
-        for vec in (sp.position, sp.velocity, sp.acceleration)
+    p, v, a = sp.position, sp.velocity, sp.acceleration
+    # spelled out rather than a generator: once per TrajectorySetpoint (saves ~0.5 µs)
+    return (
+        (isf(p[0]), isf(p[1]), isf(p[2])),
+        (isf(v[0]), isf(v[1]), isf(v[2])),
+        (isf(a[0]), isf(a[1]), isf(a[2])),
     )
 
 
@@ -63,6 +66,10 @@ def axis_problems(sp: TrajectorySetpoint) -> list[str]:
 
 
 def _axis_problems(finite: tuple[tuple[bool, bool, bool], ...]) -> list[str]:
+    (px, py, pz), (vx, vy, vz), (ax, ay, az) = finite
+    every_axis = (px or vx or ax) and (py or vy or ay) and (pz or vz or az)
+    if every_axis and px == py and vx == vy and ax == ay:
+        return []  # the usual valid setpoint, without building the lists below
     problems = []
     for i, axis in enumerate("xyz"):
         if not (finite[0][i] or finite[1][i] or finite[2][i]):
@@ -89,7 +96,7 @@ class TrajectoryContent(Check):
     def on_event(self, event: Event) -> None:
         assert isinstance(event, TrajectorySetpoint)
         flag = declared_flag(self.ctx)
-        if not from_external(self.ctx, event) or flag not in TRAJECTORY_CONTROLS:
+        if flag not in TRAJECTORY_CONTROLS or not from_external(self.ctx, event):
             return
         finite = finiteness(event)
         selected = _selected(finite)

@@ -77,17 +77,19 @@ class SetpointFrozen(Check):
         self.runs: dict[str, _Run] = {}
 
     def on_event(self, event: Event) -> None:
-        if not self.ctx.state.in_offboard or self.ctx.state.armed is False:
-            for kind in list(self.runs):
-                self._close(kind)
+        if not self.ctx.state.flying:  # out of offboard, or disarmed
+            if self.runs:
+                for kind in list(self.runs):
+                    self._close(kind)
             return
         if isinstance(event, (VehicleStatus, GateTransition)) or not from_external(self.ctx, event):
             return
-        if event.kind.startswith("rover_") and is_placeholder(event):
-            self._close(event.kind)
+        kind = event.kind
+        if kind.startswith("rover_") and is_placeholder(event):
+            self._close(kind)
             return
         raw = _getter(type(event))(event)
-        run = self.runs.get(event.kind)
+        run = self.runs.get(kind)
         ongoing = run is not None and event.t - run.last <= self.max_gap
         # identical content without NaN compares equal as a tuple, which is cheap; text is
         # needed only when it does not (NaN != NaN)
@@ -96,8 +98,8 @@ class SetpointFrozen(Check):
             run.last = event.t
             run.count += 1
             return
-        self._close(event.kind)
-        self.runs[event.kind] = _Run(content, raw, event.t, event.t, event.where)
+        self._close(kind)
+        self.runs[kind] = _Run(content, raw, event.t, event.t, event.where)
 
     def _close(self, kind: str) -> None:
         run = self.runs.pop(kind, None)

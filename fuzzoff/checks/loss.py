@@ -12,9 +12,7 @@ from dataclasses import dataclass
 
 from fuzzoff.checks._keepalive import (
     KEEPALIVE_EVENTS,
-    counts_as_keepalive,
     loss_timeout,
-    offboard_and_flying,
     px4_label,
 )
 from fuzzoff.checks.base import Check, CheckContext
@@ -59,7 +57,16 @@ class OffboardLoss(Check):
     def on_event(self, event: Event) -> None:
         if self.pending is not None and event.t - self.pending.t > RECORDED_ANSWER_WINDOW_S:
             self._flush(None)
-        if isinstance(event, GateTransition):
+        state = self.ctx.state
+        if event is state.keepalive:  # first: nearly every message is one
+            if self.last_flying:
+                self._gap_from_recording(event.t)
+            self.last, self.last_where = event.t, event.where
+            gate = self.ctx.gate
+            gate_models_it = gate.armed and gate.user_intention == NAV_STATE_OFFBOARD
+            # The gate is the authority where it models offboard; the recorded mode otherwise.
+            self.last_flying = state.flying and not gate_models_it
+        elif isinstance(event, GateTransition):
             if event.what == "signal_lost":
                 self.lost = event
             elif event.what == "failsafe":
@@ -67,16 +74,9 @@ class OffboardLoss(Check):
         elif isinstance(event, VehicleStatus):
             if self.pending is not None and event.nav_state is not None and not event.in_offboard:
                 self._flush(event)
-            if self.last_flying and not offboard_and_flying(self.ctx):
+            if self.last_flying and not state.flying:
                 self._gap_from_recording(event.t)  # only the silence spent in OFFBOARD counts
                 self.last_flying = False
-        elif counts_as_keepalive(self.ctx, event):
-            self._gap_from_recording(event.t)
-            self.last, self.last_where = event.t, event.where
-            gate = self.ctx.gate
-            gate_models_it = gate.armed and gate.user_intention == NAV_STATE_OFFBOARD
-            # The gate is the authority where it models offboard; the recorded mode otherwise.
-            self.last_flying = offboard_and_flying(self.ctx) and not gate_models_it
 
     def _from_gate(self, tr: GateTransition) -> None:
         timeout = loss_timeout(self.ctx)

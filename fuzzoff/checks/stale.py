@@ -6,10 +6,10 @@ Seed 000, ROS 2 warning item 4: PX4 does not failsafe when setpoints stop, only 
 
 from __future__ import annotations
 
-from fuzzoff.checks._keepalive import mode_note, offboard_and_flying
+from fuzzoff.checks._keepalive import mode_note
 from fuzzoff.checks.base import Check, CheckContext
 from fuzzoff.events import PX4_SETPOINTS, ControlMode, Event, Where
-from fuzzoff.tables.control_mode import SETPOINT_NAMES, row_for
+from fuzzoff.tables.control_mode import SETPOINT_NAMES
 
 ROS2_FORMATS = ("mcap", "rosbag2-sqlite3", "rosbag2-mcap")
 
@@ -36,10 +36,10 @@ class StaleSetpoints(Check):
         """Start of the keep-alive's current unbroken run."""
         self.episode: tuple[str, float, Where] | None = None
         """(what went stale, since when, where) while a stale stretch is open."""
+        self.required: dict[str | None, tuple[tuple[str, ...], ...] | None] = {}
+        """First flag -> its row's alternatives (``_alternatives``)."""
 
     def on_event(self, event: Event) -> None:
-        if not self.active:
-            return
         if event.origin == "sent" and not isinstance(event, ControlMode):
             self.last_sent[event.kind] = event.t
             return
@@ -48,28 +48,40 @@ class StaleSetpoints(Check):
         if self.last_ocm is None or event.t - self.last_ocm > self.stale:
             self.ocm_since = event.t  # the keep-alive itself paused: not "kept coming"
         self.last_ocm = event.t
-        flying = offboard_and_flying(self.ctx)
-        if not flying:
+        if not self.ctx.state.flying:
             self._close(event.t)
             return
-        row = row_for(self.ctx.profile, event.first_flag())
-        if row is None:
+        alternatives = self._alternatives(self.ctx.state.declared_flag)  # this OCM's first flag
+        if alternatives is None:
             return
         stale: list[tuple[float, str]] = []
-        for alternative in row.required:
-            published = [(self.last_sent.get(kind), kind) for kind in sorted(alternative)]
-            quiet = [(t, kind) for t, kind in published if t is not None]
-            if len(quiet) < len(published):
-                continue  # never published in full: OFB303's finding, not a stale one
-            oldest, kind = min(quiet)
-            oldest = max(oldest, self.ocm_since)  # quiet only counts under a live keep-alive
-            if event.t - oldest <= self.stale:
-                self._close(event.t)  # one alternative is being served
-                return
-            stale.append((oldest, SETPOINT_NAMES.get(kind, kind)))
+        for alternative in alternatives:
+            published = []
+            for kind in alternative:
+                t = self.last_sent.get(kind)
+                if t is None:
+                    break  # never published in full: OFB303's finding, not a stale one
+                published.append((t, kind))
+            else:
+                oldest, kind = min(published)
+                oldest = max(oldest, self.ocm_since)  # quiet only counts under a live keep-alive
+                if event.t - oldest <= self.stale:
+                    self._close(event.t)  # one alternative is being served
+                    return
+                stale.append((oldest, SETPOINT_NAMES.get(kind, kind)))
         if stale and self.episode is None:
             since, what = max(stale)
             self.episode = (what, since, event.where)
+
+    def _alternatives(self, flag: str | None) -> tuple[tuple[str, ...], ...] | None:
+        """The row's required alternatives as sorted kinds (None: no row), once per flag."""
+        try:
+            return self.required[flag]
+        except KeyError:
+            row = self.ctx.row_for(flag)
+            found = None if row is None else tuple(tuple(sorted(a)) for a in row.required)
+            self.required[flag] = found
+            return found
 
     def _close(self, t: float) -> None:
         if self.episode is None:

@@ -10,11 +10,10 @@ from dataclasses import dataclass
 
 from fuzzoff.checks._keepalive import (
     KEEPALIVE_EVENTS,
+    PROOF_SLACK_S,
     RecordedSwitches,
-    counts_as_keepalive,
     loss_timeout,
     mode_note,
-    offboard_and_flying,
     proven_gap,
     px4_label,
 )
@@ -48,6 +47,8 @@ class KeepaliveRate(Check):
     def __init__(self, ctx: CheckContext) -> None:
         super().__init__(ctx)
         self.max_gap = float(ctx.option("OFB101", "max_gap_s"))
+        self.quick = self.max_gap > PROOF_SLACK_S
+        """Short gaps may skip ``proven_gap`` (see ``PROOF_SLACK_S``)."""
         self.window = float(ctx.option("OFB101", "pre_request_window_s"))
         self.last: float | None = None
         self.last_in_offboard = False
@@ -58,31 +59,36 @@ class KeepaliveRate(Check):
         """Gaps outside offboard, kept for ``window`` seconds in case a request follows."""
 
     def on_event(self, event: Event) -> None:
-        if isinstance(event, Dropout):
+        state = self.ctx.state
+        if event is state.keepalive:  # first: nearly every message is one
+            last = self.last
+            if last is not None and not self.dropout_since_last:
+                gap = event.t - last
+                if not (self.quick and gap + PROOF_SLACK_S < self.max_gap):
+                    self._gap(event, last, proven_gap(self.ctx, event, gap))
+            self.last, self.last_where = event.t, event.where
+            self.last_in_offboard = state.flying
+            self.dropout_since_last = False
+        elif isinstance(event, Dropout):
             self.dropout_since_last = True
         elif isinstance(event, Command):
-            if event.is_offboard_switch or (event.is_arm and self.ctx.state.in_offboard):
+            if event.is_offboard_switch or (event.is_arm and state.in_offboard):
                 self._request(event.t)
         elif isinstance(event, VehicleStatus):
             if self.switches.entered_by_request(event, self.last):
                 self._request(event.t)  # no commands recorded (MAVROS): the switch itself
-            if self.last_in_offboard and not offboard_and_flying(self.ctx):
+            if self.last_in_offboard and not state.flying:
                 self._left_offboard(event)
-        elif counts_as_keepalive(self.ctx, event):
-            if self.last is not None and not self.dropout_since_last:
-                gap = event.t - self.last
-                proven = proven_gap(self.ctx, event, gap)
-                if proven >= self.max_gap:
-                    found = _Gap(self.last, event.t, proven, event.where)
-                    if self.last_in_offboard:
-                        self._report(found, "in OFFBOARD")
-                    else:
-                        self.recent.append(found)
-            self.last, self.last_where = event.t, event.where
-            self.last_in_offboard = offboard_and_flying(self.ctx)
-            self.dropout_since_last = False
         if self.recent:
             self.recent = [g for g in self.recent if event.t - g.end <= self.window]
+
+    def _gap(self, event: Event, last: float, proven: float) -> None:
+        if proven >= self.max_gap:
+            found = _Gap(last, event.t, proven, event.where)
+            if self.last_in_offboard:
+                self._report(found, "in OFFBOARD")
+            else:
+                self.recent.append(found)
 
     def _left_offboard(self, event: Event) -> None:
         """The vehicle left OFFBOARD (or disarmed) with no keep-alive since ``last``: only the part
@@ -141,13 +147,25 @@ class StreamBeforeRequest(Check):
         super().__init__(ctx)
         self.min_stream = float(ctx.option("OFB102", "min_stream_s"))
         self.max_gap = float(ctx.option("OFB101", "max_gap_s"))
+        self.quick = self.max_gap > PROOF_SLACK_S
+        """Short gaps may skip ``proven_gap`` (see ``PROOF_SLACK_S``)."""
         self.run_start: float | None = None
         self.last: float | None = None
         self.gate_verdict: dict[int, GateTransition] = {}
         self.switches = RecordedSwitches(ctx)
 
     def on_event(self, event: Event) -> None:
-        if isinstance(event, GateTransition):
+        if event is self.ctx.state.keepalive:  # first: nearly every message is one
+            last = self.last
+            if last is None:
+                self.run_start = event.t
+            else:
+                gap = event.t - last
+                short = self.quick and gap + PROOF_SLACK_S < self.max_gap
+                if not short and proven_gap(self.ctx, event, gap) >= self.max_gap:
+                    self.run_start = event.t
+            self.last = event.t
+        elif isinstance(event, GateTransition):
             if event.cause is not None and event.what in (
                 "request_accepted",
                 "request_rejected",
@@ -161,18 +179,10 @@ class StreamBeforeRequest(Check):
             elif event.is_arm and self.ctx.state.nav_state == NAV_STATE_OFFBOARD:
                 self._judge(event, "arm in OFFBOARD")
             self.gate_verdict.clear()
-        elif isinstance(event, VehicleStatus):
-            if self.switches.entered_by_request(event, self.last):
-                self._judge(event, "switch to OFFBOARD (recorded mode)")
-        elif isinstance(event, Dropout):
-            pass
-        elif counts_as_keepalive(self.ctx, event):
-            if (
-                self.last is None
-                or proven_gap(self.ctx, event, event.t - self.last) >= self.max_gap
-            ):
-                self.run_start = event.t
-            self.last = event.t
+        elif isinstance(event, VehicleStatus) and self.switches.entered_by_request(
+            event, self.last
+        ):
+            self._judge(event, "switch to OFFBOARD (recorded mode)")
 
     def _judge(self, event: Event, what: str) -> None:
         t = event.t
@@ -244,6 +254,7 @@ class KeepaliveMargin(Check):
         self.hist = _Histogram(self.budget)
         self.broken = False
         if ctx.info.sampled:
+            self.subscriptions = ()
             ctx.cannot_check(
                 "OFB105",
                 "needs the keep-alive as sent (a ULog subsamples offboard_control_mode, "
@@ -251,9 +262,10 @@ class KeepaliveMargin(Check):
             )
 
     def on_event(self, event: Event) -> None:
-        if self.ctx.info.sampled or not counts_as_keepalive(self.ctx, event):
+        state = self.ctx.state
+        if event is not state.keepalive:
             return
-        flying = offboard_and_flying(self.ctx)
+        flying = state.flying
         if flying and self.stretch_start is None:
             self.stretch_start = event.t
         elif not flying and self.stretch_start is not None:
