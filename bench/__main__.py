@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-import importlib
 import pkgutil
+import subprocess
 import sys
 from pathlib import Path
 
@@ -17,7 +17,12 @@ def main() -> None:
         if wanted and module.name.removeprefix("bench_") not in wanted:
             continue
         print(f"== {module.name}", flush=True)
-        importlib.import_module(f"bench.{module.name}").main()
+        # each benchmark in its own process: one's generated data must not weigh on the next
+        subprocess.run(
+            [sys.executable, "-c", f"import bench.{module.name} as m; m.main()"],
+            cwd=here.parent,
+            check=False,
+        )
 
 
 if __name__ == "__main__":

@@ -13,14 +13,11 @@ git-ignored) are generated on the first run; ``python -m bench ulog`` runs only 
 
 from __future__ import annotations
 
-import json
-import os
-import subprocess
 import sys
-import tempfile
-from dataclasses import dataclass
 from pathlib import Path
 
+from bench.measure import Run
+from bench.measure import measure as run_measured
 from bench.ulog_data import generate
 from fuzzoff.sources.ulog import LOADED_TOPICS
 
@@ -46,26 +43,6 @@ with source:
 """
 
 
-@dataclass
-class Run:
-    wall_s: float
-    cpu_s: float
-    rss_mb: float
-    output: str
-
-
-WRAPPER = """
-import json, os, subprocess, sys, time
-start = time.perf_counter()
-proc = subprocess.Popen(sys.argv[1:], stderr=subprocess.DEVNULL)
-_, status, usage = os.wait4(proc.pid, 0)
-wall = time.perf_counter() - start
-print(json.dumps([wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss]), file=sys.stderr)
-"""
-"""Runs the measured command from a small process: Linux carries a parent's peak RSS over to a
-child at exec, so spawning from this (large) benchmark process would floor every figure."""
-
-
 def measure(args: list[str]) -> Run:
     """Best of three (of one for runs over 10 s): the machine is shared, noise only adds."""
     best = _measure_once(args)
@@ -81,21 +58,7 @@ def measure(args: list[str]) -> Run:
 
 
 def _measure_once(args: list[str]) -> Run:
-    """Run ``args``; wall time, CPU time and its own peak RSS (measured by ``WRAPPER``)."""
-    env = {**os.environ, "NO_COLOR": "1"}
-    with tempfile.TemporaryFile() as out:
-        proc = subprocess.run(
-            [sys.executable, "-c", WRAPPER, *args],
-            stdout=out,
-            stderr=subprocess.PIPE,
-            cwd=ROOT,
-            env=env,
-            check=False,
-        )
-        out.seek(0)
-        text = out.read().decode(errors="replace")
-    wall, cpu, rss_kb = json.loads(proc.stderr.decode().strip().splitlines()[-1])
-    return Run(wall, cpu, rss_kb / 1024, text)
+    return run_measured(args)
 
 
 def lint(path: Path) -> Run:

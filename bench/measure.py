@@ -1,20 +1,32 @@
 """One measured child process: wall time, CPU time and that child's own peak RSS.
 
 Every benchmark runs each side (fuzzoff, the bare library) as its own process, so imports and
-start-up count for both and peak memory is the child's (``os.wait4``), not the maximum over all
-children of the benchmark.
+start-up count for both. The command is started from a small wrapper process, not from the
+benchmark itself: Linux carries a parent's peak RSS over to a child at exec (the old mm's high
+water mark is kept in the child's rusage), so spawning straight from a benchmark process that
+holds generated data would put a floor under every figure.
 """
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
+import sys
 import tempfile
-import time
 from dataclasses import dataclass
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
+
+WRAPPER = """
+import json, os, subprocess, sys, time
+start = time.perf_counter()
+proc = subprocess.Popen(sys.argv[1:], stderr=subprocess.DEVNULL)
+_, status, usage = os.wait4(proc.pid, 0)
+wall = time.perf_counter() - start
+print(json.dumps([wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss]), file=sys.stderr)
+"""
 
 
 @dataclass
@@ -26,13 +38,18 @@ class Run:
 
 
 def measure(args: list[str], env: dict[str, str] | None = None) -> Run:
-    """Run ``args`` from the repository root with stdout captured and stderr discarded."""
+    """Run ``args`` from the repository root; stdout captured, the child's stderr discarded."""
     full_env = {**os.environ, "NO_COLOR": "1", "MAVLINK20": "1", **(env or {})}
     with tempfile.TemporaryFile() as out:
-        start = time.perf_counter()
-        proc = subprocess.Popen(args, stdout=out, stderr=subprocess.DEVNULL, cwd=ROOT, env=full_env)
-        _, _status, usage = os.wait4(proc.pid, 0)
-        wall = time.perf_counter() - start
+        proc = subprocess.run(
+            [sys.executable, "-c", WRAPPER, *args],
+            stdout=out,
+            stderr=subprocess.PIPE,
+            cwd=ROOT,
+            env=full_env,
+            check=False,
+        )
         out.seek(0)
         text = out.read().decode(errors="replace")
-    return Run(wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024, text)
+    wall, cpu, rss_kb = json.loads(proc.stderr.decode().strip().splitlines()[-1])
+    return Run(wall, cpu, rss_kb / 1024, text)
