@@ -1,7 +1,8 @@
 """Rules read straight off the gate model (gate spec sections 5 and 12).
 
 * OFB202 gate-model-disagrees: the model's ``disagreement`` transitions (recorded mode or ack vs
-  the prediction, judged with the profile's evaluation slack, see ``fuzzoff.gate.compare``);
+  the prediction, judged with the profile's evaluation slack, see ``fuzzoff.gate.compare``); the
+  model emits them only for differences that involve OFFBOARD (others are ``mode`` rows);
 * OFB701 loss-action-summary: once per vehicle that uses offboard, what the vehicle does on loss;
 * OFB702 loss-action-unavailable: the configured loss action cannot run as configured (a mode
   whose estimate is missing, a stick mode without manual control).

@@ -55,6 +55,7 @@ EMPTY: list[GateTransition] = []
 """Returned when an event changes nothing (shared: never mutate a returned list)."""
 
 TERMINATION = 13
+NOT_OFFBOARD = "no OFFBOARD on either side: other modes' own rules are not modelled; followed"
 
 
 class GateModel:
@@ -694,15 +695,31 @@ class GateModel:
         model = nav_state_name(self._nav)
         if self._fallback is not None:
             model += f" (failsafe {self._fallback.action})"
-        self._emit(
-            pending.t,
-            "disagreement",
-            f"recorded: {nav_state_name(status.nav_state)} at {pending.t:.2f} s; model: {model}",
-            "12",
-            cause=status,
-            recorded_nav_state=status.nav_state,
-        )
+        text = f"recorded: {nav_state_name(status.nav_state)} at {pending.t:.2f} s; model: {model}"
+        if self._involves_offboard(status.nav_state, status.user_intention) or (
+            self._involves_offboard(pending.latest.nav_state, pending.latest.user_intention)
+        ):
+            self._emit(
+                pending.t,
+                "disagreement",
+                text,
+                "12",
+                cause=status,
+                recorded_nav_state=status.nav_state,
+            )
+        else:
+            self._emit(pending.t, "mode", f"{text} ({NOT_OFFBOARD})", "12", cause=status)
         self._adopt(due, pending.latest, self._intention_for(pending.latest), False)
+
+    def _involves_offboard(self, *recorded: int | None) -> bool:
+        """Does a difference concern the offboard gate (OFB202)? OFFBOARD on either side (the
+        recorded mode or intention, the model's mode or intention), or a failsafe from it."""
+        return (
+            NAV_STATE_OFFBOARD in recorded
+            or self._nav == NAV_STATE_OFFBOARD
+            or self.user_intention == NAV_STATE_OFFBOARD
+            or self._fallback is not None
+        )
 
     def _on_ack(self, ack: CommandAck) -> None:
         self.compare.ack(ack)
@@ -718,13 +735,11 @@ class GateModel:
             what = f"switch to {nav_state_name(target)}"
         decision = decided.decision
         model = "accepted" if decision.accepted else f"rejected ({decision.reason})"
-        self._emit(
-            ack.t,
-            "disagreement",
-            f"recorded: {what} acked {ack.result_name} at {ack.t:.2f} s; model: {model}",
-            "4.3",
-            cause=ack,
-        )
+        text = f"recorded: {what} acked {ack.result_name} at {ack.t:.2f} s; model: {model}"
+        if self._involves_offboard(target, decided.before[0]):
+            self._emit(ack.t, "disagreement", text, "4.3", cause=ack)
+        else:
+            self._emit(ack.t, "mode", f"{text} ({NOT_OFFBOARD})", "4.3", cause=ack)
         if ack.accepted and cmd.command == MAV_CMD_COMPONENT_ARM_DISARM:
             self.armed = cmd.is_arm
         elif ack.accepted and target is not None:

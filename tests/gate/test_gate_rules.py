@@ -4,8 +4,9 @@ from __future__ import annotations
 
 from fuzzoff.config import Settings
 from fuzzoff.engine import run_events
-from fuzzoff.events import Event, Parameter
+from fuzzoff.events import Command, CommandAck, Event, Parameter
 from fuzzoff.findings import Finding
+from fuzzoff.gate import GateModel, GateTransition
 from fuzzoff.profiles import Profile
 from fuzzoff.sources.base import RecordingInfo
 from tests.gate.streams import flags, in_offboard, status, stream
@@ -69,3 +70,69 @@ def test_ofb202_not_checkable_without_recorded_mode() -> None:
         events, info, profile, Settings(select=frozenset({"OFB202", "OFB002"}))
     )
     assert any(f.code == "OFB002" and "OFB202" in f.message for f in findings)
+
+
+# OFB202 only for differences that involve OFFBOARD (rules/OFB202.toml): the model does not model
+# other modes' own rules (a NAV_TAKEOFF into AUTO_TAKEOFF, a rejected AUTO_MISSION).
+
+LOITER, TAKEOFF, MISSION, OFFBOARD_NAV = 4, 17, 3, 14
+
+
+def _gate(px4: str, events: list[Event]) -> list[GateTransition]:
+    gate = GateModel(Profile(px4=px4, vehicle="mc"), {}, "")
+    out: list[GateTransition] = []
+    for event in sorted(events, key=lambda e: e.t):
+        out += gate.feed(event)
+    return out + gate.finish(events[-1].t + 1.0)
+
+
+def _auto_takeoff() -> list[Event]:
+    """pyulog's sample_px4_events.ulg in short: disarmed in AUTO_LOITER, an arm command, PX4
+    runs AUTO_TAKEOFF (a NAV_TAKEOFF the model does not model); no offboard at all."""
+    return [
+        status(0.0, LOITER, False, LOITER),
+        Command(t=14.932, command=400, params=(1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)),
+        *(status(round(14.936 + 0.5 * k, 3), TAKEOFF, True, TAKEOFF) for k in range(12)),
+        status(21.3, LOITER, True, LOITER),
+    ]
+
+
+def test_ofb202_silent_on_a_flight_that_never_uses_offboard() -> None:
+    assert _lint("1.15", _auto_takeoff(), "OFB202") == []
+    rows = [tr for tr in _gate("1.15", _auto_takeoff()) if tr.message.startswith("recorded:")]
+    assert [tr.what for tr in rows] == ["mode"]
+    assert "AUTO_TAKEOFF" in rows[0].message and "no OFFBOARD on either side" in rows[0].message
+
+
+def test_ofb202_silent_on_a_rejected_switch_between_other_modes() -> None:
+    events: list[Event] = [
+        status(0.0, POSCTL, True, POSCTL),
+        Command(t=1.0, command=176, params=(1.0, 4.0, 4.0, 0.0, 0.0, 0.0, 0.0)),
+        CommandAck(t=1.01, command=176, result=2),
+        *(status(1.5 + 0.5 * k, POSCTL, True, POSCTL) for k in range(4)),
+    ]
+    assert _lint("1.15", events, "OFB202") == []
+
+
+def test_ofb202_still_reports_a_rejected_switch_to_offboard() -> None:
+    """Armed with a live stream the model accepts the switch (4.1); the ack says denied."""
+    events: list[Event] = [
+        status(0.0, POSCTL, True, POSCTL),
+        *stream(0.0, 3.0),
+        Command(t=2.0, command=176, params=(1.0, 6.0, 0.0, 0.0, 0.0, 0.0, 0.0)),
+        CommandAck(t=2.01, command=176, result=2),
+        *(status(2.5 + 0.5 * k, POSCTL, True, POSCTL) for k in range(2)),
+    ]
+    (finding,) = _lint("1.15", events, "OFB202")
+    assert "switch to OFFBOARD acked" in finding.message
+
+
+def test_ofb202_still_reports_a_failsafe_from_offboard_the_vehicle_did_not_take() -> None:
+    """The stream stops in OFFBOARD; the model runs the loss failsafe, the recording stays."""
+    events: list[Event] = [
+        in_offboard(),
+        *stream(0.0, 1.0),
+        *(status(0.5 * k, OFFBOARD_NAV, True, OFFBOARD_NAV) for k in range(1, 9)),
+    ]
+    (finding,) = _lint("1.15", events, "OFB202")
+    assert "recorded: OFFBOARD" in finding.message and "POSCTL" in finding.message
