@@ -501,3 +501,81 @@ def test_ofb107_sampled_comparison_finds_the_same_runs_as_comparing_every_messag
             start = i
     found = [(f.time_s, f.end_s) for f in codes(lint_events(events), "OFB107")]
     assert found == [(pytest.approx(a), pytest.approx(b)) for a, b in expected]
+
+
+# -- OFB303 on a MAVLink stream: PX4 forwards MAVLink setpoints only in OFFBOARD -------------
+
+POSITION_MASK = 0b110111111000  # position only, no yaw (3576)
+
+
+def mavlink_stream(times: Sequence[float], frame: int = 1) -> list[Event]:
+    return [
+        SetPositionTargetLocal(
+            t=round(t, 6), type_mask=POSITION_MASK, coordinate_frame=frame, position=(0, 0, -2)
+        )
+        for t in times
+    ]
+
+
+def test_ofb303_mavlink_setpoints_only_before_the_switch_hold_the_vehicle() -> None:
+    events: list[Event] = [
+        status(0.0, POSCTL),
+        *mavlink_stream(every(0.0, 1.0, 0.1)),
+        status(1.05, OFFBOARD),
+        *mavlink_stream(every(2.0, 3.0, 0.1)),
+    ]
+    (found,) = codes(lint_events(events, fmt="tlog"), "OFB303")
+    assert found.severity is Severity.ERROR
+    assert found.time_s == pytest.approx(1.55)
+    assert "no MAVLink setpoint PX4 takes has arrived by 1.550 s" in found.message
+    assert "sent at 1.000 s, before the switch" in found.message
+    assert "PX4 forwards MAVLink setpoints only in OFFBOARD" in found.message
+
+
+@pytest.mark.parametrize(("first_after", "flagged"), [(1.5, False), (1.6, True)])
+def test_ofb303_mavlink_grace_edge(first_after: float, flagged: bool) -> None:
+    events: list[Event] = [
+        status(0.0, POSCTL),
+        *mavlink_stream(every(0.0, 1.0, 0.1)),
+        status(1.0, OFFBOARD),
+        *mavlink_stream(every(first_after, 3.0, 0.1)),
+    ]
+    assert bool(codes(lint_events(events, fmt="tlog"), "OFB303")) is flagged
+
+
+def test_ofb303_mavlink_steady_stream_through_the_switch_is_clean() -> None:
+    events: list[Event] = [
+        status(0.0, POSCTL),
+        *mavlink_stream(every(0.0, 3.0, 0.1)),
+        status(1.02, OFFBOARD),
+    ]
+    assert codes(lint_events(events, fmt="tlog"), "OFB303") == []
+
+
+def test_ofb303_mavlink_setpoints_the_receiver_drops_do_not_count() -> None:
+    events: list[Event] = [
+        status(0.0, OFFBOARD),
+        *mavlink_stream(every(0.0, 2.0, 0.1), frame=9),  # BODY_OFFSET_NED: dropped (6.2)
+    ]
+    (found,) = codes(lint_events(events, px4="1.16", fmt="tlog"), "OFB303")
+    assert "are all dropped by PX4's receiver" in found.message
+
+
+def test_ofb303_mavlink_parked_disarmed_then_armed() -> None:
+    parked: list[Event] = [
+        status(0.0, OFFBOARD, armed=False),
+        *mavlink_stream(every(0.0, 1.0, 0.1)),
+    ]
+    assert codes(lint_events(parked, fmt="tlog"), "OFB303") == []
+    armed = [*parked, status(1.5, OFFBOARD, armed=True), status(3.0, OFFBOARD, armed=True)]
+    (found,) = codes(lint_events(armed, fmt="tlog"), "OFB303")
+    assert found.time_s == pytest.approx(2.0)
+
+
+def test_ofb303_mavlink_attitude_target_counts() -> None:
+    events: list[Event] = [
+        status(0.0, POSCTL),
+        status(0.5, OFFBOARD),
+        *[SetAttitudeTarget(t=round(t, 6), type_mask=7, thrust=0.5) for t in every(0, 2, 0.1)],
+    ]
+    assert codes(lint_events(events, fmt="tlog"), "OFB303") == []

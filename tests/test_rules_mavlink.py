@@ -1,4 +1,4 @@
-"""MAVLink setpoint-field rules (OFB601-OFB607) at the edges of the docs' tables, per profile."""
+"""MAVLink setpoint-field rules (OFB601-OFB607, OFB609) at the edges of the docs' tables."""
 
 from __future__ import annotations
 
@@ -61,7 +61,14 @@ def test_every_documented_combination_and_frame_passes_the_docs(
 ) -> None:
     event = setpoint(kind, type_mask=mask_for(groups), coordinate_frame=frame)
     found = lint([event], px4, vehicle)
-    assert not codes(found, "OFB602")
+    combo_findings = codes(found, "OFB602")
+    if kind == tm.LOCAL and frame == 8 and groups == {"position"}:
+        # Listed by the docs, but BODY_NED always ignores the position (gate spec 6.2, D17).
+        assert [f.severity for f in combo_findings] == [Severity.ERROR]
+        assert "docs list this frame" in combo_findings[0].message
+        assert "drops the message" in combo_findings[0].message
+    else:
+        assert not combo_findings
     frame_findings = codes(found, "OFB601")
     if frame in tm.RECEIVER_FRAMES[kind]:
         assert not frame_findings
@@ -336,3 +343,114 @@ def test_user_can_turn_a_rule_off() -> None:
     settings = Settings(ignore=frozenset({"OFB601"}))
     event = setpoint(tm.LOCAL, type_mask=3576, coordinate_frame=7)
     assert not codes(lint([event], settings=settings), "OFB601")
+
+
+# -- OFB602: BODY_NED keeps no position (gate spec 6.2, D17) ---------------------------------
+
+POSITION_ONLY = mask_for(frozenset({"position"}))
+
+
+@pytest.mark.parametrize(
+    ("mask", "dropped"),
+    [
+        (POSITION_ONLY, True),
+        (POSITION_ONLY & ~tm.YAW_IGNORE, True),  # with a yaw: still nothing the receiver keeps
+        (mask_for(frozenset({"velocity"})) | tm.VZ_IGNORE, True),  # vx, vy only: no velocity
+        (mask_for(frozenset({"acceleration"})) | tm.AZ_IGNORE, True),
+        (mask_for(frozenset({"velocity"})), False),
+        (mask_for(frozenset({"position", "velocity"})), False),
+    ],
+)
+def test_body_ned_message_the_receiver_empties_is_an_error(mask: int, dropped: bool) -> None:
+    event = SetPositionTargetLocal(t=0.0, type_mask=mask, coordinate_frame=8)
+    found = codes(lint([event]), "OFB602")
+    if not dropped:
+        assert found == []
+        return
+    (finding,) = found
+    assert finding.severity is Severity.ERROR
+    assert "MAV_FRAME_BODY_NED (8)" in finding.message
+    assert "docs list this frame" in finding.message
+    assert "PX4 drops the message (no setpoint, no keep-alive)" in finding.message
+    # The same mask in LOCAL_NED is a documented, working setpoint (partial ones are a mix).
+    local = SetPositionTargetLocal(t=0.0, type_mask=mask, coordinate_frame=1)
+    assert [f.severity for f in codes(lint([local]), "OFB602")] in ([], [Severity.WARNING])
+
+
+def test_body_ned_position_of_a_rover_is_ofb601_alone() -> None:
+    event = SetPositionTargetLocal(t=0.0, type_mask=POSITION_ONLY, coordinate_frame=8)
+    found = lint([event], vehicle="rover-ackermann")
+    assert codes(found, "OFB602") == []
+    (frame,) = codes(found, "OFB601")
+    assert "ignores the position in this frame and, with nothing else left, drops" in (
+        frame.message
+    )
+
+
+# -- OFB609: the legacy / 1.11 receiver -----------------------------------------------------
+
+NAN = float("nan")
+INF = float("inf")
+
+
+@pytest.mark.parametrize(
+    ("event", "words"),
+    [
+        (
+            SetPositionTargetLocal(t=0.0, type_mask=POSITION_ONLY, velocity=(NAN, NAN, NAN)),
+            "non-finite vx, vy, vz",
+        ),
+        (
+            SetPositionTargetLocal(t=0.0, type_mask=POSITION_ONLY | tm.YAW_IGNORE, yaw=NAN),
+            "non-finite yaw",
+        ),
+        (
+            SetPositionTargetLocal(t=0.0, type_mask=mask_for(frozenset(), 512 | NO_YAW)),
+            "FORCE bit",
+        ),
+        (SetPositionTargetLocal(t=0.0, type_mask=POSITION_ONLY | 4096), "takeoff (4096)"),
+        (SetPositionTargetLocal(t=0.0, type_mask=POSITION_ONLY | 8192), "land (8192)"),
+        (SetAttitudeTarget(t=0.0, type_mask=7, thrust=0.5, q=(NAN, 0.0, 0.0, 0.0)), "q[0]"),
+        (SetAttitudeTarget(t=0.0, type_mask=128, thrust=0.5, body_yaw_rate=INF), "yaw"),
+        (SetPositionTargetGlobal(t=0.0, type_mask=POSITION_ONLY), "not handled"),
+    ],
+)
+def test_legacy_receiver_drops(event: Event, words: str) -> None:
+    (found,) = codes(lint([event], px4="legacy"), "OFB609")
+    assert found.severity is Severity.ERROR
+    assert words in found.message
+    # No docs page covers these versions, and 1.13+ has its own rules.
+    assert codes(lint([event], px4="1.13"), "OFB609") == []
+
+
+@pytest.mark.parametrize(
+    "event",
+    [
+        SetPositionTargetLocal(t=0.0, type_mask=POSITION_ONLY, position=(1.0, 2.0, -3.0)),
+        SetPositionTargetLocal(t=0.0, type_mask=POSITION_ONLY | 12288),
+        SetPositionTargetLocal(t=0.0, type_mask=POSITION_ONLY | 16384),
+        SetPositionTargetLocal(t=0.0, type_mask=POSITION_ONLY, yaw_rate=NAN),  # not checked
+        SetPositionTargetLocal(t=0.0, type_mask=mask_for(frozenset({"position"}), 512)),
+        SetAttitudeTarget(t=0.0, type_mask=7, thrust=0.5),
+    ],
+)
+def test_legacy_receiver_takes(event: Event) -> None:
+    assert codes(lint([event], px4="legacy"), "OFB609") == []
+    assert codes(lint([event], px4="1.11"), "OFB609") == []
+
+
+def test_global_int_on_1_11_is_a_warning_that_says_unverified() -> None:
+    event = SetPositionTargetGlobal(t=0.0, type_mask=POSITION_ONLY)
+    (found,) = codes(lint([event], px4="1.11"), "OFB609")
+    assert found.severity is Severity.WARNING
+    assert "unverified" in found.message
+
+
+def test_legacy_drops_are_one_finding_per_stretch() -> None:
+    events: list[Event] = [
+        SetPositionTargetLocal(t=i * 0.1, type_mask=POSITION_ONLY, velocity=(NAN, NAN, NAN))
+        for i in range(20)
+    ]
+    (found,) = codes(lint(events, px4="legacy"), "OFB609")
+    assert found.time_s == 0.0
+    assert found.end_s == pytest.approx(1.9)

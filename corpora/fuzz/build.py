@@ -34,15 +34,13 @@ class Entry:
 
 _MAV = r"silent hazard \((mavlink|mavros), "
 ENTRIES = (
-    Entry(_MAV + r"PX4 (legacy|1\.11)\): setpoint_dropped", "explained", "legacy", "mavlink", 1),
     Entry(
-        r"setpoint_dropped .*no position, velocity or acceleration",
+        _MAV + r"PX4 1\.11\): setpoint_dropped .*GLOBAL_INT handler \(unverified\)",
         "explained",
-        "1.16",
+        "1.11",
         "mavlink",
-        5,
+        1,
     ),
-    Entry(_MAV + r".*controller .*no TrajectorySetpoint since", "explained", "1.15", "mavlink", 0),
 )
 
 

@@ -1,4 +1,4 @@
-"""Build the MAVLink setpoint-field corpus (OFB601-OFB607, OFB507-OFB509): tlogs and MAVROS bags.
+"""Build the MAVLink setpoint-field corpus (OFB601-OFB609, OFB507-OFB509): tlogs and MAVROS bags.
 
 Run ``.venv/bin/python corpora/rules_mavlink/build.py``; it is deterministic. Each case is
 written as a tlog (``fuzzoff.writers.tlog``: the MAVLink the companion sent, with the
@@ -15,7 +15,8 @@ companion (1/191) streams its setpoint at 20 Hz from 1.0 s, switches to OFFBOARD
 after the HEARTBEAT (1 Hz) showed the new mode at 10.0 s (a MAVROS bag sees the switch only
 there). A bad
 case changes the stream, or adds a second one from 5.0 s to 6.0 s at 10 Hz beside the good
-stream, so the keep-alive and the gate stay as in the good flight.
+stream, so the keep-alive and the gate stay as in the good flight. The OFB609 cases fly the same
+pattern on PX4 1.8.2 (``legacy``), tlog only.
 """
 
 from __future__ import annotations
@@ -131,9 +132,10 @@ def flight(
     extra: Maker | None = None,
     params: dict[str, float] | None = None,
     arm_result: int = 0,
+    version: str = VERSION,
 ) -> list[Event]:
     events: list[Event] = [
-        VehicleInfo(t=0.0, vehicle="1", px4_version=VERSION),
+        VehicleInfo(t=0.0, vehicle="1", px4_version=version),
         VehicleInfo(t=0.0, vehicle="1", mav_type=MAV_TYPES[vehicle], vehicle_type=vehicle),
     ]
     events += [
@@ -192,9 +194,13 @@ class Case:
     bag_findings: list[Planted] | None = None
     """What the bag shows where it differs from the tlog (None: the same)."""
     notes: list[str] = field(default_factory=list)
+    px4: str = PX4
+    """The profile the recording's AUTOPILOT_VERSION names."""
 
 
 MC_RULES = ["OFB601", "OFB602", "OFB605", "OFB606", "OFB607"]
+LEGACY_RULES = ["OFB607", "OFB609", "OFB801"]
+LEGACY_VERSION = "1.8.2"
 FW_RULES = ["OFB601", "OFB602", "OFB603", "OFB604", "OFB606", "OFB607"]
 ROVER_RULES = ["OFB507", "OFB508", "OFB509", "OFB601", "OFB602", "OFB607"]
 
@@ -225,6 +231,17 @@ def cases() -> list[Case]:
     def broadcast(t: float) -> Event:
         return local(t, POSITION_YAW, target_system=0, target_component=0)
 
+    def body_position(t: float) -> Event:
+        return local(t, POSITION_ONLY, 8)
+
+    def nan_unused(t: float) -> Event:
+        # NaN in the unused fields: fine from v1.12, dropped by the legacy receiver (6.5).
+        nan = math.nan
+        return local(t, POSITION_YAW, velocity=(nan, nan, nan), acceleration=(nan, nan, nan))
+
+    def legacy_flight(extra: Maker | None = None) -> list[Event]:
+        return flight("mc", local, extra, version=LEGACY_VERSION)
+
     def heading_hold(t: float) -> Event:
         return attitude(t, 7, q=(math.cos(0.25), 0.0, 0.0, math.sin(0.25)), thrust=0.3)
 
@@ -244,6 +261,14 @@ def cases() -> list[Case]:
             flight("mc", local, yaw_only),
             [("OFB602", "error", EXTRA_FROM)],
             ["OFB601", "OFB605", "OFB606", "OFB607"],
+        ),
+        Case(
+            "ofb602_body_ned_position",
+            "mc",
+            flight("mc", local, body_position),
+            [("OFB602", "error", EXTRA_FROM)],
+            ["OFB601", "OFB605", "OFB606", "OFB607"],
+            notes=["the docs list BODY_NED for position setpoints; the receiver drops them"],
         ),
         Case(
             "good_copter_global_position",
@@ -346,6 +371,24 @@ def cases() -> list[Case]:
                 "to arm: with MAV_FWDEXTSP = 0 the stream is no keep-alive (OFB201 below)"
             ],
         ),
+        Case(
+            "good_legacy_copter_position",
+            "mc",
+            legacy_flight(),
+            [],
+            LEGACY_RULES,
+            bag=False,
+            px4="legacy",
+        ),
+        Case(
+            "ofb609_legacy_nan_unused_fields",
+            "mc",
+            legacy_flight(nan_unused),
+            [("OFB609", "error", EXTRA_FROM)],
+            ["OFB607", "OFB801"],
+            bag=False,
+            px4="legacy",
+        ),
     ]
 
 
@@ -362,7 +405,7 @@ def write_spec(
 ) -> None:
     found = [finding(p, tlog) for p in planted]
     levels = {f["severity"] for f in found}
-    applies = [c for c in case.clean if get_rule(c).applies_to(PX4, case.vehicle)]
+    applies = [c for c in case.clean if get_rule(c).applies_to(case.px4, case.vehicle)]
     if not tlog:  # a bag cannot show these two (see the module docstring)
         applies = [c for c in applies if c not in ("OFB607", "OFB509")]
     spec = {
@@ -370,7 +413,7 @@ def write_spec(
         "args": args,
         "exit_status": 1 if levels & {"error", "warning"} else 0,
         "complete": True,
-        "profile": {"px4": PX4, "vehicle": case.vehicle, "detected": True},
+        "profile": {"px4": case.px4, "vehicle": case.vehicle, "detected": True},
         "findings": sorted(found, key=lambda f: (f["time_s"] or -1.0, f["code"])),
         "clean": applies,
     }
@@ -389,7 +432,7 @@ def main() -> None:
             extra += BAG_OTHER_RULES.get(case.name, [])
             if case.vehicle.startswith("rover"):
                 extra.append(("OFB002", "info", None))  # OFB509: no parameters in a bag
-            args = ["--px4", PX4, "--vehicle", case.vehicle]
+            args = ["--px4", case.px4, "--vehicle", case.vehicle]
             write_spec(f"{case.name}.mavros", bag.name, case, planted + extra, args, False)
 
 

@@ -9,16 +9,20 @@ from __future__ import annotations
 from fuzzoff.checks._external import Episodes, declared_flag, mode_note
 from fuzzoff.checks.base import Check, CheckContext
 from fuzzoff.events import (
+    MAVLINK_SETPOINTS,
     PX4_SETPOINTS,
     Command,
     CommandAck,
     ControlMode,
     Event,
     FailsafeFlags,
+    MavlinkTarget,
+    SetAttitudeTarget,
     VehicleStatus,
     Where,
 )
 from fuzzoff.gate import GateTransition
+from fuzzoff.gate.receiver import DROPPED, ReceiverContext, receive
 from fuzzoff.tables.control_mode import (
     SETPOINT_NAMES,
     FlagRow,
@@ -102,10 +106,23 @@ class SetpointNotDeclared(Check):
 
 
 class DeclaredSetpointMissing(Check):
-    """OFB303: in offboard, the declared setpoint message has not been published."""
+    """OFB303: in offboard, the declared setpoint message has not been published.
+
+    ROS 2: per the first true field of ``OffboardControlMode``; a setpoint published once before
+    counts (it stays on the topic). MAVLink (no ``OffboardControlMode`` in the recording): PX4's
+    receiver forwards a setpoint only while the vehicle is in OFFBOARD (gate spec 6.1), so only a
+    setpoint it takes at or after the switch counts."""
 
     codes = ("OFB303",)
-    wants = (*PX4_SETPOINTS, ControlMode, VehicleStatus, GateTransition, Command, CommandAck)
+    wants = (
+        *PX4_SETPOINTS,
+        *MAVLINK_SETPOINTS,
+        ControlMode,
+        VehicleStatus,
+        GateTransition,
+        Command,
+        CommandAck,
+    )
 
     def __init__(self, ctx: CheckContext) -> None:
         super().__init__(ctx)
@@ -117,17 +134,33 @@ class DeclaredSetpointMissing(Check):
         self.checked = False
         self.armed: bool | None = None
         self.armed_at = 0.0
+        self.mav_sent: MavlinkTarget | None = None
+        """The newest MAVLink setpoint sent (None: not a MAVLink stream, so far)."""
+        self.mav_taken: float | None = None
+        """When PX4's receiver last took one (published a setpoint in OFFBOARD)."""
+        self.mav_since: float | None = None
+        self.mav_checked = False
 
     def on_event(self, event: Event) -> None:
         self._due(event.t)
+        self._mav_due(event.t)
         if event.kind in SETPOINT_NAMES and event.origin != "model":
             self.first_seen.setdefault(event.kind, event.t)
         state = self.ctx.state
+        if isinstance(event, MavlinkTarget) and event.origin == "sent":
+            self.mav_sent = event
+            if state.in_offboard and self._taken(event):
+                self.mav_taken = event.t
         if state.armed is not self.armed:
             self.armed = state.armed
             self.armed_at = event.t
         # A vehicle parked disarmed in OFFBOARD (accepted from 1.14) needs no setpoint yet.
         active = state.in_offboard and state.armed is not False
+        if not active:
+            self.mav_since = None
+        elif self.mav_since is None:
+            self.mav_since = max(state.offboard_since or event.t, self.armed_at)
+            self.mav_checked = False
         flag = declared_flag(self.ctx) if active else None
         if flag != self.flag:
             if self.flag is None and state.offboard_since is not None:
@@ -163,8 +196,52 @@ class DeclaredSetpointMissing(Check):
             for alt in row.required
         )
 
+    # -- MAVLink ------------------------------------------------------------------------
+
+    def _taken(self, event: MavlinkTarget) -> bool:
+        """Does PX4's receiver publish a setpoint for it (gate spec 6.1-6.4)?"""
+        gate = self.ctx.gate
+        rx = ReceiverContext(
+            px4=self.ctx.profile.px4,
+            own_system=int(self.ctx.vehicle) if self.ctx.vehicle.isdigit() else None,
+            own_component=int(gate.params.get("MAV_COMP_ID", 1.0)),
+            fwdextsp=bool(gate.params.get("MAV_FWDEXTSP", 1.0)),
+            est=gate.est,
+        )
+        mask, axes, _, _ = receive(event, rx)
+        return mask != DROPPED and (axes != 0 or isinstance(event, SetAttitudeTarget))
+
+    def _mav_due(self, t: float) -> None:
+        since = self.mav_since
+        if since is None or self.mav_checked or t <= since + self.grace:
+            return  # a setpoint at the deadline itself is in time
+        self.mav_checked = True
+        sent = self.mav_sent
+        if sent is None or self.ctx.state.control_mode is not None:
+            return  # not a MAVLink stream (so far), or ROS 2's declaration decides
+        deadline = since + self.grace
+        if self.mav_taken is not None and self.mav_taken >= since:
+            return
+        if sent.t >= since:
+            what = (
+                f"the MAVLink setpoints sent since (the newest {sent.kind.upper()} at "
+                f"{sent.t:.3f} s) are all dropped by PX4's receiver (see OFB6xx)"
+            )
+        else:
+            what = f"the newest MAVLink setpoint was sent at {sent.t:.3f} s, before the switch"
+        self.ctx.report(
+            "OFB303",
+            f"in OFFBOARD since {since:.3f} s, but no MAVLink setpoint PX4 takes has arrived "
+            f"by {deadline:.3f} s ({what}): PX4 forwards MAVLink setpoints only in OFFBOARD, "
+            "so the vehicle holds (a multicopter flies a failsafe hold setpoint) until the "
+            f"next one arrives{mode_note(self.ctx)}",
+            deadline,
+            sent.where,
+        )
+
     def finish(self, t_end: float) -> None:
         self._due(t_end)
+        self._mav_due(t_end + 1e-9)
 
 
 class ControlModeChanged(Check):

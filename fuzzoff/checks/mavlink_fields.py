@@ -4,6 +4,9 @@ Seed 000 "MAVLink Offboard Control" (1.15+) and seed 002 "MAVLink 消息" (1.13-
 vehicle type, the supported ``coordinate_frame`` values and ``type_mask`` combinations; the
 tables are in ``fuzzoff.tables.mavlink``. Every setpoint the recording shows on its way to the
 vehicle is judged, in any mode: a message PX4 drops is also a keep-alive that never counted.
+
+OFB609 covers PX4 legacy and 1.11, which no seed documents field by field: it follows the legacy
+receiver (gate spec 6.3-6.5) and reports what it drops or does not forward.
 """
 
 from __future__ import annotations
@@ -12,7 +15,12 @@ import math
 
 from fuzzoff.checks._episodes import Episodes, Offence
 from fuzzoff.checks.base import Check, CheckContext
-from fuzzoff.events import Event, SetPositionTargetGlobal, SetPositionTargetLocal
+from fuzzoff.events import (
+    Event,
+    SetAttitudeTarget,
+    SetPositionTargetGlobal,
+    SetPositionTargetLocal,
+)
 from fuzzoff.findings import Severity
 from fuzzoff.profiles import at_least
 from fuzzoff.tables import mavlink as tm
@@ -119,11 +127,15 @@ class PositionTargetFields(Check):
                     Severity.WARNING,
                 )
             }
-        consequence = (
-            "PX4 ignores the position in this frame"
-            if body_position and frame in receiver
-            else "PX4 drops the message (no setpoint, no keep-alive)"
-        )
+        consequence = "PX4 drops the message (no setpoint, no keep-alive)"
+        if body_position and frame in receiver:
+            if tm.body_ned_groups(event.type_mask):
+                consequence = "PX4 ignores the position in this frame"
+            else:
+                consequence = (
+                    "PX4 ignores the position in this frame and, with nothing else left, "
+                    "drops the message (no setpoint, no keep-alive)"
+                )
         return {f"frame:{frame}": Offence(f"{what}: {docs_text}; {consequence}")}
 
     # -- OFB602 -------------------------------------------------------------------------
@@ -149,6 +161,9 @@ class PositionTargetFields(Check):
                 )
             }
         usable = selected - rules.ignored
+        body = self._body_ned_drop(event, head, rules, selected, usable)
+        if body is not None:
+            return body
         if not usable or usable in rules.combos:
             return {}
         supported = "; ".join(tm.describe_combo(c) for c in rules.combos)
@@ -158,6 +173,39 @@ class PositionTargetFields(Check):
                 f"{self.ctx.profile.px4} docs support on a {self.vehicle_label} (supported: "
                 f"{supported}); PX4's receiver passes it on and the controllers decide per axis",
                 Severity.WARNING,
+            )
+        }
+
+    def _body_ned_drop(
+        self,
+        event: PositionTarget,
+        head: str,
+        rules: tm.PositionTargetRules,
+        selected: tm.Combo,
+        usable: tm.Combo,
+    ) -> dict[str, Offence] | None:
+        """BODY_NED (gate spec 6.2, D17): the receiver always ignores the position and takes a
+        velocity or acceleration only with all three components; with nothing left it drops the
+        message. Frames the docs do not list for the combination are OFB601's."""
+        frame = event.coordinate_frame
+        if event.kind != tm.LOCAL or frame != 8 or frame not in rules.frames_for(usable):
+            return None
+        if tm.body_ned_groups(event.type_mask):
+            return None
+        partial = sorted(g for g in ("velocity", "acceleration") if g in selected)
+        why = "always ignores the position"
+        if partial:
+            why += (
+                f" and takes {' or '.join(partial)} only with all three components used (an "
+                "ignore bit on any one drops the whole vector)"
+            )
+        return {
+            "body_ned": Offence(
+                f"{head} selects {tm.describe_combo(selected)} in {tm.frame_name(frame)} "
+                f"({frame}): the PX4 {self.ctx.profile.px4} docs list this frame for "
+                f"{tm.describe_combo(usable)} setpoints on a {self.vehicle_label}, but in it "
+                f"PX4's receiver {why}, so nothing is left and PX4 drops the message (no "
+                "setpoint, no keep-alive)"
             )
         }
 
@@ -216,6 +264,132 @@ class PositionTargetFields(Check):
                 "the docs say PX4 maps them to a normalised thrust, not an acceleration"
             )
         }
+
+    def finish(self, t_end: float) -> None:
+        self.episodes.finish()
+
+
+# -- OFB609: the legacy receiver (PX4 legacy and 1.11) --------------------------------------
+
+LEGACY_SETPOINT_TYPES = {0x1000: "takeoff", 0x2000: "land"}
+"""Setpoint-type values the legacy receiver classifies as LOITER (it tests ``mask & 0x3000``
+first, gate spec 6.5, D14)."""
+
+
+def _nonfinite(names: tuple[str, ...], values: tuple[float, ...]) -> list[str]:
+    return [n for n, v in zip(names, values, strict=True) if not math.isfinite(v)]
+
+
+class LegacySetpointDropped(Check):
+    """OFB609: what the legacy / 1.11 MAVLink receiver drops or does not forward (gate spec
+    6.3 legacy, 6.4 legacy, 6.5). Addressing is OFB607's."""
+
+    codes = ("OFB609",)
+    wants = (SetPositionTargetLocal, SetPositionTargetGlobal, SetAttitudeTarget)
+
+    def __init__(self, ctx: CheckContext) -> None:
+        super().__init__(ctx)
+        self.episodes = Episodes(ctx)
+        self.px4 = ctx.profile.px4
+
+    def on_event(self, event: Event) -> None:
+        if event.origin != "sent":
+            return
+        if isinstance(event, SetPositionTargetLocal):
+            offences = self._local(event)
+        elif isinstance(event, SetPositionTargetGlobal):
+            offences = self._global(event)
+        elif isinstance(event, SetAttitudeTarget):
+            offences = self._attitude(event)
+        else:
+            return
+        self.episodes.update("OFB609", event.kind, event.t, event.where, offences)
+
+    def _dropped(self, name: str, fields: list[str], checked: str) -> dict[str, Offence]:
+        return {
+            "nonfinite": Offence(
+                f"{name} carries a non-finite {', '.join(fields)}: PX4 {self.px4}'s receiver "
+                f"drops the whole message unless {checked} are all finite, ignored or not (no "
+                "setpoint, no keep-alive)"
+            )
+        }
+
+    def _local(self, event: SetPositionTargetLocal) -> dict[str, Offence]:
+        name = tm.MESSAGE_NAMES[tm.LOCAL]
+        bad = _nonfinite(
+            ("x", "y", "z", "vx", "vy", "vz", "afx", "afy", "afz", "yaw"),
+            (*event.position, *event.velocity, *event.acceleration, event.yaw),
+        )
+        if bad:
+            return self._dropped(name, bad, "x/y/z, vx/vy/vz, afx/afy/afz and yaw")
+        mask = event.type_mask
+        head = f"{name} type_mask {mask}"
+        if mask & tm.FORCE_BIT and mask & tm.POSITION_BITS and mask & tm.VELOCITY_BITS:
+            return {
+                "force": Offence(
+                    f"{head} sets the FORCE bit with position and velocity ignored: PX4 "
+                    f'{self.px4}\'s receiver logs "force setpoint not supported" and forwards '
+                    "no setpoint (the keep-alive still counts, so the vehicle stays in "
+                    "offboard without a setpoint)"
+                )
+            }
+        kind = LEGACY_SETPOINT_TYPES.get(mask & tm.SETPOINT_TYPE_BITS)
+        if kind is not None:
+            value = mask & tm.SETPOINT_TYPE_BITS
+            return {
+                f"type:{value}": Offence(
+                    f"{head} carries the setpoint type {kind} ({value}): PX4 {self.px4}'s "
+                    "receiver tests the loiter value (mask & 0x3000) first, so it forwards a "
+                    f"LOITER setpoint instead of a {kind} (only 12288 loiter and 16384 idle "
+                    "work as documented)"
+                )
+            }
+        return {}
+
+    def _global(self, event: SetPositionTargetGlobal) -> dict[str, Offence]:
+        name = tm.MESSAGE_NAMES[tm.GLOBAL]
+        if self.px4 == "legacy":
+            return {
+                "global": Offence(
+                    f"{name} is not handled by PX4's receiver before v1.10 (v1.5-v1.8 have no "
+                    "handler): PX4 ignores it (no setpoint, no keep-alive); use "
+                    "SET_POSITION_TARGET_LOCAL_NED"
+                )
+            }
+        return {
+            "global": Offence(
+                f"{name} on PX4 1.11 goes to a legacy-style handler whose details are "
+                "unverified (gate spec 6.3): fuzzoff's gate model takes it as a keep-alive "
+                "without a position setpoint; SET_POSITION_TARGET_LOCAL_NED is the safe choice",
+                Severity.WARNING,
+            )
+        }
+
+    def _attitude(self, event: SetAttitudeTarget) -> dict[str, Offence]:
+        bad = _nonfinite(
+            (
+                "q[0]",
+                "q[1]",
+                "q[2]",
+                "q[3]",
+                "thrust",
+                "body_roll_rate",
+                "body_pitch_rate",
+                "body_yaw_rate",
+            ),
+            (
+                *event.q,
+                event.thrust,
+                event.body_roll_rate,
+                event.body_pitch_rate,
+                event.body_yaw_rate,
+            ),
+        )
+        if bad:
+            return self._dropped(
+                tm.MESSAGE_NAMES[tm.ATTITUDE], bad, "q, thrust and the three body rates"
+            )
+        return {}
 
     def finish(self, t_end: float) -> None:
         self.episodes.finish()

@@ -40,6 +40,7 @@ _DROPPED = frozenset(
         "OFB605",
         "OFB606",
         "OFB607",
+        "OFB609",
         "OFB507",
         "OFB508",
         "OFB509",

@@ -11,17 +11,8 @@ from __future__ import annotations
 _MAV = r"silent hazard \((mavlink|mavros), "
 
 KNOWN: dict[str, str] = {
-    _MAV + r".*controller .*no TrajectorySetpoint since": (
-        "PX4 forwards MAVLink setpoints only in OFFBOARD, so after the switch the vehicle holds "
-        "until the next one arrives; no rule reports a long hold after the switch for a "
-        "MAVLink stream (OFB303 covers ROS 2 only)"
-    ),
-    _MAV + r"PX4 (legacy|1\.11)\): setpoint_dropped": (
-        "legacy/1.11 MAVLink receiver drops (GLOBAL_INT not handled, non-finite fields, FORCE "
-        "bit, takeoff bit as loiter): no legacy rule covers them (OFB6xx apply from 1.13)"
-    ),
-    r"setpoint_dropped .*no position, velocity or acceleration": (
-        "SET_POSITION_TARGET_LOCAL_NED in MAV_FRAME_BODY_NED with only position set: the "
-        "receiver drops it (gate spec 6.2, D17) but OFB601/OFB602 are silent"
+    _MAV + r"PX4 1\.11\): setpoint_dropped .*GLOBAL_INT handler \(unverified\)": (
+        "PX4 1.11's SET_POSITION_TARGET_GLOBAL_INT handler is unverified (gate spec 6.3): the "
+        "gate model takes it as a keep-alive without a setpoint, OFB609 says so as a warning"
     ),
 }

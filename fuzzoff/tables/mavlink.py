@@ -279,6 +279,12 @@ def selected_groups(type_mask: int) -> Combo:
     return frozenset(g for g, bits in GROUP_BITS.items() if used(type_mask, bits))
 
 
+def body_ned_groups(type_mask: int) -> Combo:
+    """What PX4's receiver keeps of a LOCAL_NED in MAV_FRAME_BODY_NED (gate spec 6.2, D17):
+    never the position; a velocity or acceleration only with all three components used."""
+    return frozenset(g for g in ("velocity", "acceleration") if not type_mask & GROUP_BITS[g])
+
+
 def describe_combo(groups: Combo) -> str:
     if not groups:
         return "nothing"
