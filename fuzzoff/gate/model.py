@@ -90,6 +90,13 @@ class GateModel:
         self._deadline = INF
         self._clock = -INF
         """The newest event time fed: nothing is emitted earlier (the timeline never goes back)."""
+        self._sig_changed_at = -INF
+        """When the model's signal state (available / lost) last changed."""
+        self._flag: tuple[float, bool, FailsafeFlags] | None = None
+        """A recorded ``offboard_control_signal_lost`` that differs from the model, waiting for
+        the slack (time, recorded value, event)."""
+        self._flag_episode = False
+        """A flag difference was reported and the two have not agreed since."""
         self._failsafe_due = INF
         """1.14+: the Commander iteration that will run the loss failsafe (2.1.3), inf if none."""
         self._dirty = False
@@ -211,20 +218,28 @@ class GateModel:
             self.ctl.reuse_due,
             self.compare.due(),
             self._failsafe_due,
+            self._flag_due,
         )
+
+    @property
+    def _flag_due(self) -> float:
+        return INF if self._flag is None else self._flag[0] + self.compare.slack
 
     def _advance(self, t: float) -> None:
         while True:
             lost = self.signal.lost_at()
             timeout = self.signal.timeout_at()
             failsafe = self._failsafe_due
-            due = min(lost, timeout, self.ctl.reuse_due, self.compare.due(), failsafe)
+            flag = self._flag_due
+            due = min(lost, timeout, self.ctl.reuse_due, self.compare.due(), failsafe, flag)
             if due > t:
                 return
             # Due before an event already applied (a deadline that moved earlier): PX4 acts at
             # the next pass it runs, never in the past.
             at = max(due, self._clock)
-            if failsafe == due:
+            if flag == due:
+                self._flag_differs()
+            elif failsafe == due:
                 self._failsafe_due = INF
                 self._refresh(at, cause=None)
             elif lost == due:
@@ -242,6 +257,7 @@ class GateModel:
 
     def _signal_lost(self, t: float) -> None:
         self.signal.mark_lost()
+        self._signal_changed(t)
         last = self.signal.last
         age = f"{t - last:.2f} s after the newest keep-alive" if last is not None else ""
         why = estimate_failure(self.px4, self.ocm_mask, self.est) if self.tick_based else None
@@ -283,6 +299,7 @@ class GateModel:
         self._dirty = became or not self._good or changed or stamp is not None
         if became:
             self._failsafe_due = INF
+            self._signal_changed(t)
             self._emit(
                 t,
                 "signal_available",
@@ -369,7 +386,55 @@ class GateModel:
         if self.ctl.legacy and event.current_valid and self.ctl.setpoint(event.t):
             self._update_controller(event.t)
 
+    # ------------------------------------------------------------------ PX4's own verdict
+
+    def _signal_changed(self, t: float) -> None:
+        self._sig_changed_at = t
+        if self._flag is not None and self._flag[1] == (not self.signal.available):
+            self._flag = None  # the model reached the recorded value within the slack
+
+    def _recorded_flag(self, event: FailsafeFlags) -> None:
+        """``failsafe_flags.offboard_control_signal_lost`` is PX4's verdict on the signal: a
+        value the model does not reach within the evaluation slack is a disagreement (2.1).
+        Judged while OFFBOARD is selected (recorded or predicted), where the verdict decides
+        the mode; elsewhere it only matters to a switch request, which the acks judge."""
+        recorded = event.offboard_control_signal_lost
+        if recorded is None:
+            return
+        if recorded == (not self.signal.available):
+            self._flag = None
+            self._flag_episode = False
+            return
+        if self._flag_episode or self._flag is not None:
+            return
+        status = self.compare.last_status
+        seen = (status.nav_state, status.user_intention) if status is not None else ()
+        if not self._involves_offboard(*seen):
+            return
+        if event.t - self._sig_changed_at <= self.compare.slack:
+            return  # the log lags the model's own change
+        self._flag = (event.t, recorded, event)
+
+    def _flag_differs(self) -> None:
+        pending, self._flag = self._flag, None
+        if pending is None:
+            return
+        t, recorded, event = pending
+        self._flag_episode = True
+        model = "available" if self.signal.available else "lost"
+        last = self.signal.last
+        age = f", newest keep-alive at {last:.2f} s" if last is not None else ", no keep-alive"
+        self._emit(
+            t,
+            "disagreement",
+            f"recorded: offboard_control_signal_lost {str(recorded).lower()} at {t:.2f} s "
+            f"(PX4's own verdict); model: offboard signal {model}{age}",
+            self.signal.spec,
+            cause=event,
+        )
+
     def _on_failsafe_flags(self, event: FailsafeFlags) -> None:
+        self._recorded_flag(event)
         if self.est.update(event):
             self._mask_changed()
             if self.tick_based and estimate_failure(self.px4, self.ocm_mask, self.est):
