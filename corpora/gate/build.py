@@ -17,6 +17,13 @@ stream rules the flights also touch):
 * ``rc_lost_117_return`` (1.17.0): no manual control; on loss 1.17 replaces Position by
   NAV_RCL_ACT (Return): the log shows AUTO_RTL; OFB702 clean (no stick mode without RC on
   1.17), OFB202 clean.
+* ``signal_flag_agrees`` (1.15): ``loss_and_resume_agrees`` with PX4's own verdict logged at
+  10 Hz (``failsafe_flags.offboard_control_signal_lost``): lost from the 6.0 s check pass,
+  available again from 8.0 s, as the model says: OFB202 clean.
+* ``signal_flag_lost_early`` (1.15): the same, but the flag says lost from 5.6 s, while the
+  newest keep-alive (5.0 s) is 0.6 s old and COM_OF_LOSS_T is 1 s (as if the vehicle ran a
+  lower timeout that the log does not record; the modes are the same as above): OFB202 at the
+  first lost sample (5.605 s), 0.4 s beyond the slack, and once only.
 """
 
 from __future__ import annotations
@@ -138,6 +145,21 @@ NOT_CHECKABLE_115 = [("OFB002", "info", None)] * 5
 GAP = [("OFB101", "error", STOP_T), ("OFB103", "error", 6.01)]
 
 
+def signal_flags(lost: tuple[float, float]) -> list[Event]:
+    """``failsafe_flags`` as PX4 publishes them after each 10 Hz check pass (5 ms later), the
+    offboard signal lost within ``lost`` = (from, until)."""
+    out: list[Event] = []
+    for k in range(int(END_T * 10) + 1):
+        t = round(0.1 * k + 0.005, 6)
+        flag = lost[0] <= t < lost[1]
+        out.append(FailsafeFlags(t=t, offboard_control_signal_lost=flag))
+    return out
+
+
+def with_flags(events: list[Event], lost: tuple[float, float]) -> list[Event]:
+    return sorted([*events, *signal_flags(lost)], key=lambda e: e.t)
+
+
 def cases() -> list[Case]:
     return [
         Case(
@@ -164,6 +186,18 @@ def cases() -> list[Case]:
             [*NOT_CHECKABLE_115, ("OFB701", "info", SWITCH_T), *GAP],
             ["OFB202", "OFB702"],
             px4_version="1.17.0",
+        ),
+        Case(
+            "signal_flag_agrees",
+            with_flags(offboard_flight((POSCTL, True)), (6.0, RESUME_T)),
+            [*NOT_CHECKABLE_115, ("OFB701", "info", SWITCH_T), *GAP],
+            ["OFB202", "OFB702"],
+        ),
+        Case(
+            "signal_flag_lost_early",
+            with_flags(offboard_flight((POSCTL, True)), (5.6, RESUME_T)),
+            [*NOT_CHECKABLE_115, ("OFB701", "info", SWITCH_T), *GAP, ("OFB202", "warning", 5.605)],
+            ["OFB702"],
         ),
     ]
 
