@@ -24,6 +24,10 @@ stream rules the flights also touch):
   newest keep-alive (5.0 s) is 0.6 s old and COM_OF_LOSS_T is 1 s (as if the vehicle ran a
   lower timeout that the log does not record; the modes are the same as above): OFB202 at the
   first lost sample (5.605 s), 0.4 s beyond the slack, and once only.
+* ``auto_takeoff_no_offboard`` (1.15): as pyulog's ``sample_px4_events.ulg`` (a real auto
+  flight, too large for this corpus): disarmed in AUTO_LOITER, an arm command, PX4 runs
+  AUTO_TAKEOFF (NAV_TAKEOFF, which the model does not model), then Hold and Return. No offboard
+  at all: OFB202 clean (rules/OFB202.toml: only differences that involve OFFBOARD).
 """
 
 from __future__ import annotations
@@ -160,6 +164,29 @@ def with_flags(events: list[Event], lost: tuple[float, float]) -> list[Event]:
     return sorted([*events, *signal_flags(lost)], key=lambda e: e.t)
 
 
+def auto_takeoff() -> list[Event]:
+    loiter, takeoff = 4, 17
+    events: list[Event] = [
+        valid(),
+        logged(Command(t=ARM_T, command=400, params=(1.0, 0, 0, 0, 0, 0, 0))),
+        CommandAck(t=ARM_T + 0.004, command=400, result=0),
+        logged(Command(t=7.0, command=176, params=(1.0, 4.0, 5.0, 0, 0, 0, 0))),
+        CommandAck(t=7.004, command=176, result=0),
+    ]
+    for k in range(int(END_T * 2) + 1):
+        t = round(0.5 * k, 6)
+        if t < ARM_T:
+            nav, armed = loiter, False
+        elif t < 6.0:
+            nav, armed = takeoff, True
+        elif t < 7.0:
+            nav, armed = loiter, True
+        else:
+            nav, armed = RTL, True
+        events.append(VehicleStatus(t=t, nav_state=nav, armed=armed, user_intention=nav))
+    return sorted(events, key=lambda e: e.t)
+
+
 def cases() -> list[Case]:
     return [
         Case(
@@ -198,6 +225,12 @@ def cases() -> list[Case]:
             with_flags(offboard_flight((POSCTL, True)), (5.6, RESUME_T)),
             [*NOT_CHECKABLE_115, ("OFB701", "info", SWITCH_T), *GAP, ("OFB202", "warning", 5.605)],
             ["OFB702"],
+        ),
+        Case(
+            "auto_takeoff_no_offboard",
+            auto_takeoff(),
+            [],  # no keep-alive: nothing to judge
+            ["OFB202", "OFB701", "OFB702"],
         ),
     ]
 
