@@ -114,11 +114,14 @@ class VehicleRun:
     def feed(self, event: Event) -> None:
         """The hot path: runs once per event of a recording, so it is kept flat."""
         self.last_t = event.t
-        self.state.update(event)
-        transitions = self.gate.feed(event)
+        state = self.state
+        state.update(event)
+        gate = self.gate
+        transitions = gate.feed(event)
         if transitions:
             self._transitions(transitions)
-        self.state.set_predicted(self.gate.in_offboard, event.t)
+        if gate.in_offboard != state.predicted_offboard:  # set_predicted's own first test
+            state.set_predicted(gate.in_offboard, event.t)
         if self.timeline is not None:
             self._record(event)
         handlers = self.handlers.get(type(event))
@@ -174,7 +177,8 @@ def run_events(
             run = runs[event.vehicle] = VehicleRun(event.vehicle, profile, settings, info, timeline)
         run.feed(event)
         kinds[event.kind] += 1
-        t_end = max(t_end, event.t)
+        if event.t > t_end:  # max(t_end, event.t) without the call
+            t_end = event.t
         count += 1
         if on_event is not None and count % 4096 == 0:
             on_event(count)

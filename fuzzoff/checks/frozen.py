@@ -54,16 +54,41 @@ def is_placeholder(event: Event) -> bool:
     return bool(values) and all(math.isnan(v) for v in values)
 
 
+def _may_hold_nan(value: Any) -> bool:
+    """Could ``value`` (content as read: a value or nested tuples) hold a NaN?
+
+    Content that differs as a tuple can still be the same content only through NaN (NaN !=
+    NaN; every other value the events carry has a ``repr`` that tells unequal values apart),
+    so without a NaN the ``repr`` comparison is skipped: ~1 µs here against ~3.7 µs for the
+    ``repr`` of a ``SET_POSITION_TARGET_LOCAL_NED``, on every message whose content changes.
+    """
+    if value.__class__ is not tuple:
+        return bool(value != value)
+    for item in value:
+        if item.__class__ is tuple:  # a vector: one level down, without a call per vector
+            for x in item:
+                if x != x or x.__class__ is tuple:
+                    return True  # NaN, or deeper than events nest: let ``repr`` decide
+        elif item != item:
+            return True
+    return False
+
+
 @dataclass(slots=True)
 class _Run:
-    content: str
-    """``repr`` of the content: equal text means equal content, NaN included."""
     raw: Any
-    """The content as read; equal tuples are equal content without the cost of ``repr``."""
+    """The content as read (first message of the run); equal tuples are equal content."""
     start: float
     last: float
     where: Where
     count: int = 1
+    content: str | None = None
+    """``repr`` of ``raw`` once needed: equal text means equal content, NaN included."""
+
+    def text(self) -> str:
+        if self.content is None:
+            self.content = repr(self.raw)
+        return self.content
 
 
 class SetpointFrozen(Check):
@@ -90,16 +115,23 @@ class SetpointFrozen(Check):
             return
         raw = _getter(type(event))(event)
         run = self.runs.get(kind)
-        ongoing = run is not None and event.t - run.last <= self.max_gap
-        # identical content without NaN compares equal as a tuple, which is cheap; text is
-        # needed only when it does not (NaN != NaN)
-        content = "" if ongoing and run is not None and raw == run.raw else content_of(event)
-        if run is not None and ongoing and (not content or content == run.content):
-            run.last = event.t
-            run.count += 1
-            return
+        text = None
+        if run is not None and event.t - run.last <= self.max_gap:
+            # identical content without NaN compares equal as a tuple, which is cheap; text is
+            # needed only when it does not and a NaN could be the reason (NaN != NaN)
+            if raw == run.raw:
+                same = True
+            elif _may_hold_nan(raw):
+                text = repr(raw)
+                same = text == run.text()
+            else:
+                same = False
+            if same:
+                run.last = event.t
+                run.count += 1
+                return
         self._close(kind)
-        self.runs[kind] = _Run(content, raw, event.t, event.t, event.where)
+        self.runs[kind] = _Run(raw, event.t, event.t, event.where, content=text)
 
     def _close(self, kind: str) -> None:
         run = self.runs.pop(kind, None)

@@ -199,7 +199,8 @@ class Rosbag1Source(Source):
         counts: dict[int, int] = {}
         first_bad: SourceProblem | None = None
         bad = 0
-        last: tuple[str, float] | None = None
+        last: tuple[str, int, float] | None = None
+        """(topic, index, t) of the last message decoded; named only if reading stops."""
         try:
             for conn, timestamp, raw in messages:
                 self._done += 1
@@ -219,11 +220,11 @@ class Rosbag1Source(Source):
                     bad += 1
                     first_bad = first_bad or SourceProblem(what, f"{conn.topic} #{index}", t)
                     continue
-                last = (f"{conn.topic} #{index}", t)
+                last = (conn.topic, index, t)  # formatted only on failure: once per message
                 yield from handler(msg, t, index)
         except Exception as exc:  # rosbags ReaderError, asserts, codec errors on corrupt chunks
             detail = str(exc).rstrip(".") if isinstance(exc, ReaderError) else type(exc).__name__
-            where, t_last = last if last is not None else (None, None)
+            where, t_last = (f"{last[0]} #{last[1]}", last[2]) if last is not None else (None, None)
             after = "after the message" if last is not None else "before the first message"
             what = f"bag data corrupt ({detail}); reading stopped {after}"
             self.problems.append(SourceProblem(what, where, t_last))
