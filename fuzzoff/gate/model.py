@@ -6,7 +6,10 @@ Interface (stable for the engine and the checks):
   over the recording's ``Parameter`` events, which win over PX4's defaults); ``vehicle`` is the
   vehicle id the events carry (the vehicle *type* comes from ``profile.vehicle``);
 * ``feed(event) -> list[GateTransition]``: advance the clock to ``event.t`` (timeouts are computed
-  arithmetically, see ``signal``), then apply the event. The returned list must not be mutated;
+  arithmetically, see ``signal``), then apply the event. The returned list must not be mutated.
+  No transition is earlier than one returned before, with one exception: a ``disagreement``
+  (and its ``mode`` twin for differences without OFFBOARD) is confirmed one evaluation slack
+  after the recorded difference began and carries that beginning as its time;
 * ``finish(t_end) -> list[GateTransition]``;
 * ``signal_ok``, ``armed``, ``user_intention``, ``nav_state`` (effective), ``in_offboard``,
   ``params``.
