@@ -15,6 +15,7 @@ import math
 
 from fuzzoff.checks._episodes import Episodes, Offence
 from fuzzoff.checks.base import Check, CheckContext
+from fuzzoff.checks.content import _axis_problems
 from fuzzoff.events import (
     Event,
     SetAttitudeTarget,
@@ -22,6 +23,7 @@ from fuzzoff.events import (
     SetPositionTargetLocal,
 )
 from fuzzoff.findings import Severity
+from fuzzoff.gate.receiver import DROPPED, ReceiverContext, receive
 from fuzzoff.profiles import at_least
 from fuzzoff.tables import mavlink as tm
 
@@ -58,6 +60,16 @@ class PositionTargetFields(Check):
         self.vehicle_label = VEHICLE_LABELS[self.group]
         self.by_mask: dict[tuple[str, int, int], list[tuple[str, dict[str, Offence]]]] = {}
         """Verdicts by (message, type_mask, frame): a stream repeats the same few."""
+        self.rx: ReceiverContext | None = None
+        """PX4's receiver, to see the axes a copter setpoint leaves (1.13+: a docs page)."""
+        if self.group == "copter" and tm.page_for(ctx.profile) is not None:
+            self.rx = ReceiverContext(
+                px4=ctx.profile.px4,
+                own_system=None,
+                own_component=int(ctx.gate.params.get("MAV_COMP_ID", 1.0)),
+                fwdextsp=True,
+                est=ctx.gate.est,
+            )
 
     def on_event(self, event: Event) -> None:
         if event.origin != "sent" or not isinstance(
@@ -70,6 +82,9 @@ class PositionTargetFields(Check):
             judged = self.by_mask[key] = self._judge_mask(event)
         for code, offences in judged:
             self.episodes.update(code, event.kind, event.t, event.where, offences)
+        if self.group == "copter" and self.rx is not None:
+            offences = self._mc_axes(event, self.rx)
+            self.episodes.update("OFB602", event.kind, event.t, event.where, offences)
         if self.group == "fixedwing":
             rules = tm.position_rules(self.ctx.profile, event.kind)
             if rules is not None:
@@ -206,6 +221,36 @@ class PositionTargetFields(Check):
                 f"{tm.describe_combo(usable)} setpoints on a {self.vehicle_label}, but in it "
                 f"PX4's receiver {why}, so nothing is left and PX4 drops the message (no "
                 "setpoint, no keep-alive)"
+            )
+        }
+
+    def _mc_axes(self, event: PositionTarget, rx: ReceiverContext) -> dict[str, Offence]:
+        """What PX4's multicopter position controller rejects (gate spec 8, ``_inputValid``)
+        in the setpoint the receiver makes of the message: each axis needs a finite position,
+        velocity or acceleration, and x and y of each must be both finite or both NaN. Dropped
+        messages are the other verdicts' (or OFB607's)."""
+        mask, axes, _, _ = receive(event, rx)
+        if mask == DROPPED or not axes:
+            return {}
+        finite = tuple(
+            (bool(axes & 1 << shift), bool(axes & 2 << shift), bool(axes & 4 << shift))
+            for shift in (0, 3, 6)
+        )
+        problems = _axis_problems(finite)
+        if not problems:
+            return {}
+        fallback = (
+            "reuses the last valid setpoint for up to 200 ms, then flies a failsafe hold"
+            if self.ctx.profile.at_least("1.16")
+            else "flies a failsafe hold"
+        )
+        return {
+            f"axes:{problems[0]}": Offence(
+                f"{tm.MESSAGE_NAMES[event.kind]} type_mask {event.type_mask}: in the setpoint "
+                f"PX4's receiver makes of it, {'; '.join(problems)} (a used field that is NaN "
+                "counts as missing); PX4's multicopter position controller rejects such a "
+                f"setpoint and {fallback} (no mode change, no failsafe flag); the docs' "
+                "combinations use all three components of a group"
             )
         }
 
