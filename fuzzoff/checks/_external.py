@@ -78,6 +78,8 @@ class Episodes:
             episode.count += 1
 
     def good(self, key: str) -> None:
+        if not self.open:  # the usual clean message with nothing open
+            return
         episode = self.open.pop(key, None)
         if episode is not None:
             self._report(episode)

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 
-from fuzzoff.checks._external import Episodes, declared_flag, from_external, is_armed
+from fuzzoff.checks._external import Episodes, from_external, is_armed
 from fuzzoff.checks.base import Check, CheckContext
 from fuzzoff.events import (
     ActuatorMotors,
@@ -95,7 +95,7 @@ class TrajectoryContent(Check):
 
     def on_event(self, event: Event) -> None:
         assert isinstance(event, TrajectorySetpoint)
-        flag = declared_flag(self.ctx)
+        flag = self.ctx.state.declared_flag  # declared_flag(ctx), without the call
         if flag not in TRAJECTORY_CONTROLS or not from_external(self.ctx, event):
             return
         finite = finiteness(event)

@@ -42,7 +42,8 @@ class SetpointsOutsideOffboard(Check):
             self.logged = True
             return
         if self.ctx.state.in_offboard:
-            self._close()
+            if self.run is not None:  # _close's own test, without the call on every message
+                self._close()
             return
         if event.kind not in SETPOINT_NAMES:
             return
