@@ -93,7 +93,7 @@ def best_of(methods: dict[str, Callable[[], Run]], repeats: int) -> dict[str, Ru
             run = fn()
             if what not in best or run.cpu_s < best[what].cpu_s:
                 rss = max(run.rss_mb, best.get(what, run).rss_mb)
-                best[what] = Run(run.wall_s, rss, run.cpu_s, "")
+                best[what] = Run(wall_s=run.wall_s, cpu_s=run.cpu_s, rss_mb=rss, output="")
     return best
 
 
