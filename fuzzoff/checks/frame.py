@@ -82,11 +82,11 @@ class FrameConventionSuspect(Check):
             if event.what == "disarmed" and self.armed is None:
                 self.takeoff_pending = True
             return
-        if not from_external(self.ctx, event):
-            return
+        # from_external last: after take-off the usual setpoint needs no further look
         if isinstance(event, (AttitudeSetpoint, RatesSetpoint)):
-            self._thrust(event)
-        elif self.takeoff_pending:
+            if from_external(self.ctx, event):
+                self._thrust(event)
+        elif self.takeoff_pending and from_external(self.ctx, event):
             self._takeoff(event)
 
     def _takeoff(self, event: Event) -> None:
