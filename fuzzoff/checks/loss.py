@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 from fuzzoff.checks._keepalive import (
     KEEPALIVE_EVENTS,
+    TIME_EPSILON_S,
     loss_timeout,
     px4_label,
 )
@@ -82,7 +83,9 @@ class OffboardLoss(Check):
         timeout = loss_timeout(self.ctx)
         if self.last is None:
             stopped = "no keep-alive"
-        elif tr.t - self.last < timeout and self.lost is not None:
+        elif self.lost is not None and self.lost.t - self.last < timeout - TIME_EPSILON_S:
+            # lost sooner than a timeout after the newest keep-alive: not silence but, e.g., an
+            # old timestamp (gate spec 2.1.1) or a declaration without a flag
             why = self.lost.reason or _inner(self.lost.message)
             stopped = f"the keep-alive kept arriving but PX4 no longer counts it ({why})"
         else:
