@@ -215,3 +215,12 @@ def test_ofb201_arm_in_predicted_offboard_without_a_recorded_mode() -> None:
     events = [switch(1.0), ack(1.01, 0), arm, ack(2.01, 1, command=400)]
     (found,) = codes(lint_events(events), "OFB201")
     assert "arm in OFFBOARD" in found.message
+
+
+def test_ofb101_a_gap_that_spans_the_switch_counts() -> None:
+    # keep-alive stops at 1.0 s in POSCTL; the switch comes at 1.3 s; the stream resumes at 1.8 s
+    events = [status(0.0, POSCTL), *ocm(every(0.0, 1.0, 0.1)), switch(1.3), ack(1.31, 0)]
+    events += [status(1.32, OFFBOARD), *ocm(every(1.8, 3.0, 0.1))]
+    (found,) = codes(lint_events(events), "OFB101")
+    assert "across the switch" in found.message
+    assert found.time_s == pytest.approx(1.0) and found.end_s == pytest.approx(1.8)

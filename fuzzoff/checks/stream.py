@@ -55,6 +55,8 @@ class KeepaliveRate(Check):
         self.dropout_since_last = False
         self.last_where = Where("keep-alive")
         self.switches = RecordedSwitches(ctx)
+        self.request_in_gap = False
+        """An offboard request came while no keep-alive has arrived since ``last``."""
         self.recent: list[_Gap] = []
         """Gaps outside offboard, kept for ``window`` seconds in case a request follows."""
 
@@ -69,6 +71,7 @@ class KeepaliveRate(Check):
             self.last, self.last_where = event.t, event.where
             self.last_in_offboard = state.flying
             self.dropout_since_last = False
+            self.request_in_gap = False
         elif isinstance(event, Dropout):
             self.dropout_since_last = True
         elif isinstance(event, Command):
@@ -87,6 +90,8 @@ class KeepaliveRate(Check):
             found = _Gap(last, event.t, proven, event.where)
             if self.last_in_offboard:
                 self._report(found, "in OFFBOARD")
+            elif self.request_in_gap or self.ctx.state.flying:
+                self._report(found, "across the switch to OFFBOARD")
             else:
                 self.recent.append(found)
 
@@ -104,6 +109,7 @@ class KeepaliveRate(Check):
             )
 
     def _request(self, t: float) -> None:
+        self.request_in_gap = self.last is not None  # a silence still open at the request
         for found in self.recent:
             if t - found.end <= self.window:
                 self._report(found, "in the second before an offboard request")
