@@ -15,11 +15,6 @@ from fuzzoff.events import Event, Where
 from fuzzoff.findings import Severity
 
 
-def mode_note(ctx: CheckContext) -> str:
-    """Appended to messages that depend on the mode when the recording has none."""
-    return "" if ctx.state.mode_recorded else " (mode predicted by the gate model)"
-
-
 def declared_flag(ctx: CheckContext) -> str | None:
     """The first true field of the latest ``OffboardControlMode`` (None: none seen, or empty)."""
     return ctx.state.declared_flag

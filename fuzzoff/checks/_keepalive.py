@@ -14,15 +14,6 @@ KEEPALIVE_EVENTS: tuple[type[Event], ...] = (*KEEPALIVE_TYPES, Dropout)
 """What a stream rule subscribes to: the keep-alive kinds, and logger dropouts (ULog)."""
 
 
-def counts_as_keepalive(ctx: CheckContext, event: Event) -> bool:
-    """The docs' keep-alive: an OCM, or a supported MAVLink setpoint addressed to this vehicle.
-
-    Worked out once per event by ``VehicleState.update`` (``state.keepalive``); the stream rules
-    on the hot path compare ``event is ctx.state.keepalive`` inline, which is the same test.
-    """
-    return event is ctx.state.keepalive
-
-
 def logging_interval(ctx: CheckContext, event: Event) -> float:
     """The logger's interval for this kind in a subsampled recording (ULog), else 0."""
     return ctx.info.sampled_intervals.get(event.kind, 0.0)
@@ -44,12 +35,9 @@ def proven_gap(ctx: CheckContext, event: Event, gap: float) -> float:
 
 
 def loss_timeout(ctx: CheckContext) -> float:
-    """The gap after which the profile's PX4 declares the offboard signal lost (gate spec 2)."""
-    if ctx.profile.px4 == "legacy":
-        return 0.5
-    value = ctx.gate.params.get("COM_OF_LOSS_T")
-    default = 0.5 if ctx.profile.px4 == "1.11" else 1.0
-    return float(default if value is None else value)
+    """The gap after which the profile's PX4 declares the offboard signal lost (gate spec 2):
+    the gate model's own value (legacy's fixed 500 ms, else the effective COM_OF_LOSS_T)."""
+    return ctx.gate.loss_timeout
 
 
 def px4_label(ctx: CheckContext) -> str:
@@ -57,15 +45,8 @@ def px4_label(ctx: CheckContext) -> str:
     return f"PX4 {ctx.profile.px4}"
 
 
-def offboard_and_flying(ctx: CheckContext) -> bool:
-    """In offboard and not known to be disarmed (a disarmed vehicle parked in OFFBOARD is idle).
-
-    Kept up to date by ``VehicleState`` (``state.flying``), which the hot paths read directly.
-    """
-    return ctx.state.flying
-
-
 def mode_note(ctx: CheckContext) -> str:
+    """Appended to messages that depend on the mode when the recording has none."""
     return "" if ctx.state.mode_recorded else " (mode predicted by the gate model)"
 
 

@@ -6,7 +6,8 @@ Seed 000 "The OffboardControlMode PX4 message" (1.15+; rover table in "Рове�
 
 from __future__ import annotations
 
-from fuzzoff.checks._external import Episodes, declared_flag, mode_note
+from fuzzoff.checks._external import Episodes, declared_flag
+from fuzzoff.checks._keepalive import mode_note
 from fuzzoff.checks.base import Check, CheckContext
 from fuzzoff.events import (
     MAVLINK_SETPOINTS,

@@ -14,7 +14,8 @@ from dataclasses import dataclass, fields
 from operator import attrgetter
 from typing import Any
 
-from fuzzoff.checks._external import from_external, mode_note
+from fuzzoff.checks._external import from_external
+from fuzzoff.checks._keepalive import mode_note
 from fuzzoff.checks.base import Check, CheckContext
 from fuzzoff.events import MAVLINK_SETPOINTS, PX4_SETPOINTS, Event, VehicleStatus, Where
 from fuzzoff.gate import GateTransition

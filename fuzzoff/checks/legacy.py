@@ -6,7 +6,8 @@ semantics of the ``ignore_*`` flags are in fuzzoff/tables/control_mode.py.
 
 from __future__ import annotations
 
-from fuzzoff.checks._external import Episodes, mode_note
+from fuzzoff.checks._external import Episodes
+from fuzzoff.checks._keepalive import mode_note
 from fuzzoff.checks.base import Check, CheckContext
 from fuzzoff.events import (
     Event,

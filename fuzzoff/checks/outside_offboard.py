@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from fuzzoff.checks._external import mode_note
+from fuzzoff.checks._keepalive import mode_note
 from fuzzoff.checks.base import Check, CheckContext
 from fuzzoff.events import PX4_SETPOINTS, Event, VehicleStatus, Where
 from fuzzoff.gate import GateTransition
