@@ -24,7 +24,7 @@ from fuzzoff.profiles import (
     px4_profile_for,
 )
 from fuzzoff.sources import SourceError, find_recordings, open_source
-from fuzzoff.sources.base import RecordingInfo
+from fuzzoff.sources.base import RecordingInfo, SourceProblem
 from fuzzoff.state import VehicleState
 
 Progress = Callable[[float], None]
@@ -285,9 +285,7 @@ def lint_file(
     return report
 
 
-def _problem(exc: SourceError) -> Any:
-    from fuzzoff.sources.base import SourceProblem
-
+def _problem(exc: SourceError) -> SourceProblem:
     return SourceProblem(exc.what, exc.where)
 
 
