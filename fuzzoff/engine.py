@@ -12,6 +12,7 @@ from typing import Any
 
 from fuzzoff.catalog import get_rule
 from fuzzoff.checks import CheckContext, load_all
+from fuzzoff.checks.base import STREAM_TYPES, Check, StreamBatch
 from fuzzoff.config import Settings
 from fuzzoff.events import Event, VehicleStatus, is_keepalive
 from fuzzoff.findings import FileReport, Finding, Report, Severity
@@ -28,6 +29,9 @@ from fuzzoff.sources.base import RecordingInfo, SourceProblem
 from fuzzoff.state import VehicleState
 
 Progress = Callable[[float], None]
+
+BATCH_LIMIT = 1024
+"""The longest run of stream messages held for the checks that take runs (bounded memory)."""
 
 
 def resolve_profile(info: RecordingInfo, settings: Settings) -> Profile:
@@ -73,6 +77,8 @@ class VehicleRun:
         settings: Settings,
         info: RecordingInfo,
         timeline: Timeline | None,
+        *,
+        batching: bool = True,
     ) -> None:
         self.state = VehicleState(
             mode_recorded="vehicle_status" in info.kinds,
@@ -89,16 +95,43 @@ class VehicleRun:
         )
         self.checks = [cls(self.ctx) for cls in load_all() if cls.wanted(self.ctx)]
         self.handlers: dict[type, list[Callable[[Event], None]]] = {}
-        self._wants = [(check.subscriptions, check.on_event) for check in self.checks]
+        self.batched = [c for c in self.checks if batching and _takes_runs(c)]
+        """Checks that take the stream messages as runs (``StreamBatch``), not one by one."""
+        self._wants = [
+            (check.subscriptions, check.on_event, check in self.batched) for check in self.checks
+        ]
+        self._batch: StreamBatch | None = None
         self.timeline = timeline
         self.last_t = 0.0
 
     def _handlers_for(self, cls: type) -> list[Callable[[Event], None]]:
         handlers = self.handlers.get(cls)
         if handlers is None:
-            handlers = [h for wants, h in self._wants if issubclass(cls, wants)]
+            stream = cls in STREAM_TYPES
+            handlers = [
+                h
+                for wants, h, runs in self._wants
+                if issubclass(cls, wants) and not (runs and stream)
+            ]
             self.handlers[cls] = handlers
         return handlers
+
+    def _flush(self) -> None:
+        """Hand the open run to the checks that take runs (before anything that changes state)."""
+        batch = self._batch
+        if batch is None:
+            return
+        self._batch = None
+        ctx = self.ctx
+        live = ctx.state, ctx.gate
+        ctx.state, ctx.gate = batch.state, batch.gate
+        try:
+            for check in self.batched:
+                on_batch = check.on_batch
+                assert on_batch is not None
+                on_batch(batch)
+        finally:
+            ctx.state, ctx.gate = live
 
     def _dispatch(self, event: Event) -> None:
         for handler in self._handlers_for(type(event)):
@@ -112,23 +145,48 @@ class VehicleRun:
             self._dispatch(tr)
 
     def feed(self, event: Event) -> None:
-        """The hot path: runs once per event of a recording, so it is kept flat."""
+        """The hot path: runs once per event of a recording, so it is kept flat.
+
+        Stream messages also join the open run for the checks that take runs; the run is
+        handed over before any other event, before a gate transition, and before a change of
+        the declared control mode, so that it never spans a change of what checks read."""
+        cls = type(event)
+        stream = cls in STREAM_TYPES
+        batch = self._batch
+        if batch is not None and not stream:
+            self._flush()
+            batch = None
         self.last_t = event.t
         state = self.state
         state.update(event)
         gate = self.gate
         transitions = gate.feed(event)
         if transitions:
+            if batch is not None:
+                self._flush()
+                batch = None
             self._transitions(transitions)
         if gate.in_offboard != state.predicted_offboard:  # set_predicted's own first test
+            if batch is not None:
+                self._flush()
+                batch = None
             state.set_predicted(gate.in_offboard, event.t)
         if self.timeline is not None:
             self._record(event)
-        handlers = self.handlers.get(type(event))
+        handlers = self.handlers.get(cls)
         if handlers is None:
-            handlers = self._handlers_for(type(event))
+            handlers = self._handlers_for(cls)
         for handler in handlers:
             handler(event)
+        if stream and self.batched:
+            if batch is not None and state.declared_flag != batch.state.declared_flag:
+                self._flush()
+                batch = None
+            if batch is None:
+                batch = self._batch = StreamBatch(state, gate)
+            batch.events.append(event)
+            if len(batch.events) >= BATCH_LIMIT:
+                self._flush()
 
     def _record(self, event: Event) -> None:
         assert self.timeline is not None
@@ -145,6 +203,7 @@ class VehicleRun:
                 series.append(event.t)
 
     def finish(self, t_end: float) -> list[Finding]:
+        self._flush()
         self._transitions(self.gate.finish(t_end))
         for check in self.checks:
             check.finish(t_end)
@@ -162,8 +221,12 @@ def run_events(
     *,
     timelines: dict[str, Timeline] | None = None,
     on_event: Callable[[int], None] | None = None,
+    batching: bool = True,
 ) -> tuple[list[Finding], dict[str, Any]]:
-    """Run the gate and every enabled check over ``events`` (one recording, any vehicles)."""
+    """Run the gate and every enabled check over ``events`` (one recording, any vehicles).
+
+    ``batching=False`` hands every stream message to every check one at a time, as the
+    checks' ``on_batch`` must be equivalent to (the tests compare the two)."""
     runs: dict[str, VehicleRun] = {}
     kinds: Counter[str] = Counter()
     count = 0
@@ -174,7 +237,9 @@ def run_events(
             timeline = None
             if timelines is not None:
                 timeline = timelines.setdefault(event.vehicle, Timeline())
-            run = runs[event.vehicle] = VehicleRun(event.vehicle, profile, settings, info, timeline)
+            run = runs[event.vehicle] = VehicleRun(
+                event.vehicle, profile, settings, info, timeline, batching=batching
+            )
         run.feed(event)
         kinds[event.kind] += 1
         if event.t > t_end:  # max(t_end, event.t) without the call
@@ -213,6 +278,13 @@ def run_events(
     return findings, stats
 
 
+def _takes_runs(check: Check) -> bool:
+    """Does the check define ``on_batch`` and want any stream message?"""
+    return check.on_batch is not None and any(
+        issubclass(cls, check.subscriptions) for cls in STREAM_TYPES
+    )
+
+
 def _sort_key(finding: Finding) -> tuple[float, str, str]:
     t = -math.inf if finding.time_s is None else finding.time_s
     return (t, finding.vehicle, finding.code)
@@ -224,8 +296,11 @@ def lint_file(
     *,
     progress: Progress | None = None,
     timelines: dict[str, Timeline] | None = None,
+    batching: bool = True,
 ) -> FileReport:
-    """Lint one recording. Never raises for a bad file: it becomes OFB001 and ``complete=False``."""
+    """Lint one recording. Never raises for a bad file: it becomes OFB001 and ``complete=False``.
+
+    ``batching=False`` gives every check the stream one message at a time (see ``run_events``)."""
     settings = settings or Settings()
     path = Path(path)
     unreadable = get_rule("OFB001")
@@ -258,7 +333,13 @@ def lint_file(
 
         try:
             findings, stats = run_events(
-                source.events(), info, profile, settings, timelines=timelines, on_event=tick
+                source.events(),
+                info,
+                profile,
+                settings,
+                timelines=timelines,
+                on_event=tick,
+                batching=batching,
             )
         except SourceError as exc:  # a reader that gives up mid-way keeps what it yielded
             source.problems.append(_problem(exc))

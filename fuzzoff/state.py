@@ -102,6 +102,13 @@ class VehicleState:
         elif was and not now:
             self.offboard_since = None
 
+    def counts_as_keepalive(self, event: Event) -> bool:
+        """What ``update`` puts in ``keepalive`` for this event (runs of messages use it)."""
+        if isinstance(event, MavlinkTarget):
+            target = event.target_system
+            return target == 0 or self.own_system is None or target == self.own_system
+        return isinstance(event, (ControlMode, LegacyControlMode))
+
     def _status(self, event: Event) -> None:
         assert isinstance(event, VehicleStatus)
         if event.nav_state is not None:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from operator import sub
+
 from fuzzoff.checks.base import CheckContext
 from fuzzoff.events import (
     KEEPALIVE_TYPES,
@@ -12,6 +14,18 @@ from fuzzoff.events import (
 
 KEEPALIVE_EVENTS: tuple[type[Event], ...] = (*KEEPALIVE_TYPES, Dropout)
 """What a stream rule subscribes to: the keep-alive kinds, and logger dropouts (ULog)."""
+
+
+def worst_gap(last: float | None, events: list[Event]) -> float:
+    """The longest interval between consecutive ``events`` (and from ``last`` to the first, when
+    given), 0 for fewer than two times: the runs' fast paths test it against their limits."""
+    times = [e.t for e in events]
+    if last is not None:
+        times.insert(0, last)
+    if len(times) < 2:
+        return 0.0
+    gaps: map[float] = map(sub, times[1:], times)
+    return max(gaps)
 
 
 def logging_interval(ctx: CheckContext, event: Event) -> float:

@@ -4,17 +4,31 @@ A check subclasses ``Check``, names the rule codes it can report (``codes``) and
 types it wants (``wants``; ``GateTransition`` included for checks driven by the gate model),
 and reports through ``self.ctx.report``. Subclassing registers it; a module in this package
 is imported automatically, so adding a rule needs no edit elsewhere.
+
+A check on the hot path may also define ``on_batch``: the engine then hands it the stream
+messages (keep-alives and setpoints, ``STREAM_TYPES``) as runs, a ``StreamBatch`` at a time,
+instead of one call per message. A run never spans anything that changes what the checks read
+(see ``StreamBatch``), so the check can judge it with a tight loop or in one step; every other
+event still reaches ``on_event``, after the runs before it.
 """
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 from fuzzoff.catalog import get_rule
 from fuzzoff.config import Settings
-from fuzzoff.events import Event, Where
+from fuzzoff.events import (
+    KEEPALIVE_TYPES,
+    PX4_SETPOINTS,
+    ControlMode,
+    Event,
+    LegacyControlMode,
+    Where,
+)
 from fuzzoff.findings import Finding, Severity
 from fuzzoff.gate import GateModel
 from fuzzoff.profiles import Profile
@@ -100,6 +114,44 @@ class CheckContext:
         return any(kind in self.info.kinds for kind in kinds)
 
 
+STREAM_TYPES: frozenset[type[Event]] = frozenset((*KEEPALIVE_TYPES, *PX4_SETPOINTS))
+"""The high-rate messages the engine may group into runs: keep-alives and setpoints."""
+
+
+class StreamBatch:
+    """A run of consecutive stream messages of one vehicle, in time order.
+
+    Within a run nothing changes what a check reads: no other event of the vehicle, no gate
+    transition and no change of the declared control mode (first true OCM flag) falls inside
+    it; only the messages themselves do (which one is the latest keep-alive or setpoint).
+    ``state`` and ``gate`` are copies of the shared state and the gate model as every message
+    of the run saw them: the engine may close a run only after its next message has moved the
+    live ones on (a gate transition it caused). While a check's ``on_batch`` runs, the
+    engine points ``ctx.state`` and ``ctx.gate`` at these copies, so code shared with
+    ``on_event`` reads the right values.
+
+    ``on_batch`` must report exactly what ``on_event`` would for the same messages one at a
+    time; ``Check.replay`` does that, and a check's own fast path proves the common case
+    (nothing to report, only counters and times move) and replays the rest.
+    ``tests/test_batching.py`` and the ``runs`` fuzz property compare the two.
+    """
+
+    __slots__ = ("_keepalives", "events", "gate", "state")
+
+    def __init__(self, state: VehicleState, gate: GateModel) -> None:
+        self.events: list[Event] = []
+        self.state = copy.copy(state)
+        self.gate = copy.copy(gate)
+        self._keepalives: list[Event] | None = None
+
+    def keepalives(self) -> list[Event]:
+        """The run's messages that count as keep-alive (``VehicleState.keepalive`` rules)."""
+        if self._keepalives is None:
+            counts = self.state.counts_as_keepalive
+            self._keepalives = [e for e in self.events if counts(e)]
+        return self._keepalives
+
+
 class Check:
     codes: ClassVar[tuple[str, ...]] = ()
     wants: ClassVar[tuple[type[Event], ...]] = ()
@@ -122,6 +174,29 @@ class Check:
 
     def on_event(self, event: Event) -> None:
         """Called for every event whose type is in ``wants``, in time order."""
+
+    on_batch: ClassVar[Callable[[Any, StreamBatch], None] | None] = None
+    """Optional: ``on_batch(self, batch)`` takes the stream messages a run at a time (see
+    ``StreamBatch``); ``on_event`` then sees only the other events it wants. The run holds
+    every stream message; the check picks the ones it wants."""
+
+    def replay(self, batch: StreamBatch, start: int = 0) -> None:
+        """``on_event`` for the run's messages from ``start`` on that this check wants, with
+        the per-message parts of the state (``keepalive``, ``control_mode``) set as
+        ``VehicleState.update`` sets them: the exact fallback of an ``on_batch``."""
+        state = self.ctx.state
+        wants = self.subscriptions
+        counts = state.counts_as_keepalive
+        on_event = self.on_event
+        events = batch.events
+        for i in range(start, len(events)):
+            event = events[i]
+            if isinstance(event, (ControlMode, LegacyControlMode)):
+                state.control_mode = event
+            if isinstance(event, wants):
+                state.keepalive = event if counts(event) else None
+                on_event(event)
+        state.keepalive = None
 
     def finish(self, t_end: float) -> None:
         """Called once after the last event (``t_end`` = the recording's last time)."""

@@ -16,8 +16,9 @@ from fuzzoff.checks._keepalive import (
     mode_note,
     proven_gap,
     px4_label,
+    worst_gap,
 )
-from fuzzoff.checks.base import Check, CheckContext
+from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import (
     NAV_STATE_OFFBOARD,
     Command,
@@ -84,6 +85,25 @@ class KeepaliveRate(Check):
                 self._left_offboard(event)
         if self.recent:
             self.recent = [g for g in self.recent if event.t - g.end <= self.window]
+
+    def on_batch(self, batch: StreamBatch) -> None:
+        """Fast path: only short gaps (under the limit whatever the logger's interval) and no
+        gap outside offboard kept for a later request: just move ``last`` on."""
+        keepalives = batch.keepalives()
+        if not keepalives:
+            return
+        if self.recent or not self.quick:
+            self.replay(batch)
+            return
+        last = None if self.dropout_since_last else self.last
+        if worst_gap(last, keepalives) + PROOF_SLACK_S >= self.max_gap:
+            self.replay(batch)
+            return
+        newest = keepalives[-1]
+        self.last, self.last_where = newest.t, newest.where
+        self.last_in_offboard = batch.state.flying
+        self.dropout_since_last = False
+        self.request_in_gap = False
 
     def _gap(self, event: Event, last: float, proven: float) -> None:
         if proven >= self.max_gap:

@@ -19,10 +19,13 @@
   itself), OFB002 and OFB003 are left out: they describe the file, not the stream.
 * ``gate_invariants_hold`` (e): invariants of the gate spec, on the sent stream (see
   ``fuzz.invariants``).
+* ``runs_match_single_messages`` (f): the checks that take the stream as runs
+  (``on_batch``) report exactly what they report when given one message at a time.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 import shutil
 import tempfile
@@ -287,6 +290,20 @@ def gate_invariants_hold(scenario: Scenario, ctx: FuzzContext) -> list[str]:
     return invariant_violations(scenario)
 
 
+# ----------------------------------------------------------------------------- runs
+
+
+def runs_match_single_messages(scenario: Scenario, ctx: FuzzContext) -> list[str]:
+    """Exactly the same findings: every field, message text and order included."""
+    single = run(scenario, ctx.settings, batching=False)
+    runs = run(scenario, ctx.settings, batching=True)
+    return [
+        f"one at a time: {a}; as runs: {b}"
+        for a, b in itertools.zip_longest(single, runs)
+        if a != b
+    ][:3]
+
+
 @dataclass(frozen=True, slots=True)
 class PropertySpec:
     name: str
@@ -328,6 +345,11 @@ PROPERTIES: dict[str, PropertySpec] = {
             "invariants",
             gate_invariants_hold,
             "the gate model keeps the gate spec's invariants",
+        ),
+        PropertySpec(
+            "runs",
+            runs_match_single_messages,
+            "checks given the stream as runs report what they report one message at a time",
         ),
     )
 }

@@ -106,13 +106,16 @@ def run(
     *,
     events: Sequence[Event] | None = None,
     timelines: dict[str, Timeline] | None = None,
+    batching: bool = True,
 ) -> list[Finding]:
     """The findings ``fuzzoff lint`` gives for the scenario (or for ``events`` instead of its
     own, judged with its profile), sorted like the lint report."""
     stream = list(scenario.events if events is None else events)
     info = info_for(stream, RECORDING_FORMAT[scenario.transport])
     settings = scenario.settings(base)
-    findings, _ = run_events(stream, info, scenario.profile, settings, timelines=timelines)
+    findings, _ = run_events(
+        stream, info, scenario.profile, settings, timelines=timelines, batching=batching
+    )
     findings = [f for f in findings if settings.enabled(f.code)]
     findings.sort(key=lambda f: (-1e300 if f.time_s is None else f.time_s, f.vehicle, f.code))
     return findings

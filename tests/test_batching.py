@@ -1,0 +1,57 @@
+"""Checks that take the stream as runs (``on_batch``) must report what they report when given
+one message at a time: compared on every corpus recording and on generated streams."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from fuzzoff.cli import build_parser
+from fuzzoff.commands._common import settings_from_args
+from fuzzoff.engine import VehicleRun, lint_file
+from fuzzoff.fuzz.properties import FuzzContext, runs_match_single_messages
+from fuzzoff.fuzz.scenario import Scenario
+from fuzzoff.fuzz.streams import scenarios
+from fuzzoff.profiles import PX4_PROFILES
+
+CORPORA = Path(__file__).resolve().parent.parent / "corpora"
+EXPECTED = sorted(CORPORA.rglob("*.expected.json"))
+
+
+@pytest.mark.parametrize(
+    "expected_file", EXPECTED, ids=[str(p.relative_to(CORPORA)) for p in EXPECTED]
+)
+def test_corpus_findings_are_the_same_as_runs_and_one_at_a_time(expected_file: Path) -> None:
+    spec = json.loads(expected_file.read_text())
+    recording = expected_file.parent / spec["recording"]
+    args = build_parser("lint").parse_args(["lint", str(recording), *spec.get("args", [])])
+    lint_settings = settings_from_args(args)
+    single = lint_file(recording, lint_settings, batching=False)
+    runs = lint_file(recording, lint_settings, batching=True)
+    assert runs.findings == single.findings
+
+
+def test_runs_are_used_on_the_hot_path() -> None:
+    """The equivalence above only means something if checks do take runs."""
+    from fuzzoff.config import Settings
+    from fuzzoff.profiles import Profile
+    from fuzzoff.sources.base import RecordingInfo
+
+    for kinds in ({"offboard_control_mode", "trajectory_setpoint"}, {"set_position_target_local"}):
+        info = RecordingInfo("x", "mcap", kinds=set(kinds))
+        profile = Profile(px4="1.15", vehicle="mc", px4_detected=True, vehicle_detected=True)
+        run = VehicleRun("1", profile, Settings(), info, None)
+        assert run.batched, kinds
+
+
+@pytest.mark.parametrize("px4", PX4_PROFILES)
+@settings(max_examples=40, deadline=None, suppress_health_check=list(HealthCheck), derandomize=True)
+@given(data=st.data())
+def test_generated_streams_give_the_same_findings_as_runs(px4: str, data: st.DataObject) -> None:
+    scenario: Scenario = data.draw(scenarios(px4, None, None))
+    problems = runs_match_single_messages(scenario, FuzzContext())
+    assert not problems, problems
