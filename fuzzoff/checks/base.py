@@ -136,13 +136,22 @@ class StreamBatch:
     ``tests/test_batching.py`` and the ``runs`` fuzz property compare the two.
     """
 
-    __slots__ = ("_keepalives", "events", "gate", "state")
+    __slots__ = ("_keepalives", "_of", "events", "gate", "state")
 
     def __init__(self, state: VehicleState, gate: GateModel) -> None:
         self.events: list[Event] = []
         self.state = copy.copy(state)
         self.gate = copy.copy(gate)
         self._keepalives: list[Event] | None = None
+        self._of: dict[tuple[type[Event], ...], list[Event]] = {}
+
+    def of(self, types: tuple[type[Event], ...]) -> list[Event]:
+        """The run's messages of these types (worked out once per run and tuple: several
+        checks ask for the same, e.g. their ``subscriptions``)."""
+        found = self._of.get(types)
+        if found is None:
+            found = self._of[types] = [e for e in self.events if isinstance(e, types)]
+        return found
 
     def keepalives(self) -> list[Event]:
         """The run's messages that count as keep-alive (``VehicleState.keepalive`` rules)."""
