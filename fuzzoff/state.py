@@ -92,8 +92,11 @@ class VehicleState:
         updater = _UPDATER_BY_TYPE.get(type(event))
         if updater is None:
             updater = _UPDATER_BY_TYPE[type(event)] = _updater_for(type(event))
-        was = self.in_offboard
         self.keepalive = None
+        if updater not in _MODE_UPDATERS:  # nothing the mode depends on moves (every setpoint)
+            updater(self, event)
+            return
+        was = self.in_offboard
         updater(self, event)
         now = self.in_offboard = self._now_in_offboard()
         self.flying = now and self.armed is not False
@@ -184,6 +187,11 @@ _UPDATERS: tuple[tuple[type, Callable[[VehicleState, Event], None]], ...] = (
 )
 """In the order ``update`` used to test them with ``isinstance``; looked up once per event type
 instead of walking the chain on every message (about 0.3 µs a setpoint on a tlog)."""
+
+
+_MODE_UPDATERS = frozenset((VehicleState._status, VehicleState._command_ack))
+"""The only updaters that move ``nav_state`` or ``armed``; after any other, ``in_offboard``,
+``flying`` and ``offboard_since`` stay as they were (``set_predicted`` moves them too)."""
 
 
 _UPDATER_BY_TYPE: dict[type, Callable[[VehicleState, Event], None]] = {}
