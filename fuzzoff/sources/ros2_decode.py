@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from functools import cache
 from typing import Any
 
-from rosbags.typesys import get_types_from_idl
+from rosbags.typesys import get_types_from_idl, get_types_from_msg
 from rosbags.typesys.store import Typestore
 
 from fuzzoff.events import NOWHERE, Event, Origin, VehicleStatus, Where
@@ -103,12 +103,14 @@ def bundled(message: str, release: str) -> Definition | None:
 
 @cache
 def bundled_layout(message: str, release: str) -> tuple[Any, ...] | None:
-    """The field layout of a bundled definition (no code generation: cheap to compare)."""
+    """The field layout of a bundled definition, parsed only: a type store would also generate
+    and compile its deserialisers (three times the cost), and only the layout is compared.
+    rosbags' store keeps the parser's field list as is, so the two layouts compare equal."""
     text = px4_msgs.definition(release, message)
     if text is None:
         return None
     typename = px4_msgs.type_name(message)
-    return tuple(px4_msgs.typestore_for(typename, text).fielddefs[typename][1])
+    return tuple(get_types_from_msg(text, typename)[typename][1])
 
 
 def message_of(topic: str, msgtype: str) -> tuple[str | None, TopicRef | None]:
@@ -141,9 +143,29 @@ class TopicDecoder:
     """Why no definition can decode this topic (then every message is counted as failed)."""
 
     def event(self, raw: bytes | memoryview, t: float) -> Event | None:
-        """The event for one payload, or None (not decodable: counted as a problem)."""
+        """The event for one payload, or None (not decodable: counted as a problem).
+
+        The usual payload (a definition in use, little-endian CDR, decoding to its exact
+        length) is decoded here in one step; anything else goes through ``decode``, whose
+        verdict is the same function of the same bytes, so the events are the same.
+        """
         index = self.index
         self.index = index + 1
+        build = self.builder
+        definition = self.definition
+        if build is not None and definition is not None:
+            message: Any = None
+            try:
+                if raw[1] == 1 and not raw[0]:
+                    message, pos = definition.little(raw[4:], 0, definition.cls, definition.store)
+            except _DECODE_ERRORS:
+                message = None
+            if message is not None and pos == len(raw) - 4:
+                return build(message, t, Where(self.topic, index), message.timestamp)
+        return self._checked(raw, t, index)
+
+    def _checked(self, raw: bytes | memoryview, t: float, index: int) -> Event | None:
+        """``event`` for any payload: definition chosen if need be, every failure counted."""
         if self.builder is None:
             if self.unusable is None:
                 self.resolve(raw, t)

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import re
 import sqlite3
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import suppress
 from pathlib import Path
 from typing import Any
@@ -254,11 +254,11 @@ class Rosbag2Source(Source):
                 selected.append(conn)
         if not selected:  # rosbags reads every message when given no connection
             return
-        by_id: dict[int, Decoder] = {}
+        by_id: dict[int, Callable[[bytes | memoryview, float], Event | None]] = {}
         for conn in selected:
             decoder = self._decoders[(conn.topic, conn.msgtype)]
             assert decoder is not None
-            by_id[conn.id] = decoder
+            by_id[conn.id] = decoder.event  # bound once, not per message
         t0 = self._t0
         count = 0
         self._last_ns = -1
@@ -268,7 +268,7 @@ class Rosbag2Source(Source):
                     t0 = self._t0 = stamp
                 count += 1
                 self._last_ns = stamp
-                event = by_id[conn.id].event(raw, (stamp - t0) / 1e9)
+                event = by_id[conn.id](raw, (stamp - t0) / 1e9)
                 if event is not None:
                     yield event
         except Exception as exc:  # rosbags, sqlite and codec errors mid-read
