@@ -228,8 +228,8 @@ class UlogSource(Source):
         ulog = self._load().ulog
         t0 = int(ulog.start_timestamp)
         context = self._context(info)
-        streams: list[Iterator[tuple[int, int, int, ev.Event]]] = [self._preamble(ulog, info)]
         ranks = {name: rank for rank, name in enumerate(TOPICS, start=10)}
+        topics: list[_Stream] = []
         datasets = self._datasets()
         for d in datasets:
             spec = TOPICS.get(d.name)
@@ -237,22 +237,41 @@ class UlogSource(Source):
                 continue
             rank = ranks[d.name] * 256 + d.multi_id
             topic = d.name if d.multi_id == 0 else f"{d.name}_{d.multi_id}"
-            streams.append(_stream(d.data, topic, rank, t0, spec.decode, context))
+            topics.append(_stream(d.data, topic, rank, t0, spec.decode, context))
         legacy = _legacy_flags(datasets)
         if legacy is not None:
             rank = (len(ranks) + 10) * 256
-            streams.append(
-                _stream(legacy.data, "vehicle_status", rank, t0, failsafe_flags, context)
-            )
-        streams.append(self._records(ulog, t0))
+            topics.append(_stream(legacy.data, "vehicle_status", rank, t0, failsafe_flags, context))
+        records = _Stream.of(self._records(ulog, t0))
+        streams = [_Stream.of(self._preamble(ulog, info)), *topics, records]
         try:
-            for _key, _rank, _index, event in heapq.merge(*streams):
-                self._yielded += 1
-                yield event
+            yield from self._merge(streams)
         except (KeyError, ValueError, TypeError, IndexError, OverflowError) as exc:
             # A layout no release has (a damaged format record that still parsed).
             where = f"the event after the first {self._yielded}"
             raise SourceError(self.path, f"cannot decode the data ({exc!r})", where) from None
+
+    def _merge(self, streams: list[_Stream]) -> Iterator[ev.Event]:
+        """The streams' events by (time, rank, index), as ``heapq.merge`` of the keyed streams.
+
+        The order is worked out on the keys alone, in numpy (``_merged_order``), and the events
+        are taken from their streams in that order. Each stream is advanced exactly when
+        ``heapq.merge`` would advance it (all primed first; one read after its event is
+        consumed), so even a decoder raising mid-way stops at the same event.
+        """
+        order = _merged_order(streams)
+        if order is None:  # keys numpy cannot order exactly: heapq.merge itself
+            for _key, _rank, _index, event in heapq.merge(*(s.keyed() for s in streams)):
+                self._yielded += 1
+                yield event
+            return
+        iters = [iter(s.events) for s in streams]
+        heads: list[Any] = [next(it, None) for it in iters]
+        for start in range(0, len(order), CHUNK_ROWS):
+            for s in order[start : start + CHUNK_ROWS].tolist():
+                self._yielded += 1
+                yield heads[s]
+                heads[s] = next(iters[s], None)
 
     def _context(self, info: RecordingInfo) -> Context:
         context = Context()
@@ -408,22 +427,89 @@ def _legacy_flags(datasets: list[Any]) -> Any:
     return None
 
 
-def _stream(
-    cols: Any, topic: str, rank: int, t0: int, decode: Any, context: Context
-) -> Iterator[tuple[int, int, int, ev.Event]]:
+class _Stream:
+    """One source of events in merge order: its merge keys (``key``, ``rank``; the index is
+    the position) and the events, one per key, made lazily."""
+
+    def __init__(self, keys: Any, rank: int | list[int], index: Any, events: Iterator[ev.Event]):
+        self.keys = keys
+        """Merge keys (time, us) in stream order: a numpy array or a list of ints."""
+        self.rank = rank
+        """The stream's rank, or one per event (records, preamble)."""
+        self.index = index
+        self.events = events
+
+    @classmethod
+    def of(cls, items: Iterator[tuple[int, int, int, ev.Event]]) -> _Stream:
+        """A stream of already keyed items (few: the preamble and the records)."""
+        listed = list(items)
+        return cls(
+            [item[0] for item in listed],
+            [item[1] for item in listed],
+            [item[2] for item in listed],
+            iter([item[3] for item in listed]),
+        )
+
+    def keyed(self) -> Iterator[tuple[int, int, int, ev.Event]]:
+        """(key, rank, index, event) tuples, for ``heapq.merge``."""
+        keys = self.keys.tolist() if isinstance(self.keys, np.ndarray) else self.keys
+        ranks = self.rank if isinstance(self.rank, list) else repeat(self.rank)
+        index = self.index.tolist() if isinstance(self.index, np.ndarray) else self.index
+        return zip(keys, ranks, index, self.events, strict=False)
+
+
+def _merged_order(streams: list[_Stream]) -> Any:
+    """Which stream each merged event comes from, in ``heapq.merge`` order; None when numpy
+    cannot decide it exactly (the caller then merges with ``heapq.merge``).
+
+    The first stream is the preamble (key -1: before everything, in its own order); the last
+    one holds the records (ranks above every topic's). The topic streams are each sorted by
+    (key, index), with distinct ranks: so a stable sort by key of the streams laid end to end in
+    rank order is the (key, rank, index) order.
+    """
+    preamble, *middle, records = streams
+    ranks = [s.rank for s in middle if isinstance(s.rank, int)]
+    if (
+        len(ranks) != len(middle)
+        or len(set(ranks)) != len(ranks)
+        or max(ranks, default=0) >= _RECORD_RANK
+    ):
+        return None
+    topics = [s for _, s in sorted(zip(ranks, middle, strict=True), key=lambda item: item[0])]
+    if any(k != _SORTED_FIRST for k in preamble.keys):
+        return None
+    if not all(s.keys.dtype.kind == "u" for s in topics):
+        return None  # a damaged format with a signed or float timestamp
+    if any(not 0 <= k < 1 << 64 for k in records.keys):
+        return None
+    position = {id(s): n for n, s in enumerate(streams)}
+    keys = [s.keys.astype(np.uint64) for s in topics]
+    keys.append(np.array(records.keys, dtype=np.uint64))
+    owner = [position[id(s)] for s in topics] + [len(streams) - 1]
+    which = np.repeat(np.array(owner, dtype=np.int64), [len(k) for k in keys])
+    merged = which[np.argsort(np.concatenate(keys), kind="stable")]
+    return np.concatenate([np.zeros(len(preamble.keys), dtype=np.int64), merged])
+
+
+def _stream(cols: Any, topic: str, rank: int, t0: int, decode: Any, context: Context) -> _Stream:
     """One topic instance's events in timestamp order, made a chunk at a time."""
     ts = cols["timestamp"]
     n = len(ts)
     order: Any = None
     if n > 1 and bool(np.any(ts[1:] < ts[:-1])):
         order = np.argsort(ts, kind="stable")
+    keys = ts if order is None else ts[order]
+    index = np.arange(n) if order is None else order
+    return _Stream(keys, rank, index, _chunks(cols, order, n, topic, t0, decode, context))
+
+
+def _chunks(
+    cols: Any, order: Any, n: int, topic: str, t0: int, decode: Any, context: Context
+) -> Iterator[ev.Event]:
     for start in range(0, n, CHUNK_ROWS):
         sel = (
             slice(start, min(n, start + CHUNK_ROWS))
             if order is None
             else order[start : start + CHUNK_ROWS]
         )
-        chunk = Chunk(cols, sel, topic, t0)
-        # zip builds the merge keys in C: no Python frame per event here.
-        events = decode(chunk, context)  # one event per row
-        yield from zip(chunk.ts, repeat(rank), chunk.index, events, strict=False)
+        yield from decode(Chunk(cols, sel, topic, t0), context)  # one event per row
