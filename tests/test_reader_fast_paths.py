@@ -147,3 +147,42 @@ def test_bundled_layout_is_the_type_store_layout() -> None:
             assert text is not None
             store = px4_msgs.typestore_for(typename, text)
             assert bundled_layout(message, release) == tuple(store.fielddefs[typename][1])
+
+
+def test_rosbag1_decoder_is_the_library_call() -> None:
+    """``_decoder`` gives rosbags' message, or raises rosbags' own error, for any payload."""
+    from fuzzoff.sources.rosbag1 import Rosbag1Source, _decoder
+    from fuzzoff.sources.rosbag1_chunkwise import ChunkwiseReader
+
+    bag = ROOT / "corpora" / "rosbag1" / "offboard_good.bag"
+    source = Rosbag1Source(bag)
+    source.open()
+    store = source._typestore
+    reader = ChunkwiseReader(bag)
+    reader.open()
+    try:
+        seen = set()
+        for conn, _, raw in reader.messages(connections=source._wanted):
+            if conn.msgtype in seen:
+                continue
+            seen.add(conn.msgtype)
+            decode = _decoder(store, conn.msgtype)
+            for payload in (raw, raw + b"\x00", raw[:-1], raw[:5], b""):
+                try:
+                    want: Any = repr(store.deserialize_ros1(payload, conn.msgtype))
+                except Exception as exc:
+                    want = (type(exc), str(exc))
+                try:
+                    got: Any = repr(decode(payload))
+                except Exception as exc:
+                    got = (type(exc), str(exc))
+                assert got == want
+        assert len(seen) >= 2
+    finally:
+        reader.close()
+        source.close()
+    unknown = _decoder(store, "nobody_msgs/msg/Nothing")
+    with pytest.raises(Exception) as raised:
+        unknown(b"")
+    with pytest.raises(type(raised.value)):
+        store.deserialize_ros1(b"", "nobody_msgs/msg/Nothing")

@@ -19,6 +19,9 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from math import atan2 as _atan2
+from math import cos as _cos
+from math import sin as _sin
 from typing import Any, NamedTuple
 
 from fuzzoff.events import (
@@ -167,8 +170,9 @@ class MavrosOptions:
     """``setpoint_attitude/reverse_thrust``: thrust may be in [-1, 0)."""
 
 
-Handler = Callable[[Any, float, "int | None"], list[Event]]
-"""(message, recording time, index on its topic) -> events."""
+Handler = Callable[[Any, float, "int | None"], Event | None]
+"""(message, recording time, index on its topic) -> the event, if MAVROS sends one (it sends at
+most one MAVLink message per ROS message; a pair is sent on its second message)."""
 
 
 @dataclass(slots=True)
@@ -197,7 +201,8 @@ class MavrosConverter:
     def convert(self, topic: str, msg: Any, t: float, index: int | None = None) -> list[Event]:
         """The events MAVROS produces for ``msg`` on ``topic`` at recording time ``t``."""
         handler = self.handler(topic)
-        return [] if handler is None else handler(msg, t, index)
+        event = None if handler is None else handler(msg, t, index)
+        return [] if event is None else [event]
 
     def handler(self, topic: str) -> Handler | None:
         """The conversion for one topic, looked up once (readers call it per connection)."""
@@ -213,19 +218,19 @@ class MavrosConverter:
             return None
         ns, name = split
         if name == "state":
-            return lambda msg, t, index: [
-                state_to_status(msg, t=t, vehicle=ns, where=Where(topic, index))
-            ]
+            return lambda msg, t, index: state_to_status(
+                msg, t=t, vehicle=ns, where=Where(topic, index)
+            )
         if name in ("setpoint_attitude/attitude", "setpoint_attitude/cmd_vel"):
 
-            def body(msg: Any, t: float, index: int | None) -> list[Event]:
+            def body(msg: Any, t: float, index: int | None) -> Event | None:
                 self._body[ns] = _Pending(t, (name, msg), Where(topic, index))
                 return self._pair(ns)
 
             return body
         if name == "setpoint_attitude/thrust":
 
-            def thrust(msg: Any, t: float, index: int | None) -> list[Event]:
+            def thrust(msg: Any, t: float, index: int | None) -> Event | None:
                 self._thrust[ns] = _Pending(t, msg, Where(topic, index))
                 return self._pair(ns)
 
@@ -235,23 +240,21 @@ class MavrosConverter:
             return None
         options = self.options
 
-        def setpoint(msg: Any, t: float, index: int | None) -> list[Event]:
-            event = make(msg, options, t, ns, Where(topic, index))
-            return [] if event is None else [event]
+        def setpoint(msg: Any, t: float, index: int | None) -> Event | None:
+            return make(msg, options, t, ns, Where(topic, index))
 
         return setpoint
 
-    def _pair(self, ns: str) -> list[Event]:
+    def _pair(self, ns: str) -> Event | None:
         body, thrust = self._body.get(ns), self._thrust.get(ns)
         if body is None or thrust is None:
-            return []
+            return None
         del self._body[ns], self._thrust[ns]
         later = body if body.t >= thrust.t else thrust
         name, msg = body.msg
-        event = attitude_setpoint(
+        return attitude_setpoint(
             name, msg, float(thrust.msg.thrust), self.options, later.t, ns, later.where
         )
-        return [] if event is None else [event]
 
 
 def _local(
@@ -299,14 +302,18 @@ def raw_local(
     if frame in BODY_FRAMES:
         position, velocity = (p.x, -p.y, -p.z), (v.x, -v.y, -v.z)
         acceleration, yaw = (a.x, -a.y, -a.z), yaw_flu_to_frd(msg.yaw)
-    else:  # inlined enu_to_ned: this is the hot path of a MAVROS bag
+    else:  # inlined enu_to_ned and yaw_enu_to_ned: this is the hot path of a MAVROS bag
         position, velocity = (p.y, p.x, -p.z), (v.y, v.x, -v.z)
-        acceleration, yaw = (a.y, a.x, -a.z), yaw_enu_to_ned(msg.yaw)
+        yaw = msg.yaw
+        acceleration, yaw = (a.y, a.x, -a.z), _atan2(_cos(yaw), _sin(yaw))
+    stamp = msg.header.stamp  # inlined stamp_to_time_boot_us
+    ns_stamp = int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)
+    boot_us = ((ns_stamp // 1_000_000) & 0xFFFFFFFF) * 1000 if ns_stamp > 0 else None
     return SetPositionTargetLocal(
         t=t,
         vehicle=ns,
         where=where,
-        sender_time_us=stamp_to_time_boot_us(msg.header),
+        sender_time_us=boot_us,
         target_system=MAVROS_TARGET_SYSTEM,
         target_component=MAVROS_TARGET_COMPONENT,
         type_mask=int(msg.type_mask),

@@ -75,6 +75,5 @@ class MavrosTopicDecoder:
             if self.first_failure is None:
                 self.first_failure = (t, f"payload cannot be decoded ({exc})")
             return None
-        events = self.handler(msg, t, index)
         # MAVROS sends at most one MAVLink message per ROS message (pairs: on the second).
-        return events[0] if events else None
+        return self.handler(msg, t, index)

@@ -17,6 +17,7 @@ read are kept and the file is reported incomplete, with one line saying why.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -177,15 +178,9 @@ class Rosbag1Source(Source):
 
     def _handler(
         self, converter: MavrosConverter, conn: Connection
-    ) -> tuple[Handler | None, Callable[..., Any]]:
+    ) -> tuple[Handler | None, Callable[[bytes], Any]]:
         """The conversion and the decoder for one connection (looked up once, not per message)."""
-        store = self._typestore
-        msgtype = conn.msgtype
-
-        def decode(raw: bytes) -> Any:
-            return store.deserialize_ros1(raw, msgtype)
-
-        return converter.handler(conn.topic), decode
+        return converter.handler(conn.topic), _decoder(self._typestore, conn.msgtype)
 
     def _convert(
         self, messages: Iterator[tuple[Connection, int, bytes]], start_ns: list[int]
@@ -195,21 +190,22 @@ class Rosbag1Source(Source):
         ``start_ns[0]`` is the recording's first time (set by the salvage once it has read it).
         """
         converter = MavrosConverter()
-        handlers: dict[int, tuple[Handler | None, Callable[..., Any]]] = {}
+        handlers: dict[int, tuple[Handler | None, Callable[[bytes], Any]]] = {}
         counts: dict[int, int] = {}
         first_bad: SourceProblem | None = None
         bad = 0
-        last: tuple[str, int, float] | None = None
-        """(topic, index, t) of the last message decoded; named only if reading stops."""
+        last: tuple[Connection, int, float] | None = None
+        """(connection, index, t) of the last message decoded; named only if reading stops."""
         try:
             for conn, timestamp, raw in messages:
                 self._done += 1
-                index = counts.get(conn.id, 0)
-                counts[conn.id] = index + 1
+                cid = conn.id
+                index = counts.get(cid, 0)
+                counts[cid] = index + 1
                 t = (timestamp - start_ns[0]) / 1e9
-                entry = handlers.get(conn.id)
+                entry = handlers.get(cid)
                 if entry is None:
-                    entry = handlers[conn.id] = self._handler(converter, conn)
+                    entry = handlers[cid] = self._handler(converter, conn)
                 handler, decode = entry
                 if handler is None:
                     continue
@@ -220,11 +216,14 @@ class Rosbag1Source(Source):
                     bad += 1
                     first_bad = first_bad or SourceProblem(what, f"{conn.topic} #{index}", t)
                     continue
-                last = (conn.topic, index, t)  # formatted only on failure: once per message
-                yield from handler(msg, t, index)
+                last = (conn, index, t)  # formatted only on failure: once per message
+                event = handler(msg, t, index)
+                if event is not None:
+                    yield event
         except Exception as exc:  # rosbags ReaderError, asserts, codec errors on corrupt chunks
             detail = str(exc).rstrip(".") if isinstance(exc, ReaderError) else type(exc).__name__
-            where, t_last = (f"{last[0]} #{last[1]}", last[2]) if last is not None else (None, None)
+            where = f"{last[0].topic} #{last[1]}" if last is not None else None
+            t_last = last[2] if last is not None else None
             after = "after the message" if last is not None else "before the first message"
             what = f"bag data corrupt ({detail}); reading stopped {after}"
             self.problems.append(SourceProblem(what, where, t_last))
@@ -234,3 +233,27 @@ class Rosbag1Source(Source):
                 SourceProblem(first_bad.what + more, first_bad.where, first_bad.time_s)
             )
         self.stats["messages_decoded"] = self._done
+
+
+def _decoder(store: Any, msgtype: str) -> Callable[[bytes], Any]:
+    """``store.deserialize_ros1(raw, msgtype)`` with the type's deserialiser looked up once.
+
+    A message that does not decode to exactly its length goes through
+    ``store.deserialize_ros1`` itself, which raises the library's own error for it.
+    """
+    try:
+        msgdef = store.get_msgdef(msgtype)
+    except Exception:  # an unknown type: the library's call fails per message, as it would
+        return partial(store.deserialize_ros1, typename=msgtype)
+    func, cls = msgdef.deserialize_ros1, msgdef.cls
+
+    def decode(raw: bytes) -> Any:
+        try:
+            message, pos = func(raw, 0, cls, store)
+        except Exception:
+            return store.deserialize_ros1(raw, msgtype)
+        if pos != len(raw):
+            return store.deserialize_ros1(raw, msgtype)
+        return message
+
+    return decode
