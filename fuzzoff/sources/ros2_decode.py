@@ -109,7 +109,12 @@ def bundled_layout(message: str, release: str) -> tuple[Any, ...] | None:
     text = px4_msgs.definition(release, message)
     if text is None:
         return None
-    typename = px4_msgs.type_name(message)
+    return _parsed_layout(px4_msgs.type_name(message), text)
+
+
+@cache
+def _parsed_layout(typename: str, text: str) -> tuple[Any, ...]:
+    """One parse per distinct text (releases often share a message's text)."""
     return tuple(get_types_from_msg(text, typename)[typename][1])
 
 
