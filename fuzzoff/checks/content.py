@@ -8,10 +8,13 @@ judge MAVLink ``SET_ATTITUDE_TARGET`` where its ``type_mask`` uses the field.
 from __future__ import annotations
 
 import math
+from operator import attrgetter
+from typing import cast
 
 from fuzzoff.checks._external import Episodes, from_external, is_armed
-from fuzzoff.checks.base import Check, CheckContext
+from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import (
+    PX4_SETPOINTS,
     ActuatorMotors,
     ActuatorServos,
     AttitudeSetpoint,
@@ -34,6 +37,37 @@ THRUST_BODY_SET = 32
 
 MAVLINK_THRUST_RANGE: dict[str, tuple[float, float]] = {"mc": (0.0, 1.0), "vtol": (0.0, 1.0)}
 """SET_ATTITUDE_TARGET ``thrust``: 0..1, -1..1 where the vehicle can reverse (fw, rovers)."""
+
+_TRAJECTORY: tuple[type[Event], ...] = (TrajectorySetpoint,)
+_ORIGIN = attrgetter("origin")
+_RATES = attrgetter("roll", "pitch", "yaw")
+_THRUST_BODY = attrgetter("thrust_body")
+
+
+def _setpoints_of(batch: StreamBatch, cls: type[Event]) -> list[Event]:
+    """The run's setpoints of one class, picked from its PX4 setpoints (a list the checks
+    share): nothing to look through on a MAVLink run."""
+    setpoints = batch.of(PX4_SETPOINTS)
+    return [e for e in setpoints if isinstance(e, cls)] if setpoints else setpoints
+
+
+def _single_origin(events: list[Event]) -> bool:
+    """All from one origin: then ``from_external`` says the same for each (state is fixed)."""
+    return len(set(map(_ORIGIN, events))) == 1
+
+
+def _nan_pattern(motors: ActuatorMotors) -> tuple[tuple[bool, ...], tuple[bool, ...]]:
+    """Which controls are NaN and which finite: all that OFB407 reads of a message."""
+    control = motors.control
+    return tuple(map(math.isnan, control)), tuple(map(math.isfinite, control))
+
+
+def _extend(episodes: Episodes, key: str, last: float, count: int) -> None:
+    """``episodes.bad(key, ...)`` for ``count`` more messages, the newest at ``last``, with the
+    episode ``key`` already open: only its end and its count move."""
+    episode = episodes.open[key]
+    episode.last = last
+    episode.count += count
 
 
 def finiteness(sp: TrajectorySetpoint) -> tuple[tuple[bool, bool, bool], ...]:
@@ -131,6 +165,49 @@ class TrajectoryContent(Check):
             )
         else:
             self.axis.good("axis")
+
+    def on_batch(self, batch: StreamBatch) -> None:
+        """Within a run the declared flag and the mode are fixed, so a setpoint's verdict
+        depends only on its origin and on which components are finite. When every setpoint
+        of the run has the same of both, the first is judged by ``on_event`` and the rest only
+        extend the episodes it left open (a clean run with nothing open costs nothing more)."""
+        flag = batch.state.declared_flag
+        if flag not in TRAJECTORY_CONTROLS:
+            return
+        events = batch.of(_TRAJECTORY)
+        if not events:
+            return
+        if len(set(map(_ORIGIN, events))) > 1:
+            self.replay(batch)
+            return
+        first = events[0]
+        if not from_external(self.ctx, first):
+            return
+        keys = set(map(finiteness, cast(list[TrajectorySetpoint], events)))
+        if len(keys) > 1:
+            self.replay(batch)
+            return
+        bad = self._bad_keys(flag, keys.pop())
+        if not bad and not (self.mismatch.open or self.all_nan.open or self.axis.open):
+            return
+        self.on_event(first)
+        if len(events) > 1:
+            for episodes, key in bad:
+                _extend(episodes, key, events[-1].t, len(events) - 1)
+
+    def _bad_keys(
+        self, flag: str, finite: tuple[tuple[bool, bool, bool], ...]
+    ) -> list[tuple[Episodes, str]]:
+        """The episodes ``on_event`` extends for a setpoint of this finiteness."""
+        selected = _selected(finite)
+        if selected is None:
+            return [(self.all_nan, "nan")]
+        bad = []
+        if selected != flag:
+            bad.append((self.mismatch, f"{flag}/{selected}"))
+        if self.multicopter and _axis_problems(finite):
+            bad.append((self.axis, "axis"))
+        return bad
 
     def finish(self, t_end: float) -> None:
         for episodes in (self.mismatch, self.all_nan, self.axis):
@@ -292,6 +369,31 @@ class ActuatorNanDisarms(Check):
             "PX4 disarms that motor output",
         )
 
+    def on_batch(self, batch: StreamBatch) -> None:
+        """Arming and the mode are fixed within a run. When every message has the same NaN
+        pattern, each reports the same indices (``active`` only gains finite ones, which are
+        never NaN in this pattern): the first is judged, the rest extend its episode."""
+        motors = _setpoints_of(batch, ActuatorMotors)
+        if not motors:
+            return
+        self.saw_motors = True
+        if not is_armed(self.ctx):
+            self.active.clear()
+            self.episodes.close_all()
+            return
+        if not _single_origin(motors):
+            self.replay(batch)
+            return
+        first = motors[0]
+        if not from_external(self.ctx, first):
+            return
+        if len(set(map(_nan_pattern, cast(list[ActuatorMotors], motors)))) > 1:
+            self.replay(batch)
+            return
+        self.on_event(first)
+        if len(motors) > 1 and "nan" in self.episodes.open:
+            _extend(self.episodes, "nan", motors[-1].t, len(motors) - 1)
+
     def finish(self, t_end: float) -> None:
         self.episodes.close_all()
         if self.saw_motors and not self.ctx.has("vehicle_status", "command"):
@@ -331,6 +433,21 @@ class RatesIncomplete(Check):
             f"VehicleRatesSetpoint with NaN in {', '.join(missing)}: the docs require roll, "
             "pitch, yaw and thrust_body",
         )
+
+    def on_batch(self, batch: StreamBatch) -> None:
+        """No NaN in any field of the run (their sum is not NaN) and nothing open: every
+        message is clean and changes nothing. Otherwise replayed."""
+        rates = _setpoints_of(batch, RatesSetpoint)
+        if not rates:
+            return
+        if self.episodes.open or not _single_origin(rates):
+            self.replay(batch)
+            return
+        if not from_external(self.ctx, rates[0]):
+            return
+        total = sum(map(sum, map(_RATES, rates))) + sum(map(sum, map(_THRUST_BODY, rates)))
+        if math.isnan(total):
+            self.replay(batch)
 
     def finish(self, t_end: float) -> None:
         self.episodes.close_all()

@@ -6,9 +6,12 @@ Seed 000 "The OffboardControlMode PX4 message" (1.15+; rover table in "Рове�
 
 from __future__ import annotations
 
+from itertools import chain
+from operator import attrgetter
+
 from fuzzoff.checks._external import Episodes, declared_flag
 from fuzzoff.checks._keepalive import mode_note
-from fuzzoff.checks.base import Check, CheckContext
+from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import (
     MAVLINK_SETPOINTS,
     PX4_SETPOINTS,
@@ -24,6 +27,7 @@ from fuzzoff.events import (
 )
 from fuzzoff.gate import GateTransition
 from fuzzoff.gate.receiver import DROPPED, ReceiverContext, receive
+from fuzzoff.state import VehicleState
 from fuzzoff.tables.control_mode import (
     SETPOINT_NAMES,
     FlagRow,
@@ -31,6 +35,10 @@ from fuzzoff.tables.control_mode import (
     estimate_valid,
     row_for,
 )
+
+_OCM: tuple[type[Event], ...] = (ControlMode,)
+_ORIGIN = attrgetter("origin")
+_KIND = attrgetter("kind")
 
 
 class ControlModeEmpty(Check):
@@ -55,6 +63,16 @@ class ControlModeEmpty(Check):
             "OffboardControlMode with no field true: it declares no setpoint, and PX4 takes "
             "it for no offboard signal at all",
         )
+
+    def on_batch(self, batch: StreamBatch) -> None:
+        """A run never spans a change of the declared first flag, so its OCMs are all empty
+        (``declared_flag`` None: judged one by one) or all declare something: then the first
+        one closes an open episode and the rest change nothing."""
+        if batch.state.declared_flag is None:
+            if batch.of(_OCM):
+                self.replay(batch)
+        elif self.episodes.open and batch.of(_OCM):
+            self.episodes.good("empty")
 
     def finish(self, t_end: float) -> None:
         self.episodes.close_all()
@@ -95,6 +113,27 @@ class SetpointNotDeclared(Check):
             f"first true field is '{flag}', which does not select it: PX4's own controller "
             f"still writes this topic{mode_note(self.ctx)}",
         )
+
+    def on_batch(self, batch: StreamBatch) -> None:
+        """Within a run the mode and the declared flag are fixed, so the verdict depends only
+        on each setpoint's origin and kind: logged copies only set ``logged``; sent setpoints of
+        kinds the declaration selects, with nothing open, change nothing but ``sent``."""
+        events = batch.of(PX4_SETPOINTS)
+        if not events:
+            return
+        origins = set(map(_ORIGIN, events))
+        if "sent" not in origins:
+            self.logged = True
+            return
+        if len(origins) > 1 or self.episodes.open:
+            self.replay(batch)
+            return
+        self.sent = True
+        row = self.ctx.row_for(batch.state.declared_flag)
+        if not batch.state.in_offboard or row is None:
+            return  # close_all with nothing open
+        if not row.allowed.issuperset(map(_KIND, events)):
+            self.replay(batch)
 
     def finish(self, t_end: float) -> None:
         self.episodes.close_all()
@@ -141,6 +180,8 @@ class DeclaredSetpointMissing(Check):
         """When PX4's receiver last took one (published a setpoint in OFFBOARD)."""
         self.mav_since: float | None = None
         self.mav_checked = False
+        self._rx: ReceiverContext | None = None
+        """The receiver context last built (``_receiver``), reused while the gate agrees."""
 
     def on_event(self, event: Event) -> None:
         self._due(event.t)
@@ -150,7 +191,7 @@ class DeclaredSetpointMissing(Check):
         state = self.ctx.state
         if isinstance(event, MavlinkTarget) and event.origin == "sent":
             self.mav_sent = event
-            if state.in_offboard and self._taken(event):
+            if state.in_offboard and self._taken(event, self._receiver()):
                 self.mav_taken = event.t
         if state.armed is not self.armed:
             self.armed = state.armed
@@ -171,6 +212,61 @@ class DeclaredSetpointMissing(Check):
                 self.since = None if flag is None else event.t
             self.flag = flag
             self.checked = False
+
+    def on_batch(self, batch: StreamBatch) -> None:
+        """Fast path once a period is settled (both deadlines judged, and the run's first
+        message would not start a new period): then ``on_event`` only records the first time
+        of each setpoint kind and the newest MAVLink setpoint sent and taken, which are
+        worked out from the end of the run. Otherwise the run is replayed."""
+        if not self._settled(batch.state):
+            self.replay(batch)
+            return
+        setpoints = batch.of(PX4_SETPOINTS)
+        self._note_first_seen(setpoints)
+        if len(setpoints) + len(batch.of(_OCM)) < len(batch.events):  # else no MAVLink in it
+            self._note_mavlink(batch.events, batch.state.in_offboard)
+
+    def _settled(self, state: VehicleState) -> bool:
+        """Nothing due can be reported and a message of this state moves no period on."""
+        if self.since is not None and not self.checked and self.flag is not None:
+            return False
+        if self.mav_since is not None and not self.mav_checked:
+            return False
+        active = state.in_offboard and state.armed is not False
+        return (
+            state.armed is self.armed
+            and active is (self.mav_since is not None)
+            and (state.declared_flag if active else None) == self.flag
+        )
+
+    def _note_first_seen(self, setpoints: list[Event]) -> None:
+        """``first_seen.setdefault`` for each setpoint, looked at only for kinds not seen yet."""
+        first_seen = self.first_seen
+        new = {kind for kind in set(map(_KIND, setpoints)) if kind not in first_seen}
+        if not new:
+            return
+        for event in setpoints:
+            if event.kind in new and event.kind in SETPOINT_NAMES and event.origin != "model":
+                first_seen.setdefault(event.kind, event.t)
+
+    def _note_mavlink(self, events: list[Event], in_offboard: bool) -> None:
+        """The newest MAVLink setpoint sent, and the newest one PX4's receiver takes (in
+        offboard): the last assignment of each in ``on_event``, found from the end (on a
+        MAVLink stream usually the run's last message)."""
+        sent = (e for e in reversed(events) if isinstance(e, MavlinkTarget) and e.origin == "sent")
+        newest = next(sent, None)
+        if newest is None:
+            return
+        assert isinstance(newest, MavlinkTarget)
+        self.mav_sent = newest
+        if not in_offboard:
+            return
+        rx = self._receiver()
+        for event in chain((newest,), sent):
+            assert isinstance(event, MavlinkTarget)
+            if self._taken(event, rx):
+                self.mav_taken = event.t
+                return
 
     def _due(self, t: float) -> None:
         if self.since is None or self.checked or self.flag is None:
@@ -199,16 +295,31 @@ class DeclaredSetpointMissing(Check):
 
     # -- MAVLink ------------------------------------------------------------------------
 
-    def _taken(self, event: MavlinkTarget) -> bool:
-        """Does PX4's receiver publish a setpoint for it (gate spec 6.1-6.4)?"""
+    def _receiver(self) -> ReceiverContext:
+        """What PX4's receiver reads besides the message, from the gate model now (the last
+        one built while the parameters agree and the estimates are the same object)."""
         gate = self.ctx.gate
-        rx = ReceiverContext(
-            px4=self.ctx.profile.px4,
-            own_system=int(self.ctx.vehicle) if self.ctx.vehicle.isdigit() else None,
-            own_component=int(gate.params.get("MAV_COMP_ID", 1.0)),
-            fwdextsp=bool(gate.params.get("MAV_FWDEXTSP", 1.0)),
-            est=gate.est,
-        )
+        own_component = int(gate.params.get("MAV_COMP_ID", 1.0))
+        fwdextsp = bool(gate.params.get("MAV_FWDEXTSP", 1.0))
+        rx = self._rx
+        if (
+            rx is None
+            or rx.est is not gate.est
+            or rx.own_component != own_component
+            or rx.fwdextsp != fwdextsp
+        ):
+            rx = self._rx = ReceiverContext(
+                px4=self.ctx.profile.px4,
+                own_system=int(self.ctx.vehicle) if self.ctx.vehicle.isdigit() else None,
+                own_component=own_component,
+                fwdextsp=fwdextsp,
+                est=gate.est,
+            )
+        return rx
+
+    @staticmethod
+    def _taken(event: MavlinkTarget, rx: ReceiverContext) -> bool:
+        """Does PX4's receiver publish a setpoint for it (gate spec 6.1-6.4)?"""
         mask, axes, _, _ = receive(event, rx)
         return mask != DROPPED and (axes != 0 or isinstance(event, SetAttitudeTarget))
 
@@ -275,6 +386,22 @@ class ControlModeChanged(Check):
             )
         self.flag = flag
 
+    def on_batch(self, batch: StreamBatch) -> None:
+        """Every OCM of a run has the run's declared first flag (a change of it ends a run), so
+        only the first can report a change; the rest leave ``flag`` as it is."""
+        if not batch.of(_OCM):
+            return
+        if not batch.state.in_offboard:
+            self.flag = None
+            return
+        flag = batch.state.declared_flag
+        if flag is None:
+            return
+        if self.flag is not None and flag != self.flag:
+            self.replay(batch)
+            return
+        self.flag = flag
+
 
 class RequiredEstimateMissing(Check):
     """OFB305: the estimate the first true field requires is invalid at the request or in
@@ -295,27 +422,50 @@ class RequiredEstimateMissing(Check):
         if not (self.ctx.state.in_offboard or request):
             self.bad_key = None
             return
-        flags = self.ctx.state.failsafe_flags
-        flag = declared_flag(self.ctx)
-        row = row_for(self.ctx.profile, flag)
-        if flags is None or row is None or row.estimate is None:
+        missing = self._missing()
+        if missing is None:
             self.bad_key = None
             return
-        if estimate_valid(flags, row.estimate) is not False:
-            self.bad_key = None
-            return
-        key = f"{flag}/{row.estimate}"
+        flag, estimate = missing
+        key = f"{flag}/{estimate}"
         if key == self.bad_key and not request:
             return
         self.bad_key = key
         at = "at the offboard request" if request else f"in offboard{mode_note(self.ctx)}"
         self.ctx.report(
             "OFB305",
-            f"first true field '{flag}' requires a valid {row.estimate} estimate, but the "
+            f"first true field '{flag}' requires a valid {estimate} estimate, but the "
             f"recording shows it invalid {at}",
             event.t,
             _where(event),
         )
+
+    def _missing(self) -> tuple[str | None, str] | None:
+        """(declared flag, its estimate) when the recording shows that estimate invalid."""
+        flags = self.ctx.state.failsafe_flags
+        flag = declared_flag(self.ctx)
+        row = self.ctx.row_for(flag)
+        if flags is None or row is None or row.estimate is None:
+            return None
+        if estimate_valid(flags, row.estimate) is not False:
+            return None
+        return flag, row.estimate
+
+    def on_batch(self, batch: StreamBatch) -> None:
+        """The state an OCM is judged on is fixed within a run, so every OCM of it gives the
+        same key: only the first can report (then replayed), the rest keep ``bad_key``."""
+        if not batch.of(_OCM):
+            return
+        self.saw_mode = True
+        key = None
+        if batch.state.in_offboard:
+            missing = self._missing()
+            if missing is not None:
+                key = f"{missing[0]}/{missing[1]}"
+        if key is not None and key != self.bad_key:
+            self.replay(batch)
+            return
+        self.bad_key = key
 
     def finish(self, t_end: float) -> None:
         if self.saw_mode and not self.ctx.has("failsafe_flags"):
