@@ -1,0 +1,85 @@
+"""Helpers for ``on_batch``: a run's messages of the types a check wants, and episodes.
+
+``messages_of`` finds the messages by type rather than ``isinstance``.
+
+``StreamBatch.of`` tests ``isinstance(event, types)`` per message, which walks the tuple of
+types (~0.4 µs a message for the sixteen setpoint types). A run holds only messages whose exact
+class is one of ``STREAM_TYPES`` (the engine tests ``type(event) in STREAM_TYPES``), so the set of
+those classes a check wants (``wanted_types``) answers the same question by set membership, and
+one pass over the types usually shows that all or none of the run is wanted.
+"""
+
+from __future__ import annotations
+
+from itertools import compress, repeat
+from operator import attrgetter, le, sub
+
+from fuzzoff.checks._episodes import MERGE_GAP_S, Episodes, Offence
+from fuzzoff.checks.base import STREAM_TYPES, StreamBatch
+from fuzzoff.events import Event
+
+
+def wanted_types(subscriptions: tuple[type[Event], ...]) -> frozenset[type[Event]]:
+    """The stream classes an ``isinstance(event, subscriptions)`` test accepts."""
+    return frozenset(cls for cls in STREAM_TYPES if issubclass(cls, subscriptions))
+
+
+def messages_of(batch: StreamBatch, wanted: frozenset[type[Event]]) -> list[Event]:
+    """``batch.of(subscriptions)`` for ``wanted = wanted_types(subscriptions)`` (do not change
+    the list: it may be ``batch.events`` itself)."""
+    events = batch.events
+    present = set(map(type, events))
+    if present <= wanted:
+        return events
+    if present.isdisjoint(wanted):
+        return []
+    return list(compress(events, map(wanted.__contains__, map(type, events))))
+
+
+Verdicts = list[tuple[str, dict[str, Offence]]]
+"""What one message commits, as ``Episodes.update`` takes it: (code, offences), in order."""
+
+_T = attrgetter("t")
+
+
+def commit_alike(
+    episodes: Episodes, stream: str, events: list[Event], verdicts: list[Verdicts]
+) -> bool:
+    """``Episodes.update`` for a run of messages of one stream whose verdicts are known without
+    each message: ``verdicts`` holds the distinct verdicts of the run. Done (True) when nothing
+    is offended and nothing is open (``update`` then returns at once for every message), or when
+    every message commits the same verdicts and only extends what the first one opens
+    (``extend_alike``); False (nothing done): replay the run."""
+    if not episodes.open and not any(offences for v in verdicts for _, offences in v):
+        return True
+    if len(verdicts) != 1:
+        return False
+    return extend_alike(episodes, stream, events, verdicts[0])
+
+
+def extend_alike(episodes: Episodes, stream: str, events: list[Event], verdicts: Verdicts) -> bool:
+    """Every message commits ``verdicts``: the first is committed as ``on_event`` does; the
+    others only extend the stretches it opened, provided no gap between them exceeds
+    ``MERGE_GAP_S`` and no other stretch of these codes and this stream is still open after
+    the first (a later message could close it). False (nothing done) when that does not hold."""
+    times = list(map(_T, events))
+    if not all(map(le, map(sub, times[1:], times[:-1]), repeat(MERGE_GAP_S))):
+        return False
+    names: dict[str, set[str]] = {}
+    for code, offences in verdicts:
+        names.setdefault(code, set()).update(offences)
+    for (code, where, name), stretch in episodes.open.items():
+        other = where == stream and name not in names.get(code, (name,))
+        if other and not times[0] - stretch.last_t > MERGE_GAP_S:  # update closes it, or not
+            return False
+    first = events[0]
+    for code, offences in verdicts:
+        episodes.update(code, stream, first.t, first.where, offences)
+    more = len(events) - 1
+    if more:
+        for code, offences in verdicts:
+            for name in offences:
+                stretch = episodes.open[(code, stream, name)]
+                stretch.last_t = times[-1]
+                stretch.count += more
+    return True
