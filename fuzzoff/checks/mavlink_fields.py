@@ -11,10 +11,14 @@ receiver (gate spec 6.3-6.5) and reports what it drops or does not forward.
 
 from __future__ import annotations
 
+import copy
 import math
+from itertools import chain
+from operator import attrgetter
 
 from fuzzoff.checks._episodes import Episodes, Offence
-from fuzzoff.checks.base import Check, CheckContext
+from fuzzoff.checks._runs import Verdicts, commit_alike, messages_of, wanted_types
+from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.checks.content import _axis_problems
 from fuzzoff.events import (
     Event,
@@ -23,6 +27,7 @@ from fuzzoff.events import (
     SetPositionTargetLocal,
 )
 from fuzzoff.findings import Severity
+from fuzzoff.gate.estimates import Estimates
 from fuzzoff.gate.receiver import DROPPED, ReceiverContext, receive
 from fuzzoff.profiles import at_least
 from fuzzoff.tables import mavlink as tm
@@ -30,6 +35,42 @@ from fuzzoff.tables import mavlink as tm
 VEHICLE_LABELS = {"copter": "multicopter/VTOL", "fixedwing": "fixed-wing", "rover": "rover"}
 
 PositionTarget = SetPositionTargetLocal | SetPositionTargetGlobal
+
+_ORIGIN = attrgetter("origin")
+_MASK_KEY = attrgetter("kind", "type_mask")
+_KEY = attrgetter("kind", "type_mask", "coordinate_frame", "target_system", "target_component")
+"""Besides which float fields are finite, everything ``receive`` reads from a position target;
+the rest of the verdicts read only kind, type_mask and coordinate_frame."""
+
+_FLOATS = {
+    SetPositionTargetLocal: (("position", "velocity", "acceleration"), ("yaw", "yaw_rate")),
+    SetPositionTargetGlobal: (("velocity", "acceleration"), ("alt", "yaw", "yaw_rate")),
+    SetAttitudeTarget: (("q",), ("thrust", "body_roll_rate", "body_pitch_rate", "body_yaw_rate")),
+}
+"""The float fields of each message: vectors, then single values."""
+
+
+def all_finite(events: list[Event]) -> bool:
+    """Is every float field of every message (``_FLOATS``: all that the receivers read) finite?
+
+    A sum is finite only if every term is (an overflow, or a value that is not a number, only
+    fails the proof); with every value finite, ``receive`` gives the same answer for messages
+    with the same ``_KEY``."""
+    types = set(map(type, events))
+    try:
+        for cls in types:
+            group = events if len(types) == 1 else [e for e in events if type(e) is cls]
+            vectors, values = _FLOATS[cls]
+            total = 0.0
+            for name in vectors:
+                total += sum(chain.from_iterable(map(attrgetter(name), group)))
+            for name in values:
+                total += sum(map(attrgetter(name), group))
+            if not math.isfinite(total):
+                return False
+    except (TypeError, OverflowError):
+        return False
+    return True
 
 
 def frames_text(frames: frozenset[int]) -> str:
@@ -60,6 +101,11 @@ class PositionTargetFields(Check):
         self.vehicle_label = VEHICLE_LABELS[self.group]
         self.by_mask: dict[tuple[str, int, int], list[tuple[str, dict[str, Offence]]]] = {}
         """Verdicts by (message, type_mask, frame): a stream repeats the same few."""
+        self.stream_types = wanted_types(self.wants)
+        self.by_key: dict[tuple[object, ...], Verdicts] = {}
+        """What a message commits by ``_KEY``, with every float finite (runs only)."""
+        self.est_seen: Estimates | None = None
+        """The receiver's estimates ``by_key`` was worked out with (a copy)."""
         self.rx: ReceiverContext | None = None
         """PX4's receiver, to see the axes a copter setpoint leaves (1.13+: a docs page)."""
         if self.group == "copter" and tm.page_for(ctx.profile) is not None:
@@ -70,6 +116,54 @@ class PositionTargetFields(Check):
                 fwdextsp=True,
                 est=ctx.gate.est,
             )
+
+    def on_batch(self, batch: StreamBatch) -> None:
+        """Fast path: the verdicts depend on the message only through ``_KEY`` (and, for the
+        receiver's axes, on every float field being finite, ``all_finite``). With no offence and
+        nothing open, nothing happens; with one key, every message commits the same offences
+        and (gaps under ``MERGE_GAP_S``) only extends the stretches the first one opened."""
+        events = messages_of(batch, self.stream_types)
+        if events and set(map(_ORIGIN, events)) != {"sent"}:
+            events = [e for e in events if e.origin == "sent"]
+        if not events:
+            return
+        verdicts = self._verdicts_by_key(events)
+        if verdicts is None or not commit_alike(self.episodes, events[0].kind, events, verdicts):
+            self.replay(batch)
+
+    def _verdicts_by_key(self, events: list[Event]) -> list[Verdicts] | None:
+        """What a message of each ``_KEY`` of the run commits, or None where that needs each
+        message (fixed-wing ignored fields, a non-finite value for the axes)."""
+        if self.group == "fixedwing":
+            return None
+        if self.group == "copter" and self.rx is not None:
+            if not all_finite(events):
+                return None
+            if self.rx.est != self.est_seen:  # the answers below hold for these estimates
+                self.by_key.clear()
+                self.est_seen = copy.copy(self.rx.est)
+        keys = set(map(_KEY, events))
+        if len(keys) == 1:
+            (key,) = keys
+            verdicts = self.by_key.get(key)
+            if verdicts is None:
+                verdicts = self.by_key[key] = self._verdicts(events[0])
+            return [verdicts]
+        first: dict[tuple[object, ...], Event] = {}
+        for event in events:
+            first.setdefault(_KEY(event), event)
+        return [self._verdicts(event) for event in first.values()]
+
+    def _verdicts(self, event: Event) -> Verdicts:
+        """What ``on_event`` commits for this message (all but the fixed-wing part)."""
+        assert isinstance(event, (SetPositionTargetLocal, SetPositionTargetGlobal))
+        key = (event.kind, event.type_mask, event.coordinate_frame)
+        judged = self.by_mask.get(key)
+        if judged is None:
+            judged = self.by_mask[key] = self._judge_mask(event)
+        if self.group == "copter" and self.rx is not None:
+            return [*judged, ("OFB602", self._mc_axes(event, self.rx))]
+        return judged
 
     def on_event(self, event: Event) -> None:
         if event.origin != "sent" or not isinstance(
@@ -336,19 +430,44 @@ class LegacySetpointDropped(Check):
         super().__init__(ctx)
         self.episodes = Episodes(ctx)
         self.px4 = ctx.profile.px4
+        self.stream_types = wanted_types(self.wants)
 
     def on_event(self, event: Event) -> None:
         if event.origin != "sent":
             return
-        if isinstance(event, SetPositionTargetLocal):
-            offences = self._local(event)
-        elif isinstance(event, SetPositionTargetGlobal):
-            offences = self._global(event)
-        elif isinstance(event, SetAttitudeTarget):
-            offences = self._attitude(event)
-        else:
+        offences = self._offences(event)
+        if offences is not None:
+            self.episodes.update("OFB609", event.kind, event.t, event.where, offences)
+
+    def on_batch(self, batch: StreamBatch) -> None:
+        """Fast path: with every float field finite (``all_finite``) the offences depend only on
+        the message type and its type_mask; then as ``commit_alike``, else replay."""
+        events = messages_of(batch, self.stream_types)
+        if events and set(map(_ORIGIN, events)) != {"sent"}:
+            events = [e for e in events if e.origin == "sent"]
+        if not events:
             return
-        self.episodes.update("OFB609", event.kind, event.t, event.where, offences)
+        if not all_finite(events):
+            self.replay(batch)
+            return
+        first: dict[tuple[str, int], Event] = {}
+        if len(set(map(_MASK_KEY, events))) == 1:
+            first[_MASK_KEY(events[0])] = events[0]
+        else:
+            for event in events:
+                first.setdefault(_MASK_KEY(event), event)
+        verdicts = [[("OFB609", self._offences(event) or {})] for event in first.values()]
+        if not commit_alike(self.episodes, events[0].kind, events, verdicts):
+            self.replay(batch)
+
+    def _offences(self, event: Event) -> dict[str, Offence] | None:
+        if isinstance(event, SetPositionTargetLocal):
+            return self._local(event)
+        if isinstance(event, SetPositionTargetGlobal):
+            return self._global(event)
+        if isinstance(event, SetAttitudeTarget):
+            return self._attitude(event)
+        return None
 
     def _dropped(self, name: str, fields: list[str], checked: str) -> dict[str, Offence]:
         return {

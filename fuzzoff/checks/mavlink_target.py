@@ -11,13 +11,28 @@ recording shows: the system id its own messages come from (HEARTBEAT and the res
 from __future__ import annotations
 
 from dataclasses import dataclass
+from operator import attrgetter
 
 from fuzzoff.checks._episodes import Episodes, Offence
-from fuzzoff.checks.base import Check, CheckContext
+from fuzzoff.checks._runs import commit_alike, messages_of, wanted_types
+from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import Event, MavlinkTarget, SetAttitudeTarget, Where
 from fuzzoff.tables import mavlink as tm
 
 AUTOPILOT_COMPONENT = 1
+
+_ORIGIN = attrgetter("origin")
+_MASK = attrgetter("type_mask")
+_ROUTE = attrgetter("origin", "transport")
+_TARGET = attrgetter("target_system", "target_component")
+
+
+def sent_by_mavlink(events: list[Event]) -> list[Event]:
+    """The messages recorded on their way to the vehicle as MAVLink (origin ``sent``, not a
+    MAVROS topic) of a run's MAVLink setpoints."""
+    if not events or set(map(_ROUTE, events)) == {("sent", "mavlink")}:
+        return events
+    return [e for e in events if _ROUTE(e) == ("sent", "mavlink")]
 
 
 class AttitudeTargetMask(Check):
@@ -27,6 +42,8 @@ class AttitudeTargetMask(Check):
     def __init__(self, ctx: CheckContext) -> None:
         super().__init__(ctx)
         self.episodes = Episodes(ctx)
+        self.stream_types = wanted_types(self.wants)
+        self.by_mask: dict[int, dict[str, Offence]] = {}
 
     def on_event(self, event: Event) -> None:
         if event.origin != "sent" or not isinstance(event, SetAttitudeTarget):
@@ -34,7 +51,31 @@ class AttitudeTargetMask(Check):
         rules = tm.attitude_rules(self.ctx.profile)
         if rules is None or not rules.supported:
             return  # no page for this profile, or a rover (OFB507)
-        mask = event.type_mask
+        offences = self._offences(event.type_mask)
+        self.episodes.update("OFB606", event.kind, event.t, event.where, offences)
+
+    def on_batch(self, batch: StreamBatch) -> None:
+        """Fast path: the offences depend only on the type_mask (``commit_alike``)."""
+        events = messages_of(batch, self.stream_types)
+        if events and set(map(_ORIGIN, events)) != {"sent"}:
+            events = [e for e in events if e.origin == "sent"]
+        if not events:
+            return
+        rules = tm.attitude_rules(self.ctx.profile)
+        if rules is None or not rules.supported:
+            return
+        verdicts = [[("OFB606", self._offences(mask))] for mask in set(map(_MASK, events))]
+        if not commit_alike(self.episodes, events[0].kind, events, verdicts):
+            self.replay(batch)
+
+    def _offences(self, mask: int) -> dict[str, Offence]:
+        """What a SET_ATTITUDE_TARGET with this type_mask offends (the same for every one)."""
+        known = self.by_mask.get(mask)
+        if known is None:
+            known = self.by_mask[mask] = self._judge(mask)
+        return known
+
+    def _judge(self, mask: int) -> dict[str, Offence]:
         offences: dict[str, Offence] = {}
         head = f"SET_ATTITUDE_TARGET type_mask {mask}"
         if not tm.attitude_used(mask) and not tm.rates_used(mask):
@@ -54,7 +95,7 @@ class AttitudeTargetMask(Check):
                 f"{head} ignores the thrust: the docs support attitude or body rates only "
                 f"together with thrust; {effect}"
             )
-        self.episodes.update("OFB606", event.kind, event.t, event.where, offences)
+        return offences
 
     def finish(self, t_end: float) -> None:
         self.episodes.finish()
@@ -81,6 +122,7 @@ class SetpointTarget(Check):
         self.pending: dict[tuple[int, int], _Pending] = {}
         self.judged: dict[tuple[int, int, tuple[int, int] | None], dict[str, Offence]] = {}
         """Verdicts by (target system, target component, the vehicle's ids)."""
+        self.setpoint_types = wanted_types((MavlinkTarget,))
 
     def _own_ids(self) -> tuple[int, int] | None:
         params = self.ctx.state.params
@@ -104,17 +146,64 @@ class SetpointTarget(Check):
         if event.transport != "mavlink":
             return  # MAVROS fills the ids from its own parameters: not in the recording
         if self._own_ids() is None:
-            target = (event.target_system, event.target_component)
-            pending = self.pending.get(target)
-            if pending is None:
-                self.pending[target] = _Pending(event.t, event.where, event.t)
-            else:
-                pending.last_t = event.t
-                pending.count += 1
+            self._add_one(event)
             return
         self.episodes.update("OFB607", "setpoints", event.t, event.where, self._judge(event))
 
-    def _judge(self, event: MavlinkTarget) -> dict[str, Offence]:
+    def on_batch(self, batch: StreamBatch) -> None:
+        """Fast path. The vehicle's own messages of the run change nothing unless they are the
+        first sign of its autopilot or could resolve pending setpoints (then replay). Before the
+        vehicle's ids are known the setpoints only join ``pending``; after, their verdict
+        depends only on the target ids (``commit_alike``)."""
+        events = batch.events
+        if "vehicle" in set(map(_ORIGIN, events)) and (
+            (not self.autopilot_seen and self.ctx.vehicle.isdigit())
+            or (self.pending and self._own_ids() is not None)
+        ):
+            self.replay(batch)
+            return
+        setpoints = sent_by_mavlink(messages_of(batch, self.setpoint_types))
+        if not setpoints:
+            return
+        if self._own_ids() is None:
+            self._add_pending(setpoints)
+            return
+        first: dict[tuple[int, int], Event] = {}
+        targets = set(map(_TARGET, setpoints))
+        if len(targets) == 1:
+            first[_TARGET(setpoints[0])] = setpoints[0]
+        else:
+            for event in setpoints:
+                first.setdefault(_TARGET(event), event)
+        verdicts = [[("OFB607", self._judge(event))] for event in first.values()]
+        if not commit_alike(self.episodes, "setpoints", setpoints, verdicts):
+            self.replay(batch)
+
+    def _add_pending(self, setpoints: list[Event]) -> None:
+        """What ``on_event`` does with each of these setpoints while the ids are unknown."""
+        if len(set(map(_TARGET, setpoints))) > 1:
+            for event in setpoints:
+                self._add_one(event)
+            return
+        first, last = setpoints[0], setpoints[-1]
+        self._add_one(first)
+        if last is not first:
+            pending = self.pending[_TARGET(first)]
+            pending.last_t = last.t
+            pending.count += len(setpoints) - 1
+
+    def _add_one(self, event: Event) -> None:
+        assert isinstance(event, MavlinkTarget)
+        target = (event.target_system, event.target_component)
+        pending = self.pending.get(target)
+        if pending is None:
+            self.pending[target] = _Pending(event.t, event.where, event.t)
+        else:
+            pending.last_t = event.t
+            pending.count += 1
+
+    def _judge(self, event: Event) -> dict[str, Offence]:
+        assert isinstance(event, MavlinkTarget)
         key = (event.target_system, event.target_component, self._own_ids())
         judged = self.judged.get(key)
         if judged is None:
