@@ -12,9 +12,12 @@ Two signs of a frame mix-up that a real flight almost never shows:
 from __future__ import annotations
 
 import math
+from itertools import repeat
+from operator import attrgetter, gt, itemgetter
 
 from fuzzoff.checks._external import Episodes, from_external
-from fuzzoff.checks.base import Check, CheckContext
+from fuzzoff.checks._runs import messages_of, wanted_types
+from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import (
     AttitudeSetpoint,
     Event,
@@ -30,6 +33,10 @@ MAV_FRAME_BODY_NED = 8
 IGNORE_Z = 4
 IGNORE_V = 8 | 16 | 32
 IGNORE_VZ = 32
+
+_ORIGIN_KIND = attrgetter("origin", "kind")
+_THRUST_Z = attrgetter("thrust_body")
+_Z = itemgetter(2)
 
 
 def vertical_command(event: Event) -> tuple[float, float]:
@@ -69,6 +76,41 @@ class FrameConventionSuspect(Check):
         """Waiting for the first sizeable vertical command since the vehicle was on the ground."""
         self.armed: bool | None = None
         """The last recorded arming state (None: not recorded yet)."""
+        self.thrust_types = wanted_types((AttitudeSetpoint, RatesSetpoint))
+        self.takeoff_types = wanted_types((TrajectorySetpoint, SetPositionTargetLocal))
+
+    def on_batch(self, batch: StreamBatch) -> None:
+        """Fast path: no external setpoint that could be the first vertical command (else
+        replay), and no thrust above the threshold: every thrust setpoint is then ``good``, which
+        only closes (reports) an open stretch at the first message of its kind."""
+        if self.takeoff_pending and self._external(messages_of(batch, self.takeoff_types)):
+            self.replay(batch)
+            return
+        if self.ctx.profile.vehicle != "mc":
+            return
+        thrust = self._external(messages_of(batch, self.thrust_types))
+        if not thrust:
+            return
+        if any(map(gt, map(_Z, map(_THRUST_Z, thrust)), repeat(self.thrust_z))):
+            self.replay(batch)  # a bad one (or an infinite z, which is good: on_event decides)
+            return
+        if self.thrust.open:
+            for kind in dict.fromkeys(event.kind for event in thrust):
+                self.thrust.good(kind)
+
+    def _external(self, events: list[Event]) -> list[Event]:
+        """The external controller's messages among these (``from_external`` depends only on
+        the origin and kind within a run)."""
+        if not events:
+            return events
+        pairs = set(map(_ORIGIN_KIND, events))
+        if len(pairs) == 1:
+            return events if from_external(self.ctx, events[0]) else []
+        first: dict[tuple[str, str], Event] = {}
+        for event in events:
+            first.setdefault(_ORIGIN_KIND(event), event)
+        keep = {pair for pair, event in first.items() if from_external(self.ctx, event)}
+        return [event for event in events if _ORIGIN_KIND(event) in keep]
 
     def on_event(self, event: Event) -> None:
         if isinstance(event, VehicleStatus) and event.armed is not None:
