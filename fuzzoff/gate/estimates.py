@@ -26,11 +26,15 @@ class Estimates:
     """True once the recording said whether manual control is present."""
     recorded: bool = False
     """True once the recording carried any estimate flag."""
-    _key: int = 255
+    bits: int = 255
+    """Every flag the gate reads as one small integer (cheap change detection and memo keys)."""
+
+    def __post_init__(self) -> None:
+        self.bits = self._compute_key()
 
     def update(self, flags: FailsafeFlags) -> bool:
         """Apply a ``FailsafeFlags`` event; True when anything the gate reads changed."""
-        before = self._key
+        before = self.bits
         for name in (
             "local_position",
             "local_velocity",
@@ -47,12 +51,12 @@ class Estimates:
         if flags.manual_control_signal_lost is not None:
             self.rc_present = not flags.manual_control_signal_lost
             self.rc_recorded = True
-        self._key = self._compute_key()
-        return self._key != before
+        self.bits = self._compute_key()
+        return self.bits != before
 
     def key(self) -> int:
         """A small integer summarising every flag (cheap change detection)."""
-        return self._key
+        return self.bits
 
     def _compute_key(self) -> int:
         bits = (

@@ -46,7 +46,7 @@ from fuzzoff.gate.compare import Comparator
 from fuzzoff.gate.estimates import Estimates
 from fuzzoff.gate.failsafe import LossAction, loss_action
 from fuzzoff.gate.params import default_params
-from fuzzoff.gate.receiver import DROPPED, ReceiverContext, receive
+from fuzzoff.gate.receiver import DROPPED, SHAPES, ReceiverContext, Result, Shape, receive
 from fuzzoff.gate.requests import Decision, arm_decision, decode_mode, switch_decision
 from fuzzoff.gate.signal import INF, LOOP_PERIOD, estimate_failure, make_signal, slack
 from fuzzoff.gate.tracker import ControllerTracker
@@ -116,6 +116,9 @@ class GateModel:
             fwdextsp=bool(self.params.get("MAV_FWDEXTSP", 1.0)),
             est=self.est,
         )
+        self._verdicts: dict[Shape, Result] = {}
+        """``receive``'s accepted verdicts by message shape (``receiver.shape``) under the current
+        receiver context: cleared when a parameter or an estimate changes."""
         self._handlers: dict[type, Callable[[Any], None]] = {
             ControlMode: self._on_control_mode,
             LegacyControlMode: self._on_legacy_control_mode,
@@ -288,6 +291,18 @@ class GateModel:
             self._refresh(t, cause=None)
 
     def _keepalive(self, t: float, mask: int, event: Event, stamp: float | None = None) -> None:
+        if mask == self.ocm_mask and self._good and (self._sampled or event.origin != "vehicle"):
+            # The steady stream: same flags, good, sampling settled: only the signal moves. A
+            # good keep-alive received now while available only moves the loss later: the
+            # cached deadline stays a valid lower bound (feed() recomputes it when it is
+            # reached). One with its own timestamp (2.1.1) may lag and move the loss earlier
+            # (the signal says).
+            if self.signal.keepalive(t, True, stamp):
+                self._dirty = True
+                self._signal_available(t, mask)
+            else:
+                self._dirty = stamp is not None and not self.signal.moved_later
+            return
         changed = mask != self.ocm_mask
         if changed:
             self.ocm_mask = mask
@@ -296,22 +311,22 @@ class GateModel:
             self._sampled = True
             self.compare.sampled_keepalive()
         became = self.signal.keepalive(t, self._good, stamp)
-        # A good keep-alive received now while available only moves the loss later: the cached
-        # deadline stays a valid lower bound (feed() recomputes it when it is reached). One with
-        # its own timestamp (2.1.1) may lag and move the loss earlier.
-        self._dirty = became or not self._good or changed or stamp is not None
+        self._dirty = True  # a new mask, a bad keep-alive or a newly available signal
         if became:
-            self._failsafe_due = INF
-            self._signal_changed(t)
-            self._emit(
-                t,
-                "signal_available",
-                f"offboard signal available ({ocm.names(mask)})",
-                self.signal.spec,
-            )
-            self._refresh(t)
+            self._signal_available(t, mask)
         if changed:
             self._update_controller(t)
+
+    def _signal_available(self, t: float, mask: int) -> None:
+        self._failsafe_due = INF
+        self._signal_changed(t)
+        self._emit(
+            t,
+            "signal_available",
+            f"offboard signal available ({ocm.names(mask)})",
+            self.signal.spec,
+        )
+        self._refresh(t)
 
     def _mask_changed(self) -> None:
         """Recompute what depends only on the OCM flags and the estimates (cached: the hot path
@@ -347,8 +362,21 @@ class GateModel:
     def _on_legacy_control_mode(self, event: LegacyControlMode) -> None:
         self._keepalive(event.t, ocm.legacy_mask(event), event)
 
+    def _receive(self, event: SetPositionTargetLocal, key: Shape | None) -> Result:
+        """``receive(event, self._rx)``, remembered under ``key`` (its shape). Only verdicts
+        without a reason are kept: a reason's text shows field values, whose repr the shape
+        does not fix (``1`` and ``True`` are the same key)."""
+        verdict = receive(event, self._rx)
+        if key is not None and verdict[2] is None:
+            self._verdicts[key] = verdict
+        return verdict
+
     def _on_mavlink(self, event: SetPositionTargetLocal) -> None:
-        mask, axes, reason, spec = receive(event, self._rx)
+        key = SHAPES[type(event)](event)
+        verdict = self._verdicts.get(key) if key is not None else None
+        if verdict is None:
+            verdict = self._receive(event, key)
+        mask, axes, reason, spec = verdict
         if mask == DROPPED:
             if reason != self._drop_reason:
                 self._drop_reason = reason
@@ -372,16 +400,24 @@ class GateModel:
             )
         elif reason is None:
             self._drop_reason = None
-        self._keepalive(event.t, mask, event)
-        if axes and self._nav == NAV_STATE_OFFBOARD:
-            dirty = self._dirty
-            self._trajectory(event.t, axes)
-            self._dirty = self._dirty or dirty
-        elif axes and self.ctl.legacy:
-            self.ctl.setpoint(event.t)  # legacy: counted once offboard runs (section 8)
+        t = event.t
+        self._keepalive(t, mask, event)
+        if not axes:
+            return
+        if self._nav == NAV_STATE_OFFBOARD:
+            if self.ctl.trajectory(t, axes, True):
+                self._dirty = True
+                self._update_controller(t)
+        elif self.ctl.legacy:
+            self.ctl.setpoint(t)  # legacy: counted once offboard runs (section 8)
 
     def _on_trajectory(self, event: TrajectorySetpoint) -> None:
-        self._trajectory(event.t, controllers.axes_of(event))
+        t = event.t
+        self._dirty = self.ctl.trajectory(
+            t, controllers.axes_of(event), self._nav == NAV_STATE_OFFBOARD
+        )
+        if self._dirty:
+            self._update_controller(t)
 
     def _on_triplet(self, event: PositionSetpointTriplet) -> None:
         """legacy/1.11: the offboard setpoint as mc_pos_control sees it (section 8)."""
@@ -439,6 +475,7 @@ class GateModel:
     def _on_failsafe_flags(self, event: FailsafeFlags) -> None:
         self._recorded_flag(event)
         if self.est.update(event):
+            self._verdicts.clear()
             self._mask_changed()
             if self.tick_based and estimate_failure(self.px4, self.ocm_mask, self.est):
                 self.signal.turned_bad(event.t)
@@ -450,6 +487,7 @@ class GateModel:
         if name in self.overrides:
             return
         self.params[name] = event.value
+        self._verdicts.clear()
         if name == "COM_OF_LOSS_T":
             if self.px4 == "legacy":
                 self.signal.loss_extra = max(0.0, event.value)  # type: ignore[attr-defined]
@@ -532,11 +570,6 @@ class GateModel:
         self._update_controller(t)
 
     # ------------------------------------------------------------------ controllers
-
-    def _trajectory(self, t: float, axes: int) -> None:
-        self._dirty = self.ctl.trajectory(t, axes, self._nav == NAV_STATE_OFFBOARD)
-        if self._dirty:
-            self._update_controller(t)
 
     def _update_controller(self, t: float) -> None:
         self.ctl.land_speed = float(self.params.get("MPC_LAND_SPEED", 0.7))

@@ -11,9 +11,16 @@ it would publish (``controllers.axes_*`` bits), ``reason`` why it was dropped (o
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
-from fuzzoff.events import MavlinkTarget, SetAttitudeTarget, SetPositionTargetGlobal
+from fuzzoff.events import (
+    MavlinkTarget,
+    SetAttitudeTarget,
+    SetPositionTargetGlobal,
+    SetPositionTargetLocal,
+)
 from fuzzoff.gate.estimates import Estimates
 from fuzzoff.gate.ocm import ACCELERATION, ATTITUDE, BODY_RATE, POSITION, VELOCITY
 from fuzzoff.profiles import at_least
@@ -76,6 +83,67 @@ def _present3(v: tuple[float, float, float], ignore: int, old_rule: bool) -> tup
         elif not old_rule and not math.isnan(value):
             present = True
     return finite, present
+
+
+Shape = tuple[object, ...]
+"""Everything ``receive`` reads from one message, as a cache key (see ``shape``)."""
+
+
+def _local_shape(msg: SetPositionTargetLocal) -> Shape | None:
+    px, py, pz = msg.position
+    vx, vy, vz = msg.velocity
+    ax, ay, az = msg.acceleration
+    # A sum of floats is finite only if every term is (an overflow only sends the message to
+    # the uncached path), so one test proves that every float receive() classifies is finite.
+    if not math.isfinite(px + py + pz + vx + vy + vz + ax + ay + az + msg.yaw + msg.yaw_rate):
+        return None
+    return (
+        SetPositionTargetLocal,
+        msg.type_mask,
+        msg.coordinate_frame,
+        msg.target_system,
+        msg.target_component,
+    )
+
+
+def _global_shape(msg: SetPositionTargetGlobal) -> Shape | None:
+    vx, vy, vz = msg.velocity
+    ax, ay, az = msg.acceleration
+    if not math.isfinite(vx + vy + vz + ax + ay + az + msg.alt + msg.yaw + msg.yaw_rate):
+        return None
+    return (
+        SetPositionTargetGlobal,
+        msg.type_mask,
+        msg.coordinate_frame,
+        msg.target_system,
+        msg.target_component,
+    )
+
+
+def _attitude_shape(msg: SetAttitudeTarget) -> Shape | None:
+    qw, qx, qy, qz = msg.q
+    rates = msg.body_roll_rate + msg.body_pitch_rate + msg.body_yaw_rate
+    if not math.isfinite(qw + qx + qy + qz + msg.thrust + rates):
+        return None
+    return (SetAttitudeTarget, msg.type_mask, msg.target_system, msg.target_component)
+
+
+SHAPES: dict[type, Callable[[Any], Shape | None]] = {
+    SetPositionTargetLocal: _local_shape,
+    SetPositionTargetGlobal: _global_shape,
+    SetAttitudeTarget: _attitude_shape,
+}
+
+
+def shape(msg: MavlinkTarget) -> Shape | None:
+    """A cache key for ``receive(msg, ctx)`` under a fixed ``ctx``, or None (do not cache).
+
+    ``receive`` reads from the message its type, ``type_mask``, ``coordinate_frame``, the
+    target ids and, of its float fields, only whether each is finite (NaN or Inf). The key holds
+    the former; the latter is settled by answering None unless every float field is finite.
+    Two messages with the same key thus get the same answer from the same context."""
+    of = SHAPES.get(type(msg))
+    return None if of is None else of(msg)
 
 
 def receive(msg: MavlinkTarget, ctx: ReceiverContext) -> Result:

@@ -80,6 +80,9 @@ class Signal:
         """The newest keep-alive arrived with a timestamp already older than the timeout."""
         self.arrived: float | None = None
         """When the newest keep-alive arrived (``last`` is its timestamp as PX4 sees it)."""
+        self.moved_later = False
+        """The newest stamped keep-alive (2.1.1) was good and moved the loss no earlier than
+        the one before it (set by ``TickSignal``; False elsewhere)."""
 
     @property
     def stamps_lag(self) -> bool:
@@ -122,13 +125,23 @@ class TickSignal(Signal):
     def keepalive(self, t: float, good: bool, stamp: float | None = None) -> bool:
         """``stamp``: the OCM ``timestamp`` as PX4 sees it (2.1.1); the receive time if None.
         A sample already older than the timeout on arrival counts as bad."""
+        before = self.last
         self.last = t if stamp is None else stamp
         self.arrived = t
         self.stale_stamp = good and t >= self.last + self.timeout and stamp is not None
         if not good or t >= self.last + self.timeout:
+            self.moved_later = False
             if self.available and self.bad_since is None:
                 self.bad_since = t
             return False
+        if stamp is not None:
+            # Available, not bad before and a stamp no older: lost_at() cannot move earlier.
+            self.moved_later = (
+                self.available
+                and self.bad_since is None
+                and before is not None
+                and self.last >= before
+            )
         self.bad_since = None
         if not self.available:
             self.available = True

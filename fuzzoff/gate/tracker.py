@@ -81,7 +81,10 @@ class ControllerTracker:
                 self.traj_axes = axes
                 return self.vehicle_type == "fw" and in_offboard
             return False
-        invalid = self.invalid(axes)
+        try:  # self.invalid(axes), inlined: once per setpoint
+            invalid = self._memo[(axes << 8) | self.est.bits]
+        except KeyError:
+            invalid = self.invalid(axes)
         if invalid is None:
             self.last_valid_t = t
         if axes != self.traj_axes or invalid is not None or self.kind != "ok":
@@ -91,7 +94,7 @@ class ControllerTracker:
 
     def invalid(self, axes: int) -> str | None:
         """Why the position controller rejects this content (memoised per axes/estimates)."""
-        key = (axes << 8) | self.est.key()
+        key = (axes << 8) | self.est.bits
         try:
             return self._memo[key]
         except KeyError:
