@@ -21,6 +21,7 @@ from fuzzoff.engine import VehicleRun
 from fuzzoff.events import (
     MAV_CMD_DO_SET_MODE,
     ActuatorMotors,
+    ActuatorServos,
     AttitudeSetpoint,
     Command,
     CommandAck,
@@ -31,6 +32,7 @@ from fuzzoff.events import (
     SetAttitudeTarget,
     SetPositionTargetLocal,
     ThrustSetpoint,
+    TorqueSetpoint,
     TrajectorySetpoint,
     VehicleStatus,
 )
@@ -66,7 +68,9 @@ def template(draw: st.DrawFn) -> dict[str, Any]:
                     AttitudeSetpoint,
                     RatesSetpoint,
                     ThrustSetpoint,
+                    TorqueSetpoint,
                     ActuatorMotors,
+                    ActuatorServos,
                     SetPositionTargetLocal,
                     SetAttitudeTarget,
                 ]
@@ -80,6 +84,7 @@ def template(draw: st.DrawFn) -> dict[str, Any]:
         "b": draw(vec3),
         "c": draw(vec3),
         "s": draw(value),
+        "q": draw(st.sampled_from([None, (1.0, 0.0, 0.0, 0.0), (0.5, 0.5, 0.5, 0.5)])),
     }
 
 
@@ -88,22 +93,23 @@ def build(tpl: dict[str, Any], t: float) -> Event:
     common: dict[str, Any] = {"t": t, "vehicle": "1", "origin": tpl["origin"]}
     a, b, c = (tuple(map(fresh, tpl[k])) for k in "abc")
     s = fresh(tpl["s"])
+    q = (*b, s) if tpl["q"] is None else tuple(map(fresh, tpl["q"]))
     if cls is ControlMode:
         return ControlMode(**common, **{flag: True for flag in tpl["flags"]})
     if cls is TrajectorySetpoint:
         return cls(**common, position=a, velocity=b, acceleration=c, yaw=s)
     if cls is AttitudeSetpoint:
-        return cls(**common, q_d=(*b, s), thrust_body=a)
+        return cls(**common, q_d=q, thrust_body=a)
     if cls is RatesSetpoint:
         return cls(**common, roll=s, pitch=fresh(0.1), yaw=fresh(0.2), thrust_body=a)
-    if cls is ThrustSetpoint:
+    if cls in (ThrustSetpoint, TorqueSetpoint):
         return cls(**common, xyz=a)
-    if cls is ActuatorMotors:
+    if cls in (ActuatorMotors, ActuatorServos):
         return cls(**common, control=(*a, *b))
     mav = {"target_system": tpl["target"][0], "target_component": tpl["target"][1]}
     if cls is SetPositionTargetLocal:
         return cls(**common, **mav, type_mask=tpl["mask"], position=a, velocity=b)
-    return SetAttitudeTarget(**common, **mav, type_mask=tpl["mask"], q=(*a, s), thrust=s)
+    return SetAttitudeTarget(**common, **mav, type_mask=tpl["mask"], q=q, thrust=s)
 
 
 def between(kind: str, t: float) -> list[Event]:
@@ -208,4 +214,6 @@ def test_the_checks_take_runs() -> None:
     batched = {type(c).__name__ for c in run.batched}
     expected = {"ControlModeEmpty", "SetpointNotDeclared", "DeclaredSetpointMissing"}
     expected |= {"ControlModeChanged", "RequiredEstimateMissing", "TrajectoryContent"}
+    expected |= {"QuaternionNotUnit", "NormalizedOutOfRange", "ActuatorNanDisarms"}
+    expected |= {"RatesIncomplete"}
     assert expected <= batched

@@ -8,13 +8,13 @@ judge MAVLink ``SET_ATTITUDE_TARGET`` where its ``type_mask`` uses the field.
 from __future__ import annotations
 
 import math
-from operator import attrgetter
-from typing import cast
+from itertools import chain, repeat
+from operator import attrgetter, mul, sub
+from typing import Any, cast
 
 from fuzzoff.checks._external import Episodes, from_external, is_armed
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import (
-    PX4_SETPOINTS,
     ActuatorMotors,
     ActuatorServos,
     AttitudeSetpoint,
@@ -39,16 +39,50 @@ MAVLINK_THRUST_RANGE: dict[str, tuple[float, float]] = {"mc": (0.0, 1.0), "vtol"
 """SET_ATTITUDE_TARGET ``thrust``: 0..1, -1..1 where the vehicle can reverse (fw, rovers)."""
 
 _TRAJECTORY: tuple[type[Event], ...] = (TrajectorySetpoint,)
+_ATTITUDE: tuple[type[Event], ...] = (AttitudeSetpoint,)
+_SET_ATTITUDE: tuple[type[Event], ...] = (SetAttitudeTarget,)
+_MOTORS: tuple[type[Event], ...] = (ActuatorMotors,)
+_RATES_SETPOINT: tuple[type[Event], ...] = (RatesSetpoint,)
+_Q_D = attrgetter("q_d")
+_XYZ = attrgetter("xyz")
+_CONTROL = attrgetter("control")
 _ORIGIN = attrgetter("origin")
 _RATES = attrgetter("roll", "pitch", "yaw")
 _THRUST_BODY = attrgetter("thrust_body")
 
 
-def _setpoints_of(batch: StreamBatch, cls: type[Event]) -> list[Event]:
-    """The run's setpoints of one class, picked from its PX4 setpoints (a list the checks
-    share): nothing to look through on a MAVLink run."""
-    setpoints = batch.of(PX4_SETPOINTS)
-    return [e for e in setpoints if isinstance(e, cls)] if setpoints else setpoints
+_run_types: tuple[StreamBatch | None, frozenset[type[Event]]] = (None, frozenset())
+"""The last run asked about and the classes of its messages (``_of``)."""
+
+
+def _of(batch: StreamBatch, classes: tuple[type[Event], ...]) -> list[Event]:
+    """``batch.of(classes)`` (shared between checks), or at once nothing when the run has no
+    message of these classes: the classes present are worked out once per run for all the
+    content checks (a run holds only exact stream classes, none a subclass of another)."""
+    global _run_types
+    seen, present = _run_types
+    if seen is not batch:
+        present = frozenset(map(type, batch.events))
+        _run_types = (batch, present)
+    if present.isdisjoint(classes):
+        return []
+    return batch.of(classes)
+
+
+def _all_unit(quaternions: list[tuple[float, ...]], tolerance: float) -> bool:
+    """Every norm within ``tolerance`` of 1: the norms are ``QuaternionNotUnit``'s own
+    expression (the same products summed in the same order), so the verdict is exact."""
+    norms = map(math.sqrt, map(sum, map(map, repeat(mul), quaternions, quaternions)))
+    return math.isfinite(tolerance) and all(
+        map(tolerance.__ge__, map(abs, map(sub, norms, repeat(1.0))))
+    )
+
+
+def _within(values: list[tuple[float, ...]], low: float, high: float) -> bool:
+    """No finite value outside [low, high] (NaN never wins a ``max``/``min`` started from a
+    number; an infinity fails the test and is judged one by one)."""
+    flat = list(chain.from_iterable(values))
+    return max(chain((low,), flat)) <= high and min(chain((high,), flat)) >= low
 
 
 def _single_origin(events: list[Event]) -> bool:
@@ -174,7 +208,7 @@ class TrajectoryContent(Check):
         flag = batch.state.declared_flag
         if flag not in TRAJECTORY_CONTROLS:
             return
-        events = batch.of(_TRAJECTORY)
+        events = _of(batch, _TRAJECTORY)
         if not events:
             return
         if len(set(map(_ORIGIN, events))) > 1:
@@ -263,6 +297,29 @@ class QuaternionNotUnit(Check):
             f"it as is",
         )
 
+    def on_batch(self, batch: StreamBatch) -> None:
+        """Nothing open and every quaternion used a unit one: every message is clean and
+        changes nothing. Otherwise replayed."""
+        attitude = _of(batch, _ATTITUDE)
+        mavlink = _of(batch, _SET_ATTITUDE)
+        if not (attitude or mavlink):
+            return
+        if self.episodes.open:
+            self.replay(batch)
+            return
+        quaternions: list[tuple[float, ...]] = []
+        if attitude:
+            if not _single_origin(attitude):
+                self.replay(batch)
+                return
+            if from_external(self.ctx, attitude[0]):
+                quaternions.extend(map(_Q_D, attitude))
+        if mavlink:
+            targets = cast(list[SetAttitudeTarget], mavlink)
+            quaternions.extend(e.q for e in targets if not e.type_mask & ATTITUDE_IGNORE)
+        if not _all_unit(quaternions, self.tolerance):
+            self.replay(batch)
+
     def finish(self, t_end: float) -> None:
         self.episodes.close_all()
 
@@ -280,6 +337,14 @@ class NormalizedOutOfRange(Check):
         ActuatorServos,
         SetAttitudeTarget,
     )
+
+    FIELDS: tuple[tuple[tuple[type[Event], ...], attrgetter[Any]], ...] = (
+        ((AttitudeSetpoint, RatesSetpoint), _THRUST_BODY),
+        ((ThrustSetpoint, TorqueSetpoint), _XYZ),
+        ((ActuatorMotors, ActuatorServos), _CONTROL),
+    )
+    """The PX4 setpoints judged, and the field in [-1, 1] (as in ``_values``)."""
+    PX4_TYPES = tuple(cls for classes, _ in FIELDS for cls in classes)
 
     def __init__(self, ctx: CheckContext) -> None:
         super().__init__(ctx)
@@ -321,6 +386,27 @@ class NormalizedOutOfRange(Check):
             event.where,
             f"{name} outside [{low:g}, {high:g}]: {shown}",
         )
+
+    def on_batch(self, batch: StreamBatch) -> None:
+        """Nothing open, PX4 setpoints only (``SET_ATTITUDE_TARGET`` depends on each mask:
+        replayed), and no finite value outside [-1, 1]: every message is clean and changes
+        nothing. Otherwise replayed."""
+        if _of(batch, _SET_ATTITUDE) or (self.episodes.open and _of(batch, self.PX4_TYPES)):
+            self.replay(batch)
+            return
+        values: list[tuple[float, ...]] = []
+        for classes, field in self.FIELDS:
+            for cls in classes:  # a logged copy is external or not by its kind
+                judged = _of(batch, (cls,))
+                if not judged:
+                    continue
+                if not _single_origin(judged):
+                    self.replay(batch)
+                    return
+                if from_external(self.ctx, judged[0]):
+                    values.extend(map(field, judged))
+        if values and not _within(values, -1.0, 1.0):
+            self.replay(batch)
 
     def finish(self, t_end: float) -> None:
         self.episodes.close_all()
@@ -373,7 +459,7 @@ class ActuatorNanDisarms(Check):
         """Arming and the mode are fixed within a run. When every message has the same NaN
         pattern, each reports the same indices (``active`` only gains finite ones, which are
         never NaN in this pattern): the first is judged, the rest extend its episode."""
-        motors = _setpoints_of(batch, ActuatorMotors)
+        motors = _of(batch, _MOTORS)
         if not motors:
             return
         self.saw_motors = True
@@ -437,7 +523,7 @@ class RatesIncomplete(Check):
     def on_batch(self, batch: StreamBatch) -> None:
         """No NaN in any field of the run (their sum is not NaN) and nothing open: every
         message is clean and changes nothing. Otherwise replayed."""
-        rates = _setpoints_of(batch, RatesSetpoint)
+        rates = _of(batch, _RATES_SETPOINT)
         if not rates:
             return
         if self.episodes.open or not _single_origin(rates):
