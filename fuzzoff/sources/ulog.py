@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import heapq
 from collections.abc import Iterator
-from itertools import repeat
+from itertools import chain, repeat
 from pathlib import Path
 from typing import Any
 
@@ -267,11 +267,16 @@ class UlogSource(Source):
             return
         iters = [iter(s.events) for s in streams]
         heads: list[Any] = [next(it, None) for it in iters]
-        for start in range(0, len(order), CHUNK_ROWS):
-            for s in order[start : start + CHUNK_ROWS].tolist():
-                self._yielded += 1
-                yield heads[s]
-                heads[s] = next(iters[s], None)
+        yielded = self._yielded
+        try:
+            for start in range(0, len(order), CHUNK_ROWS):
+                for s in order[start : start + CHUNK_ROWS].tolist():
+                    yielded += 1
+                    yield heads[s]
+                    heads[s] = next(iters[s], None)
+                self._yielded = yielded  # for progress(), once a chunk
+        finally:
+            self._yielded = yielded  # exact, also when a decoder raised
 
     def _context(self, info: RecordingInfo) -> Context:
         context = Context()
@@ -506,10 +511,16 @@ def _stream(cols: Any, topic: str, rank: int, t0: int, decode: Any, context: Con
 def _chunks(
     cols: Any, order: Any, n: int, topic: str, t0: int, decode: Any, context: Context
 ) -> Iterator[ev.Event]:
-    for start in range(0, n, CHUNK_ROWS):
-        sel = (
-            slice(start, min(n, start + CHUNK_ROWS))
-            if order is None
-            else order[start : start + CHUNK_ROWS]
-        )
-        yield from decode(Chunk(cols, sel, topic, t0), context)  # one event per row
+    """The events of ``decode`` chunk after chunk, chained by ``itertools.chain`` (no Python
+    frame per event between the merge and the decoder); each chunk is made when the one
+    before it is used up, as a generator would."""
+    selections = (
+        slice(start, min(n, start + CHUNK_ROWS))
+        if order is None
+        else order[start : start + CHUNK_ROWS]
+        for start in range(0, n, CHUNK_ROWS)
+    )
+    return chain.from_iterable(
+        decode(Chunk(cols, sel, topic, t0), context)  # one event per row
+        for sel in selections
+    )
