@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
-from operator import sub
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+from operator import attrgetter, sub
 
-from fuzzoff.checks.base import CheckContext
+from fuzzoff.checks.base import CheckContext, StreamBatch
 from fuzzoff.events import (
     KEEPALIVE_TYPES,
     Dropout,
@@ -26,6 +29,50 @@ def worst_gap(last: float | None, events: list[Event]) -> float:
         return 0.0
     gaps: map[float] = map(sub, times[1:], times)
     return max(gaps)
+
+
+_TIME = attrgetter("t")
+
+
+@dataclass(frozen=True, slots=True)
+class KeepaliveRun:
+    """A run's keep-alive messages with their times and the gaps between them, worked out once
+    per run for every stream rule (``keepalive_run``); each rule adds the gap from its own
+    ``last``. The gaps are ``later.t - earlier.t``, the very subtraction ``on_event`` makes."""
+
+    events: list[Event]
+    times: list[float]
+    gaps: list[float]
+    """The gaps between consecutive keep-alives of the run, smallest first (one fewer than
+    ``times``): sorting is cheaper than ``min`` and ``max`` and gives both."""
+
+    @property
+    def widest(self) -> float:
+        """The largest gap, -inf for none."""
+        return self.gaps[-1] if self.gaps else -math.inf
+
+    @property
+    def narrowest(self) -> float:
+        """The smallest gap, +inf for none."""
+        return self.gaps[0] if self.gaps else math.inf
+
+    def worst_gap(self, last: float | None) -> float:
+        """``worst_gap(last, self.events)``, from the figures already worked out."""
+        widest = self.widest
+        if last is not None:
+            first = self.times[0] - last
+            return first if first > widest else widest
+        return 0.0 if widest == -math.inf else widest
+
+
+@lru_cache(maxsize=1)
+def keepalive_run(batch: StreamBatch) -> KeepaliveRun:
+    """The run's ``KeepaliveRun`` (non-empty runs only: callers test ``batch.keepalives()``).
+    Cached on the run itself (identity; the cache holds it, so it cannot be another run)."""
+    events = batch.keepalives()
+    times = list(map(_TIME, events))
+    gaps = sorted(map(sub, times[1:], times))
+    return KeepaliveRun(events, times, gaps)
 
 
 def logging_interval(ctx: CheckContext, event: Event) -> float:

@@ -13,10 +13,11 @@ from dataclasses import dataclass
 from fuzzoff.checks._keepalive import (
     KEEPALIVE_EVENTS,
     TIME_EPSILON_S,
+    keepalive_run,
     loss_timeout,
     px4_label,
 )
-from fuzzoff.checks.base import Check, CheckContext
+from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import NAV_STATE_OFFBOARD, Event, VehicleStatus, Where
 from fuzzoff.gate import GateTransition
 from fuzzoff.modes import nav_state_name
@@ -78,6 +79,31 @@ class OffboardLoss(Check):
             if self.last_flying and not state.flying:
                 self._gap_from_recording(event.t)  # only the silence spent in OFFBOARD counts
                 self.last_flying = False
+
+    def on_batch(self, batch: StreamBatch) -> None:
+        """Fast path: no answer pending and no gap (from ``last`` into the run, or inside it
+        while the recorded mode is the authority) as long as the loss timeout, the only gap
+        ``_gap_from_recording`` reports: then only ``last`` and ``last_flying`` move, to
+        what the run's newest keep-alive leaves (every keep-alive sets the same
+        ``last_flying``: the state and the gate model do not change within a run)."""
+        if self.pending is not None:
+            self.replay(batch)  # any message may close the recorded-answer window
+            return
+        if not batch.keepalives():
+            return  # without an answer pending only keep-alives matter
+        run = keepalive_run(batch)
+        gate = self.ctx.gate
+        gate_models_it = gate.armed and gate.user_intention == NAV_STATE_OFFBOARD
+        flying = batch.state.flying and not gate_models_it
+        timeout = loss_timeout(self.ctx)
+        last = self.last
+        if (self.last_flying and last is not None and not run.times[0] - last < timeout) or (
+            flying and not run.widest < timeout
+        ):
+            self.replay(batch)
+            return
+        self.last, self.last_where = run.times[-1], run.events[-1].where
+        self.last_flying = flying
 
     def _from_gate(self, tr: GateTransition) -> None:
         timeout = loss_timeout(self.ctx)

@@ -8,13 +8,18 @@ publishes ``trajectory_setpoint`` and the others in its own modes, and a ULog lo
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from operator import attrgetter
 
 from fuzzoff.checks._keepalive import mode_note
-from fuzzoff.checks.base import Check, CheckContext
+from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import PX4_SETPOINTS, Event, VehicleStatus, Where
 from fuzzoff.gate import GateTransition
 from fuzzoff.modes import nav_state_name
-from fuzzoff.tables.control_mode import SETPOINT_NAMES
+from fuzzoff.tables.control_mode import SETPOINT_KINDS, SETPOINT_NAMES
+
+_KIND = attrgetter("kind")
+_ORIGIN = attrgetter("origin")
+_SENT = {"sent"}
 
 
 @dataclass(slots=True)
@@ -55,6 +60,40 @@ class SetpointsOutsideOffboard(Check):
         self.run.count += 1
         if name not in self.run.topics:
             self.run.topics.append(name)
+
+    def on_batch(self, batch: StreamBatch) -> None:
+        """The run's setpoints all see the same ``in_offboard``, and what ``on_event`` does
+        with them does not depend on their order: any logged copy sets ``logged``; in
+        offboard the first one as sent closes the open run; outside it those as sent extend
+        the run (opened by the first), adding their topics in order of first appearance."""
+        setpoints = batch.of(PX4_SETPOINTS)
+        if not setpoints:
+            return
+        kinds = dict.fromkeys(map(_KIND, setpoints))
+        if not SETPOINT_KINDS.issuperset(kinds):
+            self.replay(batch)  # a kind without a name: keep on_event's order of tests
+            return
+        if set(map(_ORIGIN, setpoints)) != _SENT:
+            self.logged = True
+            setpoints = [e for e in setpoints if e.origin == "sent"]
+            if not setpoints:
+                return
+            kinds = dict.fromkeys(map(_KIND, setpoints))
+        if batch.state.in_offboard:
+            if self.run is not None:
+                self._close()
+            return
+        self.sent = True
+        first = setpoints[0]
+        if self.run is None:
+            self.run = _Run(first.t, first.t, first.where, self._mode(), count=0)
+        run = self.run
+        run.last = setpoints[-1].t
+        run.count += len(setpoints)
+        for kind in kinds:
+            name = SETPOINT_NAMES[kind]
+            if name not in run.topics:
+                run.topics.append(name)
 
     def _mode(self) -> str:
         nav = self.ctx.state.nav_state if self.ctx.state.mode_recorded else None

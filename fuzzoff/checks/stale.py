@@ -6,12 +6,18 @@ Seed 000, ROS 2 warning item 4: PX4 does not failsafe when setpoints stop, only 
 
 from __future__ import annotations
 
+from operator import attrgetter, le, sub
+
 from fuzzoff.checks._keepalive import mode_note
-from fuzzoff.checks.base import Check, CheckContext
+from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import PX4_SETPOINTS, ControlMode, Event, Where
 from fuzzoff.tables.control_mode import SETPOINT_NAMES
 
 ROS2_FORMATS = ("mcap", "rosbag2-sqlite3", "rosbag2-mcap")
+
+_OCM: tuple[type[Event], ...] = (ControlMode,)
+_TIME = attrgetter("t")
+_KIND = attrgetter("kind")
 
 
 class StaleSetpoints(Check):
@@ -72,6 +78,79 @@ class StaleSetpoints(Check):
         if stale and self.episode is None:
             since, what = max(stale)
             self.episode = (what, since, event.where)
+
+    def on_batch(self, batch: StreamBatch) -> None:
+        """Fast path: the run's messages in time order, the keep-alive never pausing for more
+        than ``stale_s``, and (in offboard, with a row and no stale stretch open) one
+        alternative whose every kind was published, before and throughout the run, at most
+        ``stale_s`` before each OffboardControlMode: then each of them finds a served
+        alternative (``event.t - oldest`` can only be smaller) and nothing is reported.
+        Only the last times move."""
+        ocms = batch.of(_OCM)
+        setpoints = batch.of(PX4_SETPOINTS)
+        if not ocms:
+            self._note_sent(setpoints)
+            return
+        ocm_times = list(map(_TIME, ocms))
+        last_ocm = self.last_ocm
+        if max(map(sub, ocm_times[1:], ocm_times), default=0.0) > self.stale or (
+            last_ocm is not None and ocm_times[0] - last_ocm > self.stale
+        ):
+            self.replay(batch)  # the keep-alive paused: ocm_since moves
+            return
+        if batch.state.flying:
+            alternatives = self._alternatives(batch.state.declared_flag)
+            if alternatives is not None and (
+                self.episode is not None
+                or not self._served(batch, alternatives, setpoints, ocm_times[-1])
+            ):
+                self.replay(batch)
+                return
+        elif self.episode is not None:
+            self._close(ocm_times[0])
+        if last_ocm is None:
+            self.ocm_since = ocm_times[0]
+        self.last_ocm = ocm_times[-1]
+        self._note_sent(setpoints)
+
+    def _served(
+        self,
+        batch: StreamBatch,
+        alternatives: tuple[tuple[str, ...], ...],
+        setpoints: list[Event],
+        newest_ocm: float,
+    ) -> bool:
+        """Does one alternative provably serve every OffboardControlMode of the run? With
+        the run in time order, the latest ``kind`` before an OCM is at most a gap between
+        consecutive ``kind`` times (or the gap from the last one to the newest OCM) old."""
+        times = list(map(_TIME, batch.events))
+        if not all(map(le, times, times[1:])):
+            return False
+        for alternative in alternatives:
+            for kind in alternative:
+                before = self.last_sent.get(kind)
+                if before is None:
+                    break
+                sent = [e.t for e in setpoints if e.kind == kind and e.origin == "sent"]
+                sent.insert(0, before)
+                oldest = max(map(sub, sent[1:], sent), default=0.0)
+                if newest_ocm - sent[-1] > oldest:
+                    oldest = newest_ocm - sent[-1]
+                if oldest > self.stale:
+                    break
+            else:
+                return True
+        return False
+
+    def _note_sent(self, setpoints: list[Event]) -> None:
+        """``last_sent`` as ``on_event`` leaves it: each kind's newest message as sent."""
+        missing = set(map(_KIND, setpoints))
+        for event in reversed(setpoints):  # usually a step or two per kind
+            if event.kind in missing and event.origin == "sent":
+                self.last_sent[event.kind] = event.t
+                missing.discard(event.kind)
+                if not missing:
+                    return
 
     def _alternatives(self, flag: str | None) -> tuple[tuple[str, ...], ...] | None:
         """The row's required alternatives as sorted kinds (None: no row), once per flag."""

@@ -6,17 +6,20 @@ messages say both what the docs require and what the profile's PX4 does (gate sp
 
 from __future__ import annotations
 
+import math
+from bisect import bisect_left
 from dataclasses import dataclass
+from functools import cache
 
 from fuzzoff.checks._keepalive import (
     KEEPALIVE_EVENTS,
     PROOF_SLACK_S,
     RecordedSwitches,
+    keepalive_run,
     loss_timeout,
     mode_note,
     proven_gap,
     px4_label,
-    worst_gap,
 )
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import (
@@ -96,7 +99,7 @@ class KeepaliveRate(Check):
             self.replay(batch)
             return
         last = None if self.dropout_since_last else self.last
-        if worst_gap(last, keepalives) + PROOF_SLACK_S >= self.max_gap:
+        if keepalive_run(batch).worst_gap(last) + PROOF_SLACK_S >= self.max_gap:
             self.replay(batch)
             return
         newest = keepalives[-1]
@@ -210,6 +213,19 @@ class StreamBeforeRequest(Check):
         ):
             self._judge(event, "switch to OFFBOARD (recorded mode)")
 
+    def on_batch(self, batch: StreamBatch) -> None:
+        """Fast path: no gap in the run (nor from ``last`` to it) can break the unbroken stream,
+        as ``on_event`` tests it: only ``last`` moves (and ``run_start`` at the very first)."""
+        if not batch.keepalives():
+            return
+        run = keepalive_run(batch)
+        if not self.quick or run.worst_gap(self.last) + PROOF_SLACK_S >= self.max_gap:
+            self.replay(batch)
+            return
+        if self.last is None:
+            self.run_start = run.times[0]
+        self.last = run.times[-1]
+
     def _judge(self, event: Event, what: str) -> None:
         t = event.t
         fresh = self.last is not None and t - self.last < self.max_gap
@@ -240,6 +256,18 @@ class StreamBeforeRequest(Check):
         self.ctx.report("OFB102", message, t, event.where, severity=Severity.WARNING)
 
 
+@cache
+def _bin_start(ms: int) -> float:
+    """The least gap that ``_Histogram.add`` puts in bin ``ms`` or above (``int(gap * 1000)``
+    only grows with the gap): ``ms / 1000`` moved by the odd ulp that rounding takes."""
+    gap = ms / 1000
+    while int(gap * 1000) >= ms:
+        gap = math.nextafter(gap, -math.inf)
+    while int(gap * 1000) < ms:
+        gap = math.nextafter(gap, math.inf)
+    return gap
+
+
 class _Histogram:
     """Gap counts in 1 ms bins up to the budget: bounded memory however long the stretch."""
 
@@ -256,6 +284,19 @@ class _Histogram:
         self.count += 1
         if gap > self.worst:
             self.worst = gap
+
+    def add_many(self, gaps: list[float]) -> None:
+        """``add`` for each of ``gaps``, sorted and none negative: ``int(gap * 1000)`` never
+        falls as the gap grows, so each bin's gaps are a block, ended by bisection."""
+        start, end = 0, len(gaps)
+        while start < end:
+            ms = int(gaps[start] * 1000)
+            stop = bisect_left(gaps, _bin_start(ms + 1), start, end)
+            self.bins[ms if ms < self.top else self.top] += stop - start
+            start = stop
+        self.count += end
+        if end and gaps[-1] > self.worst:
+            self.worst = gaps[-1]
 
     def quantile(self, q: float) -> float:
         target = q * self.count
@@ -307,6 +348,34 @@ class KeepaliveMargin(Check):
             else:
                 self.hist.add(gap)
         self.last = event.t
+
+    def on_batch(self, batch: StreamBatch) -> None:
+        """The run's keep-alives all see the same ``flying``. Out of offboard only the first
+        may close a stretch. In offboard the fast path needs time-ordered keep-alives, all
+        after the stretch's start, and every gap under the budget: then each gap goes to the
+        histogram as ``on_event`` would add it (``add_many``), in bulk."""
+        if not batch.keepalives():
+            return
+        run = keepalive_run(batch)
+        times = run.times
+        if not batch.state.flying:
+            if self.stretch_start is not None:
+                self._close(times[0])
+            self.last = times[-1]
+            return
+        start = times[0] if self.stretch_start is None else self.stretch_start
+        last = self.last
+        first = None if last is None or not last >= start else times[0] - last
+        if not (run.narrowest >= 0.0 and times[0] >= start and run.widest < self.budget) or (
+            first is not None and not 0.0 <= first < self.budget
+        ):
+            self.replay(batch)  # a long or negative gap, or one before the stretch: rare
+            return
+        self.stretch_start = start
+        if first is not None:
+            self.hist.add(first)
+        self.hist.add_many(run.gaps)
+        self.last = times[-1]
 
     def _close(self, t: float) -> None:
         start = self.stretch_start

@@ -10,10 +10,17 @@ freshest sender-to-recording offset seen so far.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from itertools import repeat
+from operator import attrgetter, le, sub, truediv
 
-from fuzzoff.checks.base import Check, CheckContext
+from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import ControlMode, Event, Where
 from fuzzoff.findings import Severity
+
+_OCM: tuple[type[Event], ...] = (ControlMode,)
+_STAMP = attrgetter("sender_time_us")
+_ORIGIN = attrgetter("origin")
+_TIME = attrgetter("t")
 
 
 @dataclass(slots=True)
@@ -56,6 +63,36 @@ class KeepaliveTimestamp(Check):
         self.previous = stamp
         if lag > self.lag_limit:
             self._note("lag", event, lag)
+
+    def on_batch(self, batch: StreamBatch) -> None:
+        """Fast path: none of the run's OffboardControlMode as sent (only ``logged`` moves);
+        or all as sent, with non-zero stamps that never go back and that lag by no more than
+        the limit even against the best offset after the run (no greater than any offset a
+        message saw, so every lag ``on_event`` works out is at most that): then none is noted
+        and only ``best_offset`` and ``previous`` move (to the least offset and last stamp)."""
+        ocms = batch.of(_OCM)
+        if not ocms:
+            return
+        origins = set(map(_ORIGIN, ocms))
+        if "sent" not in origins:  # a ULog's copies: nothing but ``logged`` to note
+            self.logged = self.logged or "vehicle" in origins
+            return
+        stamps = list(map(_STAMP, ocms))
+        if len(origins) > 1 or None in stamps or 0 in stamps:
+            self.replay(batch)
+            return
+        offsets = list(map(sub, map(_TIME, ocms), map(truediv, stamps, repeat(1e6))))
+        if self.previous is not None:
+            stamps.insert(0, self.previous)
+        best = min(offsets)
+        if self.best_offset is not None and self.best_offset <= best:
+            best = self.best_offset
+        if max(offsets) - best > self.lag_limit or not all(map(le, stamps, stamps[1:])):
+            self.replay(batch)
+            return
+        self.sent = True
+        self.best_offset = best
+        self.previous = stamps[-1]
 
     def _lag(self, t: float, stamp_us: int) -> float:
         offset = t - stamp_us / 1e6
