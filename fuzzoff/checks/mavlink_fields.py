@@ -13,8 +13,10 @@ from __future__ import annotations
 
 import copy
 import math
+from collections.abc import Callable
 from itertools import chain
 from operator import attrgetter
+from typing import Any
 
 from fuzzoff.checks._episodes import Episodes, Offence
 from fuzzoff.checks._runs import Verdicts, commit_alike, messages_of, wanted_types
@@ -42,12 +44,19 @@ _KEY = attrgetter("kind", "type_mask", "coordinate_frame", "target_system", "tar
 """Besides which float fields are finite, everything ``receive`` reads from a position target;
 the rest of the verdicts read only kind, type_mask and coordinate_frame."""
 
-_FLOATS = {
-    SetPositionTargetLocal: (("position", "velocity", "acceleration"), ("yaw", "yaw_rate")),
-    SetPositionTargetGlobal: (("velocity", "acceleration"), ("alt", "yaw", "yaw_rate")),
-    SetAttitudeTarget: (("q",), ("thrust", "body_roll_rate", "body_pitch_rate", "body_yaw_rate")),
+_FLOATS: dict[type[Event], tuple[tuple[Callable[[Event], Any], ...], ...]] = {
+    cls: (tuple(map(attrgetter, vectors)), tuple(map(attrgetter, values)))
+    for cls, vectors, values in (
+        (SetPositionTargetLocal, ("position", "velocity", "acceleration"), ("yaw", "yaw_rate")),
+        (SetPositionTargetGlobal, ("velocity", "acceleration"), ("alt", "yaw", "yaw_rate")),
+        (
+            SetAttitudeTarget,
+            ("q",),
+            ("thrust", "body_roll_rate", "body_pitch_rate", "body_yaw_rate"),
+        ),
+    )
 }
-"""The float fields of each message: vectors, then single values."""
+"""The float fields of each message (vectors, then single values), as getters."""
 
 
 def all_finite(events: list[Event]) -> bool:
@@ -62,10 +71,10 @@ def all_finite(events: list[Event]) -> bool:
             group = events if len(types) == 1 else [e for e in events if type(e) is cls]
             vectors, values = _FLOATS[cls]
             total = 0.0
-            for name in vectors:
-                total += sum(chain.from_iterable(map(attrgetter(name), group)))
-            for name in values:
-                total += sum(map(attrgetter(name), group))
+            for read in vectors:
+                total += sum(chain.from_iterable(map(read, group)))
+            for read in values:
+                total += sum(map(read, group))
             if not math.isfinite(total):
                 return False
     except (TypeError, OverflowError):
