@@ -126,22 +126,27 @@ class TickSignal(Signal):
         """``stamp``: the OCM ``timestamp`` as PX4 sees it (2.1.1); the receive time if None.
         A sample already older than the timeout on arrival counts as bad."""
         before = self.last
-        self.last = t if stamp is None else stamp
+        last = self.last = t if stamp is None else stamp
         self.arrived = t
-        self.stale_stamp = good and t >= self.last + self.timeout and stamp is not None
-        if not good or t >= self.last + self.timeout:
-            self.moved_later = False
+        stale = t >= last + self.timeout
+        if stamp is None:
+            self.stale_stamp = False
+        else:
+            self.stale_stamp = good and stale
+            # Available, good, not bad before and a stamp no older: lost_at() cannot move
+            # earlier.
+            self.moved_later = (
+                good
+                and not stale
+                and self.available
+                and self.bad_since is None
+                and before is not None
+                and last >= before
+            )
+        if not good or stale:
             if self.available and self.bad_since is None:
                 self.bad_since = t
             return False
-        if stamp is not None:
-            # Available, not bad before and a stamp no older: lost_at() cannot move earlier.
-            self.moved_later = (
-                self.available
-                and self.bad_since is None
-                and before is not None
-                and self.last >= before
-            )
         self.bad_since = None
         if not self.available:
             self.available = True
