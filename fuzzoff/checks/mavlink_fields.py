@@ -40,9 +40,12 @@ PositionTarget = SetPositionTargetLocal | SetPositionTargetGlobal
 
 _ORIGIN = attrgetter("origin")
 _MASK_KEY = attrgetter("kind", "type_mask")
-_KEY = attrgetter("kind", "type_mask", "coordinate_frame", "target_system", "target_component")
-"""Besides which float fields are finite, everything ``receive`` reads from a position target;
-the rest of the verdicts read only kind, type_mask and coordinate_frame."""
+_KEY = attrgetter(
+    "origin", "kind", "type_mask", "coordinate_frame", "target_system", "target_component"
+)
+"""Whether ``on_event`` judges the message (origin) and, besides which float fields are finite,
+everything ``receive`` reads from a position target; the rest of the verdicts read only kind,
+type_mask and coordinate_frame."""
 
 _FLOATS: dict[type[Event], tuple[tuple[Callable[[Event], Any], ...], ...]] = {
     cls: (tuple(map(attrgetter, vectors)), tuple(map(attrgetter, values)))
@@ -132,17 +135,21 @@ class PositionTargetFields(Check):
         nothing open, nothing happens; with one key, every message commits the same offences
         and (gaps under ``MERGE_GAP_S``) only extends the stretches the first one opened."""
         events = messages_of(batch, self.stream_types)
-        if events and set(map(_ORIGIN, events)) != {"sent"}:
+        keys = set(map(_KEY, events))
+        if any(key[0] != "sent" for key in keys):  # on_event judges only these
             events = [e for e in events if e.origin == "sent"]
+            keys = set(map(_KEY, events))
         if not events:
             return
-        verdicts = self._verdicts_by_key(events)
+        verdicts = self._verdicts_by_key(events, keys)
         if verdicts is None or not commit_alike(self.episodes, events[0].kind, events, verdicts):
             self.replay(batch)
 
-    def _verdicts_by_key(self, events: list[Event]) -> list[Verdicts] | None:
-        """What a message of each ``_KEY`` of the run commits, or None where that needs each
-        message (fixed-wing ignored fields, a non-finite value for the axes)."""
+    def _verdicts_by_key(
+        self, events: list[Event], keys: set[tuple[object, ...]]
+    ) -> list[Verdicts] | None:
+        """What a message of each ``_KEY`` (``keys``) of the run commits, or None where that
+        needs each message (fixed-wing ignored fields, a non-finite value for the axes)."""
         if self.group == "fixedwing":
             return None
         if self.group == "copter" and self.rx is not None:
@@ -151,7 +158,6 @@ class PositionTargetFields(Check):
             if self.rx.est != self.est_seen:  # the answers below hold for these estimates
                 self.by_key.clear()
                 self.est_seen = copy.copy(self.rx.est)
-        keys = set(map(_KEY, events))
         if len(keys) == 1:
             (key,) = keys
             verdicts = self.by_key.get(key)

@@ -25,14 +25,9 @@ _ORIGIN = attrgetter("origin")
 _MASK = attrgetter("type_mask")
 _ROUTE = attrgetter("origin", "transport")
 _TARGET = attrgetter("target_system", "target_component")
-
-
-def sent_by_mavlink(events: list[Event]) -> list[Event]:
-    """The messages recorded on their way to the vehicle as MAVLink (origin ``sent``, not a
-    MAVROS topic) of a run's MAVLink setpoints."""
-    if not events or set(map(_ROUTE, events)) == {("sent", "mavlink")}:
-        return events
-    return [e for e in events if _ROUTE(e) == ("sent", "mavlink")]
+_ROUTE_TARGET = attrgetter("origin", "transport", "target_system", "target_component")
+"""Whether ``on_event`` judges a MAVLink setpoint (recorded as MAVLink on its way to the
+vehicle), and what its verdict depends on."""
 
 
 class AttitudeTargetMask(Check):
@@ -155,22 +150,24 @@ class SetpointTarget(Check):
         first sign of its autopilot or could resolve pending setpoints (then replay). Before the
         vehicle's ids are known the setpoints only join ``pending``; after, their verdict
         depends only on the target ids (``commit_alike``)."""
-        events = batch.events
-        if "vehicle" in set(map(_ORIGIN, events)) and (
-            (not self.autopilot_seen and self.ctx.vehicle.isdigit())
-            or (self.pending and self._own_ids() is not None)
-        ):
+        may_change = (not self.autopilot_seen and self.ctx.vehicle.isdigit()) or (
+            self.pending and self._own_ids() is not None
+        )
+        if may_change and "vehicle" in set(map(_ORIGIN, batch.events)):
             self.replay(batch)
             return
-        setpoints = sent_by_mavlink(messages_of(batch, self.setpoint_types))
+        setpoints = messages_of(batch, self.setpoint_types)  # judged: sent as MAVLink
+        routes = set(map(_ROUTE_TARGET, setpoints))
+        if any(route[:2] != ("sent", "mavlink") for route in routes):
+            setpoints = [e for e in setpoints if _ROUTE(e) == ("sent", "mavlink")]
+            routes = set(map(_ROUTE_TARGET, setpoints))
         if not setpoints:
             return
         if self._own_ids() is None:
             self._add_pending(setpoints)
             return
         first: dict[tuple[int, int], Event] = {}
-        targets = set(map(_TARGET, setpoints))
-        if len(targets) == 1:
+        if len(routes) == 1:
             first[_TARGET(setpoints[0])] = setpoints[0]
         else:
             for event in setpoints:
