@@ -52,21 +52,24 @@ _THRUST_BODY = attrgetter("thrust_body")
 
 
 _run_types: tuple[StreamBatch | None, frozenset[type[Event]]] = (None, frozenset())
-"""The last run asked about and the classes of its messages (``_of``)."""
+"""The last run asked about and the classes of its messages (``run_classes``)."""
 
 
-def _of(batch: StreamBatch, classes: tuple[type[Event], ...]) -> list[Event]:
-    """``batch.of(classes)`` (shared between checks), or at once nothing when the run has no
-    message of these classes: the classes present are worked out once per run for all the
-    content checks (a run holds only exact stream classes, none a subclass of another)."""
+def run_classes(batch: StreamBatch) -> frozenset[type[Event]]:
+    """The classes of the run's messages, worked out once per run for all the checks that ask
+    (a run holds only exact stream classes, none a subclass of another)."""
     global _run_types
     seen, present = _run_types
     if seen is not batch:
         present = frozenset(map(type, batch.events))
         _run_types = (batch, present)
-    if present.isdisjoint(classes):
-        return []
-    return batch.of(classes)
+    return present
+
+
+def _of(batch: StreamBatch, classes: tuple[type[Event], ...]) -> list[Event]:
+    """``batch.of(classes)`` (shared between checks), or at once nothing when the run has no
+    message of these classes."""
+    return [] if run_classes(batch).isdisjoint(classes) else batch.of(classes)
 
 
 def _all_unit(quaternions: list[tuple[float, ...]], tolerance: float) -> bool:
@@ -391,7 +394,12 @@ class NormalizedOutOfRange(Check):
         """Nothing open, PX4 setpoints only (``SET_ATTITUDE_TARGET`` depends on each mask:
         replayed), and no finite value outside [-1, 1]: every message is clean and changes
         nothing. Otherwise replayed."""
-        if _of(batch, _SET_ATTITUDE) or (self.episodes.open and _of(batch, self.PX4_TYPES)):
+        present = run_classes(batch)
+        if present.isdisjoint(self.PX4_TYPES):
+            if SetAttitudeTarget in present:
+                self.replay(batch)
+            return
+        if SetAttitudeTarget in present or self.episodes.open:
             self.replay(batch)
             return
         values: list[tuple[float, ...]] = []

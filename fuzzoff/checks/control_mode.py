@@ -12,6 +12,7 @@ from operator import attrgetter
 from fuzzoff.checks._external import Episodes, declared_flag
 from fuzzoff.checks._keepalive import mode_note
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
+from fuzzoff.checks.content import run_classes
 from fuzzoff.events import (
     MAVLINK_SETPOINTS,
     PX4_SETPOINTS,
@@ -36,7 +37,6 @@ from fuzzoff.tables.control_mode import (
     row_for,
 )
 
-_OCM: tuple[type[Event], ...] = (ControlMode,)
 _ORIGIN = attrgetter("origin")
 _KIND = attrgetter("kind")
 
@@ -68,10 +68,11 @@ class ControlModeEmpty(Check):
         """A run never spans a change of the declared first flag, so its OCMs are all empty
         (``declared_flag`` None: judged one by one) or all declare something: then the first
         one closes an open episode and the rest change nothing."""
+        if ControlMode not in run_classes(batch):
+            return
         if batch.state.declared_flag is None:
-            if batch.of(_OCM):
-                self.replay(batch)
-        elif self.episodes.open and batch.of(_OCM):
+            self.replay(batch)
+        elif self.episodes.open:
             self.episodes.good("empty")
 
     def finish(self, t_end: float) -> None:
@@ -118,9 +119,9 @@ class SetpointNotDeclared(Check):
         """Within a run the mode and the declared flag are fixed, so the verdict depends only
         on each setpoint's origin and kind: logged copies only set ``logged``; sent setpoints of
         kinds the declaration selects, with nothing open, change nothing but ``sent``."""
-        events = batch.of(PX4_SETPOINTS)
-        if not events:
+        if run_classes(batch).isdisjoint(PX4_SETPOINTS):
             return
+        events = batch.of(PX4_SETPOINTS)
         origins = set(map(_ORIGIN, events))
         if "sent" not in origins:
             self.logged = True
@@ -221,9 +222,11 @@ class DeclaredSetpointMissing(Check):
         if not self._settled(batch.state):
             self.replay(batch)
             return
-        setpoints = batch.of(PX4_SETPOINTS)
-        self._note_first_seen(setpoints)
-        if len(setpoints) + len(batch.of(_OCM)) < len(batch.events):  # else no MAVLink in it
+        present = run_classes(batch)
+        new = {cls.kind for cls in present if cls.kind not in self.first_seen}
+        if not new.isdisjoint(SETPOINT_NAMES):
+            self._note_first_seen(batch.of(PX4_SETPOINTS), new)
+        if not present.isdisjoint(MAVLINK_SETPOINTS):
             self._note_mavlink(batch.events, batch.state.in_offboard)
 
     def _settled(self, state: VehicleState) -> bool:
@@ -239,12 +242,9 @@ class DeclaredSetpointMissing(Check):
             and (state.declared_flag if active else None) == self.flag
         )
 
-    def _note_first_seen(self, setpoints: list[Event]) -> None:
-        """``first_seen.setdefault`` for each setpoint, looked at only for kinds not seen yet."""
+    def _note_first_seen(self, setpoints: list[Event], new: set[str]) -> None:
+        """``first_seen.setdefault`` for each setpoint of a kind not seen yet (``new``)."""
         first_seen = self.first_seen
-        new = {kind for kind in set(map(_KIND, setpoints)) if kind not in first_seen}
-        if not new:
-            return
         for event in setpoints:
             if event.kind in new and event.kind in SETPOINT_NAMES and event.origin != "model":
                 first_seen.setdefault(event.kind, event.t)
@@ -389,7 +389,7 @@ class ControlModeChanged(Check):
     def on_batch(self, batch: StreamBatch) -> None:
         """Every OCM of a run has the run's declared first flag (a change of it ends a run), so
         only the first can report a change; the rest leave ``flag`` as it is."""
-        if not batch.of(_OCM):
+        if ControlMode not in run_classes(batch):
             return
         if not batch.state.in_offboard:
             self.flag = None
@@ -454,7 +454,7 @@ class RequiredEstimateMissing(Check):
     def on_batch(self, batch: StreamBatch) -> None:
         """The state an OCM is judged on is fixed within a run, so every OCM of it gives the
         same key: only the first can report (then replayed), the rest keep ``bad_key``."""
-        if not batch.of(_OCM):
+        if ControlMode not in run_classes(batch):
             return
         self.saw_mode = True
         key = None
