@@ -158,11 +158,12 @@ class SetpointTarget(Check):
             return
         setpoints = messages_of(batch, self.setpoint_types)  # judged: sent as MAVLink
         routes = set(map(_ROUTE_TARGET, setpoints))
-        if any(route[:2] != ("sent", "mavlink") for route in routes):
+        judged = [route[:2] == ("sent", "mavlink") for route in routes]
+        if not any(judged):  # none (MAVROS, or no setpoint at all)
+            return
+        if not all(judged):
             setpoints = [e for e in setpoints if _ROUTE(e) == ("sent", "mavlink")]
             routes = set(map(_ROUTE_TARGET, setpoints))
-        if not setpoints:
-            return
         if self._own_ids() is None:
             self._add_pending(setpoints)
             return
