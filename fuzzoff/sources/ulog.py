@@ -442,6 +442,7 @@ class _Stream:
         self.rank = rank
         """The stream's rank, or one per event (records, preamble)."""
         self.index = index
+        """Each event's row in its topic (None: rows in file order, the usual case)."""
         self.events = events
 
     @classmethod
@@ -459,7 +460,11 @@ class _Stream:
         """(key, rank, index, event) tuples, for ``heapq.merge``."""
         keys = self.keys.tolist() if isinstance(self.keys, np.ndarray) else self.keys
         ranks = self.rank if isinstance(self.rank, list) else repeat(self.rank)
-        index = self.index.tolist() if isinstance(self.index, np.ndarray) else self.index
+        index = self.index
+        if index is None:  # rows in file order
+            index = range(len(keys))
+        elif isinstance(index, np.ndarray):
+            index = index.tolist()
         return zip(keys, ranks, index, self.events, strict=False)
 
 
@@ -488,12 +493,12 @@ def _merged_order(streams: list[_Stream]) -> Any:
     if any(not 0 <= k < 1 << 64 for k in records.keys):
         return None
     position = {id(s): n for n, s in enumerate(streams)}
-    keys = [s.keys.astype(np.uint64) for s in topics]
+    keys = [s.keys.astype(np.uint64, copy=False) for s in topics]
     keys.append(np.array(records.keys, dtype=np.uint64))
     owner = [position[id(s)] for s in topics] + [len(streams) - 1]
-    which = np.repeat(np.array(owner, dtype=np.int64), [len(k) for k in keys])
+    which = np.repeat(np.array(owner, dtype=np.int32), [len(k) for k in keys])
     merged = which[np.argsort(np.concatenate(keys), kind="stable")]
-    return np.concatenate([np.zeros(len(preamble.keys), dtype=np.int64), merged])
+    return np.concatenate([np.zeros(len(preamble.keys), dtype=np.int32), merged])
 
 
 def _stream(cols: Any, topic: str, rank: int, t0: int, decode: Any, context: Context) -> _Stream:
@@ -504,8 +509,7 @@ def _stream(cols: Any, topic: str, rank: int, t0: int, decode: Any, context: Con
     if n > 1 and bool(np.any(ts[1:] < ts[:-1])):
         order = np.argsort(ts, kind="stable")
     keys = ts if order is None else ts[order]
-    index = np.arange(n) if order is None else order
-    return _Stream(keys, rank, index, _chunks(cols, order, n, topic, t0, decode, context))
+    return _Stream(keys, rank, order, _chunks(cols, order, n, topic, t0, decode, context))
 
 
 def _chunks(
