@@ -66,10 +66,12 @@ def run_classes(batch: StreamBatch) -> frozenset[type[Event]]:
     return present
 
 
-def _of(batch: StreamBatch, classes: tuple[type[Event], ...]) -> list[Event]:
-    """``batch.of(classes)`` (shared between checks), or at once nothing when the run has no
-    message of these classes."""
-    return [] if run_classes(batch).isdisjoint(classes) else batch.of(classes)
+def run_of(batch: StreamBatch, classes: tuple[type[Event], ...]) -> list[Event]:
+    """``batch.of(classes)`` asked only for the classes the run holds (fewer ``isinstance``
+    tests, and lists shared with checks that want just those), or at once nothing."""
+    present = run_classes(batch)
+    held = tuple(cls for cls in classes if cls in present)
+    return batch.of(held) if held else []
 
 
 def _all_unit(quaternions: list[tuple[float, ...]], tolerance: float) -> bool:
@@ -211,7 +213,7 @@ class TrajectoryContent(Check):
         flag = batch.state.declared_flag
         if flag not in TRAJECTORY_CONTROLS:
             return
-        events = _of(batch, _TRAJECTORY)
+        events = run_of(batch, _TRAJECTORY)
         if not events:
             return
         if len(set(map(_ORIGIN, events))) > 1:
@@ -303,8 +305,8 @@ class QuaternionNotUnit(Check):
     def on_batch(self, batch: StreamBatch) -> None:
         """Nothing open and every quaternion used a unit one: every message is clean and
         changes nothing. Otherwise replayed."""
-        attitude = _of(batch, _ATTITUDE)
-        mavlink = _of(batch, _SET_ATTITUDE)
+        attitude = run_of(batch, _ATTITUDE)
+        mavlink = run_of(batch, _SET_ATTITUDE)
         if not (attitude or mavlink):
             return
         if self.episodes.open:
@@ -405,7 +407,7 @@ class NormalizedOutOfRange(Check):
         values: list[tuple[float, ...]] = []
         for classes, field in self.FIELDS:
             for cls in classes:  # a logged copy is external or not by its kind
-                judged = _of(batch, (cls,))
+                judged = run_of(batch, (cls,))
                 if not judged:
                     continue
                 if not _single_origin(judged):
@@ -467,7 +469,7 @@ class ActuatorNanDisarms(Check):
         """Arming and the mode are fixed within a run. When every message has the same NaN
         pattern, each reports the same indices (``active`` only gains finite ones, which are
         never NaN in this pattern): the first is judged, the rest extend its episode."""
-        motors = _of(batch, _MOTORS)
+        motors = run_of(batch, _MOTORS)
         if not motors:
             return
         self.saw_motors = True
@@ -531,7 +533,7 @@ class RatesIncomplete(Check):
     def on_batch(self, batch: StreamBatch) -> None:
         """No NaN in any field of the run (their sum is not NaN) and nothing open: every
         message is clean and changes nothing. Otherwise replayed."""
-        rates = _of(batch, _RATES_SETPOINT)
+        rates = run_of(batch, _RATES_SETPOINT)
         if not rates:
             return
         if self.episodes.open or not _single_origin(rates):

@@ -12,7 +12,7 @@ from operator import attrgetter
 from fuzzoff.checks._external import Episodes, declared_flag
 from fuzzoff.checks._keepalive import mode_note
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
-from fuzzoff.checks.content import run_classes
+from fuzzoff.checks.content import run_classes, run_of
 from fuzzoff.events import (
     MAVLINK_SETPOINTS,
     PX4_SETPOINTS,
@@ -38,7 +38,6 @@ from fuzzoff.tables.control_mode import (
 )
 
 _ORIGIN = attrgetter("origin")
-_KIND = attrgetter("kind")
 
 
 class ControlModeEmpty(Check):
@@ -119,9 +118,9 @@ class SetpointNotDeclared(Check):
         """Within a run the mode and the declared flag are fixed, so the verdict depends only
         on each setpoint's origin and kind: logged copies only set ``logged``; sent setpoints of
         kinds the declaration selects, with nothing open, change nothing but ``sent``."""
-        if run_classes(batch).isdisjoint(PX4_SETPOINTS):
+        events = run_of(batch, PX4_SETPOINTS)
+        if not events:
             return
-        events = batch.of(PX4_SETPOINTS)
         origins = set(map(_ORIGIN, events))
         if "sent" not in origins:
             self.logged = True
@@ -133,7 +132,8 @@ class SetpointNotDeclared(Check):
         row = self.ctx.row_for(batch.state.declared_flag)
         if not batch.state.in_offboard or row is None:
             return  # close_all with nothing open
-        if not row.allowed.issuperset(map(_KIND, events)):
+        kinds = {cls.kind for cls in run_classes(batch) if cls in PX4_SETPOINTS}
+        if not row.allowed.issuperset(kinds):
             self.replay(batch)
 
     def finish(self, t_end: float) -> None:
@@ -225,7 +225,7 @@ class DeclaredSetpointMissing(Check):
         present = run_classes(batch)
         new = {cls.kind for cls in present if cls.kind not in self.first_seen}
         if not new.isdisjoint(SETPOINT_NAMES):
-            self._note_first_seen(batch.of(PX4_SETPOINTS), new)
+            self._note_first_seen(run_of(batch, PX4_SETPOINTS), new)
         if not present.isdisjoint(MAVLINK_SETPOINTS):
             self._note_mavlink(batch.events, batch.state.in_offboard)
 
