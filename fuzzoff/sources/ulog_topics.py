@@ -72,7 +72,10 @@ class Chunk:
         self.t: list[float] = seconds.tolist()
         index = np.arange(len(cols["timestamp"]))[sel].tolist()
         self.index: list[int] = index
-        self.where = list(map(ev.Where, repeat(topic), index))
+        # Made as the decoder's zip reads them (one pass): each Where is then only referenced
+        # by its event, which the consumer drops at once; a list of a chunk's Wheres kept
+        # thousands of objects alive for the garbage collector to walk over and over.
+        self.where: Iterator[ev.Where] = map(ev.Where, repeat(topic), index)
         self.n = len(self.ts)
 
     def has(self, name: str) -> bool:
@@ -104,9 +107,10 @@ class Chunk:
             return [None] * self.n
         return list(self.b(name))
 
-    def vec(self, name: str, size: int) -> list[Any]:
-        """Array field ``name[0..size)`` as tuples (typed loosely: the size varies by field)."""
-        return list(zip(*(self.f(f"{name}[{k}]") for k in range(size)), strict=True))
+    def vec(self, name: str, size: int) -> Iterator[Any]:
+        """Array field ``name[0..size)`` as tuples (typed loosely: the size varies by field),
+        made as the decoder's ``zip`` reads them (one pass), like ``where``."""
+        return zip(*(self.f(f"{name}[{k}]") for k in range(size)), strict=True)
 
     def width(self, name: str) -> int:
         """The length of array field ``name`` in this layout."""
@@ -120,22 +124,64 @@ Decoder = Callable[[Chunk, Context], Iterable[ev.Event]]
 """A chunk's events, one per row, in row order (a generator, or a list for the hot topics)."""
 
 
-def _legacy_thrust(c: Chunk) -> list[Any]:
+def _legacy_thrust(c: Chunk) -> Iterable[Any]:
     """Legacy scalar ``thrust`` (0..1, up) as a body thrust vector (FRD: negative z)."""
     if c.has("thrust_body[0]"):
         return c.vec("thrust_body", 3)
     return [(0.0, 0.0, -v) if not math.isnan(v) else ev.NAN3 for v in c.f("thrust")]
 
 
-def control_mode(c: Chunk, ctx: Context) -> Iterable[ev.Event]:
+def control_mode(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
     if c.has("ignore_thrust"):
-        return _legacy_control_mode(c)
+        if c.has("ignore_bodyrate"):
+            bodyrate = c.b("ignore_bodyrate")
+        else:  # v1.7-v1.11 split it per axis; the rates are used if any axis is
+            x, y, z = c.b("ignore_bodyrate_x"), c.b("ignore_bodyrate_y"), c.b("ignore_bodyrate_z")
+            bodyrate = [a and b and d for a, b, d in zip(x, y, z, strict=True)]
+        for t, w, ts, *row in zip(
+            c.t,
+            c.where,
+            c.ts,
+            c.b("ignore_thrust"),
+            c.b("ignore_attitude"),
+            bodyrate,
+            c.b("ignore_position"),
+            c.b("ignore_velocity"),
+            c.b("ignore_acceleration_force"),
+            c.b("ignore_alt_hold"),
+            strict=True,
+        ):
+            yield ev.LegacyControlMode(
+                t=t,
+                where=w,
+                sender_time_us=ts,
+                origin=VEHICLE,
+                ignore_thrust=row[0],
+                ignore_attitude=row[1],
+                ignore_bodyrate=row[2],
+                ignore_position=row[3],
+                ignore_velocity=row[4],
+                ignore_acceleration_force=row[5],
+                ignore_alt_hold=row[6],
+            )
+        return
     new = c.has("thrust_and_torque")
     layout: Literal["actuator", "thrust_and_torque"] = "thrust_and_torque" if new else "actuator"
-    make = ev.ControlMode
-    # A list, not a generator: the hot topic's events cost no generator step each.
-    return [
-        make(
+    for t, w, ts, pos, vel, acc, att, rate, tt, direct, act in zip(
+        c.t,
+        c.where,
+        c.ts,
+        c.b("position"),
+        c.b("velocity"),
+        c.b("acceleration"),
+        c.b("attitude"),
+        c.b("body_rate"),
+        c.b("thrust_and_torque"),
+        c.b("direct_actuator"),
+        c.b("actuator"),
+        strict=True,
+    ):
+        yield ev.ControlMode(
             t=t,
             where=w,
             sender_time_us=ts,
@@ -150,68 +196,29 @@ def control_mode(c: Chunk, ctx: Context) -> Iterable[ev.Event]:
             actuator=act,
             layout=layout,
         )
-        for t, w, ts, pos, vel, acc, att, rate, tt, direct, act in zip(
-            c.t,
-            c.where,
-            c.ts,
-            c.b("position"),
-            c.b("velocity"),
-            c.b("acceleration"),
-            c.b("attitude"),
-            c.b("body_rate"),
-            c.b("thrust_and_torque"),
-            c.b("direct_actuator"),
-            c.b("actuator"),
-            strict=True,
-        )
-    ]
 
 
-def _legacy_control_mode(c: Chunk) -> Iterator[ev.Event]:
-    """Legacy ``ignore_*`` layout (v1.5-v1.11)."""
-    if c.has("ignore_bodyrate"):
-        bodyrate = c.b("ignore_bodyrate")
-    else:  # v1.7-v1.11 split it per axis; the rates are used if any axis is
-        x, y, z = c.b("ignore_bodyrate_x"), c.b("ignore_bodyrate_y"), c.b("ignore_bodyrate_z")
-        bodyrate = [a and b and d for a, b, d in zip(x, y, z, strict=True)]
-    for t, w, ts, *row in zip(
-        c.t,
-        c.where,
-        c.ts,
-        c.b("ignore_thrust"),
-        c.b("ignore_attitude"),
-        bodyrate,
-        c.b("ignore_position"),
-        c.b("ignore_velocity"),
-        c.b("ignore_acceleration_force"),
-        c.b("ignore_alt_hold"),
-        strict=True,
-    ):
-        yield ev.LegacyControlMode(
-            t=t,
-            where=w,
-            sender_time_us=ts,
-            origin=VEHICLE,
-            ignore_thrust=row[0],
-            ignore_attitude=row[1],
-            ignore_bodyrate=row[2],
-            ignore_position=row[3],
-            ignore_velocity=row[4],
-            ignore_acceleration_force=row[5],
-            ignore_alt_hold=row[6],
-        )
-
-
-def trajectory(c: Chunk, ctx: Context) -> Iterable[ev.Event]:
+def trajectory(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
+    position: Iterable[Any]
+    velocity: Iterable[Any]
     if c.has("position[0]"):
         position, velocity = c.vec("position", 3), c.vec("velocity", 3)
     else:  # v1.13 layout
         position = list(zip(c.f("x"), c.f("y"), c.f("z"), strict=True))
         velocity = list(zip(c.f("vx"), c.f("vy"), c.f("vz"), strict=True))
-    make = ev.TrajectorySetpoint
-    # A list, not a generator: the hot topic's events cost no generator step each.
-    return [
-        make(
+    for t, w, ts, pos, vel, acc, jerk, yaw, yawspeed in zip(
+        c.t,
+        c.where,
+        c.ts,
+        position,
+        velocity,
+        c.vec("acceleration", 3),
+        c.vec("jerk", 3),
+        c.f("yaw"),
+        c.f("yawspeed"),
+        strict=True,
+    ):
+        yield ev.TrajectorySetpoint(
             t=t,
             where=w,
             sender_time_us=ts,
@@ -223,19 +230,6 @@ def trajectory(c: Chunk, ctx: Context) -> Iterable[ev.Event]:
             yaw=yaw,
             yawspeed=yawspeed,
         )
-        for t, w, ts, pos, vel, acc, jerk, yaw, yawspeed in zip(
-            c.t,
-            c.where,
-            c.ts,
-            position,
-            velocity,
-            c.vec("acceleration", 3),
-            c.vec("jerk", 3),
-            c.f("yaw"),
-            c.f("yawspeed"),
-            strict=True,
-        )
-    ]
 
 
 def attitude(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
