@@ -28,7 +28,8 @@ from fuzzoff.events import (
 )
 
 DOUBLE_ACK_WINDOW_S = 0.1
-"""A second ack for the same command within this window replaces the first (gate spec 4.3)."""
+"""A second ack for the same command within this window replaces a first that was ACCEPTED
+(gate spec 4.3: PX4 1.16/1.17's receiver acks ACCEPTED, Commander's verdict follows)."""
 
 
 @dataclass(slots=True)
@@ -37,6 +38,7 @@ class _PendingSwitch:
     to_offboard: bool
     before: int | None = None
     acked_at: float | None = None
+    first_accepted: bool = False
 
 
 @dataclass(slots=True)
@@ -162,11 +164,16 @@ class VehicleState:
         pending = self._pending.get(ack.command)
         if pending is None:
             return
-        second = pending.acked_at is not None and ack.t - pending.acked_at <= DOUBLE_ACK_WINDOW_S
+        second = (
+            pending.acked_at is not None
+            and pending.first_accepted
+            and ack.t - pending.acked_at <= DOUBLE_ACK_WINDOW_S
+        )
         if second:
             self.nav_state = pending.before  # the last ack decides: undo the first one
         else:
             pending.before = self.nav_state
+            pending.first_accepted = ack.accepted  # the receiver's own ack is ACCEPTED
         pending.acked_at = ack.t
         if ack.accepted and self.mode_recorded:
             if pending.to_offboard:

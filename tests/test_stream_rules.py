@@ -2,9 +2,17 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import pytest
 
-from fuzzoff.events import Dropout, SetPositionTargetLocal, TrajectorySetpoint, VehicleStatus
+from fuzzoff.events import (
+    Command,
+    Dropout,
+    SetPositionTargetLocal,
+    TrajectorySetpoint,
+    VehicleStatus,
+)
 from fuzzoff.findings import Severity
 from tests.streams import OFFBOARD, POSCTL, ack, codes, every, lint_events, ocm, status, switch
 
@@ -158,6 +166,28 @@ def test_ofb201_a_late_second_ack_is_a_new_answer_not_a_double_ack() -> None:
         ack(1.5, 1),
     ]
     assert codes(lint_events(events), "OFB201") == []
+
+
+def test_ofb201_acks_answer_back_to_back_switches_in_order() -> None:
+    # found by fuzzing (ROS 2): OFFBOARD then POSCTL requested 0.1 ms apart, before either
+    # ack; PX4 answers in order, so the rejection belongs to the OFFBOARD switch
+    offboard = replace(switch(1.0001), transport="ros2")
+    posctl = Command(
+        t=1.0002, command=176, params=(1.0, 3.0, 0.0, 0.0, 0.0, 0.0, 0.0), transport="ros2"
+    )
+    events = [status(0.0, POSCTL), offboard, posctl, ack(1.008, 1), ack(1.0082, 0)]
+    (found,) = codes(lint_events(events, px4="1.16"), "OFB201")
+    assert found.time_s == pytest.approx(1.008)
+    assert "switch to OFFBOARD at 1.00 s" in found.message
+    swapped = [status(0.0, POSCTL), offboard, posctl, ack(1.008, 0), ack(1.0082, 1)]
+    assert codes(lint_events(swapped, px4="1.16"), "OFB201") == []
+
+
+def test_ofb201_a_rejection_first_is_never_the_receivers_ack() -> None:
+    # 1.16's receiver acks ACCEPTED first: a first ack that rejects is Commander's verdict
+    events = [status(0.0, POSCTL), switch(1.0), ack(1.004, 2), ack(1.010, 0)]
+    (found,) = codes(lint_events(events, px4="1.16"), "OFB201")
+    assert "DENIED" in found.message
 
 
 def test_ofb101_silence_after_leaving_offboard_does_not_count() -> None:

@@ -1,7 +1,13 @@
 """OFB201: the recording shows the vehicle rejecting an offboard request.
 
-The last ack of a command decides (gate spec 4.3: PX4 1.16/1.17 answer a mode switch with the
-receiver's ACCEPTED and then Commander's verdict a few ms later). The finding carries the gate
+Acks carry the command's id but not its parameters, so they are paired with the commands of
+that id in the order sent (PX4 answers in order): a switch to OFFBOARD followed at once by a
+switch to another mode gets the first ack, the other switch the second. The last ack of a
+command decides where PX4 sends two (gate spec 4.3: 1.16/1.17 answer a mode switch with the
+receiver's ACCEPTED and then Commander's verdict a few ms later): an ack within
+``DOUBLE_ACK_WINDOW_S`` of an ACCEPTED one replaces it. A first ack that is not ACCEPTED is
+never the receiver's, and a ROS 2 command does not pass the MAVLink receiver: then the next
+ack belongs to the next command. The finding carries the gate
 model's reason for the rejection, or says that the model expected acceptance.
 """
 
@@ -20,11 +26,17 @@ from fuzzoff.events import (
 from fuzzoff.gate import GateTransition
 from fuzzoff.state import DOUBLE_ACK_WINDOW_S
 
+ACK_WAIT_S = 1.0
+"""A command still without an ack this long before a newer ack of its id never got one (a
+lost ack); pairing goes on with the commands after it."""
+
 
 @dataclass(slots=True)
 class _Request:
     command: Command
-    what: str
+    what: str | None
+    """``switch to OFFBOARD`` / ``arm in OFFBOARD``; None for another command of the same id,
+    which only takes its place in the order of the acks."""
     verdict: GateTransition | None = None
     ack: CommandAck | None = None
 
@@ -35,8 +47,8 @@ class RequestRejected(Check):
 
     def __init__(self, ctx: CheckContext) -> None:
         super().__init__(ctx)
-        self.requests: dict[int, _Request] = {}
-        """Open offboard requests by MAVLink command id (one outstanding per command)."""
+        self.requests: dict[int, list[_Request]] = {}
+        """Commands waiting for their ack (or for a second one), oldest first, by command id."""
         self.seen_ack = False
         self.unconfirmed = False
         """A request the model accepts could not be confirmed: there are no acks."""
@@ -52,20 +64,41 @@ class RequestRejected(Check):
         elif isinstance(event, Command):
             verdict = self.verdicts.pop(id(event), None)
             self.verdicts.clear()
-            request = None
+            what = None
             if event.is_offboard_switch:
-                request = _Request(event, "switch to OFFBOARD", verdict)
+                what = "switch to OFFBOARD"
             elif event.is_arm and self._offboard_selected():
-                request = _Request(event, "arm in OFFBOARD", verdict)
-            if request is not None or event.is_mode_switch or event.is_arm or event.is_disarm:
-                self._supersede(event.command)
-            if request is not None:
-                self.requests[event.command] = request
+                what = "arm in OFFBOARD"
+            if what is None and not (event.is_mode_switch or event.is_arm or event.is_disarm):
+                return
+            queue = self.requests.setdefault(event.command, [])
+            if not self.ctx.has("command_ack"):
+                self._supersede(queue)  # nothing will answer: judge the open one now
+            queue.append(_Request(event, what, verdict))
         elif isinstance(event, CommandAck):
             self.seen_ack = True
-            request = self.requests.get(event.command)
-            if request is not None:
-                request.ack = event  # a later ack within the window replaces an earlier one
+            self._ack(event)
+
+    def _ack(self, ack: CommandAck) -> None:
+        queue = self.requests.get(ack.command)
+        if not queue:
+            return
+        while queue:
+            head = queue[0]
+            if head.ack is None:
+                if head.command.t < ack.t - ACK_WAIT_S and len(queue) > 1:
+                    self._unanswered(queue.pop(0))
+                    continue
+                head.ack = ack
+                return
+            if (
+                head.ack.accepted
+                and ack.t - head.ack.t <= DOUBLE_ACK_WINDOW_S
+                and head.command.transport != "ros2"  # the second ack is the MAVLink receiver's
+            ):
+                head.ack = ack  # PX4 1.16/1.17: Commander's verdict after the receiver's
+                return
+            self._judge(queue.pop(0))
 
     def _offboard_selected(self) -> bool:
         """OFFBOARD is the selected mode: as recorded, else as the gate model has it."""
@@ -74,14 +107,17 @@ class RequestRejected(Check):
             return state.nav_state == NAV_STATE_OFFBOARD
         return self.ctx.gate.user_intention == NAV_STATE_OFFBOARD
 
-    def _supersede(self, command: int) -> None:
-        """A new request of the same command: the open one is judged as it stands."""
-        request = self.requests.pop(command, None)
-        if request is None:
-            return
-        if request.ack is not None:
-            self._judge(request)
-        else:
+    def _supersede(self, queue: list[_Request]) -> None:
+        """A new command of the same id: the open ones are judged as they stand."""
+        while queue:
+            request = queue.pop(0)
+            if request.ack is not None:
+                self._judge(request)
+            else:
+                self._unanswered(request)
+
+    def _unanswered(self, request: _Request) -> None:
+        if request.what is not None:
             self._predict(request)
 
     def _predict(self, request: _Request) -> None:
@@ -103,17 +139,15 @@ class RequestRejected(Check):
         )
 
     def _settle(self, now: float) -> None:
-        if not self.requests:
-            return
-        for key, request in list(self.requests.items()):
-            if request.ack is not None and now - request.ack.t > DOUBLE_ACK_WINDOW_S:
-                del self.requests[key]
-                self._judge(request)
+        """Judge the answered commands whose window for a second ack has passed."""
+        for queue in self.requests.values():
+            while queue and (ack := queue[0].ack) is not None and now - ack.t > DOUBLE_ACK_WINDOW_S:
+                self._judge(queue.pop(0))
 
     def _judge(self, request: _Request) -> None:
         ack = request.ack
         assert ack is not None
-        if ack.accepted:
+        if ack.accepted or request.what is None:
             return
         verdict = request.verdict
         if verdict is not None and verdict.what.endswith("rejected"):
@@ -135,8 +169,8 @@ class RequestRejected(Check):
 
     def finish(self, t_end: float) -> None:
         self._settle(float("inf"))
-        for command in list(self.requests):
-            self._supersede(command)
+        for queue in self.requests.values():
+            self._supersede(queue)
         if self.unconfirmed:
             self.ctx.cannot_check(
                 "OFB201",
