@@ -1,14 +1,4 @@
-"""Helpers for ``on_batch``: a run's messages of the types a check wants, and episodes.
-
-``messages_of`` finds the messages by type rather than ``isinstance``.
-
-``StreamBatch.of`` tests ``isinstance(event, types)`` per message, which walks the tuple of
-types (~0.4 µs a message for the sixteen setpoint types). A run holds only messages whose exact
-class is one of ``STREAM_TYPES`` (the engine tests ``type(event) in STREAM_TYPES``) and none of
-those classes is a subclass of another, so the set of those classes a check wants
-(``wanted_types``) answers the same question: the classes a run holds (one pass per run, shared)
-usually show that all or none of it is wanted, and otherwise ``batch.of`` is asked for just the
-wanted classes it holds (usually one, and a list other checks share).
+"""Helpers for ``on_batch`` of episode checks.
 
 ``commit_alike`` commits to ``Episodes`` a run whose verdicts are known without each message.
 """
@@ -19,42 +9,10 @@ from itertools import repeat
 from operator import attrgetter, le, sub
 
 from fuzzoff.checks._episodes import MERGE_GAP_S, Episodes, Offence
-from fuzzoff.checks.base import STREAM_TYPES, StreamBatch
+from fuzzoff.checks.base import STREAM_TYPES
 from fuzzoff.events import Event
 
 assert not any(a is not b and issubclass(a, b) for a in STREAM_TYPES for b in STREAM_TYPES)
-
-
-def wanted_types(subscriptions: tuple[type[Event], ...]) -> frozenset[type[Event]]:
-    """The stream classes an ``isinstance(event, subscriptions)`` test accepts."""
-    return frozenset(cls for cls in STREAM_TYPES if issubclass(cls, subscriptions))
-
-
-_last_run: tuple[StreamBatch | None, frozenset[type[Event]]] = (None, frozenset())
-"""The last run asked about and the classes of its messages (``classes_of``)."""
-
-
-def classes_of(batch: StreamBatch) -> frozenset[type[Event]]:
-    """The classes of the run's messages, worked out once per run for the checks that ask
-    (the cache holds the run itself, so an identity test cannot meet a new run at the same
-    address)."""
-    global _last_run
-    seen, present = _last_run
-    if seen is not batch:
-        present = frozenset(map(type, batch.events))
-        _last_run = (batch, present)
-    return present
-
-
-def messages_of(batch: StreamBatch, wanted: frozenset[type[Event]]) -> list[Event]:
-    """``batch.of(subscriptions)`` for ``wanted = wanted_types(subscriptions)`` (do not change
-    the list: it may be ``batch.events`` itself). Part of a run is asked of ``batch.of`` for
-    just the classes it holds, so checks that want the same share one list."""
-    present = classes_of(batch)
-    if present <= wanted:
-        return batch.events
-    held = tuple(sorted(present & wanted, key=attrgetter("__name__")))
-    return batch.of(held) if held else []
 
 
 Verdicts = list[tuple[str, dict[str, Offence]]]

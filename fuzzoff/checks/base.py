@@ -117,6 +117,8 @@ class CheckContext:
 STREAM_TYPES: frozenset[type[Event]] = frozenset((*KEEPALIVE_TYPES, *PX4_SETPOINTS))
 """The high-rate messages the engine may group into runs: keep-alives and setpoints."""
 
+assert not any(a is not b and issubclass(a, b) for a in STREAM_TYPES for b in STREAM_TYPES)
+
 
 class StreamBatch:
     """A run of consecutive stream messages of one vehicle, in time order.
@@ -136,7 +138,7 @@ class StreamBatch:
     ``tests/test_batching.py`` and the ``runs`` fuzz property compare the two.
     """
 
-    __slots__ = ("_keepalives", "_of", "events", "gate", "state")
+    __slots__ = ("_classes", "_keepalives", "_of", "events", "gate", "state")
 
     def __init__(self, state: VehicleState, gate: GateModel) -> None:
         self.events: list[Event] = []
@@ -144,13 +146,32 @@ class StreamBatch:
         self.gate = copy.copy(gate)
         self._keepalives: list[Event] | None = None
         self._of: dict[tuple[type[Event], ...], list[Event]] = {}
+        self._classes: frozenset[type[Event]] | None = None
+
+    def classes(self) -> frozenset[type[Event]]:
+        """The classes of the run's messages (exact ``STREAM_TYPES`` classes), worked out once."""
+        if self._classes is None:
+            self._classes = frozenset(map(type, self.events))
+        return self._classes
 
     def of(self, types: tuple[type[Event], ...]) -> list[Event]:
-        """The run's messages of these types (worked out once per run and tuple: several
-        checks ask for the same, e.g. their ``subscriptions``)."""
+        """The run's messages that are instances of ``types``, worked out once per run and tuple
+        (several checks ask for the same). Found by exact class: a run holds only
+        ``STREAM_TYPES`` classes, none a subclass of another, so the classes it holds tell
+        at once whether all, none or which of its messages are wanted (an ``isinstance`` test
+        per message walks the tuple: ~0.4 µs for the sixteen setpoint types). The list may be
+        ``events`` itself: do not change it."""
         found = self._of.get(types)
         if found is None:
-            found = self._of[types] = [e for e in self.events if isinstance(e, types)]
+            present = self.classes()
+            held = frozenset(cls for cls in present if issubclass(cls, types))
+            if len(held) == len(present):
+                found = self.events
+            elif not held:
+                found = []
+            else:
+                found = [e for e in self.events if type(e) in held]
+            self._of[types] = found
         return found
 
     def keepalives(self) -> list[Event]:

@@ -51,29 +51,6 @@ _RATES = attrgetter("roll", "pitch", "yaw")
 _THRUST_BODY = attrgetter("thrust_body")
 
 
-_run_types: tuple[StreamBatch | None, frozenset[type[Event]]] = (None, frozenset())
-"""The last run asked about and the classes of its messages (``run_classes``)."""
-
-
-def run_classes(batch: StreamBatch) -> frozenset[type[Event]]:
-    """The classes of the run's messages, worked out once per run for all the checks that ask
-    (a run holds only exact stream classes, none a subclass of another)."""
-    global _run_types
-    seen, present = _run_types
-    if seen is not batch:
-        present = frozenset(map(type, batch.events))
-        _run_types = (batch, present)
-    return present
-
-
-def run_of(batch: StreamBatch, classes: tuple[type[Event], ...]) -> list[Event]:
-    """``batch.of(classes)`` asked only for the classes the run holds (fewer ``isinstance``
-    tests, and lists shared with checks that want just those), or at once nothing."""
-    present = run_classes(batch)
-    held = tuple(cls for cls in classes if cls in present)
-    return batch.of(held) if held else []
-
-
 def _all_unit(quaternions: list[tuple[float, ...]], tolerance: float) -> bool:
     """Every norm within ``tolerance`` of 1: the norms are ``QuaternionNotUnit``'s own
     expression (the same products summed in the same order), so the verdict is exact."""
@@ -213,7 +190,7 @@ class TrajectoryContent(Check):
         flag = batch.state.declared_flag
         if flag not in TRAJECTORY_CONTROLS:
             return
-        events = run_of(batch, _TRAJECTORY)
+        events = batch.of(_TRAJECTORY)
         if not events:
             return
         if len(set(map(_ORIGIN, events))) > 1:
@@ -305,8 +282,8 @@ class QuaternionNotUnit(Check):
     def on_batch(self, batch: StreamBatch) -> None:
         """Nothing open and every quaternion used a unit one: every message is clean and
         changes nothing. Otherwise replayed."""
-        attitude = run_of(batch, _ATTITUDE)
-        mavlink = run_of(batch, _SET_ATTITUDE)
+        attitude = batch.of(_ATTITUDE)
+        mavlink = batch.of(_SET_ATTITUDE)
         if not (attitude or mavlink):
             return
         if self.episodes.open:
@@ -396,7 +373,7 @@ class NormalizedOutOfRange(Check):
         """Nothing open, PX4 setpoints only (``SET_ATTITUDE_TARGET`` depends on each mask:
         replayed), and no finite value outside [-1, 1]: every message is clean and changes
         nothing. Otherwise replayed."""
-        present = run_classes(batch)
+        present = batch.classes()
         if present.isdisjoint(self.PX4_TYPES):
             if SetAttitudeTarget in present:
                 self.replay(batch)
@@ -407,7 +384,7 @@ class NormalizedOutOfRange(Check):
         values: list[tuple[float, ...]] = []
         for classes, field in self.FIELDS:
             for cls in classes:  # a logged copy is external or not by its kind
-                judged = run_of(batch, (cls,))
+                judged = batch.of((cls,))
                 if not judged:
                     continue
                 if not _single_origin(judged):
@@ -469,7 +446,7 @@ class ActuatorNanDisarms(Check):
         """Arming and the mode are fixed within a run. When every message has the same NaN
         pattern, each reports the same indices (``active`` only gains finite ones, which are
         never NaN in this pattern): the first is judged, the rest extend its episode."""
-        motors = run_of(batch, _MOTORS)
+        motors = batch.of(_MOTORS)
         if not motors:
             return
         self.saw_motors = True
@@ -533,7 +510,7 @@ class RatesIncomplete(Check):
     def on_batch(self, batch: StreamBatch) -> None:
         """No NaN in any field of the run (their sum is not NaN) and nothing open: every
         message is clean and changes nothing. Otherwise replayed."""
-        rates = run_of(batch, _RATES_SETPOINT)
+        rates = batch.of(_RATES_SETPOINT)
         if not rates:
             return
         if self.episodes.open or not _single_origin(rates):

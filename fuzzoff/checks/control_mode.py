@@ -12,7 +12,6 @@ from operator import attrgetter
 from fuzzoff.checks._external import Episodes, declared_flag
 from fuzzoff.checks._keepalive import mode_note
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
-from fuzzoff.checks.content import run_classes, run_of
 from fuzzoff.events import (
     MAVLINK_SETPOINTS,
     PX4_SETPOINTS,
@@ -67,7 +66,7 @@ class ControlModeEmpty(Check):
         """A run never spans a change of the declared first flag, so its OCMs are all empty
         (``declared_flag`` None: judged one by one) or all declare something: then the first
         one closes an open episode and the rest change nothing."""
-        if ControlMode not in run_classes(batch):
+        if ControlMode not in batch.classes():
             return
         if batch.state.declared_flag is None:
             self.replay(batch)
@@ -118,7 +117,7 @@ class SetpointNotDeclared(Check):
         """Within a run the mode and the declared flag are fixed, so the verdict depends only
         on each setpoint's origin and kind: logged copies only set ``logged``; sent setpoints of
         kinds the declaration selects, with nothing open, change nothing but ``sent``."""
-        events = run_of(batch, PX4_SETPOINTS)
+        events = batch.of(PX4_SETPOINTS)
         if not events:
             return
         origins = set(map(_ORIGIN, events))
@@ -132,7 +131,7 @@ class SetpointNotDeclared(Check):
         row = self.ctx.row_for(batch.state.declared_flag)
         if not batch.state.in_offboard or row is None:
             return  # close_all with nothing open
-        kinds = {cls.kind for cls in run_classes(batch) if cls in PX4_SETPOINTS}
+        kinds = {cls.kind for cls in batch.classes() if cls in PX4_SETPOINTS}
         if not row.allowed.issuperset(kinds):
             self.replay(batch)
 
@@ -222,10 +221,10 @@ class DeclaredSetpointMissing(Check):
         if not self._settled(batch.state):
             self.replay(batch)
             return
-        present = run_classes(batch)
+        present = batch.classes()
         new = {cls.kind for cls in present if cls.kind not in self.first_seen}
         if not new.isdisjoint(SETPOINT_NAMES):
-            self._note_first_seen(run_of(batch, PX4_SETPOINTS), new)
+            self._note_first_seen(batch.of(PX4_SETPOINTS), new)
         if not present.isdisjoint(MAVLINK_SETPOINTS):
             self._note_mavlink(batch.events, batch.state.in_offboard)
 
@@ -389,7 +388,7 @@ class ControlModeChanged(Check):
     def on_batch(self, batch: StreamBatch) -> None:
         """Every OCM of a run has the run's declared first flag (a change of it ends a run), so
         only the first can report a change; the rest leave ``flag`` as it is."""
-        if ControlMode not in run_classes(batch):
+        if ControlMode not in batch.classes():
             return
         if not batch.state.in_offboard:
             self.flag = None
@@ -454,7 +453,7 @@ class RequiredEstimateMissing(Check):
     def on_batch(self, batch: StreamBatch) -> None:
         """The state an OCM is judged on is fixed within a run, so every OCM of it gives the
         same key: only the first can report (then replayed), the rest keep ``bad_key``."""
-        if ControlMode not in run_classes(batch):
+        if ControlMode not in batch.classes():
             return
         self.saw_mode = True
         key = None

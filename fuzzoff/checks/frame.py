@@ -16,7 +16,6 @@ from itertools import repeat
 from operator import attrgetter, gt, itemgetter
 
 from fuzzoff.checks._external import Episodes, from_external
-from fuzzoff.checks._runs import messages_of, wanted_types
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import (
     AttitudeSetpoint,
@@ -76,19 +75,19 @@ class FrameConventionSuspect(Check):
         """Waiting for the first sizeable vertical command since the vehicle was on the ground."""
         self.armed: bool | None = None
         """The last recorded arming state (None: not recorded yet)."""
-        self.thrust_types = wanted_types((AttitudeSetpoint, RatesSetpoint))
-        self.takeoff_types = wanted_types((TrajectorySetpoint, SetPositionTargetLocal))
+        self.thrust_types = (AttitudeSetpoint, RatesSetpoint)
+        self.takeoff_types = (TrajectorySetpoint, SetPositionTargetLocal)
 
     def on_batch(self, batch: StreamBatch) -> None:
         """Fast path: no external setpoint that could be the first vertical command (else
         replay), and no thrust above the threshold: every thrust setpoint is then ``good``, which
         only closes (reports) an open stretch at the first message of its kind."""
-        if self.takeoff_pending and self._external(messages_of(batch, self.takeoff_types)):
+        if self.takeoff_pending and self._external(batch.of(self.takeoff_types)):
             self.replay(batch)
             return
         if self.ctx.profile.vehicle != "mc":
             return
-        thrust = self._external(messages_of(batch, self.thrust_types))
+        thrust = self._external(batch.of(self.thrust_types))
         if not thrust:
             return
         if any(map(gt, map(_Z, map(_THRUST_Z, thrust)), repeat(self.thrust_z))):

@@ -18,7 +18,6 @@ from typing import Any
 
 from fuzzoff.checks._external import from_external
 from fuzzoff.checks._keepalive import mode_note
-from fuzzoff.checks._runs import messages_of, wanted_types
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import MAVLINK_SETPOINTS, PX4_SETPOINTS, Event, VehicleStatus, Where
 from fuzzoff.gate import GateTransition
@@ -199,7 +198,7 @@ class SetpointFrozen(Check):
         self.freeze = float(ctx.option("OFB107", "freeze_s"))
         self.max_gap = float(ctx.option("OFB107", "max_gap_s"))
         self.runs: dict[str, _Run] = {}
-        self.setpoints = wanted_types(self.wants)
+        self.setpoints = self.wants
         self.changing: dict[str, str | None] = {}
         """Per kind, how the last run was proven: the field that changed every time, or None
         (frozen content). Tried first on the next run."""
@@ -243,7 +242,7 @@ class SetpointFrozen(Check):
         (``all_alike``, ``changing_field``); the first message is compared with the open run as
         ``on_event`` does. The open run is then closed at most once, at a known message. Any
         other run, rover placeholders and two kinds closing a run in one batch replay."""
-        events = messages_of(batch, self.setpoints)
+        events = batch.of(self.setpoints)
         if not events:
             return
         if not self.ctx.state.flying:  # every message closes every run: the first one does

@@ -19,7 +19,7 @@ from operator import attrgetter
 from typing import Any
 
 from fuzzoff.checks._episodes import Episodes, Offence
-from fuzzoff.checks._runs import Verdicts, commit_alike, messages_of, wanted_types
+from fuzzoff.checks._runs import Verdicts, commit_alike
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.checks.content import _axis_problems
 from fuzzoff.events import (
@@ -113,7 +113,7 @@ class PositionTargetFields(Check):
         self.vehicle_label = VEHICLE_LABELS[self.group]
         self.by_mask: dict[tuple[str, int, int], list[tuple[str, dict[str, Offence]]]] = {}
         """Verdicts by (message, type_mask, frame): a stream repeats the same few."""
-        self.stream_types = wanted_types(self.wants)
+        self.stream_types = self.wants
         self.by_key: dict[tuple[object, ...], Verdicts] = {}
         """What a message commits by ``_KEY``, with every float finite (runs only)."""
         self.est_seen: Estimates | None = None
@@ -134,7 +134,7 @@ class PositionTargetFields(Check):
         receiver's axes, on every float field being finite, ``all_finite``). With no offence and
         nothing open, nothing happens; with one key, every message commits the same offences
         and (gaps under ``MERGE_GAP_S``) only extends the stretches the first one opened."""
-        events = messages_of(batch, self.stream_types)
+        events = batch.of(self.stream_types)
         keys = set(map(_KEY, events))
         if any(key[0] != "sent" for key in keys):  # on_event judges only these
             events = [e for e in events if e.origin == "sent"]
@@ -445,7 +445,7 @@ class LegacySetpointDropped(Check):
         super().__init__(ctx)
         self.episodes = Episodes(ctx)
         self.px4 = ctx.profile.px4
-        self.stream_types = wanted_types(self.wants)
+        self.stream_types = self.wants
 
     def on_event(self, event: Event) -> None:
         if event.origin != "sent":
@@ -457,7 +457,7 @@ class LegacySetpointDropped(Check):
     def on_batch(self, batch: StreamBatch) -> None:
         """Fast path: with every float field finite (``all_finite``) the offences depend only on
         the message type and its type_mask; then as ``commit_alike``, else replay."""
-        events = messages_of(batch, self.stream_types)
+        events = batch.of(self.stream_types)
         if events and set(map(_ORIGIN, events)) != {"sent"}:
             events = [e for e in events if e.origin == "sent"]
         if not events:

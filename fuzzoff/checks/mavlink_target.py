@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from operator import attrgetter
 
 from fuzzoff.checks._episodes import Episodes, Offence
-from fuzzoff.checks._runs import commit_alike, messages_of, wanted_types
+from fuzzoff.checks._runs import commit_alike
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import Event, MavlinkTarget, SetAttitudeTarget, Where
 from fuzzoff.tables import mavlink as tm
@@ -37,7 +37,7 @@ class AttitudeTargetMask(Check):
     def __init__(self, ctx: CheckContext) -> None:
         super().__init__(ctx)
         self.episodes = Episodes(ctx)
-        self.stream_types = wanted_types(self.wants)
+        self.stream_types = self.wants
         self.by_mask: dict[int, dict[str, Offence]] = {}
 
     def on_event(self, event: Event) -> None:
@@ -51,7 +51,7 @@ class AttitudeTargetMask(Check):
 
     def on_batch(self, batch: StreamBatch) -> None:
         """Fast path: the offences depend only on the type_mask (``commit_alike``)."""
-        events = messages_of(batch, self.stream_types)
+        events = batch.of(self.stream_types)
         if events and set(map(_ORIGIN, events)) != {"sent"}:
             events = [e for e in events if e.origin == "sent"]
         if not events:
@@ -117,7 +117,7 @@ class SetpointTarget(Check):
         self.pending: dict[tuple[int, int], _Pending] = {}
         self.judged: dict[tuple[int, int, tuple[int, int] | None], dict[str, Offence]] = {}
         """Verdicts by (target system, target component, the vehicle's ids)."""
-        self.setpoint_types = wanted_types((MavlinkTarget,))
+        self.setpoint_types = (MavlinkTarget,)
 
     def _own_ids(self) -> tuple[int, int] | None:
         params = self.ctx.state.params
@@ -156,7 +156,7 @@ class SetpointTarget(Check):
         if may_change and "vehicle" in set(map(_ORIGIN, batch.events)):
             self.replay(batch)
             return
-        setpoints = messages_of(batch, self.setpoint_types)  # judged: sent as MAVLink
+        setpoints = batch.of(self.setpoint_types)  # judged: sent as MAVLink
         routes = set(map(_ROUTE_TARGET, setpoints))
         judged = [route[:2] == ("sent", "mavlink") for route in routes]
         if not any(judged):  # none (MAVROS, or no setpoint at all)
