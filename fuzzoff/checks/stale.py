@@ -6,18 +6,26 @@ Seed 000, ROS 2 warning item 4: PX4 does not failsafe when setpoints stop, only 
 
 from __future__ import annotations
 
+import math
 from operator import attrgetter, le, sub
 
-from fuzzoff.checks._keepalive import mode_note
+from fuzzoff.checks._keepalive import (
+    control_modes,
+    keepalive_run,
+    mode_note,
+    of_types,
+    stream_types,
+)
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import PX4_SETPOINTS, ControlMode, Event, Where
 from fuzzoff.tables.control_mode import SETPOINT_NAMES
 
 ROS2_FORMATS = ("mcap", "rosbag2-sqlite3", "rosbag2-mcap")
 
-_OCM: tuple[type[Event], ...] = (ControlMode,)
+_SETPOINTS = stream_types(PX4_SETPOINTS)
 _TIME = attrgetter("t")
-_KIND = attrgetter("kind")
+_ORIGIN = attrgetter("origin")
+_SENT = {"sent"}
 
 
 class StaleSetpoints(Check):
@@ -86,23 +94,25 @@ class StaleSetpoints(Check):
         ``stale_s`` before each OffboardControlMode: then each of them finds a served
         alternative (``event.t - oldest`` can only be smaller) and nothing is reported.
         Only the last times move."""
-        ocms = batch.of(_OCM)
-        setpoints = batch.of(PX4_SETPOINTS)
+        present: set[type[Event]] = set(map(type, batch.events))
+        ocms = control_modes(batch, present)
+        setpoint_types: set[type[Event]] = present & _SETPOINTS
+        setpoints = of_types(batch.events, present, _SETPOINTS)
+        kinds = {cls.kind for cls in setpoint_types}
+        all_sent = not setpoints or set(map(_ORIGIN, setpoints)) == _SENT
         if not ocms:
-            self._note_sent(setpoints)
+            self._note_sent(setpoints, kinds)
             return
-        ocm_times = list(map(_TIME, ocms))
+        ocm_times, widest = self._times(batch, ocms)
         last_ocm = self.last_ocm
-        if max(map(sub, ocm_times[1:], ocm_times), default=0.0) > self.stale or (
-            last_ocm is not None and ocm_times[0] - last_ocm > self.stale
-        ):
+        if widest > self.stale or (last_ocm is not None and ocm_times[0] - last_ocm > self.stale):
             self.replay(batch)  # the keep-alive paused: ocm_since moves
             return
         if batch.state.flying:
             alternatives = self._alternatives(batch.state.declared_flag)
             if alternatives is not None and (
                 self.episode is not None
-                or not self._served(batch, alternatives, setpoints, ocm_times[-1])
+                or not self._served(batch, alternatives, setpoints, kinds, all_sent, ocm_times[-1])
             ):
                 self.replay(batch)
                 return
@@ -111,13 +121,26 @@ class StaleSetpoints(Check):
         if last_ocm is None:
             self.ocm_since = ocm_times[0]
         self.last_ocm = ocm_times[-1]
-        self._note_sent(setpoints)
+        self._note_sent(setpoints, kinds)
+
+    @staticmethod
+    def _times(batch: StreamBatch, ocms: list[Event]) -> tuple[list[float], float]:
+        """The OCMs' times and the widest gap between them (-inf for one): the keep-alive
+        figures when the OCMs are the run's keep-alives (ROS 2: they are, and several stream
+        rules share those)."""
+        if ocms is batch.keepalives():
+            run = keepalive_run(batch)
+            return run.times, run.widest
+        times = list(map(_TIME, ocms))
+        return times, max(map(sub, times[1:], times), default=-math.inf)
 
     def _served(
         self,
         batch: StreamBatch,
         alternatives: tuple[tuple[str, ...], ...],
         setpoints: list[Event],
+        kinds: set[str],
+        all_sent: bool,
         newest_ocm: float,
     ) -> bool:
         """Does one alternative provably serve every OffboardControlMode of the run? With
@@ -131,7 +154,10 @@ class StaleSetpoints(Check):
                 before = self.last_sent.get(kind)
                 if before is None:
                     break
-                sent = [e.t for e in setpoints if e.kind == kind and e.origin == "sent"]
+                if all_sent and kinds == {kind}:
+                    sent = list(map(_TIME, setpoints))
+                else:
+                    sent = [e.t for e in setpoints if e.kind == kind and e.origin == "sent"]
                 sent.insert(0, before)
                 oldest = max(map(sub, sent[1:], sent), default=0.0)
                 if newest_ocm - sent[-1] > oldest:
@@ -142,9 +168,9 @@ class StaleSetpoints(Check):
                 return True
         return False
 
-    def _note_sent(self, setpoints: list[Event]) -> None:
+    def _note_sent(self, setpoints: list[Event], kinds: set[str]) -> None:
         """``last_sent`` as ``on_event`` leaves it: each kind's newest message as sent."""
-        missing = set(map(_KIND, setpoints))
+        missing = set(kinds)
         for event in reversed(setpoints):  # usually a step or two per kind
             if event.kind in missing and event.origin == "sent":
                 self.last_sent[event.kind] = event.t

@@ -91,11 +91,16 @@ class KeepaliveRate(Check):
 
     def on_batch(self, batch: StreamBatch) -> None:
         """Fast path: only short gaps (under the limit whatever the logger's interval) and no
-        gap outside offboard kept for a later request: just move ``last`` on."""
+        gap outside offboard kept for a later request: just move ``last`` on. A gap kept in
+        ``recent`` is trimmed by every message ``on_event`` sees, keep-alive or not (a MAVLink
+        setpoint for another vehicle): replay then."""
+        if self.recent:
+            self.replay(batch)
+            return
         keepalives = batch.keepalives()
         if not keepalives:
             return
-        if self.recent or not self.quick:
+        if not self.quick:
             self.replay(batch)
             return
         last = None if self.dropout_since_last else self.last

@@ -13,11 +13,11 @@ from dataclasses import dataclass
 from itertools import repeat
 from operator import attrgetter, le, sub, truediv
 
+from fuzzoff.checks._keepalive import control_modes, keepalive_run
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import ControlMode, Event, Where
 from fuzzoff.findings import Severity
 
-_OCM: tuple[type[Event], ...] = (ControlMode,)
 _STAMP = attrgetter("sender_time_us")
 _ORIGIN = attrgetter("origin")
 _TIME = attrgetter("t")
@@ -70,7 +70,7 @@ class KeepaliveTimestamp(Check):
         the limit even against the best offset after the run (no greater than any offset a
         message saw, so every lag ``on_event`` works out is at most that): then none is noted
         and only ``best_offset`` and ``previous`` move (to the least offset and last stamp)."""
-        ocms = batch.of(_OCM)
+        ocms = control_modes(batch, set(map(type, batch.events)))
         if not ocms:
             return
         origins = set(map(_ORIGIN, ocms))
@@ -81,7 +81,9 @@ class KeepaliveTimestamp(Check):
         if len(origins) > 1 or None in stamps or 0 in stamps:
             self.replay(batch)
             return
-        offsets = list(map(sub, map(_TIME, ocms), map(truediv, stamps, repeat(1e6))))
+        # the keep-alive times when the OCMs are the run's keep-alives (ROS 2: they are)
+        times = keepalive_run(batch).times if ocms is batch.keepalives() else map(_TIME, ocms)
+        offsets = list(map(sub, times, map(truediv, stamps, repeat(1e6))))
         if self.previous is not None:
             stamps.insert(0, self.previous)
         best = min(offsets)
