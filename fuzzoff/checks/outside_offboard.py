@@ -22,6 +22,8 @@ _KIND = attrgetter("kind")
 _ORIGIN = attrgetter("origin")
 _SENT = {"sent"}
 
+assert {cls.kind for cls in PX4_SETPOINTS} <= SETPOINT_KINDS  # on_batch takes every one as named
+
 
 @dataclass(slots=True)
 class _Run:
@@ -64,22 +66,19 @@ class SetpointsOutsideOffboard(Check):
 
     def on_batch(self, batch: StreamBatch) -> None:
         """The run's setpoints all see the same ``in_offboard``, and what ``on_event`` does
-        with them does not depend on their order: any logged copy sets ``logged``; in
-        offboard the first one as sent closes the open run; outside it those as sent extend
-        the run (opened by the first), adding their topics in order of first appearance."""
+        with them does not depend on their order (every setpoint kind has a name): any
+        logged copy sets ``logged``; in offboard the first one as sent closes the open run;
+        outside it those as sent extend the run (opened by the first), adding their topics
+        in order of first appearance."""
         setpoints = run_messages(batch, _SETPOINTS)
         if not setpoints:
             return
-        kinds = dict.fromkeys(map(_KIND, setpoints))
-        if not SETPOINT_KINDS.issuperset(kinds):
-            self.replay(batch)  # a kind without a name: keep on_event's order of tests
-            return
-        if set(map(_ORIGIN, setpoints)) != _SENT:
+        origins = set(map(_ORIGIN, setpoints))
+        if origins != _SENT:
             self.logged = True
-            setpoints = [e for e in setpoints if e.origin == "sent"]
-            if not setpoints:
+            if "sent" not in origins:
                 return
-            kinds = dict.fromkeys(map(_KIND, setpoints))
+            setpoints = [e for e in setpoints if e.origin == "sent"]
         if batch.state.in_offboard:
             if self.run is not None:
                 self._close()
@@ -91,7 +90,7 @@ class SetpointsOutsideOffboard(Check):
         run = self.run
         run.last = setpoints[-1].t
         run.count += len(setpoints)
-        for kind in kinds:
+        for kind in dict.fromkeys(map(_KIND, setpoints)):
             name = SETPOINT_NAMES[kind]
             if name not in run.topics:
                 run.topics.append(name)
