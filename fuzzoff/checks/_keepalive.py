@@ -7,7 +7,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 from operator import attrgetter, sub
 
-from fuzzoff.checks.base import STREAM_TYPES, CheckContext, StreamBatch
+from fuzzoff.checks.base import CheckContext, StreamBatch
 from fuzzoff.events import (
     KEEPALIVE_TYPES,
     ControlMode,
@@ -76,44 +76,19 @@ def keepalive_run(batch: StreamBatch) -> KeepaliveRun:
     return KeepaliveRun(events, times, gaps)
 
 
-def stream_types(types: tuple[type[Event], ...]) -> frozenset[type[Event]]:
-    """The stream classes ``isinstance(event, types)`` accepts (a run holds only messages whose
-    exact class is one of ``STREAM_TYPES``), for ``run_messages``."""
-    return frozenset(cls for cls in STREAM_TYPES if issubclass(cls, types))
+_OTHER_KEEPALIVES = frozenset(KEEPALIVE_TYPES) - {ControlMode}
+_OCM: tuple[type[Event], ...] = (ControlMode,)
 
 
-def run_messages(batch: StreamBatch, wanted: frozenset[type[Event]]) -> list[Event]:
-    """``batch.of(types)`` for ``wanted = stream_types(types)``, by set membership instead of
-    ``isinstance`` over a long tuple (~0.2 µs a message for the setpoint types), and without a
-    pass when all or none of the run is wanted. Do not change the list: it may be
-    ``batch.events`` itself."""
-    return of_types(batch.events, set(map(type, batch.events)), wanted)
-
-
-def of_types(
-    events: list[Event], present: set[type[Event]], wanted: frozenset[type[Event]]
-) -> list[Event]:
-    """``run_messages`` for a run's ``events`` whose classes (``present``) are known."""
-    if present <= wanted:
-        return events
-    if present.isdisjoint(wanted):
-        return []
-    return [e for e in events if type(e) in wanted]
-
-
-_OCM = frozenset((ControlMode,))
-_OTHER_KEEPALIVES = stream_types(KEEPALIVE_TYPES) - _OCM
-
-
-def control_modes(batch: StreamBatch, present: set[type[Event]]) -> list[Event]:
-    """The run's OffboardControlMode messages (``present``: the classes in the run): without
-    a pass when they are the run's keep-alives (no other keep-alive kind in the run: ROS 2),
-    so the ``keepalive_run`` figures are theirs too. Do not change the list."""
-    if ControlMode not in present:
-        return []
-    if present.isdisjoint(_OTHER_KEEPALIVES):
+def control_modes(batch: StreamBatch) -> list[Event]:
+    """The run's OffboardControlMode messages, ``batch.of((ControlMode,))``: the run's
+    keep-alives themselves when no other keep-alive kind is in the run (ROS 2; every OCM
+    counts, ``VehicleState.counts_as_keepalive``), so the ``keepalive_run`` figures are
+    theirs too. Do not change the list."""
+    present = batch.classes()
+    if ControlMode in present and present.isdisjoint(_OTHER_KEEPALIVES):
         return batch.keepalives()
-    return of_types(batch.events, present, _OCM)
+    return batch.of(_OCM)
 
 
 def logging_interval(ctx: CheckContext, event: Event) -> float:

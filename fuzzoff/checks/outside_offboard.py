@@ -10,14 +10,13 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from operator import attrgetter
 
-from fuzzoff.checks._keepalive import mode_note, run_messages, stream_types
+from fuzzoff.checks._keepalive import mode_note
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import PX4_SETPOINTS, Event, VehicleStatus, Where
 from fuzzoff.gate import GateTransition
 from fuzzoff.modes import nav_state_name
 from fuzzoff.tables.control_mode import SETPOINT_KINDS, SETPOINT_NAMES
 
-_SETPOINTS = stream_types(PX4_SETPOINTS)
 _KIND = attrgetter("kind")
 _ORIGIN = attrgetter("origin")
 _SENT = {"sent"}
@@ -70,7 +69,7 @@ class SetpointsOutsideOffboard(Check):
         logged copy sets ``logged``; in offboard the first one as sent closes the open run;
         outside it those as sent extend the run (opened by the first), adding their topics
         in order of first appearance."""
-        setpoints = run_messages(batch, _SETPOINTS)
+        setpoints = batch.of(PX4_SETPOINTS)
         if not setpoints:
             return
         origins = set(map(_ORIGIN, setpoints))

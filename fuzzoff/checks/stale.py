@@ -9,20 +9,14 @@ from __future__ import annotations
 import math
 from operator import attrgetter, le, sub
 
-from fuzzoff.checks._keepalive import (
-    control_modes,
-    keepalive_run,
-    mode_note,
-    of_types,
-    stream_types,
-)
+from fuzzoff.checks._keepalive import control_modes, keepalive_run, mode_note
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import PX4_SETPOINTS, ControlMode, Event, Where
 from fuzzoff.tables.control_mode import SETPOINT_NAMES
 
 ROS2_FORMATS = ("mcap", "rosbag2-sqlite3", "rosbag2-mcap")
 
-_SETPOINTS = stream_types(PX4_SETPOINTS)
+_SETPOINTS: frozenset[type[Event]] = frozenset(PX4_SETPOINTS)
 _TIME = attrgetter("t")
 _ORIGIN = attrgetter("origin")
 _SENT = {"sent"}
@@ -94,11 +88,9 @@ class StaleSetpoints(Check):
         ``stale_s`` before each OffboardControlMode: then each of them finds a served
         alternative (``event.t - oldest`` can only be smaller) and nothing is reported.
         Only the last times move."""
-        present: set[type[Event]] = set(map(type, batch.events))
-        ocms = control_modes(batch, present)
-        setpoint_types: set[type[Event]] = present & _SETPOINTS
-        setpoints = of_types(batch.events, present, _SETPOINTS)
-        kinds = {cls.kind for cls in setpoint_types}
+        ocms = control_modes(batch)
+        setpoints = batch.of(PX4_SETPOINTS)
+        kinds = {cls.kind for cls in batch.classes() & _SETPOINTS}
         all_sent = not setpoints or set(map(_ORIGIN, setpoints)) == _SENT
         if not ocms:
             self._note_sent(setpoints, kinds)

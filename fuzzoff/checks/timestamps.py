@@ -70,7 +70,7 @@ class KeepaliveTimestamp(Check):
         the limit even against the best offset after the run (no greater than any offset a
         message saw, so every lag ``on_event`` works out is at most that): then none is noted
         and only ``best_offset`` and ``previous`` move (to the least offset and last stamp)."""
-        ocms = control_modes(batch, set(map(type, batch.events)))
+        ocms = control_modes(batch)
         if not ocms:
             return
         origins = set(map(_ORIGIN, ocms))
