@@ -10,17 +10,11 @@ The typed API the CLI is a thin layer over::
 
 from __future__ import annotations
 
-from importlib.metadata import PackageNotFoundError, version
-
+from fuzzoff._version import __version__
 from fuzzoff.config import ConfigError, Settings, load_settings
 from fuzzoff.engine import lint_file, lint_paths, run_events
 from fuzzoff.findings import FileReport, Finding, Report, Severity
 from fuzzoff.profiles import Profile
-
-try:
-    __version__ = version("fuzzoff")
-except PackageNotFoundError:  # pragma: no cover - running from a checkout without install
-    __version__ = "0.0.0"
 
 __all__ = [
     "ConfigError",
