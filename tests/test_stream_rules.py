@@ -6,6 +6,8 @@ from dataclasses import replace
 
 import pytest
 
+from fuzzoff.config import Settings
+from fuzzoff.engine import run_events
 from fuzzoff.events import (
     Command,
     Dropout,
@@ -14,6 +16,8 @@ from fuzzoff.events import (
     VehicleStatus,
 )
 from fuzzoff.findings import Severity
+from fuzzoff.profiles import Profile
+from fuzzoff.sources.base import RecordingInfo
 from tests.streams import OFFBOARD, POSCTL, ack, codes, every, lint_events, ocm, status, switch
 
 
@@ -254,3 +258,14 @@ def test_ofb101_a_gap_that_spans_the_switch_counts() -> None:
     (found,) = codes(lint_events(events), "OFB101")
     assert "across the switch" in found.message
     assert found.time_s == pytest.approx(1.0) and found.end_s == pytest.approx(1.8)
+
+
+def test_ofb105_keepalives_out_of_time_order_do_not_break_the_check() -> None:
+    # a recording not in time order (e.g. an MCAP read in file order) can step back in time
+    times = every(0.0, 5.0, 0.1)
+    events = [status(0.0, OFFBOARD), *ocm(times), *ocm([4.2])]
+    info = RecordingInfo("stream", "mcap", kinds={e.kind for e in events})
+    profile = Profile(px4="1.15", vehicle="mc", px4_detected=True, vehicle_detected=True)
+    for batching in (True, False):
+        found, _ = run_events(events, info, profile, Settings(), batching=batching)
+        assert codes(found, "OFB105") == []

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import lru_cache
 from operator import attrgetter, sub
 
 from fuzzoff.checks.base import CheckContext, StreamBatch
@@ -66,14 +65,16 @@ class KeepaliveRun:
         return 0.0 if widest == -math.inf else widest
 
 
-@lru_cache(maxsize=1)
 def keepalive_run(batch: StreamBatch) -> KeepaliveRun:
-    """The run's ``KeepaliveRun`` (non-empty runs only: callers test ``batch.keepalives()``).
-    Cached on the run itself (identity; the cache holds it, so it cannot be another run)."""
-    events = batch.keepalives()
-    times = list(map(_TIME, events))
-    gaps = sorted(map(sub, times[1:], times))
-    return KeepaliveRun(events, times, gaps)
+    """The run's ``KeepaliveRun`` (non-empty runs only: callers test ``batch.keepalives()``),
+    worked out once per run (``StreamBatch.memo``)."""
+    found: KeepaliveRun | None = batch.memo.get(keepalive_run)
+    if found is None:
+        events = batch.keepalives()
+        times = list(map(_TIME, events))
+        gaps = sorted(map(sub, times[1:], times))
+        found = batch.memo[keepalive_run] = KeepaliveRun(events, times, gaps)
+    return found
 
 
 _OTHER_KEEPALIVES = frozenset(KEEPALIVE_TYPES) - {ControlMode}

@@ -17,12 +17,15 @@ from __future__ import annotations
 import copy
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from operator import attrgetter
 from typing import Any, ClassVar
 
 from fuzzoff.catalog import get_rule
 from fuzzoff.config import Settings
 from fuzzoff.events import (
+    KEEPALIVE_ROS,
     KEEPALIVE_TYPES,
+    MAVLINK_SETPOINTS,
     PX4_SETPOINTS,
     ControlMode,
     Event,
@@ -119,6 +122,10 @@ STREAM_TYPES: frozenset[type[Event]] = frozenset((*KEEPALIVE_TYPES, *PX4_SETPOIN
 
 assert not any(a is not b and issubclass(a, b) for a in STREAM_TYPES for b in STREAM_TYPES)
 
+_ROS_KEEPALIVES: frozenset[type[Event]] = frozenset(KEEPALIVE_ROS)
+_MAVLINK_KEEPALIVES: frozenset[type[Event]] = frozenset(MAVLINK_SETPOINTS)
+_TARGET_SYSTEM = attrgetter("target_system")
+
 
 class StreamBatch:
     """A run of consecutive stream messages of one vehicle, in time order.
@@ -138,7 +145,7 @@ class StreamBatch:
     ``tests/test_batching.py`` and the ``runs`` fuzz property compare the two.
     """
 
-    __slots__ = ("_classes", "_keepalives", "_of", "events", "gate", "state")
+    __slots__ = ("_classes", "_keepalives", "_of", "events", "gate", "memo", "state")
 
     def __init__(self, state: VehicleState, gate: GateModel) -> None:
         self.events: list[Event] = []
@@ -147,6 +154,10 @@ class StreamBatch:
         self._keepalives: list[Event] | None = None
         self._of: dict[tuple[type[Event], ...], list[Event]] = {}
         self._classes: frozenset[type[Event]] | None = None
+        self.memo: dict[object, Any] = {}
+        """What several checks derive from the run (e.g. the keep-alive times and gaps), kept
+        with the run so that it is worked out once and goes when the run goes. Keyed by the
+        function that derives it."""
 
     def classes(self) -> frozenset[type[Event]]:
         """The classes of the run's messages (exact ``STREAM_TYPES`` classes), worked out once."""
@@ -177,9 +188,23 @@ class StreamBatch:
     def keepalives(self) -> list[Event]:
         """The run's messages that count as keep-alive (``VehicleState.keepalive`` rules)."""
         if self._keepalives is None:
-            counts = self.state.counts_as_keepalive
-            self._keepalives = [e for e in self.events if counts(e)]
+            self._keepalives = self._find_keepalives()
         return self._keepalives
+
+    def _find_keepalives(self) -> list[Event]:
+        """Decided for the whole run where its classes and targets allow (every OCM counts;
+        a MAVLink setpoint counts when addressed to all or to this vehicle), else per message."""
+        present = self.classes()
+        events = self.events
+        if present <= _ROS_KEEPALIVES:
+            return events
+        own = self.state.own_system
+        if present <= _MAVLINK_KEEPALIVES and (
+            own is None or set(map(_TARGET_SYSTEM, events)) <= {0, own}
+        ):
+            return events
+        counts = self.state.counts_as_keepalive
+        return [e for e in events if counts(e)]
 
 
 class Check:

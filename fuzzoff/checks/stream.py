@@ -284,6 +284,8 @@ class _Histogram:
 
     def add(self, gap: float) -> None:
         # min()/max() spelled out: this runs once per keep-alive message
+        if gap < 0.0:
+            return  # out-of-order times (a recording not in time order): not an interval
         ms = int(gap * 1000)
         self.bins[ms if ms < self.top else self.top] += 1
         self.count += 1
