@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from collections import Counter
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -331,19 +331,15 @@ def lint_file(
                 if fraction is not None:
                     progress(fraction)
 
-        try:
-            findings, stats = run_events(
-                source.events(),
-                info,
-                profile,
-                settings,
-                timelines=timelines,
-                on_event=tick,
-                batching=batching,
-            )
-        except SourceError as exc:  # a reader that gives up mid-way keeps what it yielded
-            source.problems.append(_problem(exc))
-            findings, stats = [], {}
+        findings, stats = run_events(
+            _until_unreadable(source.events(), source.problems),
+            info,
+            profile,
+            settings,
+            timelines=timelines,
+            on_event=tick,
+            batching=batching,
+        )
     finally:
         source.close()
     for problem in source.problems:
@@ -364,6 +360,15 @@ def lint_file(
     if progress is not None:
         progress(1.0)
     return report
+
+
+def _until_unreadable(events: Iterable[Event], problems: list[SourceProblem]) -> Iterator[Event]:
+    """The reader's events until it gives up: its error becomes a problem of the file and the
+    run ends there normally, so the findings on what was read are kept."""
+    try:
+        yield from events
+    except SourceError as exc:
+        problems.append(_problem(exc))
 
 
 def _problem(exc: SourceError) -> SourceProblem:

@@ -642,3 +642,27 @@ def test_round_trip_property(tmp_path_factory: pytest.TempPathFactory, events: l
     source, back = read(path)
     assert not source.problems
     assert [strip(e) for e in back] == [strip(e) for e in events]
+
+
+def test_a_reader_that_gives_up_midway_keeps_the_findings_before(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A reader error raised while streaming ends the file there: one OFB001 line, and the
+    findings on what was read (the 0.7 s gap at 8 s) stay."""
+    from fuzzoff.engine import lint_file
+
+    recording = Path(__file__).parent.parent / "corpora" / "tlog" / "stream_lost_in_offboard.tlog"
+    original = TlogSource.events
+
+    def give_up_at_10s(self: TlogSource) -> Any:
+        for event in original(self):
+            if event.t > 10.0:
+                raise SourceError(self.path, "simulated damage", "offset 1234")
+            yield event
+
+    monkeypatch.setattr(TlogSource, "events", give_up_at_10s)
+    report = lint_file(recording)
+    codes = [f.code for f in report.findings]
+    assert "OFB101" in codes and "OFB103" in codes
+    assert report.complete is False
+    assert report.problems == [f"{recording}: simulated damage at offset 1234"]
