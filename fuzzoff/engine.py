@@ -100,6 +100,7 @@ class VehicleRun:
         self._wants = [
             (check.subscriptions, check.on_event, check in self.batched) for check in self.checks
         ]
+        self._takers = [check.on_batch for check in self.batched if check.on_batch is not None]
         self._batch: StreamBatch | None = None
         self.timeline = timeline
         self.last_t = 0.0
@@ -126,9 +127,7 @@ class VehicleRun:
         live = ctx.state, ctx.gate
         ctx.state, ctx.gate = batch.state, batch.gate
         try:
-            for check in self.batched:
-                on_batch = check.on_batch
-                assert on_batch is not None
+            for on_batch in self._takers:
                 on_batch(batch)
         finally:
             ctx.state, ctx.gate = live
@@ -152,24 +151,18 @@ class VehicleRun:
         the declared control mode, so that it never spans a change of what checks read."""
         cls = type(event)
         stream = cls in STREAM_TYPES
-        batch = self._batch
-        if batch is not None and not stream:
+        if not stream:
             self._flush()
-            batch = None
         self.last_t = event.t
         state = self.state
         state.update(event)
         gate = self.gate
         transitions = gate.feed(event)
         if transitions:
-            if batch is not None:
-                self._flush()
-                batch = None
+            self._flush()
             self._transitions(transitions)
         if gate.in_offboard != state.predicted_offboard:  # set_predicted's own first test
-            if batch is not None:
-                self._flush()
-                batch = None
+            self._flush()
             state.set_predicted(gate.in_offboard, event.t)
         if self.timeline is not None:
             self._record(event)
@@ -178,7 +171,8 @@ class VehicleRun:
             handlers = self._handlers_for(cls)
         for handler in handlers:
             handler(event)
-        if stream and self.batched:
+        if stream and self._takers:
+            batch = self._batch
             if batch is not None and state.declared_flag != batch.state.declared_flag:
                 self._flush()
                 batch = None

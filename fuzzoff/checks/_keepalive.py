@@ -19,18 +19,6 @@ KEEPALIVE_EVENTS: tuple[type[Event], ...] = (*KEEPALIVE_TYPES, Dropout)
 """What a stream rule subscribes to: the keep-alive kinds, and logger dropouts (ULog)."""
 
 
-def worst_gap(last: float | None, events: list[Event]) -> float:
-    """The longest interval between consecutive ``events`` (and from ``last`` to the first, when
-    given), 0 for fewer than two times: the runs' fast paths test it against their limits."""
-    times = [e.t for e in events]
-    if last is not None:
-        times.insert(0, last)
-    if len(times) < 2:
-        return 0.0
-    gaps: map[float] = map(sub, times[1:], times)
-    return max(gaps)
-
-
 _TIME = attrgetter("t")
 
 
@@ -57,7 +45,8 @@ class KeepaliveRun:
         return self.gaps[0] if self.gaps else math.inf
 
     def worst_gap(self, last: float | None) -> float:
-        """``worst_gap(last, self.events)``, from the figures already worked out."""
+        """The longest interval between consecutive keep-alives of the run and from ``last``
+        (when given) to the first; 0 for fewer than two times."""
         widest = self.widest
         if last is not None:
             first = self.times[0] - last
