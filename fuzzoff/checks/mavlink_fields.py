@@ -30,7 +30,7 @@ from fuzzoff.events import (
 )
 from fuzzoff.findings import Severity
 from fuzzoff.gate.estimates import Estimates
-from fuzzoff.gate.receiver import DROPPED, ReceiverContext, receive
+from fuzzoff.gate.receiver import DROPPED, FLOAT_FIELDS, ReceiverContext, receive
 from fuzzoff.profiles import at_least
 from fuzzoff.tables import mavlink as tm
 
@@ -47,19 +47,11 @@ _KEY = attrgetter(
 everything ``receive`` reads from a position target; the rest of the verdicts read only kind,
 type_mask and coordinate_frame."""
 
-_FLOATS: dict[type[Event], tuple[tuple[Callable[[Event], Any], ...], ...]] = {
+_FLOATS: dict[type, tuple[tuple[Callable[[Event], Any], ...], ...]] = {
     cls: (tuple(map(attrgetter, vectors)), tuple(map(attrgetter, values)))
-    for cls, vectors, values in (
-        (SetPositionTargetLocal, ("position", "velocity", "acceleration"), ("yaw", "yaw_rate")),
-        (SetPositionTargetGlobal, ("velocity", "acceleration"), ("alt", "yaw", "yaw_rate")),
-        (
-            SetAttitudeTarget,
-            ("q",),
-            ("thrust", "body_roll_rate", "body_pitch_rate", "body_yaw_rate"),
-        ),
-    )
+    for cls, (vectors, values) in FLOAT_FIELDS.items()
 }
-"""The float fields of each message (vectors, then single values), as getters."""
+"""The float fields ``receive`` classifies (``FLOAT_FIELDS``), as getters."""
 
 
 def all_finite(events: list[Event]) -> bool:

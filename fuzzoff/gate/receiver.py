@@ -88,6 +88,15 @@ def _present3(v: tuple[float, float, float], ignore: int, old_rule: bool) -> tup
 Shape = tuple[object, ...]
 """Everything ``receive`` reads from one message, as a cache key (see ``shape``)."""
 
+FLOAT_FIELDS: dict[type, tuple[tuple[str, ...], tuple[str, ...]]] = {
+    SetPositionTargetLocal: (("position", "velocity", "acceleration"), ("yaw", "yaw_rate")),
+    SetPositionTargetGlobal: (("velocity", "acceleration"), ("alt", "yaw", "yaw_rate")),
+    SetAttitudeTarget: (("q",), ("thrust", "body_roll_rate", "body_pitch_rate", "body_yaw_rate")),
+}
+"""The float fields of each message ``receive`` classifies (vectors, then single values): the
+ones whose finiteness the shape must settle. The ``_*_shape`` functions below are this table
+unrolled (they run once per message); ``tests/gate/test_fast_paths.py`` ties the two."""
+
 
 def _local_shape(msg: SetPositionTargetLocal) -> Shape | None:
     px, py, pz = msg.position

@@ -8,6 +8,7 @@ only while the loss does not move earlier.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from typing import Any
 
 from hypothesis import given, settings
@@ -25,7 +26,7 @@ from fuzzoff.events import (
 )
 from fuzzoff.gate import GateModel
 from fuzzoff.gate.estimates import Estimates
-from fuzzoff.gate.receiver import ReceiverContext, receive, shape
+from fuzzoff.gate.receiver import FLOAT_FIELDS, ReceiverContext, receive, shape
 from fuzzoff.profiles import Profile
 from tests.gate.streams import ALL, in_offboard, local_ned, of, run
 
@@ -137,6 +138,21 @@ def test_a_non_finite_field_is_never_cached() -> None:
         assert shape(SetPositionTargetGlobal(t=0.0, alt=bad)) is None
     # an overflowing sum only takes the uncached path
     assert shape(local_ned(0.0, position=(1e308, 1e308, 0.0))) is None
+
+
+def test_the_shape_settles_every_float_field_the_receiver_reads() -> None:
+    """Each field of ``FLOAT_FIELDS`` made NaN takes the message off the cached path: the
+    unrolled shape functions and the table (which the checks use) name the same fields."""
+    for cls, (vectors, values) in FLOAT_FIELDS.items():
+        base = cls(t=0.0)
+        assert shape(base) is not None, cls
+        for name in vectors:
+            width = len(getattr(base, name))
+            for i in range(width):
+                vector = tuple(math.nan if j == i else 0.0 for j in range(width))
+                assert shape(replace(base, **{name: vector})) is None, (cls, name, i)
+        for name in values:
+            assert shape(replace(base, **{name: math.nan})) is None, (cls, name)
 
 
 def _dropped(trs: list[Any]) -> list[str]:
