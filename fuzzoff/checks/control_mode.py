@@ -180,8 +180,6 @@ class DeclaredSetpointMissing(Check):
         """When PX4's receiver last took one (published a setpoint in OFFBOARD)."""
         self.mav_since: float | None = None
         self.mav_checked = False
-        self._rx: ReceiverContext | None = None
-        """The receiver context last built (``_receiver``), reused while the gate agrees."""
 
     def on_event(self, event: Event) -> None:
         self._due(event.t)
@@ -191,7 +189,7 @@ class DeclaredSetpointMissing(Check):
         state = self.ctx.state
         if isinstance(event, MavlinkTarget) and event.origin == "sent":
             self.mav_sent = event
-            if state.in_offboard and self._taken(event, self._receiver()):
+            if state.in_offboard and self._taken(event, self.ctx.gate.receiver):
                 self.mav_taken = event.t
         if state.armed is not self.armed:
             self.armed = state.armed
@@ -260,7 +258,7 @@ class DeclaredSetpointMissing(Check):
         self.mav_sent = newest
         if not in_offboard:
             return
-        rx = self._receiver()
+        rx = self.ctx.gate.receiver
         for event in chain((newest,), sent):
             assert isinstance(event, MavlinkTarget)
             if self._taken(event, rx):
@@ -293,28 +291,6 @@ class DeclaredSetpointMissing(Check):
         )
 
     # -- MAVLink ------------------------------------------------------------------------
-
-    def _receiver(self) -> ReceiverContext:
-        """What PX4's receiver reads besides the message, from the gate model now (the last
-        one built while the parameters agree and the estimates are the same object)."""
-        gate = self.ctx.gate
-        own_component = int(gate.params.get("MAV_COMP_ID", 1.0))
-        fwdextsp = bool(gate.params.get("MAV_FWDEXTSP", 1.0))
-        rx = self._rx
-        if (
-            rx is None
-            or rx.est is not gate.est
-            or rx.own_component != own_component
-            or rx.fwdextsp != fwdextsp
-        ):
-            rx = self._rx = ReceiverContext(
-                px4=self.ctx.profile.px4,
-                own_system=int(self.ctx.vehicle) if self.ctx.vehicle.isdigit() else None,
-                own_component=own_component,
-                fwdextsp=fwdextsp,
-                est=gate.est,
-            )
-        return rx
 
     @staticmethod
     def _taken(event: MavlinkTarget, rx: ReceiverContext) -> bool:

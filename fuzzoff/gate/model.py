@@ -149,6 +149,12 @@ class GateModel:
         return self._nav == NAV_STATE_OFFBOARD
 
     @property
+    def receiver(self) -> ReceiverContext:
+        """What PX4's MAVLink receiver reads besides the message (parameters, estimates),
+        kept up to date as parameters arrive."""
+        return self._rx
+
+    @property
     def loss_timeout(self) -> float:
         return self.signal.timeout
 
