@@ -63,6 +63,13 @@ class Episodes:
                 current.last_t = t
                 current.count += 1
 
+    def extend(self, key: tuple[str, str, str], last_t: float, count: int) -> None:
+        """``update`` for ``count`` more messages committing the open stretch ``key``, the
+        newest at ``last_t``, with nothing to close in between: only its end and count move."""
+        stretch = self.open[key]
+        stretch.last_t = last_t
+        stretch.count += count
+
     def start(
         self,
         code: str,

@@ -72,6 +72,13 @@ class Episodes:
             episode.last = t
             episode.count += 1
 
+    def extend(self, key: str, last: float, count: int) -> None:
+        """``bad(key, ...)`` for ``count`` more messages, the newest at ``last``, with ``key``
+        already open (a run of messages that all commit it): only its end and count move."""
+        episode = self.open[key]
+        episode.last = last
+        episode.count += count
+
     def good(self, key: str) -> None:
         if not self.open:  # the usual clean message with nothing open
             return

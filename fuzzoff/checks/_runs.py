@@ -58,7 +58,5 @@ def extend_alike(episodes: Episodes, stream: str, events: list[Event], verdicts:
     if more:
         for code, offences in verdicts:
             for name in offences:
-                stretch = episodes.open[(code, stream, name)]
-                stretch.last_t = times[-1]
-                stretch.count += more
+                episodes.extend((code, stream, name), times[-1], more)
     return True

@@ -78,14 +78,6 @@ def _nan_pattern(motors: ActuatorMotors) -> tuple[tuple[bool, ...], tuple[bool, 
     return tuple(map(math.isnan, control)), tuple(map(math.isfinite, control))
 
 
-def _extend(episodes: Episodes, key: str, last: float, count: int) -> None:
-    """``episodes.bad(key, ...)`` for ``count`` more messages, the newest at ``last``, with the
-    episode ``key`` already open: only its end and its count move."""
-    episode = episodes.open[key]
-    episode.last = last
-    episode.count += count
-
-
 def finiteness(sp: TrajectorySetpoint) -> tuple[tuple[bool, bool, bool], ...]:
     """Which components of position, velocity and acceleration are finite (computed once)."""
     isf = math.isfinite
@@ -209,7 +201,7 @@ class TrajectoryContent(Check):
         self.on_event(first)
         if len(events) > 1:
             for episodes, key in bad:
-                _extend(episodes, key, events[-1].t, len(events) - 1)
+                episodes.extend(key, events[-1].t, len(events) - 1)
 
     def _bad_keys(
         self, flag: str, finite: tuple[tuple[bool, bool, bool], ...]
@@ -465,7 +457,7 @@ class ActuatorNanDisarms(Check):
             return
         self.on_event(first)
         if len(motors) > 1 and "nan" in self.episodes.open:
-            _extend(self.episodes, "nan", motors[-1].t, len(motors) - 1)
+            self.episodes.extend("nan", motors[-1].t, len(motors) - 1)
 
     def finish(self, t_end: float) -> None:
         self.episodes.close_all()
