@@ -9,11 +9,7 @@ from itertools import repeat
 from operator import attrgetter, le, sub
 
 from fuzzoff.checks._episodes import MERGE_GAP_S, Episodes, Offence
-from fuzzoff.checks.base import STREAM_TYPES
 from fuzzoff.events import Event
-
-assert not any(a is not b and issubclass(a, b) for a in STREAM_TYPES for b in STREAM_TYPES)
-
 
 Verdicts = list[tuple[str, dict[str, Offence]]]
 """What one message commits, as ``Episodes.update`` takes it: (code, offences), in order."""

@@ -185,7 +185,7 @@ class TrajectoryContent(Check):
         events = batch.of(_TRAJECTORY)
         if not events:
             return
-        if len(set(map(_ORIGIN, events))) > 1:
+        if not _single_origin(events):
             self.replay(batch)
             return
         first = events[0]
