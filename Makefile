@@ -38,7 +38,10 @@ check: $(STAMP)
 	$(BIN)/ruff check fuzzoff tests bench corpora
 	$(BIN)/mypy
 
+# A pip install compiles the package to bytecode; an editable one only when Python may write it
+# (PYTHONDONTWRITEBYTECODE stops that), so compile first: no process should pay for it.
 bench: $(STAMP)
+	$(BIN)/python -m compileall -q fuzzoff
 	$(BIN)/python -m bench
 
 # A longer campaign than the short seeded ones `make test` runs; SEED=n picks another seed.

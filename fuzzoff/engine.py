@@ -5,7 +5,6 @@ from __future__ import annotations
 import math
 from collections import Counter
 from collections.abc import Callable, Iterable, Iterator, Sequence
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -384,8 +383,9 @@ def _assumed(profile: Profile) -> Finding:
     )
 
 
-def _lint_one(args: tuple[str, Settings]) -> FileReport:
-    return lint_file(args[0], args[1])
+def _lint_one(args: tuple[Callable[[str, Settings], FileReport], str, Settings]) -> FileReport:
+    lint, path, settings = args
+    return lint(path, settings)
 
 
 def lint_paths(
@@ -394,22 +394,28 @@ def lint_paths(
     *,
     jobs: int = 1,
     on_file: Callable[[FileReport], None] | None = None,
+    lint: Callable[[str, Settings], FileReport] = lint_file,
 ) -> Report:
-    """Lint files and folders (searched recursively). ``jobs`` > 1 uses worker processes."""
+    """Lint files and folders (searched recursively). ``jobs`` > 1 uses worker processes.
+
+    ``lint`` lints one file (a module-level function, so that workers can be sent it).
+    """
     settings = settings or Settings()
-    files: list[Path] = []
-    for raw in paths:
-        files.extend(find_recordings(Path(raw)))
+    files = [str(f) for raw in paths for f in find_recordings(Path(raw))]
     report = Report()
     if jobs > 1 and len(files) > 1:
+        # imported here: a one-process lint need not pay for it at start-up
+        from concurrent.futures import ProcessPoolExecutor
+
         with ProcessPoolExecutor(max_workers=jobs) as pool:
-            for file_report in pool.map(_lint_one, [(str(f), settings) for f in files]):
+            file_reports = pool.map(_lint_one, [(lint, f, settings) for f in files])
+            for file_report in file_reports:
                 report.files.append(file_report)
                 if on_file is not None:
                     on_file(file_report)
     else:
         for f in files:
-            file_report = lint_file(f, settings)
+            file_report = lint(f, settings)
             report.files.append(file_report)
             if on_file is not None:
                 on_file(file_report)

@@ -3,12 +3,10 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import sys
 from pathlib import Path
 from typing import Any
-
-from rich.console import Console
-from rich.progress import BarColumn, Progress, TaskID, TextColumn, TimeRemainingColumn
 
 from fuzzoff.commands._common import (
     add_output_options,
@@ -18,13 +16,11 @@ from fuzzoff.commands._common import (
     write_output,
 )
 from fuzzoff.config import ConfigError, Settings
-from fuzzoff.engine import lint_file, lint_paths
+from fuzzoff.engine import lint_paths
 from fuzzoff.findings import Report
 from fuzzoff.report import renderer
 from fuzzoff.report.sanitize import printable
-from fuzzoff.report.terminal import print_report
 from fuzzoff.report.timelines import lint_with_timelines
-from fuzzoff.sources import find_recordings
 
 
 def add_parser(sub: Any) -> None:
@@ -42,20 +38,25 @@ def add_parser(sub: Any) -> None:
     parser.set_defaults(run=run)
 
 
-def _lint_with_progress(paths: list[str], settings: Settings, console: Console) -> Report:
-    """One file at a time with a progress bar on the terminal (long files take seconds)."""
-    report = Report()
-    files = [f for p in paths for f in find_recordings(Path(p))]
-    columns = (TextColumn("{task.description}"), BarColumn(), TimeRemainingColumn())
-    with Progress(*columns, console=console, transient=True) as progress:
-        for f in files:
-            task = progress.add_task(printable(f.name, 60), total=1.0)
+def _lint_on_terminal(args: argparse.Namespace, settings: Settings) -> Report:
+    """Lint with a progress bar where one helps, then print the findings with rich (imported
+    here: the machine-readable formats need not pay for it at start-up)."""
+    from rich.console import Console
 
-            def advance(fraction: float, task: TaskID = task) -> None:
-                progress.update(task, completed=fraction)
+    from fuzzoff.report.terminal import lint_with_progress, print_report
 
-            report.files.append(lint_file(f, settings, progress=advance))
-            progress.remove_task(task)
+    console = Console(stderr=False, highlight=False)
+    if console.is_terminal and not args.no_progress and args.jobs == 1:
+        report = lint_with_progress(args.paths, settings, console)
+    else:
+        report = lint_paths(args.paths, settings, jobs=args.jobs)
+    with contextlib.ExitStack() as stack:
+        if args.output:
+            fh = stack.enter_context(open(args.output, "w", encoding="utf-8"))
+            console = Console(file=fh, no_color=True, width=160, force_terminal=False)
+        print_report(
+            console, report, settings.fail_on, quiet=args.quiet, statistics=args.statistics
+        )
     return report
 
 
@@ -66,30 +67,12 @@ def run(args: argparse.Namespace) -> int:
     missing = [p for p in args.paths if not Path(p).exists()]
     if missing:
         raise ConfigError(f"no such file or folder: {missing[0]}")
-    console = Console(stderr=False, highlight=False)
-    terminal = args.format == "terminal"
-    show_progress = terminal and console.is_terminal and not args.no_progress and args.jobs == 1
-    if show_progress:
-        report = _lint_with_progress(args.paths, settings, console)
-    elif args.format == "html":  # the HTML report plots each vehicle's timeline
-        report = lint_with_timelines(args.paths, settings, jobs=args.jobs)
+    if args.format == "terminal":
+        report = _lint_on_terminal(args, settings)
     else:
-        report = lint_paths(args.paths, settings, jobs=args.jobs)
-    if terminal:
-        if args.output:
-            with open(args.output, "w", encoding="utf-8") as fh:
-                print_report(
-                    Console(file=fh, no_color=True, width=160, force_terminal=False),
-                    report,
-                    settings.fail_on,
-                    quiet=args.quiet,
-                    statistics=args.statistics,
-                )
-        else:
-            print_report(
-                console, report, settings.fail_on, quiet=args.quiet, statistics=args.statistics
-            )
-    else:
+        # the HTML report plots each vehicle's timeline
+        lint = lint_with_timelines if args.format == "html" else lint_paths
+        report = lint(args.paths, settings, jobs=args.jobs)
         write_output(renderer(args.format)(report, settings), args.output)
     for f in report.files:
         for line in f.problems:

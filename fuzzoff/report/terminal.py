@@ -9,15 +9,20 @@ sequences in a recording are shown as ``\\x1b`` and never reach the terminal.
 from __future__ import annotations
 
 from collections import Counter
+from pathlib import Path
 
 from rich import box
 from rich.console import Console
+from rich.progress import BarColumn, Progress, TaskID, TextColumn, TimeRemainingColumn
 from rich.table import Table
 from rich.text import Text
 
 from fuzzoff.catalog import get_rule
+from fuzzoff.config import Settings
+from fuzzoff.engine import lint_file
 from fuzzoff.findings import FileReport, Finding, Report, Severity
 from fuzzoff.report.sanitize import printable
+from fuzzoff.sources import find_recordings
 
 STYLE = {Severity.ERROR: "bold red", Severity.WARNING: "yellow", Severity.INFO: "cyan"}
 VERDICT = {0: "passed", 1: "failed", 2: "incomplete input"}
@@ -127,3 +132,20 @@ def print_report(
         print_file(console, file, fail_on, quiet)
     if not quiet:
         print_summary(console, report, fail_on)
+
+
+def lint_with_progress(paths: list[str], settings: Settings, console: Console) -> Report:
+    """One file at a time with a progress bar on the terminal (long files take seconds)."""
+    report = Report()
+    files = [f for p in paths for f in find_recordings(Path(p))]
+    columns = (TextColumn("{task.description}"), BarColumn(), TimeRemainingColumn())
+    with Progress(*columns, console=console, transient=True) as progress:
+        for f in files:
+            task = progress.add_task(printable(f.name, 60), total=1.0)
+
+            def advance(fraction: float, task: TaskID = task) -> None:
+                progress.update(task, completed=fraction)
+
+            report.files.append(lint_file(f, settings, progress=advance))
+            progress.remove_task(task)
+    return report

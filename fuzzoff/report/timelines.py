@@ -7,15 +7,13 @@ The timelines go into ``FileReport.extras``: ``timelines`` (vehicle -> ``Timelin
 from __future__ import annotations
 
 from collections.abc import Sequence
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 from fuzzoff.config import Settings
-from fuzzoff.engine import Timeline, lint_file
+from fuzzoff.engine import Timeline, lint_file, lint_paths
 from fuzzoff.findings import FileReport, Report
 from fuzzoff.gate import GateModel
 from fuzzoff.profiles import Profile
-from fuzzoff.sources import find_recordings
 
 
 def loss_timeout(timeline: Timeline, profile: Profile, settings: Settings) -> tuple[float, str]:
@@ -46,19 +44,8 @@ def lint_one(path: str | Path, settings: Settings) -> FileReport:
     return report
 
 
-def _lint_one(args: tuple[str, Settings]) -> FileReport:
-    return lint_one(args[0], args[1])
-
-
 def lint_with_timelines(
     paths: Sequence[str | Path], settings: Settings, *, jobs: int = 1
 ) -> Report:
     """Like ``engine.lint_paths`` but every file report carries its timelines."""
-    files = [str(f) for raw in paths for f in find_recordings(Path(raw))]
-    report = Report()
-    if jobs > 1 and len(files) > 1:
-        with ProcessPoolExecutor(max_workers=jobs) as pool:
-            report.files.extend(pool.map(_lint_one, [(f, settings) for f in files]))
-    else:
-        report.files.extend(lint_one(f, settings) for f in files)
-    return report
+    return lint_paths(paths, settings, jobs=jobs, lint=lint_one)
