@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import re
 import sqlite3
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from contextlib import suppress
 from pathlib import Path
 from typing import Any
@@ -21,7 +21,7 @@ from rosbags.rosbag2 import Reader
 from ruamel.yaml import YAML
 
 from fuzzoff.events import Event
-from fuzzoff.sources import px4_msgs
+from fuzzoff.sources import mcap_indexed, px4_msgs
 from fuzzoff.sources.base import RecordingInfo, Source, SourceError, SourceProblem
 from fuzzoff.sources.mcap_stream import McapStream
 from fuzzoff.sources.ros2_decode import Decoder, Ros2Decoding, TopicDecoder
@@ -34,6 +34,11 @@ STATUS_WINDOW_NS = 10_000_000_000
 """The vehicle type is looked up in the first VehicleStatus of the first 10 s (PX4 sends it
 at 1-2 Hz and on every change)."""
 _FORMATS = {MessageDefinitionFormat.MSG: "msg", MessageDefinitionFormat.IDL: "idl"}
+
+EventMakers = dict[int, Callable[[bytes | memoryview, float], Event | None]]
+"""Connection or channel id -> its decoder's ``event``."""
+Messages = Iterable[tuple[int, int, bytes | memoryview]]
+"""(connection or channel id, recording time in ns, CDR payload)."""
 
 
 def _why(exc: BaseException) -> str:
@@ -254,24 +259,24 @@ class Rosbag2Source(Source):
                 selected.append(conn)
         if not selected:  # rosbags reads every message when given no connection
             return
-        by_id: dict[int, Callable[[bytes | memoryview, float], Event | None]] = {}
-        for conn in selected:
-            decoder = self._decoders[(conn.topic, conn.msgtype)]
-            assert decoder is not None
-            by_id[conn.id] = decoder.event  # bound once, not per message
+        indexed = self._indexed(where, {(conn.topic, conn.msgtype) for conn in selected})
+        if indexed is not None:
+            by_id, messages = indexed
+        else:
+            by_id, messages = self._by_connection(reader, selected)
         t0 = self._t0
         count = 0
         self._last_ns = -1
         try:
-            for conn, stamp, raw in reader.messages(connections=selected):
+            for key, stamp, raw in messages:
                 if t0 is None:
                     t0 = self._t0 = stamp
                 count += 1
                 self._last_ns = stamp
-                event = by_id[conn.id](raw, (stamp - t0) / 1e9)
+                event = by_id[key](raw, (stamp - t0) / 1e9)
                 if event is not None:
                     yield event
-        except Exception as exc:  # rosbags, sqlite and codec errors mid-read
+        except Exception as exc:  # rosbags, mcap, sqlite and codec errors mid-read
             files = self._data_files(where)
             if len(files) == 1 and files[0].suffix == ".mcap":
                 # rosbags stops at the first bad chunk; the streaming reader skips it and
@@ -285,6 +290,36 @@ class Rosbag2Source(Source):
                 )
         finally:
             self._messages += count
+
+    def _by_connection(self, reader: Any, selected: list[Any]) -> tuple[EventMakers, Messages]:
+        """rosbags' own reading: (connection id, time, payload) of the selected connections."""
+        by_id: EventMakers = {}
+        for conn in selected:
+            decoder = self._decoders[(conn.topic, conn.msgtype)]
+            assert decoder is not None
+            by_id[conn.id] = decoder.event  # bound once, not per message
+        messages = (
+            (conn.id, stamp, raw) for conn, stamp, raw in reader.messages(connections=selected)
+        )
+        return by_id, messages
+
+    def _indexed(
+        self, where: Path, selected: set[tuple[str, str]]
+    ) -> tuple[EventMakers, Messages] | None:
+        """A one-file MCAP bag whose PX4 channels are a small share of its messages is read
+        through its message indexes (``mcap_indexed``); None keeps rosbags' own reading."""
+        files = self._data_files(where)
+        if len(files) != 1 or files[0].suffix != ".mcap":
+            return None
+        plan = mcap_indexed.plan(files[0], lambda topic, msgtype: (topic, msgtype) in selected)
+        if plan is None or set(plan.channels.values()) != selected:
+            return None  # the two readers must agree on what is read, or rosbags reads it
+        by_id: EventMakers = {}
+        for channel_id, key in plan.channels.items():
+            decoder = self._decoders[key]
+            assert decoder is not None
+            by_id[channel_id] = decoder.event
+        return by_id, mcap_indexed.messages(plan)
 
     def _data_files(self, where: Path) -> list[Path]:
         if where.is_file():
