@@ -132,8 +132,8 @@ def _chunk(
 
 def _chunk_data(fh: BinaryIO, size: int, index: ChunkIndex) -> bytes:
     """The chunk's records, decompressed and CRC-checked by mcap (raises on damage)."""
-    if index.uncompressed_size > MAX_CHUNK_INFLATION or index.chunk_length > size:
-        raise IndexMismatch(f"chunk at byte {index.chunk_start_offset} claims an impossible size")
+    if index.chunk_length > size:
+        raise IndexMismatch(f"chunk at byte {index.chunk_start_offset} is longer than the file")
     fh.seek(index.chunk_start_offset)
     stream = ReadDataStream(fh)
     if stream.read1() != Opcode.CHUNK:
