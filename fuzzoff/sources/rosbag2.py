@@ -293,11 +293,7 @@ class Rosbag2Source(Source):
 
     def _by_connection(self, reader: Any, selected: list[Any]) -> tuple[EventMakers, Messages]:
         """rosbags' own reading: (connection id, time, payload) of the selected connections."""
-        by_id: EventMakers = {}
-        for conn in selected:
-            decoder = self._decoders[(conn.topic, conn.msgtype)]
-            assert decoder is not None
-            by_id[conn.id] = decoder.event  # bound once, not per message
+        by_id = self._event_makers((conn.id, (conn.topic, conn.msgtype)) for conn in selected)
         messages = (
             (conn.id, stamp, raw) for conn, stamp, raw in reader.messages(connections=selected)
         )
@@ -314,12 +310,16 @@ class Rosbag2Source(Source):
         plan = mcap_indexed.plan(files[0], lambda topic, msgtype: (topic, msgtype) in selected)
         if plan is None or set(plan.channels.values()) != selected:
             return None  # the two readers must agree on what is read, or rosbags reads it
-        by_id: EventMakers = {}
-        for channel_id, key in plan.channels.items():
+        return self._event_makers(plan.channels.items()), mcap_indexed.messages(plan)
+
+    def _event_makers(self, keys: Iterable[tuple[int, tuple[str, str]]]) -> EventMakers:
+        """Id -> the ``event`` of the decoder of its (topic, type), bound once, not per message."""
+        makers: EventMakers = {}
+        for ident, key in keys:
             decoder = self._decoders[key]
             assert decoder is not None
-            by_id[channel_id] = decoder.event
-        return by_id, mcap_indexed.messages(plan)
+            makers[ident] = decoder.event
+        return makers
 
     def _data_files(self, where: Path) -> list[Path]:
         if where.is_file():
