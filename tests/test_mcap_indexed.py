@@ -13,10 +13,13 @@ from pathlib import Path
 
 import pytest
 from mcap.reader import SeekingReader
+from mcap.writer import CompressionType
 
 from bench.ros2_data import generate
 from fuzzoff.events import event_to_dict
 from fuzzoff.sources import mcap_indexed, open_source
+from fuzzoff.writers.mcap import write_mcap
+from fuzzoff.writers.ros2_messages import RawMessage
 
 ROOT = Path(__file__).resolve().parent.parent
 CORPUS_MCAP = sorted(p for p in (ROOT / "corpora").rglob("*.mcap") if "truncated" not in p.name)
@@ -99,6 +102,39 @@ def test_corpus_reads_the_same_through_the_indexes(
     assert forced[0]
     assert _rosbags_read(path, monkeypatch) == forced
     assert indexed_reads == [path]
+
+
+@pytest.mark.parametrize("compression", list(CompressionType), ids=lambda c: c.name.lower())
+def test_every_chunk_compression_reads_the_same(
+    compression: CompressionType,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    indexed_reads: list[Path],
+) -> None:
+    """Small chunks (many overlapping in time) of each compression the mcap writer offers."""
+    source = open_source(ROOT / "corpora" / "mcap" / "good_flight.mcap")
+    with source:
+        source.probe()
+        events = list(source.events())
+    end = max(e.t for e in events)
+    filler = [
+        RawMessage(
+            k / 200, "/camera/image_raw", "sensor_msgs/msg/Image", "uint8[] data", b"\0" * 600
+        )
+        for k in range(int(end * 200))
+    ]
+    path = write_mcap(
+        tmp_path / f"{compression.name}.mcap",
+        events,
+        extra=filler,
+        chunk_size=8192,
+        compression=compression,
+    )
+    assert len(_chunk_offsets(path)) > 20
+    indexed = _read(path)
+    assert indexed_reads == [path]
+    assert indexed[1] == [] and len(indexed[0]) == len(events)
+    assert _rosbags_read(path, monkeypatch) == indexed
 
 
 def _chunk_offsets(path: Path) -> list[tuple[int, int]]:

@@ -12,6 +12,7 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
+from mcap.writer import CompressionType
 from mcap_ros2.writer import Writer
 
 from fuzzoff.events import Event
@@ -37,12 +38,13 @@ def write_mcap(
     extra: Iterable[RawMessage] = (),
     start_ns: int = START_NS,
     chunk_size: int = 1024 * 1024,
+    compression: CompressionType = CompressionType.ZSTD,
 ) -> Path:
     """Write ``events`` (and ``extra`` raw messages) as a ROS 2 MCAP file; returns the path."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     with path.open("wb") as fh:
-        writer = Writer(fh, chunk_size=chunk_size)
+        writer = Writer(fh, chunk_size=chunk_size, compression=compression)
         # mcap_ros2 encodes only through a registered schema; raw payloads (foreign types, or a
         # payload of another release than the schema) go through its underlying mcap writer.
         raw_writer: Any = writer._writer
