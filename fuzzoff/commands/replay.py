@@ -43,7 +43,7 @@ def _key(f: dict[str, Any]) -> tuple[str, str, str]:
 
 
 def compare(expected: list[dict[str, Any]], actual: list[dict[str, Any]]) -> list[str]:
-    """Missing and unexpected findings (the corpus matching of tests/test_corpora.py)."""
+    """Missing and unexpected findings (also how tests/test_corpora.py matches the corpus)."""
     remaining = list(actual)
     problems = []
     for want in expected:
