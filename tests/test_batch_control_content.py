@@ -38,16 +38,12 @@ from fuzzoff.events import (
 )
 from fuzzoff.profiles import Profile
 from fuzzoff.sources.base import RecordingInfo
+from tests.helpers import fresh, in_lint_order
 
 NAN = math.nan
 VALUES: list[float] = [0.0, 1.0, -0.5, 2.0, NAN, NAN, math.inf]
 FLAGS = ("position", "velocity", "acceleration", "attitude", "body_rate", "thrust_and_torque")
 MODULES = (content.__name__, control_mode.__name__)
-
-
-def fresh(value: float) -> float:
-    """A new float object with the same value (NaN included), as a reader builds one."""
-    return value * 1.0
 
 
 value = st.sampled_from(VALUES)
@@ -183,9 +179,7 @@ def outcome(events: list[Event], profile: Profile, batching: bool) -> tuple[Any,
     for event in events:
         run.feed(event)
     mine = [c for c in run.checks if type(c).__module__ in MODULES]
-    findings = run.finish(events[-1].t if events else 0.0)
-    # sorted as lint sorts them: a run reports when it is handed over, after other checks
-    findings.sort(key=lambda f: (-math.inf if f.time_s is None else f.time_s, f.code))
+    findings = in_lint_order(run.finish(events[-1].t if events else 0.0))
     states = {type(c).__name__: state_of(c) for c in mine}
     return findings, states
 

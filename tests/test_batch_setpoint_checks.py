@@ -28,6 +28,7 @@ from fuzzoff.events import (
 )
 from fuzzoff.profiles import PX4_PROFILES, Profile
 from fuzzoff.sources.base import RecordingInfo
+from tests.helpers import fresh
 
 CODES = ("OFB107", "OFB404", "OFB601", "OFB602", "OFB603", "OFB604", "OFB605", "OFB606")
 CODES += ("OFB607", "OFB609")
@@ -35,12 +36,6 @@ CODES += ("OFB607", "OFB609")
 NAN = math.nan
 VALUES: list[Any] = [0.0, -0.0, 1.0, -3.0, 7.5, NAN, math.inf, 0, 2]
 """Values a field takes: equal-but-not-alike pairs (0.0/-0.0/0, 2/2.0...) and NaN included."""
-
-
-def fresh(value: Any, new: bool = True) -> Any:
-    """A new float object with the same bits (NaN included), as a reader builds one; or the
-    same object (``new`` false), as the events' defaults share one NaN."""
-    return value * 1.0 if new and isinstance(value, float) else value
 
 
 def vec(values: tuple[Any, ...], step: int, new: bool) -> tuple[Any, ...]:

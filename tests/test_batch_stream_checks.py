@@ -8,7 +8,6 @@ requests between runs. Both the findings and the checks' own state at the end mu
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 from hypothesis import HealthCheck, given, settings
@@ -32,6 +31,7 @@ from fuzzoff.events import (
 )
 from fuzzoff.profiles import Profile
 from fuzzoff.sources.base import RecordingInfo
+from tests.helpers import in_lint_order
 
 MODULES = tuple(m.__name__ for m in (loss, outside_offboard, stale, stream, timestamps))
 STAMPS = ("good", "good", "good", "zero", "lag", "back", "none")
@@ -177,9 +177,7 @@ def outcome(
     mine = [c for c in run.checks if type(c).__module__ in MODULES]
     run._flush()  # the last run, to compare the states before ``finish`` closes stretches
     before = {type(c).__name__: state_of(c) for c in mine}
-    findings = run.finish(max((e.t for e in events), default=0.0))
-    # sorted as lint sorts them: a run reports when it is handed over, after other checks
-    findings.sort(key=lambda f: (-math.inf if f.time_s is None else f.time_s, f.code))
+    findings = in_lint_order(run.finish(max((e.t for e in events), default=0.0)))
     findings = [f for f in findings if f.code.startswith(("OFB10", "OFB203"))]
     return findings, (before, {type(c).__name__: state_of(c) for c in mine})
 
