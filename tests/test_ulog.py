@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import struct
 from pathlib import Path
 from typing import Any
 
@@ -333,6 +334,13 @@ def _damaged(data: bytes, how: str) -> bytes:
     if how == "no-format":
         at = data.index(b"trajectory_setpoint:")
         return data[:at] + b"trajectory_setpoinX:" + data[at + 20 :]
+    if how == "garbage-definitions":
+        # Among the definitions, a record header of no known type that claims one byte more
+        # than the rest of the file (over pyulog's 10000-byte limit, so taken for damage):
+        # pyulog 1.3 alone seeks back onto that same header, forever.
+        at = data.index(b"trajectory_setpoint:") - 3  # a format record's header
+        rest = data[at : at + 10000]
+        return data[:at] + struct.pack("<HB", len(rest) + 1, ord("[")) + rest
     raise AssertionError(how)
 
 
@@ -345,6 +353,7 @@ BAD = {
     "cut0.93": "truncated in the middle of a message",
     "flipped": "corrupt",
     "no-format": "no message format for topic trajectory_setpoint",
+    "garbage-definitions": "broken definition section",
 }
 
 
@@ -354,7 +363,7 @@ def test_damaged_ulog_is_one_line_exit_2_and_json_stays_clean(
 ) -> None:
     path = tmp_path / "flight.ulg"
     path.write_bytes(_damaged(good_log, how))
-    result = run_cli(["lint", str(path), "--format", "json"])
+    result = run_cli_process(["lint", str(path), "--format", "json"], timeout=60)
     assert result.returncode == 2
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1, result.stderr
@@ -364,6 +373,9 @@ def test_damaged_ulog_is_one_line_exit_2_and_json_stays_clean(
     assert report["complete"] is False
     codes = [f["code"] for f in report["findings"]]
     assert codes.count("OFB001") == 1
+    if how == "garbage-definitions":
+        at = good_log.index(b"trajectory_setpoint:") - 3
+        assert f" at byte {at}" in lines[0]  # where the damaged record starts
     if how.startswith("cut") or how in ("flipped", "no-format"):
         assert " at byte " in lines[0]
         assert "OFB201" in codes  # found in the readable part, kept

@@ -1,10 +1,12 @@
 """Load a ULog with pyulog and say what could not be read, and where (formats.md 8.2, 8.3, 9).
 
-pyulog 1.3 falls short for a linter in three ways, wrapped here without re-parsing the file:
+pyulog 1.3 falls short for a linter in four ways, wrapped here without re-parsing the file:
 
 * it reports damage only as a ``file_corruption`` flag and a ``print`` on stdout, with no position;
 * it stops silently at a message cut in half (a truncated log looks complete);
-* it prints diagnostics on stdout, which would corrupt ``--format json``.
+* it prints diagnostics on stdout, which would corrupt ``--format json``;
+* in the definition section it can loop forever on a damaged record near the end of the file
+  (``_DefinitionsHandle`` says how, and mends it).
 
 ``_TrackedULog`` observes pyulog's own reading instead: the 3-byte record headers it decodes (a
 running end offset per section, which gives the truncation point) and the moment it first sets its
@@ -21,7 +23,7 @@ import struct
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO
 
 from pyulog import ULog
 from pyulog.core import ULogException
@@ -34,11 +36,12 @@ _unpack_header = struct.Struct("<HB").unpack
 class _Header:
     """Stands in for ``ULog._MessageHeader``; also keeps the end offset of the records read."""
 
-    __slots__ = ("end", "msg_size", "msg_type", "partial")
+    __slots__ = ("end", "msg_size", "msg_type", "partial", "start")
 
     def __init__(self, start: int) -> None:
         self.msg_size = 0
         self.msg_type = 0
+        self.start = start
         self.end = start
         self.partial = False
 
@@ -48,14 +51,56 @@ class _Header:
         except struct.error:
             self.partial = len(data) > 0  # 1 or 2 bytes: the file ends inside a record header
             raise
+        self.start = self.end
         self.end += 3 + self.msg_size
 
 
 @dataclass(slots=True)
 class _Corruption:
+    """Where pyulog first found damage: the record it was reading then."""
+
     section: str
-    offset: int
+    start: int
+    end: int
+    """Where the record ends by its header's size (past the file's end when it was cut)."""
+    plausible: bool
+    """A header a logger could have written (see ``_implausible``)."""
     last_timestamp: int
+
+
+class _DefinitionsHandle:
+    """The file as pyulog reads its definition section.
+
+    To step over a damaged record, pyulog seeks back relative to where it would be had its last
+    read returned every byte it asked for; at the end of the file the read comes back short and
+    the seek lands before the record's start, so the same records are read again and again,
+    forever. Here a relative seek after a short read is taken from the position pyulog assumes,
+    which is what it means: one byte past the damaged record's start. The data section checks
+    for short reads itself and is read from the plain file (no cost per record)."""
+
+    __slots__ = ("_assumed_end", "file")
+
+    def __init__(self, file: BinaryIO) -> None:
+        self.file = file
+        self._assumed_end: int | None = None
+
+    def read(self, size: int = -1) -> bytes:
+        start = self.file.tell()
+        data = self.file.read(size)
+        self._assumed_end = start + size if 0 <= len(data) < size else None
+        return data
+
+    def seek(self, offset: int, whence: int = os.SEEK_SET) -> int:
+        if whence == os.SEEK_CUR and self._assumed_end is not None:
+            offset, whence = self._assumed_end + offset, os.SEEK_SET
+        self._assumed_end = None
+        return self.file.seek(offset, whence)
+
+    def tell(self) -> int:
+        return self.file.tell()
+
+    def close(self) -> None:
+        self.file.close()
 
 
 class _TrackedULog(ULog):  # type: ignore[misc]
@@ -69,12 +114,13 @@ class _TrackedULog(ULog):  # type: ignore[misc]
         self.missing_format_offset: int | None = None
         self._MessageHeader = self._new_header
         self._MessageAddLogged = self._add_logged
-        super().__init__(
-            path,
-            message_name_filter_list=list(topics) if topics is not None else None,
-            disable_str_exceptions=True,
-            parse_header_only=header_only,
-        )
+        with open(path, "rb") as file:
+            super().__init__(
+                _DefinitionsHandle(file),
+                message_name_filter_list=list(topics) if topics is not None else None,
+                disable_str_exceptions=True,
+                parse_header_only=header_only,
+            )
 
     # pyulog assigns ``self._file_corrupt``; a property sees the first time it becomes true.
     @property
@@ -84,9 +130,11 @@ class _TrackedULog(ULog):  # type: ignore[misc]
     @_file_corrupt.setter
     def _file_corrupt(self, value: bool) -> None:
         if value and self._corruption is None:
-            offset = self._headers[-1][1].end if self._headers else 16
+            header = self._headers[-1][1] if self._headers else _Header(16)
             last = getattr(self, "_last_timestamp", 0)
-            self._corruption = _Corruption(self._section, offset, last)
+            self._corruption = _Corruption(
+                self._section, header.start, header.end, not _implausible(header), last
+            )
 
     def _new_header(self) -> _Header:
         handle = getattr(self, "_file_handle", None)
@@ -109,6 +157,9 @@ class _TrackedULog(ULog):  # type: ignore[misc]
 
     def _read_file_data(self, message_name_filter_list: Any, read_until: Any = None) -> None:
         self._section = "data"
+        handle = getattr(self, "_file_handle", None)
+        if isinstance(handle, _DefinitionsHandle):
+            self._file_handle = handle.file
         super()._read_file_data(message_name_filter_list, read_until)
 
     @property
@@ -179,12 +230,14 @@ def _problems(
 ) -> list[SourceProblem]:
     """At most one problem: the first thing that went wrong (later damage follows from it)."""
     definitions = ulog.last_header("definitions")
+    corruption = ulog.corruption
+    # pyulog also flags a record that the end of the file cut short: that is a truncation.
+    cut_short = corruption is not None and corruption.plausible and corruption.end > size
+    if corruption is not None and corruption.section == "definitions" and not cut_short:
+        what = "broken definition section (formats, info or parameters unreadable)"
+        return [SourceProblem(what, f"byte {corruption.start}")]
     if definitions is not None and (definitions.partial or definitions.end > size):
         return [SourceProblem("truncated in the definition section", f"byte {size}")]
-    corruption = ulog.corruption
-    if corruption is not None and corruption.section == "definitions":
-        what = "broken definition section (formats, info or parameters unreadable)"
-        return [SourceProblem(what, f"byte {corruption.offset}")]
     if ulog.missing_formats:
         names = ", ".join(ulog.missing_formats[:3])
         more = f" and {len(ulog.missing_formats) - 3} more" if len(ulog.missing_formats) > 3 else ""
@@ -198,7 +251,7 @@ def _problems(
         t = to_s(corruption.last_timestamp) if corruption.last_timestamp else None
         after = f", after the last good message at {t:.3f} s" if t is not None else ""
         what = "corrupt data: damaged records were skipped and reading resumed after them"
-        return [SourceProblem(what, f"byte {corruption.offset}{after}", time_s=t)]
+        return [SourceProblem(what, f"byte {corruption.end}{after}", time_s=t)]
     data = ulog.last_header("data")
     if header_only or data is None or not (data.partial or data.end > size):
         return []
