@@ -175,3 +175,34 @@ def test_unparsable_embedded_definition_falls_back_to_bundled(tmp_path: Path) ->
     assert source.problems == []
     assert [e.kind for e in read] == ["control_mode"] * 5
     assert any("embedded definition not usable" in note for note in source.probe().notes)
+
+
+@pytest.mark.parametrize(
+    ("event", "field"),
+    [
+        (ev.VehicleStatus(t=0.0, nav_state=14, armed=True, vehicle_type=2), "nav_state"),
+        (ev.TrajectorySetpoint(t=0.0, position=(1.0, 2.0, -3.0)), "position"),
+    ],
+)
+def test_embedded_definition_without_a_needed_field_falls_back_to_bundled(
+    tmp_path: Path, event: ev.Event, field: str
+) -> None:
+    # A fork's px4_msgs (or a damaged schema) that renamed a field fuzzoff reads: the payload
+    # still has the release's layout, so the bundled definition decodes it.
+    from fuzzoff.sources import px4_msgs
+    from fuzzoff.writers.ros2_messages import encode, to_message
+
+    message = to_message(event, "1.15")
+    text = px4_msgs.definition("1.15", message.message)
+    assert text is not None and f" {field}\n" in text
+    renamed = text.replace(f" {field}\n", f" {field}_renamed\n", 1)
+    raw = RawMessage(0.1, message.topic, message.typename, renamed, encode(message, "1.15"))
+    source, read = read_all(write_mcap(tmp_path / "f.mcap", [], extra=[raw]))
+    _, expected = read_all(write_mcap(tmp_path / "plain.mcap", [event], release="1.15"))
+    assert source.problems == []
+    assert [(type(e), e.kind) for e in read] == [(type(e), e.kind) for e in expected]
+    assert getattr(read[0], field) == getattr(expected[0], field)
+    info = source.probe()
+    assert any(f"has no field '{field}'; bundled px4_msgs used" in n for n in info.notes)
+    if isinstance(event, ev.VehicleStatus):
+        assert info.vehicle_type == "fw"  # read from the first status, through the fallback

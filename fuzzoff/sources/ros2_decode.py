@@ -166,7 +166,10 @@ class TopicDecoder:
             except _DECODE_ERRORS:
                 message = None
             if message is not None and pos == len(raw) - 4:
-                return build(message, t, Where(self.topic, index), message.timestamp)
+                try:
+                    return build(message, t, Where(self.topic, index), message.timestamp)
+                except AttributeError as exc:
+                    self.drop_definition(exc)
         return self._checked(raw, t, index)
 
     def _checked(self, raw: bytes | memoryview, t: float, index: int) -> Event | None:
@@ -182,7 +185,11 @@ class TopicDecoder:
         if why is not None:
             self._fail(t, why)
             return None
-        return self.builder(message, t, Where(self.topic, index), message.timestamp)
+        try:
+            return self.builder(message, t, Where(self.topic, index), message.timestamp)
+        except AttributeError as exc:
+            self.drop_definition(exc)
+            return self._checked(raw, t, index)
 
     def resolve(self, sample: bytes | memoryview, t: float) -> None:
         """Choose a bundled definition from a sample payload; else say why not (``unusable``)."""
@@ -199,6 +206,20 @@ class TopicDecoder:
     def use(self, definition: Definition) -> None:
         self.definition = definition
         self.builder = BUILDERS[self.message](definition.fields, self.vehicle, self.origin)
+
+    def drop_definition(self, missing: AttributeError) -> None:
+        """The definition decodes the payload but lacks a field the event is made from (an
+        embedded definition renamed or damaged). As for embedded text rosbags cannot parse, the
+        bundled definitions take over (still checked against every payload) and a note says
+        so; a bundled one never lacks a field, but would make the topic unusable."""
+        definition = self.definition
+        assert definition is not None
+        self.definition = self.builder = None
+        lacks = f"{definition.describe()} has no field {missing.name!r}"
+        if definition.source == "embedded":
+            self.owner.notes.append(f"{self.topic}: {lacks}; bundled px4_msgs used")
+        else:
+            self.unusable = lacks
 
     def _fail(self, t: float, why: str) -> None:
         self.failed += 1
@@ -339,7 +360,12 @@ class Ros2Decoding:
         decoded, why = decoder.definition.decode(raw)
         if why is not None:
             return None
-        return self.vehicle_type(decoder.builder(decoded, 0.0, NOWHERE, 0))
+        try:
+            status = decoder.builder(decoded, 0.0, NOWHERE, 0)
+        except AttributeError as exc:
+            decoder.drop_definition(exc)
+            return self.vehicle_from(decoder, raw)
+        return self.vehicle_type(status)
 
     def vehicle_type(self, status: Event) -> str | None:
         """The profile vehicle type a decoded ``VehicleStatus`` names (VTOL first)."""
