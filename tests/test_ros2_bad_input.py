@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import shutil
+import sqlite3
 from pathlib import Path
 
 import pytest
@@ -123,6 +124,39 @@ def test_malformed_metadata_reads_the_db3(bag: Path) -> None:
     assert_clean_failure(bag, "metadata.yaml cannot be used")
     _, events = read_all(bag)
     assert len(events) == 2 * N
+
+
+@pytest.mark.parametrize(
+    ("key", "value"), [("name", "[]"), ("name", "{}"), ("type", "null"), ("type", "[1, 2]")]
+)
+def test_metadata_topic_that_is_not_text_reads_the_db3(bag: Path, key: str, value: str) -> None:
+    # YAML that parses, but a topic's name or type is a list, a mapping or null: rosbags
+    # passes the value through as the connection's topic or type.
+    meta = bag / "metadata.yaml"
+    text = meta.read_text()
+    line = next(line for line in text.splitlines() if line.strip().startswith(f"{key}: "))
+    meta.write_text(text.replace(line, line.split(":")[0] + ": " + value, 1))
+    assert_clean_failure(bag, "metadata.yaml: a topic's name or type is not text")
+    _, events = read_all(bag)
+    assert len(events) == 2 * N
+
+
+def test_metadata_of_another_bag_is_not_silent(bag: Path) -> None:
+    # The database's topics are not the ones metadata.yaml lists (say, a metadata.yaml copied
+    # from another recording): rosbags then yields none of their messages, and says nothing.
+    db3 = next(bag.glob("*.db3"))
+    with sqlite3.connect(db3) as db:
+        db.execute("UPDATE topics SET name = name || '_renamed'")
+    assert_clean_failure(bag, f"{2 * N} of the {2 * N} messages metadata.yaml lists")
+
+
+def test_topic_row_that_is_not_text_is_reported(bag: Path) -> None:
+    db3 = next(bag.glob("*.db3"))
+    with sqlite3.connect(db3) as db:
+        db.execute("UPDATE topics SET type = x'00ff' WHERE name LIKE '%trajectory%'")
+    assert_clean_failure(db3, "a topic's name or type is not text; its messages were skipped")
+    _, events = read_all(db3)
+    assert [e.kind for e in events] == ["control_mode"] * N  # the other topic is read
 
 
 def test_db3_given_directly_needs_no_metadata(bag: Path) -> None:

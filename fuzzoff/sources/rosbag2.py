@@ -66,6 +66,8 @@ class Rosbag2Source(Source):
         self._vehicle: str | None = None
         self._copies = SalvageCopies()
         self._last_ns = -1
+        self._untyped = False
+        """A topic without a text name or type was met (said once)."""
 
     # -- opening -----------------------------------------------------------------------------
 
@@ -78,6 +80,18 @@ class Rosbag2Source(Source):
             reader.open()
         except Exception as exc:
             self._salvage_plan(exc)
+            return
+        texts = all(
+            isinstance(c.topic, str) and isinstance(c.msgtype, str) for c in reader.connections
+        )
+        if self.path.is_dir() and not texts:
+            # rosbags takes metadata.yaml's values as they come; the data files name their
+            # topics themselves.
+            with suppress(Exception):
+                reader.close()
+            what = "metadata.yaml: a topic's name or type is not text; read the data files directly"
+            self.problems.append(SourceProblem(what))
+            self._salvage_plan(ValueError(what))
             return
         self._reader = reader
 
@@ -231,8 +245,14 @@ class Rosbag2Source(Source):
         fmt = _FORMATS.get(msgdef.format, "msg") if msgdef is not None else "msg"
         return self._connect(topic, msgtype, text, fmt)
 
-    def _connect(self, topic: str, msgtype: str, text: str | None, fmt: str) -> Decoder | None:
+    def _connect(self, topic: Any, msgtype: Any, text: str | None, fmt: str) -> Decoder | None:
         """One decoder per (topic, type) across the bag's files and read paths."""
+        if not (isinstance(topic, str) and isinstance(msgtype, str)):  # a damaged database
+            if not self._untyped:
+                self._untyped = True
+                what = "a topic's name or type is not text; its messages were skipped"
+                self.problems.append(SourceProblem(what))
+            return None
         key = (topic, msgtype)
         if key not in self._decoders:
             self._decoders[key] = self.decoding.connection(topic, msgtype, text, fmt)
@@ -288,6 +308,15 @@ class Rosbag2Source(Source):
                         f"reading stopped: {_why(exc)}", f"{where.name} after {count} messages"
                     )
                 )
+        else:
+            listed = sum(conn.msgcount for conn in selected)
+            if count < listed:  # e.g. a metadata.yaml whose topics the database does not have
+                index = "metadata.yaml" if where.is_dir() else where.name
+                what = (
+                    f"{listed - count} of the {listed} messages {index} lists on the PX4 topics "
+                    "are not in the data (the two disagree)"
+                )
+                self.problems.append(SourceProblem(what))
         finally:
             self._messages += count
 

@@ -14,6 +14,7 @@ import struct
 import tempfile
 from contextlib import suppress
 from pathlib import Path
+from typing import Any
 
 ENCODINGS = {"ros2msg": "msg", "ros2idl": "idl"}
 
@@ -38,14 +39,17 @@ class SalvageCopies:
             self._tmp = None
 
 
-def topics(db: sqlite3.Connection) -> list[tuple[int, str, str, str | None, str]]:
-    """(topic id, name, type, embedded definition or None, its format) of every topic."""
+def topics(db: sqlite3.Connection) -> list[tuple[int, Any, Any, str | None, str]]:
+    """(topic id, name, type, embedded definition or None, its format) of every topic.
+
+    SQLite keeps any type in any column: in a damaged database a name or type may not be text.
+    """
     definitions: dict[str, tuple[str, str]] = {}
     with suppress(sqlite3.Error):  # schema 3 and older have no message_definitions
         for name, encoding, text in db.execute(
             "SELECT topic_type, encoding, encoded_message_definition FROM message_definitions"
         ):
-            if encoding in ENCODINGS and text:
+            if encoding in ENCODINGS and text and isinstance(text, str):
                 definitions[name] = (text, ENCODINGS[encoding])
     out = []
     for topic_id, name, msgtype in db.execute("SELECT id, name, type FROM topics"):
