@@ -381,6 +381,23 @@ def test_damaged_ulog_is_one_line_exit_2_and_json_stays_clean(
         assert "OFB201" in codes  # found in the readable part, kept
 
 
+def test_a_parameter_of_a_damaged_type_is_reported_and_the_rest_kept(tmp_path: Path) -> None:
+    params = {"COM_OF_LOSS_T": 2.0, "MPC_XY_VEL_MAX": 5.0}
+    data = write_ulog(tmp_path / "p.ulg", offboard_with_rejection(), params=params).read_bytes()
+    assert data.count(b"float MPC_XY_VEL_MAX") == 1
+    path = tmp_path / "damaged.ulg"
+    path.write_bytes(data.replace(b"float MPC_XY_VEL_MAX", b"floaz MPC_XY_VEL_MAX"))
+    result = run_cli(["lint", str(path), "--format", "json"])
+    assert result.returncode == 2
+    (line,) = result.stderr.strip().splitlines()
+    assert "damaged parameter records" in line and "MPC_XY_VEL_MAX" in line
+    (report,) = json.loads(result.stdout)["files"]
+    assert "OFB201" in [f["code"] for f in report["findings"]]  # the flight is still linted
+    with open_source(path) as source:
+        read = {e.name: e.value for e in source.events() if isinstance(e, Parameter)}
+    assert read["COM_OF_LOSS_T"] == 2.0 and "MPC_XY_VEL_MAX" not in read
+
+
 def test_truncation_says_when_the_last_complete_message_was(
     good_log: bytes, tmp_path: Path
 ) -> None:

@@ -211,7 +211,29 @@ def load(
     loaded = Loaded(ulog, library_output=output, size=size)
     to_s = seconds or (lambda ts: (ts - ulog.start_timestamp) / 1e6)
     loaded.problems.extend(_problems(ulog, size, header_only, to_s))
+    loaded.problems.extend(_drop_unreadable_parameters(ulog))
     return loaded
+
+
+def _drop_unreadable_parameters(ulog: Any) -> list[SourceProblem]:
+    """pyulog hands on the raw bytes of a parameter whose type it does not know (a damaged
+    type name, since PX4 logs only int32 and float parameters): those are taken out, so that
+    every parameter read on is a number, and said (the record's framing was intact, so
+    pyulog itself reports nothing)."""
+    names = [n for n, v in ulog.initial_parameters.items() if not _number(v)]
+    for name in names:
+        del ulog.initial_parameters[name]
+    changed = ulog.changed_parameters
+    names += [n for _, n, v in changed if not _number(v)]
+    changed[:] = [entry for entry in changed if _number(entry[2])]
+    if not names:
+        return []
+    shown = ", ".join(names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3 else "")
+    return [SourceProblem(f"damaged parameter records (a type no logger writes), skipped: {shown}")]
+
+
+def _number(value: Any) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool)
 
 
 def _reason(exc: Exception) -> str:
