@@ -8,6 +8,7 @@ usage error, never ignored.
 
 from __future__ import annotations
 
+import math
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
@@ -177,6 +178,8 @@ def settings_from_table(
         for name, value in dict(table["params"]).items():
             if not isinstance(value, (int, float)) or isinstance(value, bool):
                 raise ConfigError(f"{where}: params.{name} must be a number")
+            if not math.isfinite(value):
+                raise ConfigError(f"{where}: params.{name} must be a finite number")
             params[str(name).upper()] = float(value)
         settings = replace(settings, params=params)
     return settings

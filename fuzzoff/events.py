@@ -40,6 +40,17 @@ NAN = math.nan
 NAN3: Vec3 = (NAN, NAN, NAN)
 
 
+def whole(value: float) -> int | None:
+    """``int(value)`` (toward zero, as PX4's casts), or None for NaN and the infinities, which a
+    recording may hold where PX4 reads a whole number (C leaves their cast undefined)."""
+    return int(value) if math.isfinite(value) else None
+
+
+def nearest(value: float) -> int | None:
+    """``round(value)``, or None for NaN and the infinities."""
+    return round(value) if math.isfinite(value) else None
+
+
 @dataclass(frozen=True, slots=True)
 class Where:
     """Where an event sits in its file: topic or message type, and index / byte offset."""
@@ -467,9 +478,11 @@ class Command(Event):
     def is_offboard_switch(self) -> bool:
         """A switch to OFFBOARD (DO_SET_MODE custom main mode 6, or SET_NAV_STATE 14)."""
         if self.command == MAV_CMD_DO_SET_MODE:
-            return int(self.params[0]) & 1 == 1 and int(self.params[1]) == PX4_MAIN_MODE_OFFBOARD
+            base = whole(self.params[0])
+            main = whole(self.params[1])
+            return base is not None and base & 1 == 1 and main == PX4_MAIN_MODE_OFFBOARD
         if self.command == VEHICLE_CMD_SET_NAV_STATE:
-            return int(self.params[0]) == NAV_STATE_OFFBOARD
+            return whole(self.params[0]) == NAV_STATE_OFFBOARD
         return False
 
     @property
@@ -478,11 +491,11 @@ class Command(Event):
 
     @property
     def is_arm(self) -> bool:
-        return self.command == MAV_CMD_COMPONENT_ARM_DISARM and round(self.params[0]) == 1
+        return self.command == MAV_CMD_COMPONENT_ARM_DISARM and nearest(self.params[0]) == 1
 
     @property
     def is_disarm(self) -> bool:
-        return self.command == MAV_CMD_COMPONENT_ARM_DISARM and round(self.params[0]) == 0
+        return self.command == MAV_CMD_COMPONENT_ARM_DISARM and nearest(self.params[0]) == 0
 
 
 ACK_RESULT_NAMES = {

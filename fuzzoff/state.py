@@ -8,6 +8,7 @@ mode at all, the gate model's prediction is used and ``mode_source`` says so.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -141,7 +142,8 @@ class VehicleState:
 
     def _parameter(self, event: Event) -> None:
         assert isinstance(event, Parameter)
-        self.params[event.name] = event.value
+        if math.isfinite(event.value):  # PX4 parameters are numbers; see GateModel too
+            self.params[event.name] = event.value
 
     def _failsafe_flags(self, event: Event) -> None:
         assert isinstance(event, FailsafeFlags)

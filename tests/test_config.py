@@ -50,6 +50,7 @@ def test_fuzzoff_toml_wins_over_a_pyproject_further_up(tmp_path: Path) -> None:
         ("options = { OFB999 = { stale_s = 0.3 } }", "OFB999"),
         ('options = { OFB104 = { stale_s = "soon" } }', "number"),
         ('params = { COM_OF_LOSS_T = "fast" }', "number"),
+        ("params = { COM_OF_LOSS_T = nan }", "finite"),
         ('vehicle = "submarine"', "submarine"),
     ],
 )
@@ -85,6 +86,12 @@ def test_param_override_reaches_the_gate_model(tmp_path: Path) -> None:
     assert "OFB103" not in codes_of(run_cli(args, cwd=tmp_path).stdout)
     lowered = run_cli([*args, "--param", "COM_OF_LOSS_T=0.5"], cwd=tmp_path)
     assert "OFB103" in codes_of(lowered.stdout)  # a 0.7 s gap now loses the signal
+
+
+@pytest.mark.parametrize("value", ["nan", "inf", "fast", ""])
+def test_param_option_takes_only_a_finite_number(tmp_path: Path, value: str) -> None:
+    result = run_cli(["lint", str(GAP), "--param", f"COM_OF_LOSS_T={value}"], cwd=tmp_path)
+    assert result.returncode == 2 and "expected NAME=NUMBER" in result.stderr
 
 
 def test_fail_on_default_is_warning() -> None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import json
+import math
 import os
 import struct
 from pathlib import Path
@@ -666,3 +667,29 @@ def test_a_reader_that_gives_up_midway_keeps_the_findings_before(
     assert "OFB101" in codes and "OFB103" in codes
     assert report.complete is False
     assert report.problems == [f"{recording}: simulated damage at offset 1234"]
+
+
+@pytest.mark.parametrize("value", [math.nan, math.inf, -math.inf])
+def test_non_finite_command_and_parameter_values_are_linted(tmp_path: Path, value: float) -> None:
+    # MAVLink carries them as any other float; PX4 would cast them to whole numbers (undefined
+    # in C). fuzzoff lints on: such a DO_SET_MODE is not a switch to offboard, and such a
+    # parameter is shown as recorded but not applied to the gate model.
+    head = [e for e in flight() if not isinstance(e, Command | CommandAck | StatusText)]
+    odd = [
+        Parameter(t=0.6, vehicle="1", name=name, value=value)
+        for name in ("COM_OF_LOSS_T", "MAV_COMP_ID", "MAV_SYS_ID", "NAV_RCL_ACT", "COM_OBL_RC_ACT")
+    ]
+    commands = [
+        Command(t=1.5, vehicle="1", command=176, params=(value, 6.0, 0, 0, 0, 0, 0), **SENT),
+        Command(t=1.6, vehicle="1", command=176, params=(1.0, value, value, 0, 0, 0, 0), **SENT),
+        Command(t=1.7, vehicle="1", command=400, params=(value, value, 0, 0, 0, 0, 0), **SENT),
+    ]
+    events = sorted([*head, *odd, *commands], key=lambda e: e.t)
+    path = write_tlog(tmp_path / "odd.tlog", events)
+    with open_source(path) as source:
+        read = [e for e in source.events() if isinstance(e, Command)]
+    assert [e.is_offboard_switch or e.is_arm or e.is_disarm for e in read] == [False] * 3
+    result = run_cli(["lint", str(path), "--format", "json"])
+    assert result.returncode in (0, 1), result.stderr
+    (report,) = json.loads(result.stdout)["files"]
+    assert report["complete"] is True

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 from typing import Any
@@ -48,11 +49,12 @@ def parse_params(values: list[str]) -> dict[str, float]:
     for item in values:
         name, sep, value = item.partition("=")
         try:
-            if not sep:
+            number = float(value)
+            if not sep or not math.isfinite(number):
                 raise ValueError
-            params[name.strip().upper()] = float(value)
+            params[name.strip().upper()] = number
         except ValueError:
-            raise ConfigError(f"--param {item!r}: expected NAME=NUMBER") from None
+            raise ConfigError(f"--param {item!r}: expected NAME=NUMBER (a finite number)") from None
     return params
 
 

@@ -21,6 +21,7 @@ re-synchronises (arming, user intention) so one difference is reported once.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping
 from typing import Any
 
@@ -490,7 +491,9 @@ class GateModel:
     def _on_parameter(self, event: Parameter) -> None:
         name = event.name.upper()
         self.recorded_params[name] = event.value
-        if name in self.overrides:
+        if name in self.overrides or not math.isfinite(event.value):
+            # A NaN or infinite value (a damaged record) is shown as recorded but not applied:
+            # PX4 would cast it to a whole number, which C leaves undefined.
             return
         self.params[name] = event.value
         self._verdicts.clear()

@@ -13,6 +13,8 @@ from fuzzoff.events import (
     NAV_STATE_OFFBOARD,
     VEHICLE_CMD_SET_NAV_STATE,
     Command,
+    nearest,
+    whole,
 )
 from fuzzoff.modes import custom_mode_to_nav_state
 from fuzzoff.profiles import at_least
@@ -39,11 +41,11 @@ class Decision:
 def decode_mode(cmd: Command) -> int | None:
     """The nav_state a mode command asks for (None: not a mode or unknown custom mode)."""
     if cmd.command == VEHICLE_CMD_SET_NAV_STATE:
-        return int(cmd.params[0])
+        return whole(cmd.params[0])
     if cmd.command == MAV_CMD_DO_SET_MODE:
-        if int(cmd.params[0]) & 1 == 0:
+        base, main, sub = (whole(p) for p in cmd.params[:3])
+        if base is None or base & 1 == 0 or main is None or sub is None:
             return None
-        main, sub = int(cmd.params[1]), int(cmd.params[2])
         return custom_mode_to_nav_state((main & 0xFF) << 16 | (sub & 0xFF) << 24)
     return None
 
@@ -103,7 +105,7 @@ def arm_decision(
         return Decision(True, "4.2", None)
     if not at_least(px4, "1.14"):
         return Decision(True, "4.2", None, unverified=px4 == "legacy")
-    forced = round(cmd.params[1]) == FORCE_ARM_MAGIC
+    forced = nearest(cmd.params[1]) == FORCE_ARM_MAGIC
     if forced and cmd.from_external is False:
         return Decision(True, "4.2", "forced arming from an internal source: checks skipped")
     if not attitude_ok:
