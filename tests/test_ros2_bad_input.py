@@ -127,16 +127,35 @@ def test_malformed_metadata_reads_the_db3(bag: Path) -> None:
 
 
 @pytest.mark.parametrize(
-    ("key", "value"), [("name", "[]"), ("name", "{}"), ("type", "null"), ("type", "[1, 2]")]
+    ("key", "value"),
+    [
+        ("name", "[]"),
+        ("name", "{}"),
+        ("type", "null"),
+        ("type", "[1, 2]"),
+        ("message_count", "'x'"),
+        ("message_count", "-5"),
+        ("message_count", "true"),
+    ],
 )
-def test_metadata_topic_that_is_not_text_reads_the_db3(bag: Path, key: str, value: str) -> None:
-    # YAML that parses, but a topic's name or type is a list, a mapping or null: rosbags
-    # passes the value through as the connection's topic or type.
+def test_malformed_metadata_topic_reads_the_db3(bag: Path, key: str, value: str) -> None:
+    # YAML that parses, but a topic's name, type or count is a list, a mapping, null or
+    # negative: rosbags passes the value through as the connection's.
     meta = bag / "metadata.yaml"
     text = meta.read_text()
-    line = next(line for line in text.splitlines() if line.strip().startswith(f"{key}: "))
+    topics = text[text.index("topics_with_message_count:") :]
+    line = next(line for line in topics.splitlines() if line.strip(" -").startswith(f"{key}: "))
     meta.write_text(text.replace(line, line.split(":")[0] + ": " + value, 1))
-    assert_clean_failure(bag, "metadata.yaml: a topic's name or type is not text")
+    assert_clean_failure(bag, "metadata.yaml: a topic's name, type or message count is malformed")
+    _, events = read_all(bag)
+    assert len(events) == 2 * N
+
+
+def test_metadata_file_list_that_is_not_text_reads_the_folder(bag: Path) -> None:
+    meta = bag / "metadata.yaml"
+    db3 = next(bag.glob("*.db3"))
+    meta.write_text(meta.read_text().replace(f"  - {db3.name}\n", f"  - [{db3.name}]\n"))
+    assert_clean_failure(bag, "metadata.yaml cannot be used")
     _, events = read_all(bag)
     assert len(events) == 2 * N
 

@@ -41,6 +41,18 @@ Messages = Iterable[tuple[int, int, bytes | memoryview]]
 """(connection or channel id, recording time in ns, CDR payload)."""
 
 
+def _well_formed(conn: Any) -> bool:
+    """A connection as metadata.yaml must describe it: text name and type, a count."""
+    count = conn.msgcount
+    return (
+        isinstance(conn.topic, str)
+        and isinstance(conn.msgtype, str)
+        and isinstance(count, int)
+        and not isinstance(count, bool)
+        and count >= 0
+    )
+
+
 def _why(exc: BaseException) -> str:
     text = str(exc).strip().rstrip(".") or type(exc).__name__
     text = re.sub(r"^Cannot open database .*?: ", "", text)
@@ -81,15 +93,15 @@ class Rosbag2Source(Source):
         except Exception as exc:
             self._salvage_plan(exc)
             return
-        texts = all(
-            isinstance(c.topic, str) and isinstance(c.msgtype, str) for c in reader.connections
-        )
-        if self.path.is_dir() and not texts:
-            # rosbags takes metadata.yaml's values as they come; the data files name their
-            # topics themselves.
+        if self.path.is_dir() and not all(map(_well_formed, reader.connections)):
+            # rosbags takes metadata.yaml's values as they come; the data files name and count
+            # their topics themselves.
             with suppress(Exception):
                 reader.close()
-            what = "metadata.yaml: a topic's name or type is not text; read the data files directly"
+            what = (
+                "metadata.yaml: a topic's name, type or message count is malformed; "
+                "read the data files directly"
+            )
             self.problems.append(SourceProblem(what))
             self._salvage_plan(ValueError(what))
             return
@@ -127,7 +139,9 @@ class Rosbag2Source(Source):
         try:
             data = YAML(typ="safe").load(meta.read_text(encoding="utf-8"))
             names = data["rosbag2_bagfile_information"]["relative_file_paths"]
-            return [self.path / Path(str(n)).name for n in names]
+            if not all(isinstance(n, str) for n in names):
+                return None  # the folder's own files are read instead
+            return [self.path / Path(n).name for n in names]
         except Exception:
             return None
 
