@@ -398,6 +398,23 @@ def test_a_parameter_of_a_damaged_type_is_reported_and_the_rest_kept(tmp_path: P
     assert read["COM_OF_LOSS_T"] == 2.0 and "MPC_XY_VEL_MAX" not in read
 
 
+def test_a_topic_name_from_the_file_cannot_break_or_colour_the_error_line(
+    good_log: bytes, tmp_path: Path
+) -> None:
+    # The subscription record (after the format record) names a topic with no format: a line
+    # break and an ANSI colour in that name reach the message, shown escaped on one line.
+    name = b"trajectory_setpoint"
+    at = good_log.index(name, good_log.index(name + b":") + 1)
+    odd = b"traj\n\x1b[31mpoint_xyz"
+    assert len(odd) == len(name)
+    path = tmp_path / "odd.ulg"
+    path.write_bytes(good_log[:at] + odd + good_log[at + len(name) :])
+    result = run_cli(["lint", str(path), "--format", "json"])
+    assert result.returncode == 2
+    (line,) = result.stderr.splitlines()
+    assert "no message format for topic traj\\x0a\\x1b[31mpoint_xyz" in line
+
+
 def test_truncation_says_when_the_last_complete_message_was(
     good_log: bytes, tmp_path: Path
 ) -> None:
