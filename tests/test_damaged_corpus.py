@@ -2,8 +2,8 @@
 
 Hypothesis damages corpus recordings of every format (cut, flipped bits, runs of 0x00 / 0xFF, huge
 length-like words, spliced-out ranges) and lints them as a user would (``fuzzoff lint``). A sweep
-like this found a pyulog hang; a ROS 2 schema, a ULog parameter type and NaN command params that raised;
-and a garbage topic name that broke a problem across lines.
+like this found a pyulog hang; a ROS 2 schema, a ULog parameter type and NaN command params
+that raised; and a garbage topic name that broke a problem across lines.
 """
 
 from __future__ import annotations
