@@ -228,8 +228,14 @@ def _drop_unreadable_parameters(ulog: Any) -> list[SourceProblem]:
     changed[:] = [entry for entry in changed if _number(entry[2])]
     if not names:
         return []
-    shown = ", ".join(names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3 else "")
-    return [SourceProblem(f"damaged parameter records (a type no logger writes), skipped: {shown}")]
+    what = f"damaged parameter records (a type no logger writes), skipped: {_some(names)}"
+    return [SourceProblem(what)]
+
+
+def _some(names: list[str]) -> str:
+    """The first three names, and how many more."""
+    more = f" and {len(names) - 3} more" if len(names) > 3 else ""
+    return ", ".join(names[:3]) + more
 
 
 def _number(value: Any) -> bool:
@@ -261,10 +267,8 @@ def _problems(
     if definitions is not None and (definitions.partial or definitions.end > size):
         return [SourceProblem("truncated in the definition section", f"byte {size}")]
     if ulog.missing_formats:
-        names = ", ".join(ulog.missing_formats[:3])
-        more = f" and {len(ulog.missing_formats) - 3} more" if len(ulog.missing_formats) > 3 else ""
         what = (
-            f"broken definition section: no message format for topic {names}{more} "
+            f"broken definition section: no message format for topic {_some(ulog.missing_formats)} "
             "(its data cannot be decoded)"
         )
         where = f"byte {ulog.missing_format_offset} (the topic's subscription record)"
