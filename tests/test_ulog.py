@@ -323,6 +323,8 @@ def _damaged(data: bytes, how: str) -> bytes:
         return data[:10]
     if how == "definitions":
         return data[:400]
+    if how == "definitions-header":
+        return data[:18]  # inside the first record's 3-byte header
     if how.startswith("cut"):
         return data[: int(len(data) * float(how[3:]))]
     if how == "flipped":
@@ -349,6 +351,7 @@ BAD = {
     "foreign": "not a recording",
     "header": "shorter than the 16-byte ULog header",
     "definitions": "truncated in the definition section",
+    "definitions-header": "truncated in the definition section",
     "cut0.6": "truncated in the middle of a message",
     "cut0.93": "truncated in the middle of a message",
     "flipped": "corrupt",

@@ -36,12 +36,12 @@ _unpack_header = struct.Struct("<HB").unpack
 class _Header:
     """Stands in for ``ULog._MessageHeader``; also keeps the end offset of the records read."""
 
-    __slots__ = ("end", "msg_size", "msg_type", "partial", "start")
+    __slots__ = ("end", "first", "msg_size", "msg_type", "partial")
 
     def __init__(self, start: int) -> None:
         self.msg_size = 0
         self.msg_type = 0
-        self.start = start
+        self.first = start
         self.end = start
         self.partial = False
 
@@ -51,8 +51,13 @@ class _Header:
         except struct.error:
             self.partial = len(data) > 0  # 1 or 2 bytes: the file ends inside a record header
             raise
-        self.start = self.end
         self.end += 3 + self.msg_size
+
+    @property
+    def start(self) -> int:
+        """Where the last record read begins (worked out, not stored: ``initialize`` runs once
+        per record); the section's start before any."""
+        return self.end - 3 - self.msg_size if self.end != self.first else self.first
 
 
 @dataclass(slots=True)
@@ -65,6 +70,8 @@ class _Corruption:
     """Where the record ends by its header's size (past the file's end when it was cut)."""
     plausible: bool
     """A header a logger could have written (see ``_implausible``)."""
+    partial: bool
+    """The file ends inside the record's 3-byte header."""
     last_timestamp: int
 
 
@@ -133,7 +140,12 @@ class _TrackedULog(ULog):  # type: ignore[misc]
             header = self._headers[-1][1] if self._headers else _Header(16)
             last = getattr(self, "_last_timestamp", 0)
             self._corruption = _Corruption(
-                self._section, header.start, header.end, not _implausible(header), last
+                self._section,
+                header.start,
+                header.end,
+                not _implausible(header),
+                header.partial,
+                last,
             )
 
     def _new_header(self) -> _Header:
@@ -258,13 +270,15 @@ def _problems(
 ) -> list[SourceProblem]:
     """At most one problem: the first thing that went wrong (later damage follows from it)."""
     definitions = ulog.last_header("definitions")
+    cut = definitions is not None and (definitions.partial or definitions.end > size)
     corruption = ulog.corruption
-    # pyulog also flags a record that the end of the file cut short: that is a truncation.
-    cut_short = corruption is not None and corruption.plausible and corruption.end > size
+    # pyulog also flags a record that the end of the file cut short (or a header cut in two):
+    # that is a truncation, unless the record's header is one no logger writes.
+    cut_short = cut and corruption is not None and (corruption.plausible or corruption.partial)
     if corruption is not None and corruption.section == "definitions" and not cut_short:
         what = "broken definition section (formats, info or parameters unreadable)"
         return [SourceProblem(what, f"byte {corruption.start}")]
-    if definitions is not None and (definitions.partial or definitions.end > size):
+    if cut:
         return [SourceProblem("truncated in the definition section", f"byte {size}")]
     if ulog.missing_formats:
         what = (
