@@ -178,6 +178,16 @@ def test_topic_row_that_is_not_text_is_reported(bag: Path) -> None:
     assert [e.kind for e in events] == ["control_mode"] * N  # the other topic is read
 
 
+def test_damaged_schema_text_is_reported(bag: Path) -> None:
+    # Two bytes of a CREATE statement in sqlite_master overwritten: SQLite's error message
+    # quotes them, and Python's sqlite3 then raises UnicodeDecodeError instead of its own error.
+    db3 = next(bag.glob("*.db3"))
+    data = db3.read_bytes()
+    at = data.index(b"CREATE INDEX") + 2
+    db3.write_bytes(data[:at] + b"\xff\xff" + data[at + 2 :])
+    assert_clean_failure(db3, "damaged text in its schema")
+
+
 def test_db3_given_directly_needs_no_metadata(bag: Path) -> None:
     db3 = next(bag.glob("*.db3"))
     _code, report, _stderr = lint(db3)

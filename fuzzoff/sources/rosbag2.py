@@ -26,7 +26,7 @@ from fuzzoff.sources.base import RecordingInfo, Source, SourceError, SourceProbl
 from fuzzoff.sources.mcap_stream import McapStream
 from fuzzoff.sources.ros2_decode import Decoder, Ros2Decoding, TopicDecoder
 from fuzzoff.sources.ros2_order import ChunkOrder
-from fuzzoff.sources.rosbag2_sqlite import SalvageCopies
+from fuzzoff.sources.rosbag2_sqlite import SQLITE_ERRORS, SalvageCopies
 from fuzzoff.sources.rosbag2_sqlite import topics as sqlite_topics
 
 DATA_SUFFIXES = (".db3", ".mcap")
@@ -54,6 +54,8 @@ def _well_formed(conn: Any) -> bool:
 
 
 def _why(exc: BaseException) -> str:
+    if isinstance(exc, UnicodeDecodeError):  # see SQLITE_ERRORS
+        return "damaged text in its schema"
     text = str(exc).strip().rstrip(".") or type(exc).__name__
     text = re.sub(r"^Cannot open database .*?: ", "", text)
     return text.replace("\n", " ")
@@ -237,7 +239,7 @@ class Rosbag2Source(Source):
         """Topics, definitions and start time of a database rosbags cannot open."""
         try:
             db = self._copies.connect(path)
-        except (sqlite3.Error, OSError):
+        except (*SQLITE_ERRORS, OSError):
             return None
         try:
             topics = self._sqlite_topics(db)
@@ -249,7 +251,7 @@ class Rosbag2Source(Source):
                     self._vehicle = self.decoding.vehicle_from(decoder, first[0])
             row = db.execute("SELECT MIN(timestamp) FROM messages").fetchone()
             return int(row[0]) if row and row[0] is not None else None
-        except sqlite3.Error:
+        except SQLITE_ERRORS:
             return None
         finally:
             db.close()
@@ -399,7 +401,7 @@ class Rosbag2Source(Source):
         """Row by row with Python's sqlite3, in row order, until the damage (formats.md 5)."""
         try:
             db = self._copies.connect(path)
-        except (sqlite3.Error, OSError) as err:
+        except (*SQLITE_ERRORS, OSError) as err:
             what = f"cannot open the database: {_why(err)}"
             self.problems.append(SourceProblem(what, path.name))
             return
@@ -427,7 +429,7 @@ class Rosbag2Source(Source):
                         yield from order.add(stamp, event)
             finally:
                 yield from order.flush()
-        except sqlite3.Error as err:
+        except SQLITE_ERRORS as err:
             self.problems.append(
                 SourceProblem(
                     f"database damaged ({_why(err)}): read row by row up to the damage, "

@@ -31,12 +31,24 @@ class SalvageCopies:
         copy = Path(self._tmp.name) / path.name
         if not copy.exists():
             readable_copy(path, Path(self._tmp.name))
-        return sqlite3.connect(f"file:{copy}?mode=ro", uri=True)
+        db = sqlite3.connect(f"file:{copy}?mode=ro", uri=True)
+        db.text_factory = _lenient_text
+        return db
 
     def close(self) -> None:
         if self._tmp is not None:
             self._tmp.cleanup()
             self._tmp = None
+
+
+SQLITE_ERRORS = (sqlite3.Error, UnicodeDecodeError)
+"""What reading a damaged database raises: Python's sqlite3 fails to decode SQLite's own error
+message when it quotes damaged schema bytes, raising UnicodeDecodeError instead of its error."""
+
+
+def _lenient_text(raw: bytes) -> str:
+    """TEXT as Python's sqlite3 reads it, but damaged UTF-8 shows U+FFFD instead of raising."""
+    return raw.decode("utf-8", "replace")
 
 
 def topics(db: sqlite3.Connection) -> list[tuple[int, Any, Any, str | None, str]]:
@@ -45,7 +57,7 @@ def topics(db: sqlite3.Connection) -> list[tuple[int, Any, Any, str | None, str]
     SQLite keeps any type in any column: in a damaged database a name or type may not be text.
     """
     definitions: dict[str, tuple[str, str]] = {}
-    with suppress(sqlite3.Error):  # schema 3 and older have no message_definitions
+    with suppress(*SQLITE_ERRORS):  # schema 3 and older have no message_definitions
         for name, encoding, text in db.execute(
             "SELECT topic_type, encoding, encoded_message_definition FROM message_definitions"
         ):
