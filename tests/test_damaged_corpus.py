@@ -9,6 +9,7 @@ that raised; and a garbage topic name that broke a problem across lines.
 from __future__ import annotations
 
 import json
+import os
 import re
 import signal
 import struct
@@ -33,6 +34,10 @@ RECORDINGS = [
 ]
 
 UNPRINTABLE = re.compile(r"[\x00-\x1f\x7f-\x9f]")
+
+SWEEP = int(os.environ.get("FUZZOFF_DAMAGE_EXAMPLES", "0"))
+"""Set for a broad random sweep by hand, e.g. ``FUZZOFF_DAMAGE_EXAMPLES=2000 pytest
+tests/test_damaged_corpus.py``; unset, each format gets the same 60 damaged copies every run."""
 
 SECONDS = 60
 """Far above any of these files' lint time (well under a second): only a hang reaches it."""
@@ -88,7 +93,12 @@ def damaged(data: bytes, how: str, at: int, amount: int, pattern: int) -> bytes:
 
 
 @pytest.mark.parametrize("recording", RECORDINGS, ids=lambda p: p.name)
-@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(
+    max_examples=SWEEP or 60,
+    deadline=None,
+    derandomize=not SWEEP,  # the same damage on every CI run
+    suppress_health_check=[HealthCheck.too_slow],
+)
 @given(data=st.data())
 def test_any_damage_is_one_line_per_problem_never_a_traceback(
     recording: Path, data: st.DataObject, tmp_path_factory: pytest.TempPathFactory
