@@ -188,6 +188,16 @@ def test_damaged_schema_text_is_reported(bag: Path) -> None:
     assert_clean_failure(db3, "damaged text in its schema")
 
 
+def test_a_row_whose_data_is_not_a_blob_is_counted_as_undecodable(bag: Path) -> None:
+    db3 = next(bag.glob("*.db3"))
+    with sqlite3.connect(db3) as db:
+        db.execute("UPDATE messages SET data = 7 WHERE id = 5")
+    source, events = read_all(db3)
+    assert len(events) == 2 * N - 1  # the rest is read on
+    (problem,) = source.problems
+    assert "payload is not bytes but int; 1 of" in problem.what
+
+
 def test_db3_given_directly_needs_no_metadata(bag: Path) -> None:
     db3 = next(bag.glob("*.db3"))
     _code, report, _stderr = lint(db3)

@@ -65,6 +65,8 @@ class Definition:
 
     def decode(self, raw: bytes | memoryview) -> tuple[Any, str | None]:
         """(message, None) when ``raw`` decodes to exactly its length, else (None, why)."""
+        if not isinstance(raw, bytes | memoryview):  # a damaged sqlite row holds any type
+            return None, f"payload is not bytes but {type(raw).__name__}"
         try:
             if raw[0] or raw[1] > 1:
                 return None, "not a CDR payload (bad encapsulation header)"

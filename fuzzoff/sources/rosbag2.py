@@ -56,6 +56,8 @@ def _well_formed(conn: Any) -> bool:
 def _why(exc: BaseException) -> str:
     if isinstance(exc, UnicodeDecodeError):  # see SQLITE_ERRORS
         return "damaged text in its schema"
+    if isinstance(exc, MemoryError):
+        return "a record claims more bytes than SQLite will read"
     text = str(exc).strip().rstrip(".") or type(exc).__name__
     text = re.sub(r"^Cannot open database .*?: ", "", text)
     return text.replace("\n", " ")

@@ -41,9 +41,11 @@ class SalvageCopies:
             self._tmp = None
 
 
-SQLITE_ERRORS = (sqlite3.Error, UnicodeDecodeError)
-"""What reading a damaged database raises: Python's sqlite3 fails to decode SQLite's own error
-message when it quotes damaged schema bytes, raising UnicodeDecodeError instead of its error."""
+SQLITE_ERRORS = (sqlite3.Error, UnicodeDecodeError, MemoryError)
+"""What reading a damaged database raises. Besides sqlite3's own errors: UnicodeDecodeError when
+SQLite's error message quotes damaged schema bytes (Python's sqlite3 cannot decode it), and
+MemoryError when a damaged record claims more bytes than SQLite will allocate (it refuses before
+allocating: peak memory stays where it was)."""
 
 
 def _lenient_text(raw: bytes) -> str:
