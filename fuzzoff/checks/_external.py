@@ -9,7 +9,9 @@ to the vehicle (origin ``sent``: ROS 2 ``/fmu/in``, MAVLink) are always external
 from __future__ import annotations
 
 from dataclasses import dataclass
+from operator import attrgetter
 
+from fuzzoff.checks._runs import first_of_each
 from fuzzoff.checks.base import CheckContext
 from fuzzoff.events import Event, Where
 from fuzzoff.findings import Severity
@@ -28,6 +30,24 @@ def from_external(ctx: CheckContext, event: Event) -> bool:
         return False
     row = ctx.row_for(ctx.state.declared_flag)
     return row is not None and event.kind in row.allowed
+
+
+_ORIGIN_KIND = attrgetter("origin", "kind")
+
+
+def external_only(ctx: CheckContext, events: list[Event]) -> list[Event]:
+    """The external controller's messages among ``events`` of one run, in order: ``events``
+    itself when all are. Within a run the state is fixed, so ``from_external`` depends only on
+    a message's origin and kind and is asked once per pair."""
+    if not events:
+        return events
+    first = first_of_each(_ORIGIN_KIND, events)
+    keep = {pair for pair, event in first.items() if from_external(ctx, event)}
+    if len(keep) == len(first):
+        return events
+    if not keep:
+        return []
+    return [event for event in events if _ORIGIN_KIND(event) in keep]
 
 
 def is_armed(ctx: CheckContext) -> bool:

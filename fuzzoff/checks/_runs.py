@@ -1,12 +1,16 @@
-"""Helpers for ``on_batch`` of episode checks.
+"""Helpers for the checks' ``on_batch``.
 
-``commit_alike`` commits to ``Episodes`` a run whose verdicts are known without each message.
+``commit_alike`` commits to ``Episodes`` a run whose verdicts are known without each message;
+``first_of_each`` picks the message to judge for each verdict key; ``sent_only`` keeps the
+messages recorded on their way to the vehicle.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable, Hashable
 from itertools import repeat
 from operator import attrgetter, le, sub
+from typing import TypeVar
 
 from fuzzoff.checks._episodes import MERGE_GAP_S, Episodes, Offence
 from fuzzoff.events import Event
@@ -15,6 +19,30 @@ Verdicts = list[tuple[str, dict[str, Offence]]]
 """What one message commits, as ``Episodes.update`` takes it: (code, offences), in order."""
 
 _T = attrgetter("t")
+_ORIGIN = attrgetter("origin")
+_SENT = {"sent"}
+
+K = TypeVar("K", bound=Hashable)
+
+
+def first_of_each(key: Callable[[Event], K], events: list[Event]) -> dict[K, Event]:
+    """The first message of each ``key``, in order of first appearance (a run usually has
+    one key: then without a pass that builds the dict message by message)."""
+    keys = set(map(key, events))
+    if len(keys) == 1:
+        return {keys.pop(): events[0]}
+    first: dict[K, Event] = {}
+    for event in events:
+        first.setdefault(key(event), event)
+    return first
+
+
+def sent_only(events: list[Event]) -> list[Event]:
+    """The messages recorded on their way to the vehicle (origin ``sent``): ``events`` itself
+    when all are. The MAVLink checks judge only these."""
+    if not events or set(map(_ORIGIN, events)) == _SENT:
+        return events
+    return [e for e in events if e.origin == "sent"]
 
 
 def commit_alike(

@@ -12,7 +12,7 @@ from itertools import chain, repeat
 from operator import attrgetter, mul, sub
 from typing import Any, cast
 
-from fuzzoff.checks._external import Episodes, from_external, is_armed
+from fuzzoff.checks._external import Episodes, external_only, from_external, is_armed
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import (
     ActuatorMotors,
@@ -46,7 +46,6 @@ _RATES_SETPOINT: tuple[type[Event], ...] = (RatesSetpoint,)
 _Q_D = attrgetter("q_d")
 _XYZ = attrgetter("xyz")
 _CONTROL = attrgetter("control")
-_ORIGIN = attrgetter("origin")
 _RATES = attrgetter("roll", "pitch", "yaw")
 _THRUST_BODY = attrgetter("thrust_body")
 
@@ -65,11 +64,6 @@ def _within(values: list[tuple[float, ...]], low: float, high: float) -> bool:
     number; an infinity fails the test and is judged one by one)."""
     flat = list(chain.from_iterable(values))
     return max(chain((low,), flat)) <= high and min(chain((high,), flat)) >= low
-
-
-def _single_origin(events: list[Event]) -> bool:
-    """All from one origin: then ``from_external`` says the same for each (state is fixed)."""
-    return len(set(map(_ORIGIN, events))) == 1
 
 
 def _nan_pattern(motors: ActuatorMotors) -> tuple[tuple[bool, ...], tuple[bool, ...]]:
@@ -175,21 +169,16 @@ class TrajectoryContent(Check):
             self.axis.good("axis")
 
     def on_batch(self, batch: StreamBatch) -> None:
-        """Within a run the declared flag and the mode are fixed, so a setpoint's verdict
-        depends only on its origin and on which components are finite. When every setpoint
-        of the run has the same of both, the first is judged by ``on_event`` and the rest only
-        extend the episodes it left open (a clean run with nothing open costs nothing more)."""
+        """Within a run the declared flag and the mode are fixed, so an external setpoint's
+        verdict depends only on which components are finite (the others are not judged). When
+        every external setpoint of the run has the same, the first is judged by ``on_event``
+        and the rest only extend the episodes it left open (a clean run with nothing open
+        costs nothing more)."""
         flag = batch.state.declared_flag
         if flag not in TRAJECTORY_CONTROLS:
             return
-        events = batch.of(_TRAJECTORY)
+        events = external_only(self.ctx, batch.of(_TRAJECTORY))
         if not events:
-            return
-        if not _single_origin(events):
-            self.replay(batch)
-            return
-        first = events[0]
-        if not from_external(self.ctx, first):
             return
         keys = set(map(finiteness, cast(list[TrajectorySetpoint], events)))
         if len(keys) > 1:
@@ -198,7 +187,7 @@ class TrajectoryContent(Check):
         bad = self._bad_keys(flag, keys.pop())
         if not bad and not (self.mismatch.open or self.all_nan.open or self.axis.open):
             return
-        self.on_event(first)
+        self.on_event(events[0])
         if len(events) > 1:
             for episodes, key in bad:
                 episodes.extend(key, events[-1].t, len(events) - 1)
@@ -281,13 +270,7 @@ class QuaternionNotUnit(Check):
         if self.episodes.open:
             self.replay(batch)
             return
-        quaternions: list[tuple[float, ...]] = []
-        if attitude:
-            if not _single_origin(attitude):
-                self.replay(batch)
-                return
-            if from_external(self.ctx, attitude[0]):
-                quaternions.extend(map(_Q_D, attitude))
+        quaternions: list[tuple[float, ...]] = list(map(_Q_D, external_only(self.ctx, attitude)))
         if mavlink:
             targets = cast(list[SetAttitudeTarget], mavlink)
             quaternions.extend(e.q for e in targets if not e.type_mask & ATTITUDE_IGNORE)
@@ -375,15 +358,7 @@ class NormalizedOutOfRange(Check):
             return
         values: list[tuple[float, ...]] = []
         for classes, field in self.FIELDS:
-            for cls in classes:  # a logged copy is external or not by its kind
-                judged = batch.of((cls,))
-                if not judged:
-                    continue
-                if not _single_origin(judged):
-                    self.replay(batch)
-                    return
-                if from_external(self.ctx, judged[0]):
-                    values.extend(map(field, judged))
+            values.extend(map(field, external_only(self.ctx, batch.of(classes))))
         if values and not _within(values, -1.0, 1.0):
             self.replay(batch)
 
@@ -446,16 +421,13 @@ class ActuatorNanDisarms(Check):
             self.active.clear()
             self.episodes.close_all()
             return
-        if not _single_origin(motors):
-            self.replay(batch)
-            return
-        first = motors[0]
-        if not from_external(self.ctx, first):
+        motors = external_only(self.ctx, motors)
+        if not motors:
             return
         if len(set(map(_nan_pattern, cast(list[ActuatorMotors], motors)))) > 1:
             self.replay(batch)
             return
-        self.on_event(first)
+        self.on_event(motors[0])
         if len(motors) > 1 and "nan" in self.episodes.open:
             self.episodes.extend("nan", motors[-1].t, len(motors) - 1)
 
@@ -505,10 +477,11 @@ class RatesIncomplete(Check):
         rates = batch.of(_RATES_SETPOINT)
         if not rates:
             return
-        if self.episodes.open or not _single_origin(rates):
+        if self.episodes.open:
             self.replay(batch)
             return
-        if not from_external(self.ctx, rates[0]):
+        rates = external_only(self.ctx, rates)
+        if not rates:
             return
         total = sum(map(sum, map(_RATES, rates))) + sum(map(sum, map(_THRUST_BODY, rates)))
         if math.isnan(total):

@@ -15,7 +15,7 @@ import math
 from itertools import repeat
 from operator import attrgetter, gt, itemgetter
 
-from fuzzoff.checks._external import Episodes, from_external
+from fuzzoff.checks._external import Episodes, external_only, from_external
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import (
     AttitudeSetpoint,
@@ -33,7 +33,6 @@ IGNORE_Z = 4
 IGNORE_V = 8 | 16 | 32
 IGNORE_VZ = 32
 
-_ORIGIN_KIND = attrgetter("origin", "kind")
 _THRUST_Z = attrgetter("thrust_body")
 _Z = itemgetter(2)
 
@@ -82,12 +81,12 @@ class FrameConventionSuspect(Check):
         """Fast path: no external setpoint that could be the first vertical command (else
         replay), and no thrust above the threshold: every thrust setpoint is then ``good``, which
         only closes (reports) an open stretch at the first message of its kind."""
-        if self.takeoff_pending and self._external(batch.of(self.takeoff_types)):
+        if self.takeoff_pending and external_only(self.ctx, batch.of(self.takeoff_types)):
             self.replay(batch)
             return
         if self.ctx.profile.vehicle != "mc":
             return
-        thrust = self._external(batch.of(self.thrust_types))
+        thrust = external_only(self.ctx, batch.of(self.thrust_types))
         if not thrust:
             return
         if any(map(gt, map(_Z, map(_THRUST_Z, thrust)), repeat(self.thrust_z))):
@@ -96,20 +95,6 @@ class FrameConventionSuspect(Check):
         if self.thrust.open:
             for kind in dict.fromkeys(event.kind for event in thrust):
                 self.thrust.good(kind)
-
-    def _external(self, events: list[Event]) -> list[Event]:
-        """The external controller's messages among these (``from_external`` depends only on
-        the origin and kind within a run)."""
-        if not events:
-            return events
-        pairs = set(map(_ORIGIN_KIND, events))
-        if len(pairs) == 1:
-            return events if from_external(self.ctx, events[0]) else []
-        first: dict[tuple[str, str], Event] = {}
-        for event in events:
-            first.setdefault(_ORIGIN_KIND(event), event)
-        keep = {pair for pair, event in first.items() if from_external(self.ctx, event)}
-        return [event for event in events if _ORIGIN_KIND(event) in keep]
 
     def on_event(self, event: Event) -> None:
         if isinstance(event, VehicleStatus) and event.armed is not None:

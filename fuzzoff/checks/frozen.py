@@ -16,7 +16,7 @@ from itertools import chain, repeat
 from operator import attrgetter, eq, itemgetter, le, ne, sub
 from typing import Any
 
-from fuzzoff.checks._external import from_external
+from fuzzoff.checks._external import external_only, from_external
 from fuzzoff.checks._keepalive import mode_note
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import MAVLINK_SETPOINTS, PX4_SETPOINTS, Event, VehicleStatus, Where
@@ -80,7 +80,7 @@ def _may_hold_nan(value: Any) -> bool:
 _FIELDS: dict[type[Event], tuple[str, ...]] = {}
 _READ: dict[str, Callable[[Event], Any]] = {}
 _T = attrgetter("t")
-_ORIGIN_KIND = attrgetter("origin", "kind")
+_KIND = attrgetter("kind")
 
 
 def _content_fields(cls: type[Event]) -> tuple[str, ...]:
@@ -263,21 +263,17 @@ class SetpointFrozen(Check):
             self._apply(plan)
 
     def _external_by_kind(self, events: list[Event]) -> dict[str, list[Event]] | None:
-        """The external controller's messages by kind (``from_external`` depends only on the
-        origin and kind within a run); None if a rover kind needs its placeholder test."""
-        pairs = set(map(_ORIGIN_KIND, events))
-        if any(kind.startswith("rover_") for _, kind in pairs):
+        """The external controller's messages by kind; None if a rover kind needs its
+        placeholder test."""
+        kinds = set(map(_KIND, events))
+        if any(kind.startswith("rover_") for kind in kinds):
             return None
-        if len(pairs) == 1:
-            return {events[0].kind: events} if from_external(self.ctx, events[0]) else {}
-        first: dict[tuple[str, str], Event] = {}
-        for event in events:
-            first.setdefault((event.origin, event.kind), event)
-        keep = {pair for pair, event in first.items() if from_external(self.ctx, event)}
+        external = external_only(self.ctx, events)
+        if len(kinds) == 1:
+            return {external[0].kind: external} if external else {}
         groups: dict[str, list[Event]] = {}
-        for event in events:
-            if (event.origin, event.kind) in keep:
-                groups.setdefault(event.kind, []).append(event)
+        for event in external:
+            groups.setdefault(event.kind, []).append(event)
         return groups
 
     def _plan(self, kind: str, events: list[Event]) -> _Plan | None:

@@ -19,7 +19,7 @@ from operator import attrgetter
 from typing import Any
 
 from fuzzoff.checks._episodes import Episodes, Offence
-from fuzzoff.checks._runs import Verdicts, commit_alike
+from fuzzoff.checks._runs import Verdicts, commit_alike, first_of_each, sent_only
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.checks.content import _axis_problems
 from fuzzoff.events import (
@@ -38,7 +38,6 @@ VEHICLE_LABELS = {"copter": "multicopter/VTOL", "fixedwing": "fixed-wing", "rove
 
 PositionTarget = SetPositionTargetLocal | SetPositionTargetGlobal
 
-_ORIGIN = attrgetter("origin")
 _MASK_KEY = attrgetter("kind", "type_mask")
 _KEY = attrgetter(
     "origin", "kind", "type_mask", "coordinate_frame", "target_system", "target_component"
@@ -126,22 +125,16 @@ class PositionTargetFields(Check):
         receiver's axes, on every float field being finite, ``all_finite``). With no offence and
         nothing open, nothing happens; with one key, every message commits the same offences
         and (gaps under ``MERGE_GAP_S``) only extends the stretches the first one opened."""
-        events = batch.of(self.stream_types)
-        keys = set(map(_KEY, events))
-        if any(key[0] != "sent" for key in keys):  # on_event judges only these
-            events = [e for e in events if e.origin == "sent"]
-            keys = set(map(_KEY, events))
+        events = sent_only(batch.of(self.stream_types))  # on_event judges only these
         if not events:
             return
-        verdicts = self._verdicts_by_key(events, keys)
+        verdicts = self._verdicts_by_key(events)
         if verdicts is None or not commit_alike(self.episodes, events[0].kind, events, verdicts):
             self.replay(batch)
 
-    def _verdicts_by_key(
-        self, events: list[Event], keys: set[tuple[object, ...]]
-    ) -> list[Verdicts] | None:
-        """What a message of each ``_KEY`` (``keys``) of the run commits, or None where that
-        needs each message (fixed-wing ignored fields, a non-finite value for the axes)."""
+    def _verdicts_by_key(self, events: list[Event]) -> list[Verdicts] | None:
+        """What a message of each ``_KEY`` of the run commits, or None where that needs each
+        message (fixed-wing ignored fields, a non-finite value for the axes)."""
         if self.group == "fixedwing":
             return None
         if self.group == "copter" and self.rx is not None:
@@ -150,15 +143,13 @@ class PositionTargetFields(Check):
             if self.rx.est != self.est_seen:  # the answers below hold for these estimates
                 self.by_key.clear()
                 self.est_seen = copy.copy(self.rx.est)
-        if len(keys) == 1:
-            (key,) = keys
+        first = first_of_each(_KEY, events)
+        if len(first) == 1:
+            ((key, event),) = first.items()
             verdicts = self.by_key.get(key)
             if verdicts is None:
-                verdicts = self.by_key[key] = self._verdicts(events[0])
+                verdicts = self.by_key[key] = self._verdicts(event)
             return [verdicts]
-        first: dict[tuple[object, ...], Event] = {}
-        for event in events:
-            first.setdefault(_KEY(event), event)
         return [self._verdicts(event) for event in first.values()]
 
     def _verdicts(self, event: Event) -> Verdicts:
@@ -449,20 +440,13 @@ class LegacySetpointDropped(Check):
     def on_batch(self, batch: StreamBatch) -> None:
         """Fast path: with every float field finite (``all_finite``) the offences depend only on
         the message type and its type_mask; then as ``commit_alike``, else replay."""
-        events = batch.of(self.stream_types)
-        if events and set(map(_ORIGIN, events)) != {"sent"}:
-            events = [e for e in events if e.origin == "sent"]
+        events = sent_only(batch.of(self.stream_types))
         if not events:
             return
         if not all_finite(events):
             self.replay(batch)
             return
-        first: dict[tuple[str, int], Event] = {}
-        if len(set(map(_MASK_KEY, events))) == 1:
-            first[_MASK_KEY(events[0])] = events[0]
-        else:
-            for event in events:
-                first.setdefault(_MASK_KEY(event), event)
+        first = first_of_each(_MASK_KEY, events)
         verdicts = [[("OFB609", self._offences(event) or {})] for event in first.values()]
         if not commit_alike(self.episodes, events[0].kind, events, verdicts):
             self.replay(batch)

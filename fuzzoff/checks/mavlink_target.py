@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from operator import attrgetter
 
 from fuzzoff.checks._episodes import Episodes, Offence
-from fuzzoff.checks._runs import commit_alike
+from fuzzoff.checks._runs import commit_alike, first_of_each, sent_only
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import Event, MavlinkTarget, SetAttitudeTarget, Where
 from fuzzoff.tables import mavlink as tm
@@ -24,10 +24,11 @@ AUTOPILOT_COMPONENT = 1
 _ORIGIN = attrgetter("origin")
 _MASK = attrgetter("type_mask")
 _ROUTE = attrgetter("origin", "transport")
+_JUDGED = ("sent", "mavlink")
+"""The route of the MAVLink setpoints ``on_event`` judges: recorded as MAVLink on its way to
+the vehicle."""
 _TARGET = attrgetter("target_system", "target_component")
-_ROUTE_TARGET = attrgetter("origin", "transport", "target_system", "target_component")
-"""Whether ``on_event`` judges a MAVLink setpoint (recorded as MAVLink on its way to the
-vehicle), and what its verdict depends on."""
+"""What the verdict on such a setpoint depends on."""
 
 
 class AttitudeTargetMask(Check):
@@ -51,9 +52,7 @@ class AttitudeTargetMask(Check):
 
     def on_batch(self, batch: StreamBatch) -> None:
         """Fast path: the offences depend only on the type_mask (``commit_alike``)."""
-        events = batch.of(self.stream_types)
-        if events and set(map(_ORIGIN, events)) != {"sent"}:
-            events = [e for e in events if e.origin == "sent"]
+        events = sent_only(batch.of(self.stream_types))
         if not events:
             return
         rules = tm.attitude_rules(self.ctx.profile)
@@ -157,22 +156,15 @@ class SetpointTarget(Check):
             self.replay(batch)
             return
         setpoints = batch.of(self.setpoint_types)  # judged: sent as MAVLink
-        routes = set(map(_ROUTE_TARGET, setpoints))
-        judged = [route[:2] == ("sent", "mavlink") for route in routes]
+        judged = [route == _JUDGED for route in set(map(_ROUTE, setpoints))]
         if not any(judged):  # none (MAVROS, or no setpoint at all)
             return
         if not all(judged):
-            setpoints = [e for e in setpoints if _ROUTE(e) == ("sent", "mavlink")]
-            routes = set(map(_ROUTE_TARGET, setpoints))
+            setpoints = [e for e in setpoints if _ROUTE(e) == _JUDGED]
         if self._own_ids() is None:
             self._add_pending(setpoints)
             return
-        first: dict[tuple[int, int], Event] = {}
-        if len(routes) == 1:
-            first[_TARGET(setpoints[0])] = setpoints[0]
-        else:
-            for event in setpoints:
-                first.setdefault(_TARGET(event), event)
+        first = first_of_each(_TARGET, setpoints)
         verdicts = [[("OFB607", self._judge(event))] for event in first.values()]
         if not commit_alike(self.episodes, "setpoints", setpoints, verdicts):
             self.replay(batch)

@@ -54,10 +54,6 @@ class Estimates:
         self.bits = self._compute_key()
         return self.bits != before
 
-    def key(self) -> int:
-        """A small integer summarising every flag (cheap change detection)."""
-        return self.bits
-
     def _compute_key(self) -> int:
         bits = (
             self.local_position,
