@@ -9,6 +9,9 @@ behaves differently), ``options`` (thresholds with defaults) and ``example.bad``
 from __future__ import annotations
 
 import functools
+import json
+import os
+import tempfile
 import tomllib
 from collections.abc import Iterable
 from dataclasses import dataclass, field
@@ -16,6 +19,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
+from fuzzoff._version import __version__
 from fuzzoff.findings import Severity
 from fuzzoff.profiles import PX4_PROFILES, VEHICLE_TYPES
 
@@ -107,9 +111,55 @@ def _expand(
     return tuple(v for v in universe if v in chosen)
 
 
-def _load_rule(path: Path) -> Rule:
-    with path.open("rb") as fh:
-        data = tomllib.load(fh)
+CACHE = Path("__pycache__", "catalog.json")
+"""The rule pages as JSON, beside them as Python keeps bytecode beside its sources: every
+fuzzoff process needs the whole catalog, and reading 48 TOML pages costs about 25 ms where the
+JSON copy costs 2 ms."""
+
+
+def _pages(directory: Path) -> dict[str, dict[str, Any]]:
+    """Every rule page's data by file name: from the JSON copy while it was made from these
+    very pages (names, sizes and modification times, and this fuzzoff's version), else parsed
+    and the copy written again. A copy that cannot be read or written (a read-only install)
+    only costs the parse."""
+    paths = sorted(directory.glob("OFB*.toml"))
+    stats = [(path.name, path.stat()) for path in paths]
+    key = [__version__, *([name, st.st_size, st.st_mtime_ns] for name, st in stats)]
+    cache = directory / CACHE
+    try:
+        cached = json.loads(cache.read_bytes())
+        if cached["key"] == key:
+            pages: dict[str, dict[str, Any]] = cached["pages"]
+            return pages
+    except (OSError, ValueError, KeyError, TypeError):
+        pass
+    pages = {}
+    for path in paths:
+        with path.open("rb") as fh:
+            pages[path.name] = tomllib.load(fh)
+    _write(cache, {"key": key, "pages": pages})
+    return pages
+
+
+def _write(cache: Path, data: dict[str, Any]) -> None:
+    """Replace ``cache`` at once (a concurrent reader sees the old copy or the new one)."""
+    try:
+        text = json.dumps(data)
+        cache.parent.mkdir(exist_ok=True)
+        fd, temp = tempfile.mkstemp(dir=cache.parent, prefix=".catalog-", suffix=".json")
+        try:
+            with os.fdopen(fd, "w", encoding="utf-8") as fh:
+                fh.write(text)
+            os.chmod(temp, 0o644)  # readable by all, as the pages beside it
+            os.replace(temp, cache)
+        except BaseException:
+            os.unlink(temp)
+            raise
+    except (OSError, TypeError, ValueError):
+        pass  # no copy this time: the next process parses the pages again
+
+
+def _load_rule(path: Path, data: dict[str, Any]) -> Rule:
     try:
         profiles = data.get("profiles", {})
         source = data["source"]
@@ -148,7 +198,13 @@ def _load_rule(path: Path) -> Rule:
 @functools.cache
 def load_catalog() -> dict[str, Rule]:
     """All rules by code, sorted by code."""
-    rules = [_load_rule(p) for p in sorted(_catalog_dir().glob("OFB*.toml"))]
+    return read_catalog(_catalog_dir())
+
+
+def read_catalog(directory: Path) -> dict[str, Rule]:
+    """The rules of the pages in ``directory``, by code, sorted by code."""
+    pages = _pages(directory)
+    rules = [_load_rule(directory / name, data) for name, data in sorted(pages.items())]
     return {r.code: r for r in rules}
 
 
