@@ -13,6 +13,7 @@ import json
 import os
 import tempfile
 import tomllib
+import zlib
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from importlib import resources
@@ -111,33 +112,41 @@ def _expand(
     return tuple(v for v in universe if v in chosen)
 
 
-CACHE = Path("__pycache__", "catalog.json")
-"""The rule pages as JSON, beside them as Python keeps bytecode beside its sources: every
-fuzzoff process needs the whole catalog, and reading 48 TOML pages costs about 25 ms where the
-JSON copy costs 2 ms."""
+def cache_file(directory: Path) -> Path | None:
+    """Where the JSON copy of the pages in ``directory`` is kept: the user's cache folder (as
+    black and pip keep theirs), one file per catalog folder, never inside an installed package.
+
+    Every fuzzoff process needs the whole catalog: parsing 48 TOML pages costs about 25 ms, the
+    copy about 7 ms. None when there is no home folder to keep it in."""
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    if not os.path.isabs(base):
+        return None  # "~" not expanded: no home folder
+    folder = zlib.crc32(str(directory.resolve()).encode("utf-8", "surrogateescape"))
+    return Path(base, "fuzzoff", f"catalog-{folder:08x}.json")
 
 
-def _pages(directory: Path) -> dict[str, dict[str, Any]]:
-    """Every rule page's data by file name: from the JSON copy while it was made from these
-    very pages (names, sizes and modification times, and this fuzzoff's version), else parsed
-    and the copy written again. A copy that cannot be read or written (a read-only install)
-    only costs the parse."""
+def _pages(directory: Path, cache: Path | None) -> dict[str, dict[str, Any]]:
+    """Every rule page's data by file name: from the JSON copy ``cache`` while it was made from
+    these very pages (names, sizes and modification times, and this fuzzoff's version), else
+    parsed and the copy written again. A copy that cannot be read or written (no home folder, a
+    read-only one) only costs the parse."""
     paths = sorted(directory.glob("OFB*.toml"))
     stats = [(path.name, path.stat()) for path in paths]
     key = [__version__, *([name, st.st_size, st.st_mtime_ns] for name, st in stats)]
-    cache = directory / CACHE
-    try:
-        cached = json.loads(cache.read_bytes())
-        if cached["key"] == key:
-            pages: dict[str, dict[str, Any]] = cached["pages"]
-            return pages
-    except (OSError, ValueError, KeyError, TypeError):
-        pass
+    if cache is not None:
+        try:
+            cached = json.loads(cache.read_bytes())
+            if cached["key"] == key:
+                pages: dict[str, dict[str, Any]] = cached["pages"]
+                return pages
+        except (OSError, ValueError, KeyError, TypeError):
+            pass
     pages = {}
     for path in paths:
         with path.open("rb") as fh:
             pages[path.name] = tomllib.load(fh)
-    _write(cache, {"key": key, "pages": pages})
+    if cache is not None:
+        _write(cache, {"key": key, "pages": pages})
     return pages
 
 
@@ -145,12 +154,11 @@ def _write(cache: Path, data: dict[str, Any]) -> None:
     """Replace ``cache`` at once (a concurrent reader sees the old copy or the new one)."""
     try:
         text = json.dumps(data)
-        cache.parent.mkdir(exist_ok=True)
+        cache.parent.mkdir(parents=True, exist_ok=True)
         fd, temp = tempfile.mkstemp(dir=cache.parent, prefix=".catalog-", suffix=".json")
         try:
             with os.fdopen(fd, "w", encoding="utf-8") as fh:
                 fh.write(text)
-            os.chmod(temp, 0o644)  # readable by all, as the pages beside it
             os.replace(temp, cache)
         except BaseException:
             os.unlink(temp)
@@ -198,12 +206,14 @@ def _load_rule(path: Path, data: dict[str, Any]) -> Rule:
 @functools.cache
 def load_catalog() -> dict[str, Rule]:
     """All rules by code, sorted by code."""
-    return read_catalog(_catalog_dir())
+    directory = _catalog_dir()
+    return read_catalog(directory, cache_file(directory))
 
 
-def read_catalog(directory: Path) -> dict[str, Rule]:
-    """The rules of the pages in ``directory``, by code, sorted by code."""
-    pages = _pages(directory)
+def read_catalog(directory: Path, cache: Path | None = None) -> dict[str, Rule]:
+    """The rules of the pages in ``directory``, by code, sorted by code (through the JSON copy
+    ``cache`` where given)."""
+    pages = _pages(directory, cache)
     rules = [_load_rule(directory / name, data) for name, data in sorted(pages.items())]
     return {r.code: r for r in rules}
 
