@@ -315,11 +315,11 @@ class Rosbag2Source(Source):
                 if event is not None:
                     yield event
         except Exception as exc:  # rosbags, mcap, sqlite and codec errors mid-read
-            files = self._data_files(where)
-            if len(files) == 1 and files[0].suffix == ".mcap":
+            mcap_file = self._single_mcap(where)
+            if mcap_file is not None:
                 # rosbags stops at the first bad chunk; the streaming reader skips it and
                 # goes on (only messages after the last one already read are taken).
-                yield from self._salvage_mcap(files[0], after_ns=self._last_ns)
+                yield from self._salvage_mcap(mcap_file, after_ns=self._last_ns)
             else:
                 self.problems.append(
                     SourceProblem(
@@ -351,10 +351,10 @@ class Rosbag2Source(Source):
     ) -> tuple[EventMakers, Messages] | None:
         """A one-file MCAP bag whose PX4 channels are a small share of its messages is read
         through its message indexes (``mcap_indexed``); None keeps rosbags' own reading."""
-        files = self._data_files(where)
-        if len(files) != 1 or files[0].suffix != ".mcap":
+        mcap_file = self._single_mcap(where)
+        if mcap_file is None:
             return None
-        plan = mcap_indexed.plan(files[0], lambda topic, msgtype: (topic, msgtype) in selected)
+        plan = mcap_indexed.plan(mcap_file, lambda topic, msgtype: (topic, msgtype) in selected)
         if plan is None or set(plan.channels.values()) != selected:
             return None  # the two readers must agree on what is read, or rosbags reads it
         return self._event_makers(plan.channels.items()), mcap_indexed.messages(plan)
@@ -367,6 +367,11 @@ class Rosbag2Source(Source):
             assert decoder is not None
             makers[ident] = decoder.event
         return makers
+
+    def _single_mcap(self, where: Path) -> Path | None:
+        """The data file of a bag (or a bag file) stored as one MCAP file, else None."""
+        files = self._data_files(where)
+        return files[0] if len(files) == 1 and files[0].suffix == ".mcap" else None
 
     def _data_files(self, where: Path) -> list[Path]:
         if where.is_file():
