@@ -1,18 +1,19 @@
 """The ``fuzzoff`` command: a thin layer over the Python API.
 
 Each subcommand lives in ``fuzzoff/commands/<name>.py`` with ``add_parser(subparsers)`` and
-``run(args) -> int``; this module finds them, parses, and turns usage errors into exit status 2.
+``run(args) -> int``, and a one-line summary in ``fuzzoff.commands.SUMMARIES``; this module
+imports the one named on the command line, parses, and turns usage errors into exit status 2.
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
-import pkgutil
 import sys
 from collections.abc import Sequence
 
 from fuzzoff import __version__
+from fuzzoff.commands import SUMMARIES, add_command
 from fuzzoff.config import ConfigError
 
 
@@ -26,10 +27,10 @@ class _Parser(argparse.ArgumentParser):
 
 
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
-    """The parser; with ``only``, just that subcommand's module is imported (``fuzz`` pulls in
-    Hypothesis, which a ``lint`` run need not pay for at start-up)."""
-    from fuzzoff import commands
-
+    """The parser. With ``only`` naming a subcommand, just that command's module is imported
+    and its full parser built (the command line always names the command first). Otherwise
+    (``fuzzoff --help``, a mistyped command) the subcommands are listed from their summaries,
+    none imported: ``fuzz`` pulls in Hypothesis, which neither need pay for."""
     parser = _Parser(
         prog="fuzzoff",
         description="Lint and fuzz PX4 offboard setpoint streams.",
@@ -37,19 +38,19 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"fuzzoff {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
-    names = [m.name for m in pkgutil.iter_modules(commands.__path__) if not m.name.startswith("_")]
-    if only in names:
-        names = [only]
-    for name in sorted(names):
-        module = importlib.import_module(f"fuzzoff.commands.{name}")
-        module.add_parser(sub)
+    for name in sorted(SUMMARIES):
+        if only is None or only == name:
+            module = importlib.import_module(f"fuzzoff.commands.{name}")
+            module.add_parser(sub)
+        elif only not in SUMMARIES:
+            add_command(sub, name)
     return parser
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     try:
-        parser = build_parser(only=argv[0] if argv else None)
+        parser = build_parser(only=argv[0] if argv else "")
         args = parser.parse_args(argv)
         status: int = args.run(args)
         return status

@@ -3,11 +3,17 @@
 from __future__ import annotations
 
 import json
+import pkgutil
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
 
-from tests.helpers import CORPORA, run_cli, run_cli_process
+from fuzzoff import commands
+from fuzzoff.cli import main
+from fuzzoff.commands import SUMMARIES
+from tests.helpers import CORPORA, ROOT, run_cli, run_cli_process
 
 
 def test_unknown_rule_selector_is_a_usage_error(tmp_path: Path) -> None:
@@ -96,6 +102,41 @@ def test_profiles_lists_versions_and_vehicles() -> None:
     data = json.loads(run_cli(["profiles", "--format", "json"]).stdout)
     assert [p["profile"] for p in data["px4"]][:1] == ["legacy"]
     assert "rover-ackermann" in [v["type"] for v in data["vehicles"]]
+
+
+def test_top_level_help_lists_every_command_without_importing_them() -> None:
+    """``fuzzoff --help`` is the first thing a new user runs: every command and its summary,
+    and none of the commands' modules (Hypothesis among them) loaded for it."""
+    probe = (
+        "import sys\n"
+        "from fuzzoff.cli import main\n"
+        "try:\n"
+        "    main(['--help'])\n"
+        "except SystemExit as exc:\n"
+        "    assert exc.code == 0, exc.code\n"
+        "heavy = ('fuzzoff.commands.', 'hypothesis')\n"
+        "loaded = sorted(m for m in sys.modules if m.startswith(heavy))\n"
+        "print('loaded:', loaded)\n"
+    )
+    result = subprocess.run(
+        [sys.executable, "-c", probe], capture_output=True, text=True, check=True, cwd=ROOT
+    )
+    for name, summary in SUMMARIES.items():
+        assert name in result.stdout
+        assert summary.split()[0] in result.stdout
+    assert "loaded: []" in result.stdout
+
+
+def test_every_command_module_has_a_summary_and_its_own_help(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    modules = {m.name for m in pkgutil.iter_modules(commands.__path__) if m.name[0] != "_"}
+    assert set(SUMMARIES) == modules
+    for name in SUMMARIES:
+        with pytest.raises(SystemExit) as exited:
+            main([name, "--help"])
+        assert exited.value.code == 0
+        assert f"usage: fuzzoff {name}" in capsys.readouterr().out
 
 
 def test_the_installed_command_runs_as_a_process(tmp_path: Path) -> None:

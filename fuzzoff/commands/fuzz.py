@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from fuzzoff.commands import add_command
 from fuzzoff.commands._common import parse_params, settings_from_args, write_output
 from fuzzoff.config import ConfigError
 from fuzzoff.fuzz.campaign import CampaignConfig, CampaignResult, PropertyResult, run_campaign
@@ -23,9 +24,7 @@ from fuzzoff.sources import SourceError
 
 
 def add_parser(sub: Any) -> None:
-    parser = sub.add_parser(
-        "fuzz", help="search setpoint streams for hazards the rules miss (seeded, shrunk)"
-    )
+    parser = add_command(sub, "fuzz")
     parser.add_argument("--px4", metavar="VERSION", help="PX4 release or profile (default: all)")
     parser.add_argument("--vehicle", metavar="TYPE", help="vehicle type (default: all)")
     parser.add_argument("--transport", choices=TRANSPORTS, help="default: all")

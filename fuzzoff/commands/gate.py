@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from fuzzoff import __version__
+from fuzzoff.commands import add_command
 from fuzzoff.commands._common import add_profile_options, settings_from_args, write_output
 from fuzzoff.config import ConfigError
 from fuzzoff.engine import Timeline, lint_file
@@ -27,9 +28,7 @@ from fuzzoff.report.sanitize import printable
 
 
 def add_parser(sub: Any) -> None:
-    parser = sub.add_parser(
-        "gate", help="the gate model's timeline for a recording, beside the recorded mode"
-    )
+    parser = add_command(sub, "gate")
     parser.add_argument("path", metavar="PATH", help="a recording (any supported format)")
     add_profile_options(parser)
     parser.add_argument("--format", choices=("terminal", "json"), default="terminal")

@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from fuzzoff.commands import add_command
 from fuzzoff.commands._common import (
     add_output_options,
     add_profile_options,
@@ -24,7 +25,7 @@ from fuzzoff.report.timelines import lint_with_timelines
 
 
 def add_parser(sub: Any) -> None:
-    parser = sub.add_parser("lint", help="lint recordings (tlog, ULog, MCAP, ROS 2 and ROS 1 bags)")
+    parser = add_command(sub, "lint")
     parser.add_argument("paths", nargs="+", metavar="PATH", help="files, bag folders or folders")
     add_profile_options(parser)
     add_rule_options(parser)

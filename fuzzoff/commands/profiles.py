@@ -9,11 +9,12 @@ from typing import Any
 from rich.console import Console
 from rich.table import Table
 
+from fuzzoff.commands import add_command
 from fuzzoff.profiles import PX4_PROFILE_NOTES, PX4_PROFILES, VEHICLE_NOTES, VEHICLE_TYPES
 
 
 def add_parser(sub: Any) -> None:
-    parser = sub.add_parser("profiles", help="list the modelled PX4 versions and vehicle types")
+    parser = add_command(sub, "profiles")
     parser.add_argument("--format", choices=("terminal", "json"), default="terminal")
     parser.set_defaults(run=run)
 

@@ -18,6 +18,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from fuzzoff.commands import add_command
 from fuzzoff.commands._common import write_output
 from fuzzoff.config import ConfigError, Settings
 from fuzzoff.fuzz.reproducers import ReproducerError, load, recheck
@@ -27,9 +28,7 @@ TIME_TOLERANCE_S = 0.05
 
 
 def add_parser(sub: Any) -> None:
-    parser = sub.add_parser(
-        "replay", help="re-check a fuzz reproducer, or stream it to a live PX4 (--to udp:...)"
-    )
+    parser = add_command(sub, "replay")
     parser.add_argument("path", metavar="REPRODUCER", help="NAME.expected.json or its recording")
     parser.add_argument("--to", metavar="udp:HOST:PORT", help="stream the MAVLink packets there")
     parser.add_argument("--speed", type=float, default=1.0, help="time scale for --to (2 = 2x)")

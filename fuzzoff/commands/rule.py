@@ -11,11 +11,12 @@ from rich.markdown import Markdown
 from rich.table import Table
 
 from fuzzoff.catalog import Rule, get_rule, load_catalog, render_page
+from fuzzoff.commands import add_command
 from fuzzoff.config import ConfigError
 
 
 def add_parser(sub: Any) -> None:
-    parser = sub.add_parser("rule", help="show a rule's documentation, or list all rules")
+    parser = add_command(sub, "rule")
     parser.add_argument("code", nargs="?", help="a rule code such as OFB101")
     parser.add_argument("--format", choices=("terminal", "json", "markdown"), default="terminal")
     parser.set_defaults(run=run)
