@@ -39,8 +39,9 @@ YOUNG_COLLECTION_EVERY = 20_000
 (Python's default: 700). Events are freed by their reference counts, not by the collector, yet
 each collection walks the young objects, and every tenth promotes survivors until a full
 collection walks the whole heap (rosbags' type store, the catalog, the modules): about 0.45 s
-of a 1M-message MCAP or ROS 1 lint. At this threshold there is none, and at most this many
-cyclic garbage objects wait for a collection."""
+of a 1M-message MCAP or ROS 1 lint. At this threshold such a lint has no full collection, and
+at most this many cyclic garbage objects wait for one. Process-wide, as the collector is: two
+threads linting at once may each restore the other's setting early, which costs only time."""
 
 
 def resolve_profile(info: RecordingInfo, settings: Settings) -> Profile:

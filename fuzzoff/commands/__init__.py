@@ -1,4 +1,4 @@
-"""One module per ``fuzzoff`` subcommand (``add_parser`` + ``run``), found by ``cli``.
+"""One module per ``fuzzoff`` subcommand (``add_parser`` + ``run``), imported by ``cli``.
 
 ``SUMMARIES`` is the list of subcommands and their one-line help, kept here so that
 ``fuzzoff --help`` can show them without importing every command (``fuzz`` pulls in
