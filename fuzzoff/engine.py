@@ -25,7 +25,7 @@ from fuzzoff.profiles import (
     ProfileError,
     px4_profile_for,
 )
-from fuzzoff.sources import SourceError, find_recordings, open_source
+from fuzzoff.sources import SourceError, open_source, recordings_in
 from fuzzoff.sources.base import RecordingInfo, SourceProblem
 from fuzzoff.state import VehicleState
 
@@ -438,7 +438,7 @@ def lint_paths(
     ``lint`` lints one file (a module-level function, so that workers can be sent it).
     """
     settings = settings or Settings()
-    files = [str(f) for raw in paths for f in find_recordings(Path(raw))]
+    files = [str(f) for f in recordings_in(paths)]
     report = Report()
     if jobs > 1 and len(files) > 1:
         # imported here: a one-process lint need not pay for it at start-up

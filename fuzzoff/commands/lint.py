@@ -22,6 +22,7 @@ from fuzzoff.findings import Report
 from fuzzoff.report import renderer
 from fuzzoff.report.sanitize import printable
 from fuzzoff.report.timelines import lint_with_timelines
+from fuzzoff.sources import RECORDING_SUFFIXES, find_recordings
 
 
 def add_parser(sub: Any) -> None:
@@ -68,6 +69,12 @@ def run(args: argparse.Namespace) -> int:
     missing = [p for p in args.paths if not Path(p).exists()]
     if missing:
         raise ConfigError(f"no such file or folder: {missing[0]}")
+    # A folder with nothing to lint is a mistake (a wrong path, a recording step that failed):
+    # passing it would turn a CI job green without looking at a single flight.
+    empty = [p for p in args.paths if Path(p).is_dir() and not find_recordings(Path(p))]
+    if empty:
+        suffixes = ", ".join(RECORDING_SUFFIXES)
+        raise ConfigError(f"no recordings in {empty[0]} (searched for {suffixes} and bag folders)")
     if args.format == "terminal":
         report = _lint_on_terminal(args, settings)
     else:

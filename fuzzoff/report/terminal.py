@@ -9,7 +9,6 @@ sequences in a recording are shown as ``\\x1b`` and never reach the terminal.
 from __future__ import annotations
 
 from collections import Counter
-from pathlib import Path
 
 from rich import box
 from rich.console import Console
@@ -22,7 +21,7 @@ from fuzzoff.config import Settings
 from fuzzoff.engine import lint_file
 from fuzzoff.findings import FileReport, Finding, Report, Severity
 from fuzzoff.report.sanitize import printable
-from fuzzoff.sources import find_recordings
+from fuzzoff.sources import recordings_in
 
 STYLE = {Severity.ERROR: "bold red", Severity.WARNING: "yellow", Severity.INFO: "cyan"}
 VERDICT = {0: "passed", 1: "failed", 2: "incomplete input"}
@@ -137,7 +136,7 @@ def print_report(
 def lint_with_progress(paths: list[str], settings: Settings, console: Console) -> Report:
     """One file at a time with a progress bar on the terminal (long files take seconds)."""
     report = Report()
-    files = [f for p in paths for f in find_recordings(Path(p))]
+    files = recordings_in(paths)
     columns = (TextColumn("{task.description}"), BarColumn(), TimeRemainingColumn())
     with Progress(*columns, console=console, transient=True) as progress:
         for f in files:

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import importlib
 import re
+import stat
+from collections.abc import Iterable
 from pathlib import Path
 
 from fuzzoff.sources.base import RecordingInfo, Source, SourceError, SourceProblem
@@ -31,9 +33,12 @@ _MAGIC: tuple[tuple[bytes, str], ...] = (
 
 def detect_format(path: Path) -> str:
     """The format of ``path`` from its content (a folder with metadata.yaml is a rosbag2)."""
-    if path.is_dir():
-        return _detect_bag_folder(path)
     try:
+        mode = path.stat().st_mode
+        if stat.S_ISDIR(mode):
+            return _detect_bag_folder(path)
+        if not stat.S_ISREG(mode):
+            raise SourceError(path, f"{_special(mode)}, not a file: {_NEEDS_A_FILE}")
         with path.open("rb") as fh:
             head = fh.read(32)
     except OSError as exc:
@@ -48,6 +53,17 @@ def detect_format(path: Path) -> str:
     if len(head) >= 9 and head[8] in (0xFD, 0xFE):
         return "tlog"
     raise SourceError(path, "not a recording fuzzoff can read (no tlog, ULog, MCAP, rosbag header)")
+
+
+_NEEDS_A_FILE = "fuzzoff reads recordings from files (save a stream to one first)"
+
+
+def _special(mode: int) -> str:
+    if stat.S_ISFIFO(mode):
+        return "a pipe"
+    if stat.S_ISSOCK(mode):
+        return "a socket"
+    return "a device"
 
 
 def _detect_bag_folder(path: Path) -> str:
@@ -95,20 +111,60 @@ def open_source(path: Path, fmt: str | None = None) -> Source:
 
 
 def find_recordings(path: Path) -> list[Path]:
-    """The recordings in a folder, searched recursively; a ROS 2 bag folder counts as one."""
-    if not path.is_dir():
-        return [path]
-    if (path / "metadata.yaml").is_file() or _is_bag_without_metadata(path):
-        return [path]
+    """The recordings at ``path`` (see ``recordings_in``)."""
+    return recordings_in([path])
+
+
+def recordings_in(paths: Iterable[Path | str]) -> list[Path]:
+    """The recordings the paths name, in order: a file as given; a ROS 2 bag folder as one
+    recording; any other folder searched recursively for files with a recording's suffix.
+
+    Links are followed, but each real folder is searched once and each real file listed once:
+    a link back up the tree, a second name for a folder or a path given twice cannot list a
+    recording twice (nor forever). The search takes regular files only: opening a named pipe
+    waits for a writer, which would hang the lint. A folder that cannot be listed is listed
+    itself, so that linting it says why."""
+    seen: set[Path] = set()
     found: list[Path] = []
-    for child in sorted(path.iterdir()):
+    for raw in paths:
+        path = Path(raw)
+        if path.is_dir():
+            _search(path, seen, found)
+        elif _first_time(path, seen):
+            found.append(path)
+    return found
+
+
+def _first_time(path: Path, seen: set[Path]) -> bool:
+    """Is this the first time the search meets ``path``'s real file or folder?"""
+    try:
+        real = path.resolve()
+    except (OSError, RuntimeError):  # RuntimeError: a link loop, on Python before 3.13
+        real = path.absolute()
+    if real in seen:
+        return False
+    seen.add(real)
+    return True
+
+
+def _search(folder: Path, seen: set[Path], found: list[Path]) -> None:
+    if not _first_time(folder, seen):
+        return
+    try:
+        if (folder / "metadata.yaml").is_file() or _is_bag_without_metadata(folder):
+            found.append(folder)
+            return
+        children = sorted(folder.iterdir())
+    except OSError:
+        found.append(folder)
+        return
+    for child in children:
         if child.name.startswith("."):
             continue
         if child.is_dir():
-            found.extend(find_recordings(child))
-        elif child.suffix in RECORDING_SUFFIXES:
+            _search(child, seen, found)
+        elif child.suffix in RECORDING_SUFFIXES and child.is_file() and _first_time(child, seen):
             found.append(child)
-    return found
 
 
 __all__ = [
@@ -120,4 +176,5 @@ __all__ = [
     "detect_format",
     "find_recordings",
     "open_source",
+    "recordings_in",
 ]

@@ -1,0 +1,82 @@
+"""Which recordings ``fuzzoff lint PATH...`` finds: each once, never a pipe, never nothing."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+from pathlib import Path
+
+import pytest
+
+from tests.helpers import CORPORA, run_cli, run_cli_process
+
+GOOD = CORPORA / "tlog" / "good_offboard.tlog"
+GAP = CORPORA / "tlog" / "keepalive_gap_0_7s.tlog"
+
+
+def _linted(*args: str | Path) -> list[str]:
+    result = run_cli(["lint", *map(str, args), "--format", "json", "--no-progress"])
+    assert result.returncode in (0, 1), result.stderr
+    return [f["path"] for f in json.loads(result.stdout)["files"]]
+
+
+def test_a_link_back_up_the_tree_lists_each_recording_once(tmp_path: Path) -> None:
+    shutil.copy(GOOD, tmp_path / "flight.tlog")
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "sub" / "up").symlink_to("..")
+    assert _linted(tmp_path) == [str(tmp_path / "flight.tlog")]
+
+
+def test_a_linked_folder_is_searched_once_under_its_first_name(tmp_path: Path) -> None:
+    day = tmp_path / "2026-11-22"
+    day.mkdir()
+    shutil.copy(GOOD, day / "a.tlog")
+    shutil.copy(GAP, day / "b.tlog")
+    (tmp_path / "latest").symlink_to(day.name)
+    assert _linted(tmp_path) == [str(day / "a.tlog"), str(day / "b.tlog")]
+
+
+def test_a_linked_folder_given_alone_is_searched(tmp_path: Path) -> None:
+    day = tmp_path / "2026-11-22"
+    day.mkdir()
+    shutil.copy(GOOD, day / "a.tlog")
+    (tmp_path / "latest").symlink_to(day.name)
+    assert _linted(tmp_path / "latest") == [str(tmp_path / "latest" / "a.tlog")]
+
+
+def test_a_recording_named_twice_is_linted_once(tmp_path: Path) -> None:
+    shutil.copy(GOOD, tmp_path / "a.tlog")
+    a = tmp_path / "a.tlog"
+    assert _linted(tmp_path, a, a) == [str(a)]
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="named pipes are POSIX")
+def test_a_pipe_in_a_searched_folder_is_left_out_and_the_lint_finishes(tmp_path: Path) -> None:
+    shutil.copy(GOOD, tmp_path / "a.tlog")
+    os.mkfifo(tmp_path / "live.tlog")  # nobody writes to it: opening it would wait forever
+    result = run_cli_process(["lint", str(tmp_path), "--format", "json"], timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert [f["path"] for f in json.loads(result.stdout)["files"]] == [str(tmp_path / "a.tlog")]
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="named pipes are POSIX")
+def test_a_pipe_named_on_the_command_line_is_one_clear_line(tmp_path: Path) -> None:
+    pipe = tmp_path / "live.tlog"
+    os.mkfifo(pipe)
+    result = run_cli_process(["lint", str(pipe)], timeout=120)
+    assert result.returncode == 2
+    assert result.stderr.splitlines() == [
+        f"fuzzoff: {pipe}: a pipe, not a file: fuzzoff reads recordings from files "
+        "(save a stream to one first)"
+    ]
+
+
+@pytest.mark.parametrize("content", [[], ["notes.txt", "plot.png"]])
+def test_a_folder_without_recordings_is_a_usage_error(tmp_path: Path, content: list[str]) -> None:
+    for name in content:
+        (tmp_path / name).write_text("not a flight")
+    result = run_cli(["lint", str(tmp_path)])
+    assert result.returncode == 2
+    assert f"no recordings in {tmp_path}" in result.stderr
+    assert ".tlog" in result.stderr and "Traceback" not in result.stderr
