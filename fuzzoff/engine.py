@@ -26,7 +26,7 @@ from fuzzoff.profiles import (
     px4_profile_for,
 )
 from fuzzoff.sources import SourceError, open_source, recordings_in
-from fuzzoff.sources.base import RecordingInfo, SourceProblem
+from fuzzoff.sources.base import RecordingInfo, SourceProblem, path_text
 from fuzzoff.state import VehicleState
 
 Progress = Callable[[float], None]
@@ -333,15 +333,14 @@ def lint_file(
     ``batching=False`` gives every check the stream one message at a time (see ``run_events``)."""
     settings = settings or Settings()
     path = Path(path)
+    name = path_text(path)
     unreadable = get_rule("OFB001")
     try:
         source = open_source(path)
         source.px4_hint = settings.px4
         source.open()
     except SourceError as exc:
-        report = FileReport(
-            str(path), "unknown", resolve_profile(RecordingInfo(str(path), "?"), settings)
-        )
+        report = FileReport(name, "unknown", resolve_profile(RecordingInfo(name, "?"), settings))
         report.complete = False
         report.problems.append(exc.line())
         report.findings.append(Finding("OFB001", unreadable.name, Severity.ERROR, exc.line()))
@@ -350,10 +349,10 @@ def lint_file(
         try:
             info = source.probe()
         except SourceError as exc:
-            info = RecordingInfo(str(path), source.format)
+            info = RecordingInfo(name, source.format)
             source.problems.append(_problem(exc))
         profile = resolve_profile(info, settings)
-        report = FileReport(str(path), source.format, profile)
+        report = FileReport(name, source.format, profile)
 
         def tick(_: int) -> None:
             if progress is not None:
@@ -373,7 +372,7 @@ def lint_file(
     finally:
         source.close()
     for problem in source.problems:
-        line = problem.line(str(path))
+        line = problem.line(name)
         report.problems.append(line)
         findings.append(
             Finding("OFB001", unreadable.name, Severity.ERROR, line, time_s=problem.time_s)

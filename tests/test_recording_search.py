@@ -80,3 +80,19 @@ def test_a_folder_without_recordings_is_a_usage_error(tmp_path: Path, content: l
     assert result.returncode == 2
     assert f"no recordings in {tmp_path}" in result.stderr
     assert ".tlog" in result.stderr and "Traceback" not in result.stderr
+
+
+@pytest.mark.parametrize("fmt", ["json", "sarif", "junit", "html", "terminal"])
+def test_a_name_that_is_not_utf8_is_written_in_every_report(tmp_path: Path, fmt: str) -> None:
+    """A byte that is not UTF-8 in a file's name shows as ``\\xNN``: the report stays valid
+    UTF-8, instead of failing to be written at all."""
+    name = os.fsdecode(b"flight-\xff-\x1b[31m.tlog")
+    shutil.copy(GAP, tmp_path / name)
+    out = tmp_path / f"report.{fmt}"
+    result = run_cli(["lint", str(tmp_path), "--format", fmt, "--output", str(out)])
+    assert result.returncode == 1, result.stderr
+    text = out.read_bytes().decode("utf-8")  # strict: the report is UTF-8
+    assert "flight-" in text and "\ufffd" not in text
+    if fmt == "json":
+        (linted,) = json.loads(text)["files"]
+        assert linted["path"] == str(tmp_path / "flight-\\xff-\x1b[31m.tlog")

@@ -8,6 +8,7 @@ corrupt), after yielding every event it could read before that point.
 from __future__ import annotations
 
 import abc
+import os
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -17,11 +18,17 @@ from typing import Any
 from fuzzoff.events import Event
 
 
+def path_text(path: Path | str) -> str:
+    """A path as report text: bytes of its name that are not UTF-8 (which Python keeps as lone
+    surrogates, and no UTF-8 report can hold) shown as ``\\xNN``."""
+    return os.fsencode(path).decode("utf-8", "backslashreplace")
+
+
 class SourceError(Exception):
     """The recording cannot be read at all. ``str()`` is the one line the user sees."""
 
     def __init__(self, path: Path | str, what: str, where: str | None = None) -> None:
-        self.path = str(path)
+        self.path = path_text(path)
         self.what = what
         self.where = where
         super().__init__(self.line())
