@@ -99,6 +99,20 @@ def read_config_table(path: Path) -> dict[str, Any]:
     return data
 
 
+def _table(value: Any, key: str, where: str) -> dict[str, Any]:
+    if not isinstance(value, dict):
+        raise ConfigError(f"{where}: {key} must be a table, e.g. {key} = {{ ... }}")
+    return value
+
+
+def _text(value: Any, key: str, where: str, example: str) -> str:
+    """A text value; a number is refused, not turned into text: TOML reads ``px4 = 1.10`` as
+    the number 1.1, whose text would name another release."""
+    if not isinstance(value, str):
+        raise ConfigError(f'{where}: {key} must be text in quotes, e.g. {key} = "{example}"')
+    return value
+
+
 def _codes(values: Any, key: str, where: str) -> set[str]:
     if isinstance(values, str):
         values = [v for v in values.split(",")]
@@ -121,9 +135,11 @@ def settings_from_table(
         raise ConfigError(f"{where}: unknown key(s) {', '.join(sorted(unknown))}; known: {known}")
     try:
         if table.get("px4") is not None:
-            settings = replace(settings, px4=px4_profile_for(str(table["px4"])))
+            px4 = _text(table["px4"], "px4", where, "1.15")
+            settings = replace(settings, px4=px4_profile_for(px4))
         if table.get("vehicle") is not None:
-            settings = replace(settings, vehicle=vehicle_type_for(str(table["vehicle"])))
+            vehicle = _text(table["vehicle"], "vehicle", where, "mc")
+            settings = replace(settings, vehicle=vehicle_type_for(vehicle))
     except ProfileError as exc:
         raise ConfigError(f"{where}: {exc}") from None
     if table.get("select") is not None:
@@ -138,12 +154,13 @@ def settings_from_table(
         )
     if table.get("fail-on") is not None:
         try:
-            settings = replace(settings, fail_on=Severity.parse(str(table["fail-on"])))
+            fail_on = _text(table["fail-on"], "fail-on", where, "warning")
+            settings = replace(settings, fail_on=Severity.parse(fail_on))
         except ValueError as exc:
             raise ConfigError(f"{where}: fail-on: {exc}") from None
     if table.get("severity") is not None:
         levels = dict(settings.severity)
-        for selector, level in dict(table["severity"]).items():
+        for selector, level in _table(table["severity"], "severity", where).items():
             try:
                 sev = Severity.parse(str(level))
             except ValueError as exc:
@@ -153,14 +170,12 @@ def settings_from_table(
         settings = replace(settings, severity=levels)
     if table.get("options") is not None:
         options = {k: dict(v) for k, v in settings.options.items()}
-        for code, values in dict(table["options"]).items():
+        for code, values in _table(table["options"], "options", where).items():
             try:
                 rule = get_rule(code)
             except KeyError:
                 raise ConfigError(f"{where}: options: unknown rule {code!r}") from None
-            if not isinstance(values, dict):
-                raise ConfigError(f"{where}: options.{code} must be a table")
-            for name, value in values.items():
+            for name, value in _table(values, f"options.{code}", where).items():
                 try:
                     default = rule.option(name).default
                 except KeyError:
@@ -175,7 +190,7 @@ def settings_from_table(
         settings = replace(settings, options=options)
     if table.get("params") is not None:
         params = dict(settings.params)
-        for name, value in dict(table["params"]).items():
+        for name, value in _table(table["params"], "params", where).items():
             if not isinstance(value, (int, float)) or isinstance(value, bool):
                 raise ConfigError(f"{where}: params.{name} must be a number")
             if not math.isfinite(value):

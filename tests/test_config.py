@@ -52,6 +52,13 @@ def test_fuzzoff_toml_wins_over_a_pyproject_further_up(tmp_path: Path) -> None:
         ('params = { COM_OF_LOSS_T = "fast" }', "number"),
         ("params = { COM_OF_LOSS_T = nan }", "finite"),
         ('vehicle = "submarine"', "submarine"),
+        ('severity = "error"', "severity must be a table"),
+        ("options = 3", "options must be a table"),
+        ("options = { OFB104 = 0.3 }", "options.OFB104 must be a table"),
+        ("params = [1]", "params must be a table"),
+        ("px4 = 1.10", 'px4 must be text in quotes, e.g. px4 = "1.15"'),
+        ("vehicle = 3", "vehicle must be text"),
+        ("fail-on = 2", "fail-on must be text"),
     ],
 )
 def test_mistakes_are_usage_errors_naming_what_is_wrong(
