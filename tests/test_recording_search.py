@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import sys
 from pathlib import Path
 
 import pytest
@@ -96,3 +97,12 @@ def test_a_name_that_is_not_utf8_is_written_in_every_report(tmp_path: Path, fmt:
     if fmt == "json":
         (linted,) = json.loads(text)["files"]
         assert linted["path"] == str(tmp_path / "flight-\\xff-\x1b[31m.tlog")
+
+
+def test_a_folder_tree_deeper_than_pythons_recursion_limit_is_searched(tmp_path: Path) -> None:
+    folder = tmp_path
+    for _ in range(sys.getrecursionlimit() + 100):
+        folder = folder / "d"
+        folder.mkdir()
+    shutil.copy(GOOD, folder / "a.tlog")
+    assert _linted(tmp_path) == [str(folder / "a.tlog")]

@@ -5,7 +5,7 @@ from __future__ import annotations
 import importlib
 import re
 import stat
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 from fuzzoff.sources.base import RecordingInfo, Source, SourceError, SourceProblem
@@ -147,24 +147,39 @@ def _first_time(path: Path, seen: set[Path]) -> bool:
     return True
 
 
-def _search(folder: Path, seen: set[Path], found: list[Path]) -> None:
-    if not _first_time(folder, seen):
-        return
+def _search(top: Path, seen: set[Path], found: list[Path]) -> None:
+    """Depth first in name order, with a stack of each open folder's remaining children
+    (not recursion: a folder tree deeper than Python's recursion limit is still searched)."""
+    stack: list[Iterator[Path]] = []
+    folder: Path | None = top
+    while True:
+        if folder is not None and _first_time(folder, seen):
+            children = _children_to_search(folder, found)
+            if children is not None:
+                stack.append(iter(children))
+        folder = None
+        if not stack:
+            return
+        child = next(stack[-1], None)
+        if child is None:
+            stack.pop()
+        elif child.is_dir():
+            folder = child
+        elif child.suffix in RECORDING_SUFFIXES and child.is_file() and _first_time(child, seen):
+            found.append(child)
+
+
+def _children_to_search(folder: Path, found: list[Path]) -> list[Path] | None:
+    """The folder's children in name order, or None when the folder is a recording itself (a
+    bag folder) or cannot be listed: then it goes to ``found``, and linting it says why."""
     try:
         if (folder / "metadata.yaml").is_file() or _is_bag_without_metadata(folder):
             found.append(folder)
-            return
-        children = sorted(folder.iterdir())
+            return None
+        return sorted(c for c in folder.iterdir() if not c.name.startswith("."))
     except OSError:
         found.append(folder)
-        return
-    for child in children:
-        if child.name.startswith("."):
-            continue
-        if child.is_dir():
-            _search(child, seen, found)
-        elif child.suffix in RECORDING_SUFFIXES and child.is_file() and _first_time(child, seen):
-            found.append(child)
+        return None
 
 
 __all__ = [
