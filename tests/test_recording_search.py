@@ -100,9 +100,16 @@ def test_a_name_that_is_not_utf8_is_written_in_every_report(tmp_path: Path, fmt:
 
 
 def test_a_folder_tree_deeper_than_pythons_recursion_limit_is_searched(tmp_path: Path) -> None:
-    folder = tmp_path
+    folders = [tmp_path / "d"]
     for _ in range(sys.getrecursionlimit() + 100):
-        folder = folder / "d"
-        folder.mkdir()
-    shutil.copy(GOOD, folder / "a.tlog")
-    assert _linted(tmp_path) == [str(folder / "a.tlog")]
+        folders.append(folders[-1] / "d")
+    try:
+        for folder in folders:
+            folder.mkdir()
+        shutil.copy(GOOD, folders[-1] / "a.tlog")
+        assert _linted(tmp_path) == [str(folders[-1] / "a.tlog")]
+    finally:  # deepest first: shutil.rmtree (pytest's clean-up too) recurses per level
+        (folders[-1] / "a.tlog").unlink(missing_ok=True)
+        for folder in reversed(folders):
+            if folder.exists():
+                folder.rmdir()

@@ -124,7 +124,7 @@ def recordings_in(paths: Iterable[Path | str]) -> list[Path]:
     recording twice (nor forever). The search takes regular files only: opening a named pipe
     waits for a writer, which would hang the lint. A folder that cannot be listed is listed
     itself, so that linting it says why."""
-    seen: set[Path] = set()
+    seen: set[object] = set()
     found: list[Path] = []
     for raw in paths:
         path = Path(raw)
@@ -135,19 +135,21 @@ def recordings_in(paths: Iterable[Path | str]) -> list[Path]:
     return found
 
 
-def _first_time(path: Path, seen: set[Path]) -> bool:
-    """Is this the first time the search meets ``path``'s real file or folder?"""
+def _first_time(path: Path, seen: set[object]) -> bool:
+    """Is this the first time the search meets ``path``'s file or folder? Known by device and
+    inode, as ``find`` does: one ``stat`` however deep the path (``resolve`` walks it)."""
     try:
-        real = path.resolve()
-    except (OSError, RuntimeError):  # RuntimeError: a link loop, on Python before 3.13
-        real = path.absolute()
-    if real in seen:
+        info = path.stat()
+        key: object = (info.st_dev, info.st_ino)
+    except OSError:  # a dangling link, a link loop: not seen through any other name
+        key = str(path.absolute())
+    if key in seen:
         return False
-    seen.add(real)
+    seen.add(key)
     return True
 
 
-def _search(top: Path, seen: set[Path], found: list[Path]) -> None:
+def _search(top: Path, seen: set[object], found: list[Path]) -> None:
     """Depth first in name order, with a stack of each open folder's remaining children
     (not recursion: a folder tree deeper than Python's recursion limit is still searched)."""
     stack: list[Iterator[Path]] = []
