@@ -269,3 +269,13 @@ def test_ofb105_keepalives_out_of_time_order_do_not_break_the_check() -> None:
     for batching in (True, False):
         found, _ = run_events(events, info, profile, Settings(), batching=batching)
         assert codes(found, "OFB105") == []
+
+
+def test_ofb103_reports_each_loss_when_the_next_comes_before_the_recorded_answer() -> None:
+    """Two losses 1.4 s apart, the recorded mode still OFFBOARD: the first waits up to 2.5 s
+    for the recording's answer, and must not be dropped when the second one comes."""
+    times = [*every(0.0, 1.0, 0.1), *every(2.2, 2.4, 0.1)]
+    events = [status(0.0, OFFBOARD), *ocm(times), status(4.0, OFFBOARD)]
+    found = codes(lint_events(events), "OFB103")
+    assert [round(f.time_s or 0.0, 1) for f in found] == [2.0, 3.4]
+    assert all("recorded: still OFFBOARD" in f.message for f in found)

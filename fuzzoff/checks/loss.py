@@ -106,6 +106,7 @@ class OffboardLoss(Check):
         self.last_flying = flying
 
     def _from_gate(self, tr: GateTransition) -> None:
+        self._flush(None)  # a loss still waiting for the recorded answer is reported first
         timeout = loss_timeout(self.ctx)
         if self.last is None:
             stopped = "no keep-alive"
