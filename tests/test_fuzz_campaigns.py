@@ -20,15 +20,20 @@ from fuzzoff.events import (
     Event,
     SetPositionTargetLocal,
     TrajectorySetpoint,
+    VehicleStatus,
 )
 from fuzzoff.fuzz.campaign import CampaignConfig, run_campaign
 from fuzzoff.fuzz.known import KNOWN
-from fuzzoff.fuzz.properties import FuzzContext, every_unintended_outcome_is_explained
+from fuzzoff.fuzz.properties import (
+    FuzzContext,
+    every_unintended_outcome_is_explained,
+    truncated_recordings_give_a_prefix,
+)
 from fuzzoff.fuzz.reproducers import save
 from fuzzoff.fuzz.scenario import Scenario
 from fuzzoff.profiles import PX4_PROFILES
 from fuzzoff.writers.mcap import write_mcap
-from tests.helpers import run_cli
+from tests.helpers import CORPORA, run_cli
 
 SEED = 20261122
 
@@ -191,6 +196,40 @@ def test_from_recording_reports_the_stall_margin(tmp_path: Path) -> None:
     assert any(o["hazard"] == "failsafe" for o in stall["outcome_after"])
 
 
+def test_from_a_real_recording_measures_new_hazards_not_the_recordings_own(
+    tmp_path: Path,
+) -> None:
+    """A tlog as a ground station records it: a HEARTBEAT gives a status and the vehicle's
+    identity at one instant, and the stream already stops in OFFBOARD (a loss at 9 s). A
+    perturbation of size 0 changes nothing, and one that only delays that loss is no margin:
+    the stall margin is a new loss, near the 1 s timeout."""
+    recording = CORPORA / "tlog" / "stream_lost_in_offboard.tlog"
+    args = ["fuzz", "--from", str(recording), "--examples", "5", "--seed", "1"]
+    out = run_cli([*args, "--known", "--format", "json", "--no-save", "-q"])
+    assert out.returncode == 0, out.stderr
+    report = json.loads(out.stdout)
+    assert [p["property"] for p in report["properties"]] == [
+        "explained",
+        "docs-stricter",
+        "invariants",
+        "runs",
+    ]
+    stall = {m["family"]: m for m in report["margins"]}["stall"]
+    assert 0.8 <= stall["size"] <= 1.05
+    assert stall["at_s"] < 8.0  # before the recording's own loss
+
+
+def test_from_refuses_what_it_cannot_perturb_or_check() -> None:
+    ulog = CORPORA / "ulog" / "stream_lost_in_offboard.ulg"
+    out = run_cli(["fuzz", "--from", str(ulog), "--examples", "1", "--no-save"])
+    assert out.returncode == 2
+    assert f"{ulog}: no keep-alive as sent" in out.stderr and "Traceback" not in out.stderr
+    tlog = CORPORA / "tlog" / "good_offboard.tlog"
+    out = run_cli(["fuzz", "--from", str(tlog), "--property", "round-trip", "--examples", "1"])
+    assert out.returncode == 2
+    assert "round-trip tests fuzzoff's writers and readers" in out.stderr
+
+
 def test_explained_property_accepts_an_explained_loss() -> None:
     events: list[Event] = []
     for i in range(40):
@@ -224,6 +263,31 @@ def _listen(port_box: list[int], got: list[tuple[float, str]], ready: threading.
         if msg is not None and msg.get_type() != "BAD_DATA":
             got.append((time.monotonic(), msg.get_type()))
     conn.close()
+
+
+def test_truncation_leaves_out_a_stretch_the_cut_closed(tmp_path: Path) -> None:
+    """OFB105 judges a whole offboard stretch: 60 gaps of 0.3 s, then 8,000 of 0.01 s. The
+    whole file's 99th percentile is 0.01 s (no finding); cut after 33 s, the stretch ends
+    at the cut and its 99th percentile is 0.3 s. That finding is about the part the cut
+    left, not a finding the whole file lacks."""
+    times = [round(i * 0.3, 4) for i in range(61)]
+    times += [round(18.0 + 0.01 * (i + 1), 4) for i in range(8000)]
+    stream = [
+        SetPositionTargetLocal(
+            t=t,
+            vehicle="1",
+            target_system=1,
+            target_component=1,
+            type_mask=0b110111111000,
+            transport="mavlink",
+            sender_time_us=round(t * 1e3) * 1000,
+        )
+        for t in times
+    ]
+    status = VehicleStatus(t=0.0, vehicle="1", nav_state=14, armed=True)
+    scenario = Scenario("1.15", "mc", "mavlink", (status, *stream))
+    ctx = FuzzContext(workdir=tmp_path, cut_fraction=0.2)
+    assert truncated_recordings_give_a_prefix(scenario, ctx) == []
 
 
 def test_replay_streams_a_tlog_reproducer_to_udp(tmp_path: Path) -> None:

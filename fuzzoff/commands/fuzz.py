@@ -94,6 +94,7 @@ def _config(args: argparse.Namespace) -> CampaignConfig:
     if args.from_:
         from fuzzoff.fuzz.mutate import scenario_from_recording
 
+        config.properties = _from_properties(args.property)
         try:
             config.base = scenario_from_recording(
                 Path(args.from_), px4, vehicle, parse_params(args.param)
@@ -103,6 +104,21 @@ def _config(args: argparse.Namespace) -> CampaignConfig:
         except OSError as exc:
             raise ConfigError(f"{args.from_}: {exc.strerror or exc}") from None
     return config
+
+
+def _from_properties(asked: list[str] | None) -> tuple[str, ...]:
+    """The properties a ``--from`` campaign checks: not those that write the stream with
+    fuzzoff's writers and read it back (``uses_files``). They test the writers and readers on
+    the streams the campaign generates; a recording's events are a reader's output, with what
+    no writer writes (a ULog's, the vehicle's identity), so they would report on fuzzoff's
+    writers, not on the user's stream."""
+    for name in asked or ():
+        if PROPERTIES[name].uses_files:
+            raise ConfigError(
+                f"--property {name} tests fuzzoff's writers and readers on generated streams; "
+                "it does not take --from"
+            )
+    return tuple(asked or (n for n, spec in PROPERTIES.items() if not spec.uses_files))
 
 
 class _Progress:
@@ -171,14 +187,17 @@ def _save_all(result: CampaignResult, directory: Path) -> dict[str, Path]:
     saved = {}
     for r in result.results:
         if r.failed and r.counterexample is not None:
-            saved[r.name] = save(
-                r.name,
-                r.counterexample,
-                r.problems,
-                directory,
-                cut_fraction=r.cut_fraction,
-                base=result.config.settings,
-            )
+            try:
+                saved[r.name] = save(
+                    r.name,
+                    r.counterexample,
+                    r.problems,
+                    directory,
+                    cut_fraction=r.cut_fraction,
+                    base=result.config.settings,
+                )
+            except ValueError as exc:  # an event its transport's writer cannot carry
+                print(f"fuzzoff: the {r.name} counterexample was not saved: {exc}", file=sys.stderr)
     return saved
 
 

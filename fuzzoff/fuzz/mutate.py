@@ -29,6 +29,7 @@ from fuzzoff.fuzz.recordings import read_with_info
 from fuzzoff.fuzz.scenario import Scenario, TransportName, run
 from fuzzoff.fuzz.streams import settle
 from fuzzoff.profiles import DEFAULT_PX4, DEFAULT_VEHICLE, ProfileError, px4_profile_for
+from fuzzoff.sources import SourceError
 
 FAMILIES = ("stall", "drop", "jitter", "skew")
 MAX_SIZE = {"stall": 5.0, "drop": 50.0, "jitter": 1.0, "skew": 5.0}
@@ -39,8 +40,16 @@ def scenario_from_recording(
     path: Path, px4: str | None, vehicle: str | None, params: dict[str, float]
 ) -> Scenario:
     """The recording's events as a scenario (transport from its events; profile as given, else
-    as the recording says, else PX4 1.15 multicopter like ``fuzzoff lint``)."""
+    as the recording says, else PX4 1.15 multicopter like ``fuzzoff lint``). ``SourceError``
+    when the recording cannot be read, or holds no keep-alive as sent (nothing to perturb)."""
     events, info = read_with_info(path)
+    if not any(e.origin == "sent" and is_keepalive(e) for e in events):
+        what = "a ULog holds the vehicle's own copies" if info.format == "ulog" else "none found"
+        raise SourceError(
+            path,
+            f"no keep-alive as sent to the vehicle to perturb ({what}); --from takes a "
+            "recording of the stream as sent: a tlog, an MCAP, a ROS 2 or a ROS 1 bag",
+        )
     if px4 is None:
         try:
             px4 = px4_profile_for(info.px4_version) if info.px4_version else DEFAULT_PX4
@@ -52,8 +61,12 @@ def scenario_from_recording(
         transport = "mavros"
     elif any(e.kind.startswith("set_") or getattr(e, "transport", "") == "mavlink" for e in events):
         transport = "mavlink"
+    # In the generated streams' form (time-ordered from 0, strictly increasing at 0.1 ms, as
+    # ``apply`` leaves every perturbed copy): a recording has events at one instant (a
+    # HEARTBEAT gives a status and the vehicle's identity), and were only the copies settled,
+    # a perturbation of size 0 would already move them, and so the outcome the margin measures.
     return Scenario(
-        px4=px4, vehicle=vehicle, transport=transport, events=tuple(events), params=params
+        px4=px4, vehicle=vehicle, transport=transport, events=tuple(settle(events)), params=params
     )
 
 
@@ -103,7 +116,11 @@ def _shift(e: Event, dt: float) -> Event:
     return replace(e, t=e.t + dt)
 
 
-def outcome(scenario: Scenario) -> tuple[tuple[str, int], ...]:
+Outcome = tuple[tuple[str, int], ...]
+"""Hazards as (kind, time in tenths of a second), sorted."""
+
+
+def outcome(scenario: Scenario) -> Outcome:
     """The hazards the gate model predicts, by kind and rounded time (the outcome to change)."""
     timelines: dict[str, Timeline] = {}
     run(scenario, timelines=timelines)
@@ -118,7 +135,7 @@ class Margin:
     family: str
     perturbation: Perturbation | None
     """The smallest perturbation that changes the outcome (None: none up to ``MAX_SIZE``)."""
-    new_hazards: tuple[tuple[str, int], ...] = ()
+    new_hazards: Outcome = ()
 
     def to_json(self) -> dict[str, object]:
         p = self.perturbation
@@ -141,17 +158,30 @@ def _positions(scenario: Scenario, count: int) -> list[float]:
     return [keep[int(i * step)] for i in range(count)]
 
 
+def same_outcome(base: Outcome, got: Outcome, p: Perturbation) -> bool:
+    """The same hazards, each within the time the perturbation itself moves the stream (a
+    stall or jitter of 0.5 s delays a loss the stream already had by up to 0.5 s: the same
+    outcome, later), plus the 0.1 s the outcome is rounded to."""
+    if len(base) != len(got):
+        return False
+    moved = p.size if p.family in ("stall", "jitter") else 0.0
+    slack = round(moved * 10) + 1
+    pairs = zip(base, got, strict=True)
+    return all(kind == other and abs(t - u) <= slack for (kind, t), (other, u) in pairs)
+
+
 def margins(scenario: Scenario, positions: int = 24, steps: int = 12) -> list[Margin]:
     """Per family, the smallest perturbation (bisection per position) changing the outcome."""
     base = outcome(scenario)
     result = []
     for family in FAMILIES:
         best: Perturbation | None = None
-        best_outcome: tuple[tuple[str, int], ...] = ()
+        best_outcome: Outcome = ()
         for at in _positions(scenario, positions):
             hi = MAX_SIZE[family] if best is None else best.size
-            changed = outcome(apply(scenario, Perturbation(family, at, hi)))
-            if changed == base:
+            widest = Perturbation(family, at, hi)
+            changed = outcome(apply(scenario, widest))
+            if same_outcome(base, changed, widest):
                 continue
             lo, hi_outcome = 0.0, changed
             for _ in range(steps):
@@ -160,8 +190,9 @@ def margins(scenario: Scenario, positions: int = 24, steps: int = 12) -> list[Ma
                     mid = float(math.floor(mid))
                     if mid <= lo:
                         break
-                got = outcome(apply(scenario, Perturbation(family, at, mid)))
-                if got != base:
+                tried = Perturbation(family, at, mid)
+                got = outcome(apply(scenario, tried))
+                if not same_outcome(base, got, tried):
                     hi, hi_outcome = mid, got
                 else:
                     lo = mid

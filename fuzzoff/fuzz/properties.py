@@ -16,7 +16,9 @@
   exception, and its findings are a prefix of the whole file's. *Prefix*: every finding of the
   cut file that is before ``cut_t - EDGE_S`` (``cut_t`` = time of the last event the cut file
   still gives) is also a finding of the whole file; findings without a time, OFB001 (the cut
-  itself), OFB002 and OFB003 are left out: they describe the file, not the stream.
+  itself), OFB002 and OFB003 are left out: they describe the file, not the stream. So is a
+  finding about a stretch that runs into that edge (its ``end_s``): the cut closed the stretch,
+  and its verdict (OFB105's percentiles, say) is on the part the cut left.
 * ``gate_invariants_hold`` (e): invariants of the gate spec, on the sent stream (see
   ``fuzz.invariants``).
 * ``runs_match_single_messages`` (f): the checks that take the stream as runs
@@ -260,6 +262,8 @@ def truncated_recordings_give_a_prefix(scenario: Scenario, ctx: FuzzContext) -> 
     for f in part.findings:
         if f.code in FILE_LEVEL or f.time_s is None or f.time_s > cut_t - EDGE_S:
             continue
+        if f.end_s is not None and f.end_s > cut_t - EDGE_S:
+            continue  # a stretch the cut closed: judged on the part the cut left
         (key,) = _keys([f])
         if remaining[key] > 0:
             remaining[key] -= 1
