@@ -14,6 +14,7 @@ from pathlib import Path
 import pytest
 
 from fuzzoff.config import Settings
+from fuzzoff.engine import Timeline
 from fuzzoff.events import (
     Command,
     ControlMode,
@@ -23,14 +24,16 @@ from fuzzoff.events import (
     VehicleStatus,
 )
 from fuzzoff.fuzz.campaign import CampaignConfig, run_campaign
+from fuzzoff.fuzz.invariants import invariant_violations
 from fuzzoff.fuzz.known import KNOWN
+from fuzzoff.fuzz.mutate import Perturbation, apply, outcome, scenario_from_recording
 from fuzzoff.fuzz.properties import (
     FuzzContext,
     every_unintended_outcome_is_explained,
     truncated_recordings_give_a_prefix,
 )
 from fuzzoff.fuzz.reproducers import save
-from fuzzoff.fuzz.scenario import Scenario
+from fuzzoff.fuzz.scenario import Scenario, run
 from fuzzoff.profiles import PX4_PROFILES
 from fuzzoff.writers.mcap import write_mcap
 from tests.helpers import CORPORA, run_cli
@@ -344,3 +347,35 @@ def test_stateful_sessions_keep_the_gate_invariants() -> None:
         suppress_health_check=list(HealthCheck),
     )
     case().runTest()
+
+
+def test_invariant_2_dates_a_late_ros2_keepalive_by_its_timestamp() -> None:
+    """On 1.14+ PX4 dates an OffboardControlMode by its timestamp (gate spec 2.1.1): keep-alives
+    delivered 50 ms late are lost 1 s after their timestamps, 0.95 s after they arrived. That
+    is the spec, not an early loss."""
+    events: list[Event] = [ControlMode(t=0.0, position=True, sender_time_us=1)]
+    for i in range(1, 21):
+        sent = round(i * 0.1, 4)
+        late = round(sent + 0.05, 4)
+        events.append(ControlMode(t=late, position=True, sender_time_us=round(sent * 1e6)))
+    disarm = Command(t=4.0, command=400, params=(0.0,) * 7, transport="ros2")  # runs past it
+    scenario = Scenario("1.15", "mc", "ros2", (*events, disarm))
+    timelines: dict[str, Timeline] = {}
+    run(scenario, timelines=timelines)
+    lost = [tr.t for tl in timelines.values() for tr in tl.transitions if tr.what == "signal_lost"]
+    assert lost == [pytest.approx(3.0)]
+    assert invariant_violations(scenario) == []
+
+
+def test_a_perturbation_leaves_the_vehicles_side_where_it_was() -> None:
+    """Delaying the first message sent must not shift the recording's clock: the vehicle's
+    status at the loss (recorded POSCTL at 7 s) would come before the model's own loss tick,
+    and a jitter of 0.3 ms would seem to remove the failsafe. (A vehicle event may move on by
+    the 0.1 ms step that keeps times strictly increasing, never back.)"""
+    base = scenario_from_recording(CORPORA / "mcap" / "stream_lost.mcap", None, None, {})
+    jitter = Perturbation("jitter", 0.0, 0.0003)
+    moved = apply(base, jitter)
+    before = [e.t for e in base.events if e.origin != "sent"]
+    after = [e.t for e in moved.events if e.origin != "sent"]
+    assert all(0.0 <= b - a <= 0.001 for a, b in zip(before, after, strict=True))
+    assert outcome(moved) == outcome(base) == (("failsafe", 70),)

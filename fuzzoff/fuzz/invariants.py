@@ -5,7 +5,9 @@
    iteration after the loss, unless the loss action changes no mode (Disarm, none).
 2. The loss is never declared earlier than the loss timeout after the newest keep-alive
    (2.1: ``now - ts >= COM_OF_LOSS_T``; 2.2 hysteresis; 2.3 legacy 500 ms), for a stream whose
-   keep-alives all count (ROS 2 control modes with a flag; MAVLink with nothing dropped).
+   keep-alives all count (ROS 2 control modes with a flag; MAVLink with nothing dropped). On
+   1.14+ a ROS 2 control mode dates from its ``timestamp`` as PX4 rewrites it (2.1.1), which a
+   late delivery leaves older than its arrival.
 3. After a loss failsafe, the first time the signal is available again the vehicle is back in
    OFFBOARD, unless a mode or arming command came in between or the action was Terminate or
    Disarm (5.1 recovery, 5.2, 5.3).
@@ -29,7 +31,7 @@ from fuzzoff.events import (
 )
 from fuzzoff.fuzz.scenario import Scenario
 from fuzzoff.gate import GateModel, GateTransition
-from fuzzoff.gate.signal import LOOP_PERIOD
+from fuzzoff.gate.signal import LOOP_PERIOD, px4_stamp
 from fuzzoff.profiles import at_least
 
 EPS = 1e-6
@@ -45,6 +47,7 @@ def invariant_violations(scenario: Scenario) -> list[str]:
     last_keepalive: float | None = None
     all_count = True
     lost_since: float | None = None
+    dating = _Dating(new_gate)
     for event in sent:
         before_armed, before_nav = model.armed, model.nav_state
         out = model.feed(event)
@@ -58,7 +61,7 @@ def invariant_violations(scenario: Scenario) -> list[str]:
             elif tr.what == "setpoint_dropped":
                 all_count = False
         if _is_counted_keepalive(event):
-            last_keepalive = event.t
+            last_keepalive = dating.dated(event)
         elif isinstance(event, ControlMode):
             all_count = False  # an empty control mode is a keep-alive that does not count
         if (
@@ -94,6 +97,24 @@ def _in_time_order(transitions: list[GateTransition]) -> list[str]:
 
 def _vehicle(scenario: Scenario) -> str:
     return "1" if scenario.transport == "mavlink" else ""
+
+
+class _Dating:
+    """When PX4 dates a keep-alive: its receive time, except a ROS 2 control mode on 1.14+,
+    dated by its ``timestamp`` (2.1.1; the sender's clock offset taken from the first stamped
+    one, which counts as fresh, as the model takes it)."""
+
+    def __init__(self, stamped: bool) -> None:
+        self.stamped = stamped
+        self.offset: float | None = None
+
+    def dated(self, event: Event) -> float:
+        sender_us = event.sender_time_us
+        if not (self.stamped and isinstance(event, ControlMode) and sender_us):
+            return event.t
+        if self.offset is None:
+            self.offset = sender_us * 1e-6 - event.t
+        return px4_stamp(event.t, sender_us, self.offset)
 
 
 def _is_counted_keepalive(event: Event) -> bool:

@@ -109,7 +109,7 @@ def apply(scenario: Scenario, p: Perturbation) -> Scenario:
             else e
             for e in events
         ]
-    return replace(scenario, events=tuple(settle(out)))
+    return replace(scenario, events=tuple(settle(out, from_zero=False)))
 
 
 def _shift(e: Event, dt: float) -> Event:

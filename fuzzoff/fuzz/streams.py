@@ -85,13 +85,14 @@ def commands(plan: fs.CommandPlan, transport: TransportName) -> list[ev.Command]
     return out
 
 
-def settle(events: Sequence[ev.Event]) -> list[ev.Event]:
+def settle(events: Sequence[ev.Event], *, from_zero: bool = True) -> list[ev.Event]:
     """Sorted, starting at 0 (a recording's clock starts at its first message), 0.1 ms
-    resolution, strictly increasing."""
+    resolution, strictly increasing. ``from_zero=False`` keeps the clock where it is (a
+    perturbation that delays the first message must not move the others earlier)."""
     ordered = sorted(events, key=lambda e: e.t)
     if not ordered:
         return []
-    t0 = ordered[0].t
+    t0 = ordered[0].t if from_zero else 0.0
     out: list[ev.Event] = []
     last = -1.0
     for e in ordered:

@@ -49,7 +49,14 @@ from fuzzoff.gate.failsafe import LossAction, loss_action
 from fuzzoff.gate.params import default_params
 from fuzzoff.gate.receiver import DROPPED, SHAPES, ReceiverContext, Result, Shape, receive
 from fuzzoff.gate.requests import Decision, arm_decision, decode_mode, switch_decision
-from fuzzoff.gate.signal import INF, LOOP_PERIOD, estimate_failure, make_signal, slack
+from fuzzoff.gate.signal import (
+    INF,
+    LOOP_PERIOD,
+    estimate_failure,
+    make_signal,
+    px4_stamp,
+    slack,
+)
 from fuzzoff.gate.tracker import ControllerTracker
 from fuzzoff.gate.transitions import GateTransition, TransitionKind
 from fuzzoff.modes import nav_state_name
@@ -358,13 +365,9 @@ class GateModel:
         recording's is always fresh; one that stops or lags ages)."""
         if sender_us == 0:
             return t
-        sender = sender_us * 1e-6
         if self._stamp_offset is None:
-            self._stamp_offset = sender - t
-        stamp = sender - self._stamp_offset
-        if stamp < 0.0:  # unsigned wrap in PX4: clamped to now
-            return t
-        return stamp if stamp < t else t
+            self._stamp_offset = sender_us * 1e-6 - t
+        return px4_stamp(t, sender_us, self._stamp_offset)
 
     def _on_legacy_control_mode(self, event: LegacyControlMode) -> None:
         self._keepalive(event.t, ocm.legacy_mask(event), event)

@@ -67,6 +67,17 @@ def estimate_failure(px4: str, mask: int, est: Estimates) -> str | None:
     return None
 
 
+
+def px4_stamp(t: float, sender_us: int, offset: float) -> float:
+    """A ROS 2 message's ``timestamp`` as PX4 1.14+ reads it after its uXRCE-DDS rewrite
+    (2.1.1): ``min(value - offset, now)``, a value below the offset wrapping to now. ``offset``
+    is the sender's clock minus the recording's, in seconds; ``t`` the receive time. (A value
+    of 0 is also the receive time; the caller knows it before it has an offset.)"""
+    stamp = sender_us * 1e-6 - offset
+    if stamp < 0.0:  # unsigned wrap in PX4: clamped to now
+        return t
+    return stamp if stamp < t else t
+
 class Signal:
     """Common state: ``available`` and the newest keep-alive's time (``None`` before any)."""
 
