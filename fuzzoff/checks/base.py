@@ -145,12 +145,24 @@ class StreamBatch:
     ``tests/test_batching.py`` and the ``runs`` fuzz property compare the two.
     """
 
-    __slots__ = ("_classes", "_keepalives", "_of", "events", "gate", "memo", "state")
+    __slots__ = (
+        "_classes",
+        "_keepalives",
+        "_of",
+        "events",
+        "gate",
+        "memo",
+        "mode_at_start",
+        "state",
+    )
 
     def __init__(self, state: VehicleState, gate: GateModel) -> None:
         self.events: list[Event] = []
         self.state = copy.copy(state)
         self.gate = copy.copy(gate)
+        self.mode_at_start = state.control_mode
+        """The declaration the run's first message saw: ``replay`` moves ``state.control_mode``
+        through the run's own declarations and puts this back for the next check."""
         self._keepalives: list[Event] | None = None
         self._of: dict[tuple[type[Event], ...], list[Event]] = {}
         self._classes: frozenset[type[Event]] | None = None
@@ -238,20 +250,27 @@ class Check:
     def replay(self, batch: StreamBatch, start: int = 0) -> None:
         """``on_event`` for the run's messages from ``start`` on that this check wants, with
         the per-message parts of the state (``keepalive``, ``control_mode``) set as
-        ``VehicleState.update`` sets them: the exact fallback of an ``on_batch``."""
+        ``VehicleState.update`` sets them: the exact fallback of an ``on_batch``. Several checks
+        may replay one run: each finds ``control_mode`` as the run began, and leaves it so."""
         state = self.ctx.state
         wants = self.subscriptions
         counts = state.counts_as_keepalive
         on_event = self.on_event
         events = batch.events
+        declarations = (ControlMode, LegacyControlMode)
+        state.control_mode = next(
+            (e for e in reversed(events[:start]) if isinstance(e, declarations)),
+            batch.mode_at_start,
+        )
         for i in range(start, len(events)):
             event = events[i]
-            if isinstance(event, (ControlMode, LegacyControlMode)):
+            if isinstance(event, declarations):
                 state.control_mode = event
             if isinstance(event, wants):
                 state.keepalive = event if counts(event) else None
                 on_event(event)
         state.keepalive = None
+        state.control_mode = batch.mode_at_start
 
     def finish(self, t_end: float) -> None:
         """Called once after the last event (``t_end`` = the recording's last time)."""
