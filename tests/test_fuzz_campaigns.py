@@ -379,3 +379,14 @@ def test_a_perturbation_leaves_the_vehicles_side_where_it_was() -> None:
     after = [e.t for e in moved.events if e.origin != "sent"]
     assert all(0.0 <= b - a <= 0.001 for a, b in zip(before, after, strict=True))
     assert outcome(moved) == outcome(base) == (("failsafe", 70),)
+
+
+def test_explained_leaves_out_a_hazard_the_recorded_vehicle_contradicts() -> None:
+    """``switch_rejected.mcap`` perturbed by ``--from``: the model accepts the switch that the
+    recorded vehicle rejected, and predicts a hold controller it never ran. The recorded
+    answers were to the unperturbed stream; OFB202 reports the disagreement."""
+    recording = CORPORA / "mcap" / "from_switch_rejected_perturbed.mcap"
+    scenario = scenario_from_recording(recording, "1.15", "mc", {})
+    assert every_unintended_outcome_is_explained(scenario, FuzzContext(recorded_answers=True)) == []
+    (problem,) = every_unintended_outcome_is_explained(scenario, FuzzContext())
+    assert "controller at 2.482 s" in problem

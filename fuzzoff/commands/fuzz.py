@@ -92,7 +92,7 @@ def _config(args: argparse.Namespace) -> CampaignConfig:
         known=tuple(KNOWN) if args.known else (),
     )
     if args.from_:
-        from fuzzoff.fuzz.mutate import scenario_from_recording
+        from fuzzoff.fuzz.mutate import scenario_from_recording, sent_keepalives
 
         config.properties = _from_properties(args.property)
         try:
@@ -103,6 +103,12 @@ def _config(args: argparse.Namespace) -> CampaignConfig:
             raise ConfigError(exc.line()) from None
         except OSError as exc:
             raise ConfigError(f"{args.from_}: {exc.strerror or exc}") from None
+        if not sent_keepalives(config.base):
+            raise ConfigError(
+                f"{args.from_}: no keep-alive as sent to the vehicle, so nothing to perturb (a "
+                "ULog holds only the vehicle's own copies): --from takes a recording of the "
+                "stream as sent, a tlog, an MCAP, a ROS 2 or a ROS 1 bag"
+            )
     return config
 
 

@@ -133,7 +133,7 @@ def run_property(
     on_example: Callable[[PropertyResult], None] | None = None,
 ) -> PropertyResult:
     result = PropertyResult(spec.name, spec.claim)
-    ctx = FuzzContext(settings=config.settings)
+    ctx = FuzzContext(settings=config.settings, recorded_answers=config.base is not None)
     start = result.started = time.perf_counter()
     known = [re.compile(k) for k in config.known]
     failing: dict[str, Any] = {}

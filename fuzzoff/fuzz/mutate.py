@@ -29,7 +29,6 @@ from fuzzoff.fuzz.recordings import read_with_info
 from fuzzoff.fuzz.scenario import Scenario, TransportName, run
 from fuzzoff.fuzz.streams import settle
 from fuzzoff.profiles import DEFAULT_PX4, DEFAULT_VEHICLE, ProfileError, px4_profile_for
-from fuzzoff.sources import SourceError
 
 FAMILIES = ("stall", "drop", "jitter", "skew")
 MAX_SIZE = {"stall": 5.0, "drop": 50.0, "jitter": 1.0, "skew": 5.0}
@@ -41,15 +40,8 @@ def scenario_from_recording(
 ) -> Scenario:
     """The recording's events as a scenario (transport from its events; profile as given, else
     as the recording says, else PX4 1.15 multicopter like ``fuzzoff lint``). ``SourceError``
-    when the recording cannot be read, or holds no keep-alive as sent (nothing to perturb)."""
+    when the recording cannot be read."""
     events, info = read_with_info(path)
-    if not any(e.origin == "sent" and is_keepalive(e) for e in events):
-        what = "a ULog holds the vehicle's own copies" if info.format == "ulog" else "none found"
-        raise SourceError(
-            path,
-            f"no keep-alive as sent to the vehicle to perturb ({what}); --from takes a "
-            "recording of the stream as sent: a tlog, an MCAP, a ROS 2 or a ROS 1 bag",
-        )
     if px4 is None:
         try:
             px4 = px4_profile_for(info.px4_version) if info.px4_version else DEFAULT_PX4
@@ -68,6 +60,12 @@ def scenario_from_recording(
     return Scenario(
         px4=px4, vehicle=vehicle, transport=transport, events=tuple(settle(events)), params=params
     )
+
+
+def sent_keepalives(scenario: Scenario) -> int:
+    """How many keep-alives the scenario sends: what the perturbations act on (a ULog has
+    none, only the vehicle's own copies of the topics)."""
+    return sum(1 for e in scenario.events if e.origin == "sent" and is_keepalive(e))
 
 
 @dataclass(frozen=True, slots=True)

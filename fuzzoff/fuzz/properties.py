@@ -69,6 +69,9 @@ class FuzzContext:
     """Where ``truncated_recordings_give_a_prefix`` cuts (drawn per example)."""
     first_only: bool = True
     """``every_unintended_outcome_is_explained`` reports the first silent hazard only."""
+    recorded_answers: bool = False
+    """The vehicle's side is a recording's (``--from``, a reproducer): it answered the stream
+    before it was perturbed, so it may contradict the model (see ``contradicted``)."""
 
     def close(self) -> None:
         shutil.rmtree(self.workdir, ignore_errors=True)
@@ -104,6 +107,18 @@ def explains(hazard: Hazard, findings: Sequence[Finding], blind: set[str]) -> bo
     return False
 
 
+def contradicted(hazard: Hazard, findings: Sequence[Finding]) -> bool:
+    """Does the recording's own vehicle side contradict the model during ``hazard`` (OFB202:
+    the recorded mode is not the model's)? Then the hazard belongs to a stream the vehicle
+    never answered: a perturbed copy keeps the answers to the original one."""
+    return any(
+        f.code == "OFB202"
+        and f.time_s is not None
+        and hazard.t - TOLERANCE_S <= f.time_s <= hazard.end + TOLERANCE_S
+        for f in findings
+    )
+
+
 def every_unintended_outcome_is_explained(scenario: Scenario, ctx: FuzzContext) -> list[str]:
     """Only the first silent hazard of a vehicle is reported (later ones are counted): they are
     often its consequences (a dropped keep-alive, then a rejected switch)."""
@@ -116,6 +131,7 @@ def every_unintended_outcome_is_explained(scenario: Scenario, ctx: FuzzContext) 
             h
             for h in hazards(timeline.transitions, scenario.duration)
             if not explains(h, mine, blind)
+            and not (ctx.recorded_answers and contradicted(h, mine))
         ]
         head = f"silent hazard ({scenario.transport}, PX4 {scenario.px4})"
         if silent and ctx.first_only:

@@ -128,7 +128,8 @@ def recheck(spec: dict[str, Any], recording: Path) -> list[str]:
         str(info["vehicle"]),
         {str(k): float(v) for k, v in dict(info.get("params", {})).items()},
     )
-    ctx = FuzzContext(settings=Settings(ignore=frozenset(info.get("ignore", []))))
+    ignore = frozenset(info.get("ignore", []))
+    ctx = FuzzContext(settings=Settings(ignore=ignore), recorded_answers=True)
     try:
         if "cut_fraction" in spec:
             ctx.cut_fraction = float(spec["cut_fraction"])
