@@ -390,3 +390,13 @@ def test_explained_leaves_out_a_hazard_the_recorded_vehicle_contradicts() -> Non
     assert every_unintended_outcome_is_explained(scenario, FuzzContext(recorded_answers=True)) == []
     (problem,) = every_unintended_outcome_is_explained(scenario, FuzzContext())
     assert "controller at 2.482 s" in problem
+
+
+def test_explained_leaves_out_a_rejected_arming_the_recorded_vehicle_shows_granted() -> None:
+    """A rover recording perturbed by ``--from`` (timestamps lagging up to 2 s): the model
+    rejects the arming at 3.119 s; the recorded status shows the vehicle armed at 3.2 s."""
+    recording = CORPORA / "mcap" / "from_rover_perturbed_arm.mcap"
+    scenario = scenario_from_recording(recording, "1.15", "mc", {})
+    assert every_unintended_outcome_is_explained(scenario, FuzzContext(recorded_answers=True)) == []
+    (problem,) = every_unintended_outcome_is_explained(scenario, FuzzContext())
+    assert "arm_rejected at 3.119 s" in problem

@@ -105,9 +105,9 @@ def _config(args: argparse.Namespace) -> CampaignConfig:
             raise ConfigError(f"{args.from_}: {exc.strerror or exc}") from None
         if not sent_keepalives(config.base):
             raise ConfigError(
-                f"{args.from_}: no keep-alive as sent to the vehicle, so nothing to perturb (a "
-                "ULog holds only the vehicle's own copies): --from takes a recording of the "
-                "stream as sent, a tlog, an MCAP, a ROS 2 or a ROS 1 bag"
+                f"{args.from_}: no keep-alive as sent to the vehicle, so nothing to perturb: "
+                "--from takes a recording of the companion's stream (a tlog, an MCAP, a ROS 2 "
+                "or a ROS 1 bag with its setpoints; a ULog holds only the vehicle's copies)"
             )
     return config
 

@@ -40,7 +40,7 @@ from typing import Any
 from fuzzoff.catalog import get_rule
 from fuzzoff.config import Settings
 from fuzzoff.engine import Timeline, lint_file
-from fuzzoff.events import Event
+from fuzzoff.events import NAV_STATE_OFFBOARD, Event, VehicleStatus
 from fuzzoff.findings import Finding, Severity
 from fuzzoff.fuzz import recordings
 from fuzzoff.fuzz.hazards import EXPLAINED_BY, OUTCOME_RULE, Hazard, hazards
@@ -107,15 +107,32 @@ def explains(hazard: Hazard, findings: Sequence[Finding], blind: set[str]) -> bo
     return False
 
 
-def contradicted(hazard: Hazard, findings: Sequence[Finding]) -> bool:
-    """Does the recording's own vehicle side contradict the model during ``hazard`` (OFB202:
-    the recorded mode is not the model's)? Then the hazard belongs to a stream the vehicle
-    never answered: a perturbed copy keeps the answers to the original one."""
-    return any(
+RECORDED_ANSWER_S = 1.0
+"""How soon after a rejection the recording's own status may show it granted (a 1 Hz
+HEARTBEAT or ``/mavros/state``)."""
+
+
+def contradicted(hazard: Hazard, findings: Sequence[Finding], statuses: Sequence[Event]) -> bool:
+    """Does the recording's own vehicle side contradict the model during ``hazard``? Then the
+    hazard belongs to a stream the vehicle never answered: a perturbed copy keeps the answers
+    to the original one. Contradicted: the recorded mode is not the model's (OFB202) within
+    the hazard, or a rejected switch or arming shows granted in the recorded status soon
+    after."""
+    if any(
         f.code == "OFB202"
         and f.time_s is not None
         and hazard.t - TOLERANCE_S <= f.time_s <= hazard.end + TOLERANCE_S
         for f in findings
+    ):
+        return True
+    if hazard.kind not in ("arm_rejected", "request_rejected"):
+        return False
+    arming = hazard.kind == "arm_rejected"
+    return any(
+        isinstance(s, VehicleStatus)
+        and hazard.t - TOLERANCE_S <= s.t <= hazard.end + RECORDED_ANSWER_S
+        and (s.armed is True if arming else s.nav_state == NAV_STATE_OFFBOARD)
+        for s in statuses
     )
 
 
@@ -124,6 +141,10 @@ def every_unintended_outcome_is_explained(scenario: Scenario, ctx: FuzzContext) 
     often its consequences (a dropped keep-alive, then a rejected switch)."""
     findings, timelines = _timelines(scenario, ctx)
     blind = _not_checkable(findings, scenario)
+    statuses: dict[str, list[Event]] = {vehicle: [] for vehicle in timelines}
+    for e in scenario.events:
+        if isinstance(e, VehicleStatus) and e.origin != "sent" and e.vehicle in statuses:
+            statuses[e.vehicle].append(e)
     problems = []
     for vehicle, timeline in sorted(timelines.items()):
         mine = [f for f in findings if f.vehicle == vehicle or f.time_s is None]
@@ -131,7 +152,7 @@ def every_unintended_outcome_is_explained(scenario: Scenario, ctx: FuzzContext) 
             h
             for h in hazards(timeline.transitions, scenario.duration)
             if not explains(h, mine, blind)
-            and not (ctx.recorded_answers and contradicted(h, mine))
+            and not (ctx.recorded_answers and contradicted(h, mine, statuses[vehicle]))
         ]
         head = f"silent hazard ({scenario.transport}, PX4 {scenario.px4})"
         if silent and ctx.first_only:
