@@ -400,3 +400,11 @@ def test_explained_leaves_out_a_rejected_arming_the_recorded_vehicle_shows_grant
     assert every_unintended_outcome_is_explained(scenario, FuzzContext(recorded_answers=True)) == []
     (problem,) = every_unintended_outcome_is_explained(scenario, FuzzContext())
     assert "arm_rejected at 3.119 s" in problem
+
+
+def test_a_hold_counts_only_while_armed() -> None:
+    """The failsafe hold before the first TrajectorySetpoint runs 0.63 s from a switch made on
+    the ground, but only 26 ms of it armed: no hazard (the docs: "while armed")."""
+    recording = CORPORA / "mcap" / "from_hold_on_the_ground.mcap"
+    scenario = scenario_from_recording(recording, "1.15", "mc", {})
+    assert every_unintended_outcome_is_explained(scenario, FuzzContext()) == []

@@ -7,9 +7,9 @@ A *hazard* is a ``GateTransition`` of one of these kinds (gate spec section in b
   not a failsafe the model ends within one Commander iteration (a tie at the threshold, which
   changes nothing; the invariants check the model's timeline itself);
 * ``setpoint_dropped``: the MAVLink receiver dropped or ignored a setpoint (6);
-* ``controller`` with a reason that lasts ``HOLD_S`` or more: another controller runs than the
-  setpoint asked for (the failsafe setpoint, the 200 ms reuse; 8-10). Shorter ones are the
-  moment between a keep-alive and its setpoint, which PX4 also sees.
+* ``controller`` with a reason that lasts ``HOLD_S`` or more while armed: another controller
+  runs than the setpoint asked for (the failsafe setpoint, the 200 ms reuse; 8-10). Shorter
+  ones are the moment between a keep-alive and its setpoint, which PX4 also sees.
 
 ``EXPLAINED_BY`` names the rules whose findings explain each kind: rules about the very outcome
 (OFB201, OFB103, OFB6xx...) and about its causes (a gap, an empty control mode, a dropped
@@ -151,11 +151,17 @@ def hazards(transitions: Sequence[GateTransition], t_end: float) -> list[Hazard]
                 continue
             idx = next(i for i, c in enumerate(controllers) if c is tr)
             end = controllers[idx + 1].t if idx + 1 < len(controllers) else t_end
-            # Armed at some moment while it runs (arming after the switch changes no controller).
-            if not (tr.armed or any(x.armed for x in transitions if tr.t <= x.t < end)):
+            # Counted from when the vehicle is armed while it runs (arming after the switch
+            # changes no controller): a hold on the ground is no hazard.
+            armed_at = (
+                tr.t
+                if tr.armed
+                else next((x.t for x in transitions if tr.t <= x.t < end and x.armed), None)
+            )
+            if armed_at is None:
                 continue
             hold = WAIT_S if tr.reason.startswith(NO_SETPOINT_YET) else HOLD_S
-            if end - tr.t < hold:
+            if end - armed_at < hold:
                 continue
             out.append(Hazard(tr.t, what, tr.message, tr.spec, end))
         elif (what in WHILE_ARMED and not _armed_before(tr, transitions)) or (
