@@ -116,8 +116,8 @@ def _from_properties(asked: list[str] | None) -> tuple[str, ...]:
     """The properties a ``--from`` campaign checks: not those that write the stream with
     fuzzoff's writers and read it back (``uses_files``). They test the writers and readers on
     the streams the campaign generates; a recording's events are a reader's output, with what
-    no writer writes (a ULog's, the vehicle's identity), so they would report on fuzzoff's
-    writers, not on the user's stream."""
+    no writer writes back as it was (the vehicle's identity from a HEARTBEAT, say), so they
+    would report on fuzzoff's writers, not on the user's stream."""
     for name in asked or ():
         if PROPERTIES[name].uses_files:
             raise ConfigError(
