@@ -408,3 +408,18 @@ def test_a_hold_counts_only_while_armed() -> None:
     recording = CORPORA / "mcap" / "from_hold_on_the_ground.mcap"
     scenario = scenario_from_recording(recording, "1.15", "mc", {})
     assert every_unintended_outcome_is_explained(scenario, FuzzContext()) == []
+
+
+def test_a_jittered_command_keeps_the_vehicles_ack_after_it() -> None:
+    """``switch_rejected.mcap``: the vehicle rejects the switch at 2.0 s with an ack 10 ms
+    later. A jitter delays the command by up to 0.9 s; the recorded ack answers it, so it
+    moves with it, and OFB201 still sees the rejection."""
+    base = scenario_from_recording(CORPORA / "mcap" / "switch_rejected.mcap", None, None, {})
+    jittered = apply(base, Perturbation("jitter", 0.0, 0.9))
+    pairs = [e for e in jittered.events if e.kind in ("command", "command_ack")]
+    assert [e.kind for e in pairs] == ["command", "command_ack"] * 2
+    assert all(
+        ack.t - cmd.t == pytest.approx(0.01, abs=2e-4)
+        for cmd, ack in zip(pairs[::2], pairs[1::2], strict=True)
+    )
+    assert "OFB201" in {f.code for f in run(jittered)}

@@ -23,7 +23,7 @@ from pathlib import Path
 from hypothesis import strategies as st
 
 from fuzzoff.engine import Timeline
-from fuzzoff.events import ControlMode, Event, is_keepalive
+from fuzzoff.events import Command, CommandAck, ControlMode, Event, is_keepalive
 from fuzzoff.fuzz.hazards import hazards
 from fuzzoff.fuzz.recordings import read_with_info
 from fuzzoff.fuzz.scenario import Scenario, TransportName, run
@@ -97,6 +97,7 @@ def apply(scenario: Scenario, p: Perturbation) -> Scenario:
             else e
             for i, e in enumerate(events)
         ]
+        out = _acks_follow(events, out)
     else:  # skew
         out = [
             replace(e, sender_time_us=max(0, e.sender_time_us - round(p.size * 1e6)))
@@ -108,6 +109,23 @@ def apply(scenario: Scenario, p: Perturbation) -> Scenario:
             for e in events
         ]
     return replace(scenario, events=tuple(settle(out, from_zero=False)))
+
+
+def _acks_follow(before: Sequence[Event], after: Sequence[Event]) -> list[Event]:
+    """Each recorded ack moved at least as far as the command it answers (the latest one of
+    that command before it): delaying a command past the vehicle's answer to it would leave an
+    ack with nothing to answer. ``after`` is ``before`` perturbed, message for message."""
+    moved: dict[int, float] = {}
+    out = []
+    for old, new in zip(before, after, strict=True):
+        if isinstance(old, Command) and old.origin == "sent":
+            moved[old.command] = new.t - old.t
+        elif isinstance(old, CommandAck) and old.origin != "sent":
+            delay = moved.get(old.command, 0.0)
+            if new.t - old.t < delay:
+                new = _shift(old, delay)
+        out.append(new)
+    return out
 
 
 def _shift(e: Event, dt: float) -> Event:
