@@ -40,7 +40,7 @@ def add_parser(sub: Any) -> None:
     parser.set_defaults(run=run)
 
 
-def _lint_on_terminal(args: argparse.Namespace, settings: Settings) -> Report:
+def _lint_on_terminal(args: argparse.Namespace, paths: list[str], settings: Settings) -> Report:
     """Lint with a progress bar where one helps, then print the findings with rich (imported
     here: the machine-readable formats need not pay for it at start-up)."""
     from rich.console import Console
@@ -49,9 +49,9 @@ def _lint_on_terminal(args: argparse.Namespace, settings: Settings) -> Report:
 
     console = Console(stderr=False, highlight=False)
     if console.is_terminal and not args.no_progress and args.jobs == 1:
-        report = lint_with_progress(args.paths, settings, console)
+        report = lint_with_progress(paths, settings, console)
     else:
-        report = lint_paths(args.paths, settings, jobs=args.jobs)
+        report = lint_paths(paths, settings, jobs=args.jobs)
     with contextlib.ExitStack() as stack:
         if args.output:
             fh = stack.enter_context(open(args.output, "w", encoding="utf-8"))
@@ -71,16 +71,19 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(f"no such file or folder: {missing[0]}")
     # A folder with nothing to lint is a mistake (a wrong path, a recording step that failed):
     # passing it would turn a CI job green without looking at a single flight.
-    empty = [p for p in args.paths if Path(p).is_dir() and not find_recordings(Path(p))]
+    # Each folder is searched once, here; the linting takes the recordings found.
+    found = [(p, find_recordings(Path(p))) for p in args.paths]
+    empty = [p for p, recordings in found if Path(p).is_dir() and not recordings]
     if empty:
         suffixes = ", ".join(RECORDING_SUFFIXES)
         raise ConfigError(f"no recordings in {empty[0]} (searched for {suffixes} and bag folders)")
+    paths = [str(f) for _, recordings in found for f in recordings]
     if args.format == "terminal":
-        report = _lint_on_terminal(args, settings)
+        report = _lint_on_terminal(args, paths, settings)
     else:
         # the HTML report plots each vehicle's timeline
         lint = lint_with_timelines if args.format == "html" else lint_paths
-        report = lint(args.paths, settings, jobs=args.jobs)
+        report = lint(paths, settings, jobs=args.jobs)
         write_output(renderer(args.format)(report, settings), args.output)
     for f in report.files:
         for line in f.problems:

@@ -67,7 +67,6 @@ def estimate_failure(px4: str, mask: int, est: Estimates) -> str | None:
     return None
 
 
-
 def px4_stamp(t: float, sender_us: int, offset: float) -> float:
     """A ROS 2 message's ``timestamp`` as PX4 1.14+ reads it after its uXRCE-DDS rewrite
     (2.1.1): ``min(value - offset, now)``, a value below the offset wrapping to now. ``offset``
@@ -77,6 +76,7 @@ def px4_stamp(t: float, sender_us: int, offset: float) -> float:
     if stamp < 0.0:  # unsigned wrap in PX4: clamped to now
         return t
     return stamp if stamp < t else t
+
 
 class Signal:
     """Common state: ``available`` and the newest keep-alive's time (``None`` before any)."""
