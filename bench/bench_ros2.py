@@ -19,7 +19,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from bench.measure import Run, measure
+from bench.measure import Run, measure, per_message_split
 
 DATA = Path(__file__).resolve().parent / "data"
 ROOT = DATA.parent.parent
@@ -188,6 +188,14 @@ def _verdicts(kind: str, results: dict[str, dict[str, Run]]) -> list[str]:
         )
         r = cpu(size, "fuzzoff reader alone") / cpu(size, "rosbags, PX4 topics")
         out.append(f"{'':<9}   (reader alone, no checks: {r:.2f}x)")
+        bare = results[f"{tag} {size}"]["rosbags, PX4 topics"]
+        split = per_message_split(
+            int(bare.output.split()[0]),
+            work_s(bare),
+            cpu(size, "fuzzoff reader alone"),
+            cpu(size, "fuzzoff lint"),
+        )
+        out.append(f"{'':<9}   ({split})")
     r = cpu("mixed-100k", "rosbags, every message") / cpu("mixed-100k", "fuzzoff lint")
     out.append(f"{tag:<9} lint faster than decoding everything (mixed) >= 3x {r:8.2f}x   {r >= 3}")
     small = results[f"{tag} 100k"]["fuzzoff lint (CLI)"].rss_mb

@@ -15,7 +15,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from bench.measure import Run, measure
+from bench.measure import Run, measure, per_message_split
 from bench.rosbag1_data import generate
 
 DATA = Path(__file__).resolve().parent / "data"
@@ -115,6 +115,14 @@ def main() -> None:
         print(f"lint / rosbags same topics ({name:<4}) <= 1.3x              {r:7.2f}x   {r <= 1.3}")
         r = ratio(name, "fuzzoff rosbag1 reader alone", "rosbags, MAVROS topics")
         print(f"  (reader alone, no checks: {r:.2f}x)")
+        runs = results[name]
+        split = per_message_split(
+            files[name][1],
+            runs["rosbags, MAVROS topics"].cpu_s,
+            runs["fuzzoff rosbag1 reader alone"].cpu_s,
+            runs["fuzzoff lint"].cpu_s,
+        )
+        print(f"  ({split})")
     r = 1 / ratio("mixed-300k", "fuzzoff lint", "rosbags, every message")
     print(f"lint faster than decoding everything (mixed) >= 3x       {r:7.2f}x   {r >= 3.0}")
     startup = lint(ROOT / "corpora" / "rosbag1" / "offboard_good.bag").cpu_s
