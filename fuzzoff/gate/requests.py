@@ -73,7 +73,7 @@ def switch_decision(
         return Decision(
             False, "4.1", "unsupported main mode", TEMPORARILY_REJECTED, unverified=True
         )
-    if at_least(px4, "1.16") and nav_state == TERMINATION and armed:
+    if at_least(px4, "1.16") and nav_state == TERMINATION:  # armed or not
         return Decision(False, "4.1", "never out of TERMINATION", TEMPORARILY_REJECTED)
     if target != NAV_STATE_OFFBOARD:
         # Other modes' requirements are not modelled: assumed accepted.

@@ -46,10 +46,12 @@ def test_4_1_unsupported_main_mode(px4: str, rejected: bool) -> None:
     assert any("rejected" in t.message for t in trs) is rejected
 
 
+@pytest.mark.parametrize("armed", [True, False])
 @pytest.mark.parametrize(("px4", "stays"), [("1.14", False), ("1.15", False), ("1.16", True)])
-def test_4_1_never_out_of_termination_from_116(px4: str, stays: bool) -> None:
-    """4.1: from 1.16 no mode switch leaves TERMINATION."""
-    events = [status(0.0, TERMINATION, True, TERMINATION), *stream(0.0, 1.0), switch_offboard(0.5)]
+def test_4_1_never_out_of_termination_from_116(px4: str, stays: bool, armed: bool) -> None:
+    """4.1: from 1.16 no mode switch leaves TERMINATION, armed or not: the test comes after
+    the always-allowed-while-disarmed shortcut in ``UserModeIntention::change``."""
+    events = [status(0.0, TERMINATION, armed, TERMINATION), *stream(0.0, 1.0), switch_offboard(0.5)]
     assert bool(of("request_rejected", run(px4, events))) is stays
 
 
