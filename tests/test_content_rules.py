@@ -19,6 +19,7 @@ from fuzzoff.events import (
     FailsafeFlags,
     LegacyControlMode,
     Origin,
+    Parameter,
     PositionSetpointTriplet,
     RatesSetpoint,
     RoverAttitudeSetpoint,
@@ -69,6 +70,27 @@ def test_ofb106_lag_edge_is_the_loss_timeout(lag: float, flagged: bool) -> None:
     if flagged:
         assert found[0].severity is Severity.WARNING
         assert found[0].time_s == pytest.approx(0.5 + lag)
+
+
+@pytest.mark.parametrize(("loss_t_at", "severity"), [(0.0, Severity.INFO), (2.0, Severity.WARNING)])
+def test_ofb106_judges_by_the_recordings_com_of_loss_t(
+    loss_t_at: float, severity: Severity
+) -> None:
+    """The recording's COM_OF_LOSS_T (3 s) sets the line from when it is seen: a 1.5 s lag
+    after it is within the timeout; one before it was judged by the default (1 s)."""
+    times = [0.0, 0.5, 1.0, 1.5, 2.0]
+    stamps = [10_000_000, 10_000_000, 10_000_000, 10_000_000, 10_500_000]
+    events: list[Event] = [
+        *ocm_stamped(times, stamps),
+        Parameter(t=loss_t_at, name="COM_OF_LOSS_T", value=3.0),
+    ]
+    events.sort(key=lambda e: (e.t, not isinstance(e, Parameter)))
+    # lag_s 0.4: every lagging message is noted, the severity then says how PX4 takes it
+    chosen = Settings(select=MINE, options={"OFB106": {"lag_s": 0.4}})
+    (found,) = codes(_lint_events(events, settings=chosen), "OFB106")
+    assert found.severity is severity
+    if severity is Severity.WARNING:
+        assert "COM_OF_LOSS_T (1.00 s)" in found.message
 
 
 def test_ofb106_lag_is_info_on_1_13_which_ignores_the_field() -> None:

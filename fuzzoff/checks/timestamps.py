@@ -29,6 +29,9 @@ class _Seen:
     where: Where
     count: int = 1
     worst_lag: float = 0.0
+    stale_at: float | None = None
+    """The loss timeout a noted message's lag reached first (1.14+), if any did: the
+    recording's COM_OF_LOSS_T may arrive, or change, after the first message."""
 
 
 class KeepaliveTimestamp(Check):
@@ -37,15 +40,22 @@ class KeepaliveTimestamp(Check):
 
     def __init__(self, ctx: CheckContext) -> None:
         super().__init__(ctx)
-        option = float(ctx.option("OFB106", "lag_s"))
-        self.timeout = float(ctx.gate.loss_timeout)
-        self.lag_limit = option if option > 0 else self.timeout
+        self.lag_option = float(ctx.option("OFB106", "lag_s"))
         self.judged_by_timestamp = ctx.profile.at_least("1.14")
         self.best_offset: float | None = None
         self.previous: int | None = None
         self.seen: dict[str, _Seen] = {}
         self.logged = False
         self.sent = False
+
+    @property
+    def timeout(self) -> float:
+        """The gate's loss timeout now: the recording's COM_OF_LOSS_T once it has been seen."""
+        return float(self.ctx.gate.loss_timeout)
+
+    @property
+    def lag_limit(self) -> float:
+        return self.lag_option if self.lag_option > 0 else self.timeout
 
     def on_event(self, event: Event) -> None:
         assert isinstance(event, ControlMode)
@@ -105,10 +115,13 @@ class KeepaliveTimestamp(Check):
     def _note(self, what: str, event: Event, lag: float) -> None:
         seen = self.seen.get(what)
         if seen is None:
-            self.seen[what] = _Seen(event.t, event.where, worst_lag=lag)
+            seen = self.seen[what] = _Seen(event.t, event.where, worst_lag=lag)
         else:
             seen.count += 1
             seen.worst_lag = max(seen.worst_lag, lag)
+        stale = what != "zero" and self.judged_by_timestamp and lag >= self.timeout
+        if stale and seen.stale_at is None:
+            seen.stale_at = self.timeout
 
     def finish(self, t_end: float) -> None:
         for what, seen in sorted(self.seen.items(), key=lambda item: item[1].t):
@@ -121,7 +134,7 @@ class KeepaliveTimestamp(Check):
             )
 
     def _report(self, what: str, seen: _Seen) -> None:
-        stale = self.judged_by_timestamp and seen.worst_lag >= self.timeout
+        stale = seen.stale_at is not None
         px4 = f"PX4 {self.ctx.profile.px4}"
         if what == "zero":
             text = "OffboardControlMode.timestamp is 0"
@@ -140,7 +153,7 @@ class KeepaliveTimestamp(Check):
             if stale:
                 effect = (
                     f"{px4} judges the keep-alive's age by this field and takes a stamp older "
-                    f"than COM_OF_LOSS_T ({self.timeout:.2f} s) for a lost signal"
+                    f"than COM_OF_LOSS_T ({seen.stale_at:.2f} s) for a lost signal"
                 )
             elif self.judged_by_timestamp:
                 effect = f"{px4} judges the keep-alive's age by it; still within the timeout"
