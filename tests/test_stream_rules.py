@@ -251,6 +251,21 @@ def test_ofb201_arm_in_predicted_offboard_without_a_recorded_mode() -> None:
     assert "arm in OFFBOARD" in found.message
 
 
+@pytest.mark.parametrize("mode_recorded", [True, False])
+def test_ofb102_arm_in_offboard_with_or_without_a_recorded_mode(mode_recorded: bool) -> None:
+    """Disarmed, switched to OFFBOARD, then armed after 0.2 s of stream: an offboard request
+    with too little stream, whether OFFBOARD shows in a recorded status or only in the gate
+    model's prediction from the acked switch."""
+    arm = Command(t=3.0, command=400, params=(1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
+    events = [switch(1.0), ack(1.005, 0), *ocm(every(2.8, 6.0, 0.1)), arm]
+    events.append(ack(3.005, 0, command=400))
+    if mode_recorded:
+        events += [status(0.0, POSCTL, False), status(1.5, OFFBOARD, False), status(3.5, OFFBOARD)]
+    found = [f for f in codes(lint_events(events), "OFB102") if "arm in OFFBOARD" in f.message]
+    assert [f.time_s for f in found] == [3.0]
+    assert "0.20 s" in found[0].message
+
+
 def test_ofb101_a_gap_that_spans_the_switch_counts() -> None:
     # keep-alive stops at 1.0 s in POSCTL; the switch comes at 1.3 s; the stream resumes at 1.8 s
     events = [status(0.0, POSCTL), *ocm(every(0.0, 1.0, 0.1)), switch(1.3), ack(1.31, 0)]

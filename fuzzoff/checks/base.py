@@ -26,6 +26,7 @@ from fuzzoff.events import (
     KEEPALIVE_ROS,
     KEEPALIVE_TYPES,
     MAVLINK_SETPOINTS,
+    NAV_STATE_OFFBOARD,
     PX4_SETPOINTS,
     ControlMode,
     Event,
@@ -111,6 +112,13 @@ class CheckContext:
         """Say once that ``code`` cannot be judged here and what the recording would need."""
         if self.enabled(code):
             self.not_checkable.setdefault(code, needs)
+
+    def offboard_selected(self) -> bool:
+        """OFFBOARD is the selected mode (what makes an arm an offboard request): as recorded,
+        else as the gate model has the user's intention."""
+        if self.state.mode_recorded:
+            return self.state.nav_state == NAV_STATE_OFFBOARD
+        return self.gate.user_intention == NAV_STATE_OFFBOARD
 
     def has(self, *kinds: str) -> bool:
         """Does the recording carry any of these event kinds at all?"""

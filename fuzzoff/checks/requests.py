@@ -18,7 +18,6 @@ from dataclasses import dataclass
 from fuzzoff.checks._keepalive import px4_label
 from fuzzoff.checks.base import Check, CheckContext
 from fuzzoff.events import (
-    NAV_STATE_OFFBOARD,
     Command,
     CommandAck,
     Event,
@@ -67,7 +66,7 @@ class RequestRejected(Check):
             what = None
             if event.is_offboard_switch:
                 what = "switch to OFFBOARD"
-            elif event.is_arm and self._offboard_selected():
+            elif event.is_arm and self.ctx.offboard_selected():
                 what = "arm in OFFBOARD"
             if what is None and not (event.is_mode_switch or event.is_arm or event.is_disarm):
                 return
@@ -99,13 +98,6 @@ class RequestRejected(Check):
                 head.ack = ack  # PX4 1.16/1.17: Commander's verdict after the receiver's
                 return
             self._judge(queue.pop(0))
-
-    def _offboard_selected(self) -> bool:
-        """OFFBOARD is the selected mode: as recorded, else as the gate model has it."""
-        state = self.ctx.state
-        if state.mode_recorded:
-            return state.nav_state == NAV_STATE_OFFBOARD
-        return self.ctx.gate.user_intention == NAV_STATE_OFFBOARD
 
     def _supersede(self, queue: list[_Request]) -> None:
         """A new command of the same id: the open ones are judged as they stand."""

@@ -23,7 +23,6 @@ from fuzzoff.checks._keepalive import (
 )
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import (
-    NAV_STATE_OFFBOARD,
     Command,
     Dropout,
     Event,
@@ -210,7 +209,7 @@ class StreamBeforeRequest(Check):
         elif isinstance(event, Command):
             if event.is_offboard_switch:
                 self._judge(event, "switch to OFFBOARD")
-            elif event.is_arm and self.ctx.state.nav_state == NAV_STATE_OFFBOARD:
+            elif event.is_arm and self.ctx.offboard_selected():
                 self._judge(event, "arm in OFFBOARD")
             self.gate_verdict.clear()
         elif isinstance(event, VehicleStatus) and self.switches.entered_by_request(
