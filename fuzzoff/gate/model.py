@@ -83,6 +83,8 @@ class GateModel:
         self.est = Estimates()
         self.signal = make_signal(self.px4, self.params)
         self.tick_based = at_least(self.px4, "1.14")
+        self._flags_ignored = self.px4 in ("legacy", "1.11")
+        """Before 1.13 any keep-alive counts, whatever its flags (2.2)."""
         self.armed = False
         self.user_intention: int | None = None
         self._nav: int | None = None
@@ -281,6 +283,8 @@ class GateModel:
         last = self.signal.last
         age = f"{t - last:.2f} s after the newest keep-alive" if last is not None else ""
         why = estimate_failure(self.px4, self.ocm_mask, self.est) if self.tick_based else None
+        if why is None and self.ocm_mask == 0 and last is not None and not self._flags_ignored:
+            why = "no flag set in the newest keep-alive"
         if why is None and self.tick_based and self.signal.stamps_lag:
             why = "the newest keep-alive's timestamp is older than COM_OF_LOSS_T (2.1.1)"
         reason = why or "keep-alive timeout"
@@ -346,7 +350,7 @@ class GateModel:
         """Recompute what depends only on the OCM flags and the estimates (cached: the hot path
         is one keep-alive per message)."""
         mask = self.ocm_mask
-        if self.px4 in ("legacy", "1.11"):
+        if self._flags_ignored:
             self._good = True
         else:
             self._good = mask != 0 and estimate_failure(self.px4, mask, self.est) is None

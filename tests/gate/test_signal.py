@@ -107,6 +107,15 @@ def test_2_2_v113_flags_needed() -> None:
     assert len(loss_times(run("1.13", events, t_end=2.0))) == 1
 
 
+@pytest.mark.parametrize("px4", ["1.13", *TICK])
+def test_2_1_a_fresh_keepalive_with_no_flag_is_lost_for_that_reason(px4: str) -> None:
+    """2.1/2.2: an all-false OCM is a lost signal however fresh; the transition says so, not
+    "keep-alive timeout" (the keep-alive kept arriving)."""
+    events = [in_offboard(), ocm(0.0), *[ocm(0.1 * i, position=False) for i in range(1, 20)]]
+    (lost,) = of("signal_lost", run(px4, events, t_end=2.0))
+    assert "no flag set" in lost.message and "timeout" not in lost.message
+
+
 @pytest.mark.parametrize(("gap", "lost"), [(0.49, False), (0.5, True), (0.51, True)])
 def test_2_2_v111_age_against_default_half_second(gap: float, lost: bool) -> None:
     """2.2 (1.11): lost when the keep-alive's age >= COM_OF_LOSS_T (default 0.5 s)."""
