@@ -96,14 +96,15 @@ def loss_summary(ctx: CheckContext) -> str:
 
 
 def _action_text(action: LossAction) -> str:
+    """What the vehicle does, with the parameters that chose it (``note``): a disarm may come
+    from COM_OBL_RC_ACT 7 or, on 1.17+ without RC, from NAV_RCL_ACT 6."""
     if action.disarm:
-        return "disarm (COM_OBL_RC_ACT 7)"
-    if action.none:
-        return "stay in OFFBOARD without a signal (no failsafe)"
-    text = f"switch to {action.action}"
-    if action.note:
-        text += f" ({action.note})"
-    return text
+        text = "disarm"
+    elif action.none:
+        text = "stay in OFFBOARD without a signal, no failsafe"
+    else:
+        text = f"switch to {action.action}"
+    return f"{text} ({action.note})" if action.note else text
 
 
 class LossActionSummary(Check):

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import pytest
+
 from fuzzoff.config import Settings
 from fuzzoff.engine import run_events
 from fuzzoff.events import Command, CommandAck, Event, Parameter
@@ -34,6 +36,23 @@ def test_ofb701_names_where_each_value_comes_from() -> None:
     assert "COM_OF_LOSS_T 0.5 s (set on the command line)" in summary.message
     assert "COM_OBL_RC_ACT 3 (from the recording)" in summary.message
     assert "AUTO_RTL" in summary.message
+
+
+@pytest.mark.parametrize(
+    ("px4", "params", "chosen_by"),
+    [
+        ("1.15", {"COM_OBL_RC_ACT": 7.0}, "COM_OBL_RC_ACT 7"),
+        ("1.17", {"NAV_RCL_ACT": 6.0}, "replaced by NAV_RCL_ACT 6 (Disarm)"),
+    ],
+)
+def test_ofb701_a_disarm_names_the_parameter_that_chose_it(
+    px4: str, params: dict[str, float], chosen_by: str
+) -> None:
+    """5.1: COM_OBL_RC_ACT 7 disarms; on 1.17 without RC a stick mode is replaced by the
+    NAV_RCL_ACT action, which may be Disarm too (COM_OBL_RC_ACT is then 0, not 7)."""
+    events = [flags(0.0, manual_control_signal_lost=True), in_offboard(), *stream(0.0, 1.0)]
+    (summary,) = _lint(px4, events, "OFB701", **params)
+    assert "will disarm" in summary.message and chosen_by in summary.message
 
 
 def test_ofb701_once_and_only_for_vehicles_using_offboard() -> None:
