@@ -15,8 +15,8 @@ stream rules the flights also touch):
   that contradicts the model (6.5 s).
 * ``no_offboard`` (1.15): a POSCTL flight with no offboard use: OFB701, OFB702, OFB202 clean.
 * ``rc_lost_117_return`` (1.17.0): no manual control; on loss 1.17 replaces Position by
-  NAV_RCL_ACT (Return): the log shows AUTO_RTL; OFB702 clean (no stick mode without RC on
-  1.17), OFB202 clean.
+  NAV_RCL_ACT (Return): the log shows AUTO_RTL; OFB702 says the configured Position is replaced,
+  OFB202 clean.
 * ``signal_flag_agrees`` (1.15): ``loss_and_resume_agrees`` with PX4's own verdict logged at
   10 Hz (``failsafe_flags.offboard_control_signal_lost``): lost from the 6.0 s check pass,
   available again from 8.0 s, as the model says: OFB202 clean.
@@ -210,8 +210,13 @@ def cases() -> list[Case]:
         Case(
             "rc_lost_117_return",
             offboard_flight((RTL, True), rc=False),
-            [*NOT_CHECKABLE_115, ("OFB701", "info", SWITCH_T), *GAP],
-            ["OFB202", "OFB702"],
+            [
+                *NOT_CHECKABLE_115,
+                ("OFB701", "info", SWITCH_T),
+                ("OFB702", "warning", SWITCH_T),
+                *GAP,
+            ],
+            ["OFB202"],
             px4_version="1.17.0",
         ),
         Case(

@@ -129,7 +129,7 @@ class LossActionUnavailable(Check):
 
     def __init__(self, ctx: CheckContext) -> None:
         super().__init__(ctx)
-        self.reported: set[tuple[str, str | None, bool]] = set()
+        self.reported: set[tuple[str, str | None, bool, str | None]] = set()
 
     def on_event(self, event: Event) -> None:
         if not (self.ctx.gate.in_offboard or self.ctx.state.in_offboard):
@@ -142,9 +142,14 @@ class LossActionUnavailable(Check):
         ):
             return
         action = self.ctx.gate.current_loss_action()
-        if not (action.degraded_from or action.stick_mode_without_rc):
+        if not (action.degraded_from or action.stick_mode_without_rc or action.replaced_from):
             return
-        key = (action.action, action.degraded_from, action.stick_mode_without_rc)
+        key = (
+            action.action,
+            action.degraded_from,
+            action.stick_mode_without_rc,
+            action.replaced_from,
+        )
         if key in self.reported:
             return
         self.reported.add(key)
@@ -162,6 +167,12 @@ class LossActionUnavailable(Check):
                 f"the configured offboard-loss action {action.degraded_from} cannot run now "
                 f"({action.note}); PX4 {px4} would fall back to {action.action} "
                 "(mode requirements approximated by fuzzoff)"
+            )
+        if action.replaced_from:
+            return (
+                f"the configured offboard-loss action is the stick mode {action.replaced_from} "
+                f"but there is no manual control ({self._rc_source()}): PX4 {px4} will "
+                f"{_action_text(action)} instead"
             )
         return (
             f"the offboard-loss action is the stick mode {action.action} but there is no manual "

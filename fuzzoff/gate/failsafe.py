@@ -8,7 +8,7 @@ them are marked ``unverified``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from fuzzoff.gate.estimates import Estimates
 from fuzzoff.gate.params import RC_PRESENT
@@ -33,6 +33,9 @@ class LossAction:
     """The configured action, when its mode could not run and the chain picked another."""
     stick_mode_without_rc: bool = False
     """A stick mode (Position/Altitude/Stabilized/Manual) is selected with no manual control."""
+    replaced_from: str | None = None
+    """1.17+: the stick mode that was selected, replaced by the NAV_RCL_ACT action because the
+    vehicle has no manual control."""
 
     @property
     def none(self) -> bool:
@@ -160,13 +163,14 @@ def _replace(
     rc: bool,
 ) -> LossAction:
     nav, unverified, label = _nav_rcl_action(int(params.get("NAV_RCL_ACT", 2.0)), px4)
-    note += f"; no manual control: {_name(chosen)} replaced by {label}"
+    stick = _name(chosen)
+    note += f"; no manual control: {stick} replaced by {label}"
     if nav is None:
         if "Disarm" in label:
-            return LossAction("DISARM", None, "5.1", note, disarm=True)
-        return LossAction("NONE", None, "5.1", note, unverified=unverified)
+            return LossAction("DISARM", None, "5.1", note, disarm=True, replaced_from=stick)
+        return LossAction("NONE", None, "5.1", note, unverified=unverified, replaced_from=stick)
     final = _degrade(nav, est, vehicle, _CHAIN_14)
-    return _finish(nav, final, "5.1", unverified, note, rc)
+    return replace(_finish(nav, final, "5.1", unverified, note, rc), replaced_from=stick)
 
 
 # v1.13 (5.2)

@@ -68,11 +68,25 @@ def test_ofb702_return_without_global_position_degrades() -> None:
     assert "AUTO_RTL" in finding.message and "AUTO_LAND" in finding.message
 
 
-def test_ofb702_stick_mode_without_rc_only_before_117() -> None:
-    """5.1: 1.14-1.16 enter Position without manual control; 1.17 replaces it (no finding)."""
+@pytest.mark.parametrize(
+    ("px4", "shown"),
+    [
+        ("1.16", "PX4 1.16 switches to it anyway"),
+        ("1.17", "PX4 1.17 will switch to AUTO_RTL"),
+        ("main", "PX4 main will switch to AUTO_RTL"),
+    ],
+)
+def test_ofb702_stick_mode_without_rc(px4: str, shown: str) -> None:
+    """5.1: 1.14-1.16 enter Position without manual control; 1.17 and main replace it by the
+    NAV_RCL_ACT action (default 2, Return): either way not what COM_OBL_RC_ACT 0 asked for."""
     events = [flags(0.0, manual_control_signal_lost=True), in_offboard(), *stream(0.0, 1.0)]
-    assert _lint("1.16", events, "OFB702")
-    assert _lint("1.17", events, "OFB702") == []
+    (finding,) = _lint(px4, events, "OFB702")
+    assert shown in finding.message and "POSCTL" in finding.message
+
+
+def test_ofb702_silent_with_manual_control() -> None:
+    events = [flags(0.0, manual_control_signal_lost=False), in_offboard(), *stream(0.0, 1.0)]
+    assert [px4 for px4 in ("1.16", "1.17", "main") if _lint(px4, events, "OFB702")] == []
 
 
 def test_ofb202_reports_once_per_episode() -> None:
