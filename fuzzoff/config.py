@@ -12,11 +12,13 @@ import math
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
+from difflib import get_close_matches
 from pathlib import Path
 from typing import Any
 
 from fuzzoff.catalog import expand_selectors, get_rule, load_catalog
 from fuzzoff.findings import Severity
+from fuzzoff.gate.params import GATE_PARAMS
 from fuzzoff.profiles import ProfileError, px4_profile_for, vehicle_type_for
 
 
@@ -70,29 +72,36 @@ class Settings:
 
 
 def find_config(start: Path) -> Path | None:
-    """The nearest fuzzoff.toml, or pyproject.toml with a ``[tool.fuzzoff]`` table."""
+    """The nearest fuzzoff.toml, or pyproject.toml with a ``[tool.fuzzoff]`` table.
+
+    A pyproject.toml that cannot be read is an error, not skipped: it may hold the table, and
+    a parent folder's settings would silently take its place."""
     for folder in [start, *start.parents]:
         candidate = folder / "fuzzoff.toml"
         if candidate.is_file():
             return candidate
         candidate = folder / "pyproject.toml"
         if candidate.is_file():
-            try:
-                with candidate.open("rb") as fh:
-                    data = tomllib.load(fh)
-            except (OSError, tomllib.TOMLDecodeError):
-                continue
-            if "fuzzoff" in data.get("tool", {}):
+            tool = _load_toml(candidate).get("tool", {})
+            if isinstance(tool, dict) and "fuzzoff" in tool:
                 return candidate
     return None
 
 
-def read_config_table(path: Path) -> dict[str, Any]:
+def _load_toml(path: Path) -> dict[str, Any]:
     try:
         with path.open("rb") as fh:
-            data = tomllib.load(fh)
+            return tomllib.load(fh)
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{path}: not valid TOML: {exc}") from None
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f"{path}: not UTF-8 text (byte {exc.start}), as TOML must be") from None
+    except OSError as exc:
+        raise ConfigError(f"{path}: cannot be read: {exc.strerror or exc}") from None
+
+
+def read_config_table(path: Path) -> dict[str, Any]:
+    data = _load_toml(path)
     if path.name == "pyproject.toml":
         table = data.get("tool", {}).get("fuzzoff", {})
         return dict(table) if isinstance(table, dict) else {}
@@ -119,9 +128,43 @@ def _codes(values: Any, key: str, where: str) -> set[str]:
     if not isinstance(values, list) or not all(isinstance(v, str) for v in values):
         raise ConfigError(f"{where}: {key} must be a list of rule codes or prefixes")
     try:
-        return expand_selectors(values)
+        codes = expand_selectors(values)
     except ValueError as exc:
         raise ConfigError(f"{where}: {key}: {exc}") from None
+    if key == "select" and not codes:
+        # an empty selection would mean every rule: say so rather than guess
+        raise ConfigError(f"{where}: select names no rule (give codes or prefixes, or ALL)")
+    return codes
+
+
+def _option_value(value: Any, default: Any, where: str) -> Any:
+    """A rule option as the catalog types it: every numeric option is a threshold (a time, a
+    distance, a count or a fraction), so it must be a finite number, not below zero; NaN would
+    make every comparison false and silently drop the rule's findings."""
+    numeric = isinstance(default, (int, float)) and not isinstance(default, bool)
+    if not numeric:
+        return value
+    if not isinstance(value, (int, float)) or isinstance(value, bool):
+        raise ConfigError(f"{where} must be a number")
+    if not math.isfinite(value) or value < 0:
+        raise ConfigError(f"{where} must be a finite number, 0 or more (got {value})")
+    if isinstance(default, int) and value != int(value):
+        raise ConfigError(f"{where} must be a whole number (got {value})")
+    return value
+
+
+def _param_name(name: str, where: str) -> str:
+    """A parameter the gate model reads, in PX4's upper case; a typo is an error, not a value
+    that changes nothing."""
+    upper = name.upper()
+    if upper not in GATE_PARAMS:
+        close = get_close_matches(upper, GATE_PARAMS, n=1)
+        hint = f"did you mean {close[0]}? " if close else ""
+        raise ConfigError(
+            f"{where}: params: {name!r} is not a parameter the gate model reads ({hint}"
+            f"it reads {', '.join(GATE_PARAMS)})"
+        )
+    return upper
 
 
 def settings_from_table(
@@ -153,8 +196,8 @@ def settings_from_table(
             settings, ignore=frozenset(settings.ignore | _codes(table["ignore"], "ignore", where))
         )
     if table.get("fail-on") is not None:
+        fail_on = _text(table["fail-on"], "fail-on", where, "warning")
         try:
-            fail_on = _text(table["fail-on"], "fail-on", where, "warning")
             settings = replace(settings, fail_on=Severity.parse(fail_on))
         except ValueError as exc:
             raise ConfigError(f"{where}: fail-on: {exc}") from None
@@ -183,10 +226,9 @@ def settings_from_table(
                     raise ConfigError(
                         f"{where}: options.{code}: unknown option {name!r} (known: {known})"
                     ) from None
-                numeric = isinstance(default, (int, float)) and not isinstance(default, bool)
-                if numeric and (not isinstance(value, (int, float)) or isinstance(value, bool)):
-                    raise ConfigError(f"{where}: options.{code}.{name} must be a number")
-                options.setdefault(rule.code, {})[name] = value
+                options.setdefault(rule.code, {})[name] = _option_value(
+                    value, default, f"{where}: options.{code}.{name}"
+                )
         settings = replace(settings, options=options)
     if table.get("params") is not None:
         params = dict(settings.params)
@@ -195,7 +237,7 @@ def settings_from_table(
                 raise ConfigError(f"{where}: params.{name} must be a number")
             if not math.isfinite(value):
                 raise ConfigError(f"{where}: params.{name} must be a finite number")
-            params[str(name).upper()] = float(value)
+            params[_param_name(str(name), where)] = float(value)
         settings = replace(settings, params=params)
     return settings
 
@@ -211,5 +253,8 @@ def load_settings(
         settings = replace(settings, config_file=str(config))
     if overrides:
         clean = {k: v for k, v in overrides.items() if v is not None}
+        if "select" in clean:
+            # as in ruff: --select names the rules outright, the file's ignore included
+            settings = replace(settings, ignore=frozenset())
         settings = settings_from_table(clean, "command line", settings)
     return settings

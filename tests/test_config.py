@@ -59,6 +59,11 @@ def test_fuzzoff_toml_wins_over_a_pyproject_further_up(tmp_path: Path) -> None:
         ("px4 = 1.10", 'px4 must be text in quotes, e.g. px4 = "1.15"'),
         ("vehicle = 3", "vehicle must be text"),
         ("fail-on = 2", "fail-on must be text"),
+        ("options = { OFB101 = { max_gap_s = nan } }", "must be a finite number, 0 or more"),
+        ("options = { OFB101 = { max_gap_s = -1 } }", "must be a finite number, 0 or more"),
+        ("options = { OFB105 = { min_intervals = 2.5 } }", "must be a whole number"),
+        ("params = { COM_OF_LOS_T = 0.3 }", "did you mean COM_OF_LOSS_T?"),
+        ("select = []", "select names no rule"),
     ],
 )
 def test_mistakes_are_usage_errors_naming_what_is_wrong(
@@ -69,6 +74,7 @@ def test_mistakes_are_usage_errors_naming_what_is_wrong(
         load_settings(tmp_path)
     result = run_cli(["lint", str(GAP)], cwd=tmp_path)
     assert result.returncode == 2 and complaint in result.stderr
+    assert result.stderr.count("fuzzoff.toml") == 1  # the file is named once, not per layer
 
 
 def test_severity_override_changes_the_finding_and_the_exit_status(tmp_path: Path) -> None:
@@ -103,3 +109,35 @@ def test_param_option_takes_only_a_finite_number(tmp_path: Path, value: str) -> 
 
 def test_fail_on_default_is_warning() -> None:
     assert load_settings(Path("/")).fail_on is Severity.WARNING
+
+
+@pytest.mark.parametrize(
+    ("content", "complaint"),
+    [
+        (b'[tool.fuzzoff]\nselect = ["OFB103"\n', "not valid TOML"),
+        (b'[project]\nname = "caf\xe9"\n', "not UTF-8 text"),
+    ],
+)
+def test_a_pyproject_that_cannot_be_read_is_an_error_not_skipped(
+    tmp_path: Path, content: bytes, complaint: str
+) -> None:
+    """It may hold [tool.fuzzoff]: skipping it would let a parent folder's settings decide,
+    and a CI job would pass on rules nobody chose."""
+    (tmp_path / "fuzzoff.toml").write_text('select = ["OFB7"]\n')
+    project = tmp_path / "project"
+    project.mkdir()
+    (project / "pyproject.toml").write_bytes(content)
+    result = run_cli(["lint", str(GAP)], cwd=project)
+    assert result.returncode == 2
+    assert f"{project / 'pyproject.toml'}: {complaint}" in result.stderr
+    assert "Traceback" not in result.stderr
+
+
+def test_select_on_the_command_line_overrides_the_files_ignore(tmp_path: Path) -> None:
+    """As in ruff: --select names the rules outright; --ignore and --extend-select add."""
+    (tmp_path / "fuzzoff.toml").write_text('ignore = ["OFB101"]\n')
+    args = ["lint", str(GAP), "--format", "json"]
+    assert "OFB101" not in codes_of(run_cli(args, cwd=tmp_path).stdout)
+    assert "OFB101" in codes_of(run_cli([*args, "--select", "OFB101"], cwd=tmp_path).stdout)
+    extended = run_cli([*args, "--extend-select", "OFB101"], cwd=tmp_path)
+    assert "OFB101" not in codes_of(extended.stdout)
