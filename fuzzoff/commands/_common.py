@@ -3,13 +3,19 @@
 from __future__ import annotations
 
 import argparse
+import io
 import math
+import os
 import sys
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from fuzzoff.config import ConfigError, Settings, load_settings
 from fuzzoff.report import FORMATS
+
+if TYPE_CHECKING:
+    from rich.console import Console
 
 
 def add_profile_options(parser: argparse.ArgumentParser) -> None:
@@ -73,9 +79,31 @@ def settings_from_args(args: argparse.Namespace) -> Settings:
     return load_settings(Path.cwd(), overrides)
 
 
+def existing_paths(paths: list[str]) -> list[str]:
+    """The paths as given, after checking each names something: an empty one (an unset shell
+    variable) would otherwise mean the current folder."""
+    for p in paths:
+        if not p or not Path(p).exists():
+            raise ConfigError(f"no such file or folder: {p or repr(p)}")
+    return paths
+
+
+def check_output(output: str | None, inputs: list[str]) -> None:
+    """Refuse, before any work, an ``--output`` that is a folder or one of the recordings read
+    (the report would replace the flight log)."""
+    if output is None or output == "-":
+        return
+    path = Path(output)
+    if path.is_dir():
+        raise ConfigError(f"--output {output} is a folder: name a file")
+    if path.exists() and any(path.samefile(p) for p in inputs if Path(p).exists()):
+        raise ConfigError(f"--output {output} is a recording being read: name another file")
+
+
 def write_output(text: str, output: str | None) -> None:
-    if output is None:
-        sys.stdout.write(text)
+    """The report to ``output`` (parents created), or to standard output for None or ``-``."""
+    if output is None or output == "-":
+        write_stdout(text)
         return
     path = Path(output)
     try:
@@ -83,3 +111,40 @@ def write_output(text: str, output: str | None) -> None:
         path.write_text(text, encoding="utf-8")
     except OSError as exc:
         raise ConfigError(f"cannot write {output}: {exc.strerror or exc}") from None
+
+
+def write_stdout(text: str) -> None:
+    """Standard output, where a reader that stopped early (``| head``) is not an error: the
+    command still ends with its own status. A full disk or a closed stream is one line."""
+    stream = sys.stdout
+    if stream is None:
+        raise ConfigError("standard output is closed: name a file with --output")
+    try:
+        stream.write(text)
+        stream.flush()
+    except BrokenPipeError:
+        # Python would report the pipe again when it flushes at exit: point stdout elsewhere
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, stream.fileno())
+    except OSError as exc:
+        raise ConfigError(f"cannot write to standard output: {exc.strerror or exc}") from None
+
+
+def render_rich(draw: Callable[[Console], None], output: str | None = None) -> None:
+    """Draw with rich into text, then write it as ``write_output`` does. On standard output the
+    text has the colours and width of the terminal, if it is one; in a file it is plain."""
+    from rich.console import Console
+
+    buffer = io.StringIO()
+    if output is None or output == "-":
+        screen = Console(highlight=False)
+        console = Console(
+            file=buffer,
+            highlight=False,
+            force_terminal=screen.is_terminal,
+            width=screen.width,
+        )
+    else:
+        console = Console(file=buffer, highlight=False, no_color=True, width=160)
+    draw(console)
+    write_output(buffer.getvalue(), output)

@@ -13,13 +13,17 @@ import argparse
 import dataclasses
 import json
 import sys
-from pathlib import Path
 from typing import Any
 
 from fuzzoff import __version__
 from fuzzoff.commands import add_command
-from fuzzoff.commands._common import add_profile_options, settings_from_args, write_output
-from fuzzoff.config import ConfigError
+from fuzzoff.commands._common import (
+    add_profile_options,
+    check_output,
+    existing_paths,
+    settings_from_args,
+    write_output,
+)
 from fuzzoff.engine import Timeline, lint_file
 from fuzzoff.findings import FileReport
 from fuzzoff.gate import GateTransition
@@ -155,8 +159,8 @@ def _json(report: FileReport, rows: dict[str, list[Row]]) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    if not Path(args.path).exists():
-        raise ConfigError(f"no such file or folder: {args.path}")
+    existing_paths([args.path])
+    check_output(args.output, [args.path])
     report, rows = gate_report(args.path, args, controllers=not args.no_controllers)
     text = _json(report, rows) if args.format == "json" else _terminal(report, rows)
     write_output(text, args.output)

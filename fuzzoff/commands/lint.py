@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import contextlib
 import sys
 from pathlib import Path
 from typing import Any
@@ -13,6 +12,9 @@ from fuzzoff.commands._common import (
     add_output_options,
     add_profile_options,
     add_rule_options,
+    check_output,
+    existing_paths,
+    render_rich,
     settings_from_args,
     write_output,
 )
@@ -47,18 +49,18 @@ def _lint_on_terminal(args: argparse.Namespace, paths: list[str], settings: Sett
 
     from fuzzoff.report.terminal import lint_with_progress, print_report
 
-    console = Console(stderr=False, highlight=False)
-    if console.is_terminal and not args.no_progress and args.jobs == 1:
-        report = lint_with_progress(paths, settings, console)
+    screen = Console(highlight=False)
+    if screen.is_terminal and not args.no_progress and args.jobs == 1:
+        report = lint_with_progress(paths, settings, screen)
     else:
         report = lint_paths(paths, settings, jobs=args.jobs)
-    with contextlib.ExitStack() as stack:
-        if args.output:
-            fh = stack.enter_context(open(args.output, "w", encoding="utf-8"))
-            console = Console(file=fh, no_color=True, width=160, force_terminal=False)
+
+    def draw(console: Console) -> None:
         print_report(
             console, report, settings.fail_on, quiet=args.quiet, statistics=args.statistics
         )
+
+    render_rich(draw, args.output)
     return report
 
 
@@ -66,9 +68,7 @@ def run(args: argparse.Namespace) -> int:
     settings = settings_from_args(args)
     if args.jobs < 1:
         raise ConfigError("--jobs must be at least 1")
-    missing = [p for p in args.paths if not Path(p).exists()]
-    if missing:
-        raise ConfigError(f"no such file or folder: {missing[0]}")
+    existing_paths(args.paths)
     # A folder with nothing to lint is a mistake (a wrong path, a recording step that failed):
     # passing it would turn a CI job green without looking at a single flight.
     # Each folder is searched once, here; the linting takes the recordings found.
@@ -78,6 +78,7 @@ def run(args: argparse.Namespace) -> int:
         suffixes = ", ".join(RECORDING_SUFFIXES)
         raise ConfigError(f"no recordings in {empty[0]} (searched for {suffixes} and bag folders)")
     paths = [str(f) for _, recordings in found for f in recordings]
+    check_output(args.output, paths)
     if args.format == "terminal":
         report = _lint_on_terminal(args, paths, settings)
     else:

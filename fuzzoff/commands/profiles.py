@@ -10,6 +10,7 @@ from rich.console import Console
 from rich.table import Table
 
 from fuzzoff.commands import add_command
+from fuzzoff.commands._common import render_rich, write_output
 from fuzzoff.profiles import PX4_PROFILE_NOTES, PX4_PROFILES, VEHICLE_NOTES, VEHICLE_TYPES
 
 
@@ -25,19 +26,24 @@ def run(args: argparse.Namespace) -> int:
             "px4": [{"profile": p, "covers": PX4_PROFILE_NOTES[p]} for p in PX4_PROFILES],
             "vehicles": [{"type": v, "name": VEHICLE_NOTES[v]} for v in VEHICLE_TYPES],
         }
-        print(json.dumps(data, indent=2))
+        write_output(json.dumps(data, indent=2) + "\n", None)
         return 0
-    console = Console(highlight=False)
-    table = Table(title="PX4 profiles", show_edge=False)
+    render_rich(_draw)
+    return 0
+
+
+def _draw(console: Console) -> None:
+    from fuzzoff.report.terminal import table_box
+
+    table = Table(title="PX4 profiles", show_edge=False, box=table_box(console))
     table.add_column("profile")
     table.add_column("covers")
     for p in PX4_PROFILES:
         table.add_row(p, PX4_PROFILE_NOTES[p])
     console.print(table)
-    vehicles = Table(title="vehicle types", show_edge=False)
+    vehicles = Table(title="vehicle types", show_edge=False, box=table_box(console))
     vehicles.add_column("type")
     vehicles.add_column("vehicle")
     for v in VEHICLE_TYPES:
         vehicles.add_row(v, VEHICLE_NOTES[v])
     console.print(vehicles)
-    return 0

@@ -12,6 +12,7 @@ from rich.table import Table
 
 from fuzzoff.catalog import Rule, get_rule, load_catalog, render_page
 from fuzzoff.commands import add_command
+from fuzzoff.commands._common import render_rich, write_output
 from fuzzoff.config import ConfigError
 
 
@@ -39,27 +40,43 @@ def rule_json(rule: Rule) -> dict[str, Any]:
 
 
 def run(args: argparse.Namespace) -> int:
-    console = Console(highlight=False)
     if args.code:
         try:
             rule = get_rule(args.code)
         except KeyError:
             raise ConfigError(f"unknown rule {args.code!r} (fuzzoff rule lists them)") from None
         if args.format == "json":
-            print(json.dumps(rule_json(rule), indent=2, ensure_ascii=False))
-        elif args.format == "markdown" or not console.is_terminal:
-            print(render_page(rule), end="")
+            write_output(json.dumps(rule_json(rule), indent=2, ensure_ascii=False) + "\n", None)
+        elif args.format == "markdown":
+            write_output(render_page(rule), None)
         else:
-            console.print(Markdown(render_page(rule)))
+            render_rich(lambda console: _draw_page(console, rule))
         return 0
     rules = list(load_catalog().values())
     if args.format == "json":
-        print(json.dumps([rule_json(r) for r in rules], indent=2, ensure_ascii=False))
-        return 0
-    table = Table(show_edge=False)
+        text = json.dumps([rule_json(r) for r in rules], indent=2, ensure_ascii=False)
+        write_output(text + "\n", None)
+    elif args.format == "markdown":
+        write_output("\n".join(render_page(r) for r in rules), None)
+    else:
+        render_rich(lambda console: _draw_list(console, rules))
+    return 0
+
+
+def _draw_page(console: Console, rule: Rule) -> None:
+    """Rendered Markdown on a terminal; the Markdown itself in a file or a pipe."""
+    if console.is_terminal:
+        console.print(Markdown(render_page(rule)))
+    else:
+        console.out(render_page(rule), end="", highlight=False)
+
+
+def _draw_list(console: Console, rules: list[Rule]) -> None:
+    from fuzzoff.report.terminal import table_box
+
+    table = Table(show_edge=False, box=table_box(console))
     for column in ("code", "name", "severity", "profiles"):
-        table.add_column(column)
+        table.add_column(column, overflow="fold")  # a narrow screen folds a name, never cuts it
     for r in rules:
         table.add_row(r.code, r.name, r.severity.label, r.profiles_text())
     console.print(table)
-    return 0

@@ -27,7 +27,8 @@ STYLE = {Severity.ERROR: "bold red", Severity.WARNING: "yellow", Severity.INFO: 
 VERDICT = {0: "passed", 1: "failed", 2: "incomplete input"}
 
 
-def _box(console: Console) -> box.Box:
+def table_box(console: Console) -> box.Box:
+    """Heavy lines on a terminal; ASCII in a file or a pipe (CI logs, editors)."""
     return box.SIMPLE_HEAVY if console.is_terminal else box.ASCII
 
 
@@ -73,7 +74,7 @@ def print_file(console: Console, file: FileReport, fail_on: Severity, quiet: boo
 
 def print_summary(console: Console, report: Report, fail_on: Severity) -> None:
     counts = Counter(f.severity for f in report.findings)
-    table = Table(title="fuzzoff summary", box=_box(console), show_edge=False)
+    table = Table(title="fuzzoff summary", box=table_box(console), show_edge=False)
     table.add_column("files", justify="right")
     table.add_column("errors", justify="right", style=STYLE[Severity.ERROR])
     table.add_column("warnings", justify="right", style=STYLE[Severity.WARNING])
