@@ -52,6 +52,13 @@ def test_a_recording_named_twice_is_linted_once(tmp_path: Path) -> None:
     assert _linted(tmp_path, a, a) == [str(a)]
 
 
+def test_upper_case_suffixes_are_found(tmp_path: Path) -> None:
+    """Logs copied off an SD card or a Windows ground station: ``LOG001.ULG``, ``FLIGHT.TLOG``."""
+    shutil.copy(GOOD, tmp_path / "FLIGHT.TLOG")
+    shutil.copy(GAP, tmp_path / "b.Tlog")
+    assert _linted(tmp_path) == [str(tmp_path / "FLIGHT.TLOG"), str(tmp_path / "b.Tlog")]
+
+
 @pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="named pipes are POSIX")
 def test_a_pipe_in_a_searched_folder_is_left_out_and_the_lint_finishes(tmp_path: Path) -> None:
     shutil.copy(GOOD, tmp_path / "a.tlog")

@@ -167,8 +167,14 @@ def _search(top: Path, seen: set[object], found: list[Path]) -> None:
             stack.pop()
         elif child.is_dir():
             folder = child
-        elif child.suffix in RECORDING_SUFFIXES and child.is_file() and _first_time(child, seen):
+        elif _has_recording_suffix(child) and child.is_file() and _first_time(child, seen):
             found.append(child)
+
+
+def _has_recording_suffix(path: Path) -> bool:
+    """``FLIGHT.TLOG`` too: logs copied from FAT-formatted SD cards and Windows ground stations
+    often carry upper-case names."""
+    return path.suffix.lower() in RECORDING_SUFFIXES
 
 
 def _children_to_search(folder: Path, found: list[Path]) -> list[Path] | None:
