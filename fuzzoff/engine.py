@@ -61,6 +61,8 @@ def resolve_profile(info: RecordingInfo, settings: Settings) -> Profile:
         px4_detected=settings.px4 is not None or detected_px4 is not None,
         vehicle_detected=settings.vehicle is not None or info.vehicle_type is not None,
         px4_release=release,
+        px4_forced=settings.px4 is not None,
+        vehicle_forced=settings.vehicle is not None,
     )
 
 

@@ -112,13 +112,26 @@ class Profile:
     px4: str = DEFAULT_PX4
     vehicle: str = DEFAULT_VEHICLE
     px4_detected: bool = False
+    """Known, not assumed (from the recording, or set by the user: see ``px4_forced``)."""
     vehicle_detected: bool = False
     px4_release: str | None = None
     """The exact release the recording names, where it names one."""
+    px4_forced: bool = False
+    """Set by the user (``--px4``, the config file), whatever the recording says."""
+    vehicle_forced: bool = False
 
     @property
     def detected(self) -> bool:
         return self.px4_detected and self.vehicle_detected
+
+    @property
+    def px4_source(self) -> str:
+        """Where the PX4 profile came from: ``user``, ``recording`` or ``default``."""
+        return _source(self.px4_forced, self.px4_detected)
+
+    @property
+    def vehicle_source(self) -> str:
+        return _source(self.vehicle_forced, self.vehicle_detected)
 
     def at_least(self, oldest: str) -> bool:
         return at_least(self.px4, oldest)
@@ -131,9 +144,20 @@ class Profile:
         px4 = f"PX4 {self.px4}"
         if self.px4_release and px4_profile_for(self.px4_release) == self.px4:
             px4 += f" ({self.px4_release})"
-        px4 += " detected" if self.px4_detected else " assumed"
-        vehicle = f"{self.vehicle} " + ("detected" if self.vehicle_detected else "assumed")
-        return f"{px4}, {vehicle}"
+        px4 += f" {SOURCE_WORDS[self.px4_source]}"
+        if self.px4_forced and self.px4_release and px4_profile_for(self.px4_release) != self.px4:
+            px4 += f" (the recording says {self.px4_release})"
+        return f"{px4}, {self.vehicle} {SOURCE_WORDS[self.vehicle_source]}"
+
+
+SOURCE_WORDS = {"user": "set by the user", "recording": "detected", "default": "assumed"}
+"""How a report words each ``Profile.px4_source`` / ``vehicle_source``."""
+
+
+def _source(forced: bool, known: bool) -> str:
+    if forced:
+        return "user"
+    return "recording" if known else "default"
 
 
 # MAVLink MAV_TYPE -> vehicle type (rovers cannot be told apart from MAV_TYPE alone).

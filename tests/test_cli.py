@@ -68,6 +68,30 @@ def test_json_shape_follows_the_interface(tmp_path: Path) -> None:
     assert set(finding) >= {"code", "name", "severity", "message", "time_s", "location"}
 
 
+@pytest.mark.parametrize(
+    ("args", "header", "sources"),
+    [
+        ([], "PX4 1.15 (1.15.4) detected, mc detected", ("recording", "recording", True)),
+        (
+            ["--px4", "legacy"],
+            "PX4 legacy set by the user (the recording says 1.15.4), mc detected",
+            ("user", "recording", False),
+        ),
+        (["--px4", "1.15"], "PX4 1.15 (1.15.4) set by the user", ("user", "recording", False)),
+    ],
+)
+def test_the_report_says_where_the_profile_came_from(
+    args: list[str], header: str, sources: tuple[str, str, bool]
+) -> None:
+    """A profile forced on the command line is not 'detected', even where it agrees."""
+    recording = str(CORPORA / "tlog" / "stream_lost_in_offboard.tlog")
+    assert header in run_cli(["lint", recording, *args]).stdout
+    profile = json.loads(run_cli(["lint", recording, *args, "--format", "json"]).stdout)["files"][
+        0
+    ]["profile"]
+    assert (profile["px4_source"], profile["vehicle_source"], profile["detected"]) == sources
+
+
 def test_config_unknown_key_is_a_usage_error(tmp_path: Path) -> None:
     (tmp_path / "pyproject.toml").write_text('[tool.fuzzoff]\npx4 = "1.15"\nselct = ["OFB1"]\n')
     (tmp_path / "a.tlog").write_bytes(b"")

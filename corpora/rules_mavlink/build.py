@@ -400,6 +400,14 @@ def finding(planted: Planted, with_vehicle: bool) -> dict[str, Any]:
     return out
 
 
+def _sources(args: list[str]) -> dict[str, Any]:
+    """How the report gives the profile: detected from a tlog; set by the user for a bag,
+    which names neither the release nor the vehicle."""
+    if "--px4" in args:
+        return {"detected": False, "px4_source": "user", "vehicle_source": "user"}
+    return {"detected": True}
+
+
 def write_spec(
     name: str, recording: str, case: Case, planted: list[Planted], args: list[str], tlog: bool
 ) -> None:
@@ -413,7 +421,7 @@ def write_spec(
         "args": args,
         "exit_status": 1 if levels & {"error", "warning"} else 0,
         "complete": True,
-        "profile": {"px4": case.px4, "vehicle": case.vehicle, "detected": True},
+        "profile": {"px4": case.px4, "vehicle": case.vehicle, **_sources(args)},
         "findings": sorted(found, key=lambda f: (f["time_s"] or -1.0, f["code"])),
         "clean": applies,
     }

@@ -258,6 +258,10 @@ def cases() -> list[Case]:
     ]
 
 
+FORCED = {"detected": False, "px4_source": "user", "vehicle_source": "user"}
+"""How the report gives a profile set by ``--px4`` and ``--vehicle``."""
+
+
 def finding(code: str, severity: str, time_s: float | None) -> dict[str, Any]:
     return {"code": code, "severity": severity, "time_s": time_s}
 
@@ -271,7 +275,8 @@ def write(case: Case, other: list[tuple[str, str, float | None]]) -> None:
         "args": case.args(),
         "exit_status": 1 if levels & {"error", "warning"} else 0,
         "complete": True,
-        "profile": {"px4": RELEASE, "vehicle": case.vehicle, "detected": True},
+        # both set on the command line: a rover type cannot be told from the recording
+        "profile": {"px4": RELEASE, "vehicle": case.vehicle, **FORCED},
         "findings": sorted(planted, key=lambda f: (f["time_s"] or -1.0, f["code"])),
         "clean": [c for c in case.clean if get_rule(c).applies_to(RELEASE, case.vehicle)],
     }

@@ -18,6 +18,7 @@ from fuzzoff.catalog import Rule, get_rule, render_page
 from fuzzoff.config import Settings
 from fuzzoff.engine import Timeline
 from fuzzoff.findings import FileReport, Finding, Report, Severity
+from fuzzoff.profiles import SOURCE_WORDS
 from fuzzoff.report.html_style import CSS
 from fuzzoff.report.sanitize import printable
 from fuzzoff.report.svg_timeline import Marker, timeline_svg
@@ -59,8 +60,8 @@ def _time(finding: Finding) -> str:
 def _profile(file: FileReport) -> str:
     p = file.profile
     release = f" (release {e(p.px4_release)})" if p.px4_release else ""
-    px4 = "detected" if p.px4_detected else "assumed"
-    vehicle = "detected" if p.vehicle_detected else "assumed"
+    px4 = SOURCE_WORDS[p.px4_source]
+    vehicle = SOURCE_WORDS[p.vehicle_source]
     return f"PX4 <b>{e(p.px4)}</b>{release}, {px4}; vehicle <b>{e(p.vehicle)}</b>, {vehicle}"
 
 
