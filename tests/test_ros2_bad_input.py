@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import shutil
 import sqlite3
+import struct
 from pathlib import Path
 
 import pytest
@@ -287,3 +288,59 @@ def test_damaged_copy_leaves_the_original_untouched(bag: Path, tmp_path: Path) -
     before = db3.read_bytes()
     lint(copy)
     assert db3.read_bytes() == before
+
+
+_WITH_NOTE = (
+    "uint64 timestamp\nbool position\nbool velocity\nbool acceleration\nbool attitude\n"
+    "bool body_rate\nbool thrust_and_torque\nbool direct_actuator\nstring note\n"
+)
+"""OffboardControlMode as a custom px4_msgs build defines it: an extra string field."""
+
+
+def _noted_ocm(k: int, length: int | None = None) -> bytes:
+    """CDR of ``_WITH_NOTE`` at 20 Hz, its string length field ``length`` when given."""
+    text = b"ok\x00"
+    body = struct.pack("<Q", 5_000_000 + k * 50_000) + bytes([1, 0, 0, 0, 0, 0, 0, 0])
+    body += struct.pack("<I", len(text) if length is None else length) + text
+    return b"\x00\x01\x00\x00" + body
+
+
+@pytest.mark.parametrize("bad", [[30], [30, 45]])
+def test_a_corrupt_string_length_loses_that_message_only(tmp_path: Path, bad: list[int]) -> None:
+    """rosbags raises its own error for a length past the end: each such message is counted
+    and named, the others are read (a keep-alive of 20 Hz with none missing around them)."""
+    raws = [
+        RawMessage(
+            t=0.05 * k,
+            topic="/fmu/in/offboard_control_mode",
+            msgtype="px4_msgs/msg/OffboardControlMode",
+            msgdef=_WITH_NOTE,
+            data=_noted_ocm(k, 0x7FFFFFF0 if k in bad else None),
+        )
+        for k in range(60)
+    ]
+    path = write_mcap(tmp_path / "noted.mcap", [], extra=raws)
+    lines = assert_clean_failure(path, f"{len(bad)} of 60 messages not decoded")
+    assert any("Invalid string length" in line for line in lines)
+    _, report, _ = lint(path)
+    assert report["stats"]["kinds"] == {"control_mode": 60 - len(bad)}
+
+
+def test_a_huge_fixed_array_in_a_definition_is_refused_before_decoding(tmp_path: Path) -> None:
+    """``string[100000]`` would make rosbags generate code per element (gigabytes): the
+    embedded definition is refused with a note, and the bundled ones are tried instead."""
+    raws = [
+        RawMessage(
+            t=0.05 * k,
+            topic="/fmu/in/offboard_control_mode",
+            msgtype="px4_msgs/msg/OffboardControlMode",
+            msgdef="uint64 timestamp\nstring[100000] s\n",
+            data=b"\x00\x01\x00\x00" + bytes(72),
+        )
+        for k in range(40)
+    ]
+    path = write_mcap(tmp_path / "huge.mcap", [], extra=raws)
+    assert_clean_failure(path, "40 of 40 messages not decoded")
+    _, report, _ = lint(path)
+    (note,) = [n for n in report["stats"]["notes"] if "embedded definition not usable" in n]
+    assert "100000 string or message array elements in OffboardControlMode" in note

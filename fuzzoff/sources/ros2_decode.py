@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from functools import cache
 from typing import Any
 
+from rosbags.serde import SerdeError
 from rosbags.typesys import get_types_from_idl, get_types_from_msg
 from rosbags.typesys.store import Typestore
 
@@ -25,8 +26,11 @@ from fuzzoff.sources.mavros import MavrosConverter, mavros_topic
 from fuzzoff.sources.ros2_convert import BUILDERS, KIND_OF, Builder
 from fuzzoff.sources.ros2_mavros import MavrosTopicDecoder
 from fuzzoff.sources.ros2_topics import MESSAGE_FOR_NAME, OUTPUT_MESSAGES, TopicRef, parse_topic
+from fuzzoff.sources.typedefs import bounded
 
-_DECODE_ERRORS = (struct.error, IndexError, ValueError, TypeError, UnicodeDecodeError)
+_DECODE_ERRORS = (struct.error, IndexError, ValueError, TypeError, UnicodeDecodeError, SerdeError)
+"""What rosbags' CDR decoders raise on a payload that does not fit its definition (a length
+field that points past the end: ``SerdeError``)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -72,6 +76,9 @@ class Definition:
                 return None, "not a CDR payload (bad encapsulation header)"
             func = self.little if raw[1] else self.big
             message, pos = func(raw[4:], 0, self.cls, self.store)
+        except SerdeError as exc:
+            why = str(exc).rstrip(".")
+            return None, f"payload of {len(raw)} bytes does not fit {self.describe()}: {why}"
         except _DECODE_ERRORS:
             size = len(raw)
             return None, f"payload of {size} bytes is shorter than {self.describe()} needs"
@@ -90,7 +97,7 @@ def _idl_store(typename: str, text: str) -> Typestore:
     from rosbags.typesys import Stores, get_typestore
 
     store = get_typestore(Stores.EMPTY)
-    store.register(get_types_from_idl(text))
+    store.register(bounded(get_types_from_idl(text)))
     return store
 
 

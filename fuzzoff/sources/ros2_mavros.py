@@ -18,6 +18,7 @@ from rosbags.typesys.store import Typestore
 from fuzzoff.events import Event
 from fuzzoff.sources.mavros import TOPIC_KINDS, Handler, MavrosTopic
 from fuzzoff.sources.mavros_msgs import mavros_typedefs
+from fuzzoff.sources.typedefs import bounded
 
 
 @cache
@@ -26,7 +27,7 @@ def _store(msgtype: str, embedded: str | None) -> Typestore:
     store.register({k: v for k, v in mavros_typedefs().items() if k not in store.fielddefs})
     if embedded:
         try:
-            typedefs = get_types_from_msg(embedded, msgtype)
+            typedefs = bounded(get_types_from_msg(embedded, msgtype))
             store.register({k: v for k, v in typedefs.items() if k not in store.fielddefs})
         except Exception:
             pass

@@ -31,6 +31,7 @@ from fuzzoff.sources.mavros import TOPIC_KINDS, Handler, MavrosConverter, mavros
 from fuzzoff.sources.mavros_msgs import mavros_typedefs
 from fuzzoff.sources.rosbag1_chunkwise import ChunkwiseReader
 from fuzzoff.sources.rosbag1_salvage import SalvageReader, bag_header_index_pos
+from fuzzoff.sources.typedefs import bounded
 
 REINDEX_HINT = "run `rosbag reindex` on it for a complete read"
 
@@ -100,7 +101,7 @@ class Rosbag1Source(Source):
         store.register(mavros_typedefs())
         for conn in connections:
             try:
-                typedefs = get_types_from_msg(conn.msgdef.data, conn.msgtype)
+                typedefs = bounded(get_types_from_msg(conn.msgdef.data, conn.msgtype))
                 fresh = {k: v for k, v in typedefs.items() if k not in store.fielddefs}
                 store.register(fresh)
             except Exception:

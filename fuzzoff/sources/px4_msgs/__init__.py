@@ -17,6 +17,7 @@ from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.store import Typestore
 
 from fuzzoff.profiles import ProfileError, px4_profile_for
+from fuzzoff.sources.typedefs import bounded
 
 RELEASES: tuple[str, ...] = ("1.13", "1.14", "1.15", "1.16", "1.17", "main")
 """Oldest to newest; ``main`` is release/1.18 (identical to main for these messages)."""
@@ -69,7 +70,7 @@ def typestore_for(typename: str, text: str) -> Typestore:
     different definitions (formats.md 3: the per-connection choice AnyReader does not make).
     """
     store = get_typestore(Stores.EMPTY)
-    store.register(get_types_from_msg(text, typename))
+    store.register(bounded(get_types_from_msg(text, typename)))
     return store
 
 
