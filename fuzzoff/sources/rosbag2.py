@@ -23,8 +23,9 @@ from ruamel.yaml import YAML
 from fuzzoff.events import Event
 from fuzzoff.sources import mcap_indexed, px4_msgs
 from fuzzoff.sources.base import RecordingInfo, Source, SourceError, SourceProblem
+from fuzzoff.sources.mavros import mavros_topic
 from fuzzoff.sources.mcap_stream import McapStream
-from fuzzoff.sources.ros2_decode import Decoder, Ros2Decoding, TopicDecoder
+from fuzzoff.sources.ros2_decode import Decoder, Ros2Decoding, TopicDecoder, message_of
 from fuzzoff.sources.ros2_order import ChunkOrder
 from fuzzoff.sources.rosbag2_sqlite import SQLITE_ERRORS, SalvageCopies
 from fuzzoff.sources.rosbag2_sqlite import topics as sqlite_topics
@@ -51,6 +52,27 @@ def _well_formed(conn: Any) -> bool:
         and not isinstance(count, bool)
         and count >= 0
     )
+
+
+def _topics_held(path: Path) -> set[tuple[Any, Any]]:
+    """(topic, type) of every topic a data file names: a database's topics table (rosbags'
+    own opening of one would also count its messages, 0.5 s on a million), an MCAP's
+    channels through rosbags."""
+    if path.suffix == ".db3":
+        db = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
+        try:
+            return {(name, msgtype) for _, name, msgtype, _, _ in sqlite_topics(db)}
+        finally:
+            db.close()
+    with Reader(path) as single:
+        return {(conn.topic, conn.msgtype) for conn in single.connections}
+
+
+def _decoded_topic(topic: Any, msgtype: Any) -> bool:
+    """A topic fuzzoff decodes (a PX4 topic, or a MAVROS one it reads)."""
+    if not (isinstance(topic, str) and isinstance(msgtype, str)):  # a damaged database
+        return False
+    return message_of(topic, msgtype)[0] is not None or mavros_topic(topic, msgtype) is not None
 
 
 def _why(exc: BaseException) -> str:
@@ -109,7 +131,32 @@ class Rosbag2Source(Source):
             self.problems.append(SourceProblem(what))
             self._salvage_plan(ValueError(what))
             return
+        unlisted = self._unlisted_topics(reader) if self.path.is_dir() else []
+        if unlisted:
+            with suppress(Exception):
+                reader.close()
+            what = (
+                f"metadata.yaml does not list {', '.join(unlisted)}, which the data files hold; "
+                "read the data files directly"
+            )
+            self.problems.append(SourceProblem(what))
+            self._salvage_plan(ValueError(what))
+            return
         self._reader = reader
+
+    def _unlisted_topics(self, reader: Any) -> list[str]:
+        """PX4 or MAVROS topics a data file names that metadata.yaml leaves out (an edited or
+        half-written file): reading through it would drop their messages without a word, and
+        the stream rules would see a keep-alive missing that was recorded."""
+        listed = {(conn.topic, conn.msgtype) for conn in reader.connections}
+        unlisted: set[str] = set()
+        for path in self._data_files(self.path):
+            try:
+                held = _topics_held(path)
+            except Exception:  # a damaged file: the reading says what is wrong with it
+                continue
+            unlisted.update(t for t, m in held - listed if _decoded_topic(t, m))
+        return sorted(unlisted)
 
     def _salvage_plan(self, exc: BaseException) -> None:
         """rosbags could not open the bag as a whole: find the data files to read one by one."""
@@ -200,6 +247,8 @@ class Rosbag2Source(Source):
 
     def _vehicle_type(self, reader: Any) -> None:
         """The vehicle type from the first ``VehicleStatus`` (a cheap indexed read)."""
+        if self._vehicle:
+            return
         for conn in reader.connections:
             decoder = self._decoders.get((conn.topic, conn.msgtype))
             if not isinstance(decoder, TopicDecoder) or decoder.message != "VehicleStatus":
@@ -225,6 +274,8 @@ class Rosbag2Source(Source):
                         self._decoder(conn.topic, conn.msgtype, conn.msgdef)
                     if reader.message_count:
                         starts.append(reader.start_time)
+                        # as for a whole bag: definitions, release and vehicle type up front
+                        self._presample(reader)
             except Exception:  # salvaged below, and again in the reading pass
                 if path.suffix == ".db3":
                     start = self._probe_salvage(path)
