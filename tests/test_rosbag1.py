@@ -278,6 +278,52 @@ def test_unindexed_bag_is_read_and_says_reindex(good_bag: bytes, tmp_path: Path)
     assert "not indexed" in problem.what and "rosbag reindex" in problem.what
 
 
+def _record_data_at(data: bytes, op: bytes, nth: int) -> int:
+    """Where the data of the ``nth`` record with this op code starts (rosbags writes ``op``
+    as the first field of a record header)."""
+    at = -1
+    for _ in range(nth + 1):
+        at = data.index(b"op=" + op, at + 1)
+    header_length = struct.unpack("<I", data[at - 8 : at - 4])[0]
+    return at - 4 + header_length + 4
+
+
+def test_a_damaged_chunk_info_record_falls_back_to_reading_in_file_order(
+    good_bag: bytes, tmp_path: Path
+) -> None:
+    """CHUNK_INFO's version byte (the index section at the end) changed: the chunks are
+    intact, so every message is still read, and the index is named as damaged."""
+    data = bytearray(good_bag)
+    info = data.rindex(b"op=\x06")
+    version = data.index(b"ver=", info - 40) + 4
+    data[version] = 2
+    path = tmp_path / "chunk_info.bag"
+    path.write_bytes(bytes(data))
+    events, source = read(path)
+    assert len(events) == 302
+    (problem,) = source.problems
+    assert problem.what.startswith("index damaged at byte")
+
+
+def test_one_bad_offset_in_the_index_loses_at_most_its_message(
+    good_bag: bytes, tmp_path: Path
+) -> None:
+    """An IDX_DATA entry three bytes off, in the fifth chunk: the indexed read stops there,
+    and the rest is read in file order from after the last message read."""
+    data = bytearray(good_bag)
+    entries = _record_data_at(bytes(data), b"\x04", 4)
+    offset_at = entries + 8  # the first entry: time (8 bytes), then the offset
+    struct.pack_into("<I", data, offset_at, struct.unpack_from("<I", data, offset_at)[0] + 3)
+    path = tmp_path / "bad_offset.bag"
+    path.write_bytes(bytes(data))
+    events, source = read(path)
+    assert 300 <= len(events) <= 302
+    assert [e.t for e in events] == sorted(e.t for e in events)
+    (problem,) = source.problems
+    assert problem.what.startswith("the indexed read stopped")
+    assert "later messages read in file order" in problem.what
+
+
 def test_damaged_bag_as_a_process_prints_no_traceback(good_bag: bytes, tmp_path: Path) -> None:
     path = tmp_path / "cut.bag"
     path.write_bytes(damaged("flipped", good_bag))

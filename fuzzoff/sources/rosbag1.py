@@ -75,7 +75,7 @@ class Rosbag1Source(Source):
         size = self.path.stat().st_size
         if why.startswith("File magic is invalid") or "seems to be empty" in why:
             raise SourceError(self.path, "not a ROS 1 bag (no `#ROSBAG V2.0` header)")
-        if "version" in why and "not supported" in why:
+        if why.startswith(("Bag version", "Bag encryption")):  # the bag's own format
             raise SourceError(self.path, why.rstrip("."))
         index_pos = bag_header_index_pos(self.path)
         if index_pos is None:
@@ -152,7 +152,43 @@ class Rosbag1Source(Source):
         reader = self._reader
         if reader is None or not self._wanted:
             return
-        yield from self._convert(reader.messages(connections=self._wanted), [reader.start_time])
+        yield from self._convert(self._indexed_then_in_file_order(reader), [reader.start_time])
+
+    def _indexed_then_in_file_order(
+        self, reader: ChunkwiseReader
+    ) -> Iterator[tuple[Connection, int, bytes]]:
+        """The messages through the index; where a damaged index entry or chunk stops that
+        read, the rest in file order (the salvage reader), from after the last message read.
+        The data of a bag is usually intact where one offset in its index is not."""
+        last_ns = -1
+        try:
+            for conn, timestamp, raw in reader.messages(connections=self._wanted):
+                last_ns = timestamp
+                yield conn, timestamp, raw
+            return
+        except Exception as exc:  # rosbags ReaderError, asserts, codec errors
+            detail = str(exc).rstrip(".") if isinstance(exc, ReaderError) else type(exc).__name__
+        salvage = SalvageReader(self.path)
+        same = {(c.topic, c.msgtype): c for c in self._wanted}
+        resumed = 0
+        try:
+            salvage.open()
+            for conn, timestamp, raw in salvage.messages():
+                wanted = same.get((conn.topic, conn.msgtype))
+                if wanted is not None and timestamp > last_ns:
+                    resumed += 1
+                    yield wanted, timestamp, raw
+        except ReaderError as exc:
+            salvage.stopped = salvage.stopped or (str(exc), 0)
+        finally:
+            salvage.close()
+        t = (last_ns - reader.start_time) / 1e9 if last_ns >= 0 else None
+        what = f"the indexed read stopped ({detail}); {resumed} later messages read in file order"
+        at = None
+        if salvage.stopped is not None:
+            what += f", until: {salvage.stopped[0]}"
+            at = f"byte {salvage.stopped[1]}"
+        self.problems.append(SourceProblem(f"{what} ({REINDEX_HINT})", at, t))
 
     def _salvaged_events(self) -> Iterator[Event]:
         """File order, as recorded; the first message of any topic is time zero."""
