@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import os
 import subprocess
+import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import Any
 
@@ -13,7 +14,10 @@ import pytest
 from fuzzoff.catalog import load_catalog
 from fuzzoff.config import Settings
 from fuzzoff.events import Where
-from fuzzoff.findings import Finding, Report, Severity
+from fuzzoff.findings import FileReport, Finding, Report, Severity
+from fuzzoff.profiles import Profile
+from fuzzoff.report.junit import render as junit_render
+from fuzzoff.report.sanitize import printable
 from fuzzoff.report.sarif import fingerprint, sarif_log
 from tests.helpers import ROOT, run_cli
 from tests.report_fixtures import gap_recording, hostile_report
@@ -94,11 +98,12 @@ def test_results_point_at_their_rule_recording_time_and_topic(tmp_path: Path) ->
         assert rules[res["ruleIndex"]]["id"] == res["ruleId"] == finding.code
         level = {Severity.ERROR: "error", Severity.WARNING: "warning", Severity.INFO: "note"}
         assert res["level"] == level[finding.severity]
-        assert finding.message in res["message"]["text"]
+        # as a terminal shows it: control characters (ANSI escapes) written out as \xNN
+        assert printable(finding.message) in res["message"]["text"]
         if finding.time_s is not None:
             assert f"{finding.time_s:.3f} s" in res["message"]["text"]
         if finding.where is not None:
-            assert finding.where.topic in res["message"]["text"]
+            assert printable(finding.where.topic) in res["message"]["text"]
         location = res["locations"][0]["physicalLocation"]["artifactLocation"]
         # Relative to the working folder, percent-encoded (the hostile path has quotes and <>).
         assert location["uriBaseId"] == "SRCROOT"
@@ -139,3 +144,30 @@ def test_cli_writes_sarif_with_relative_uri(tmp_path: Path) -> None:
     assert run["artifacts"][0]["location"] == {"uri": "gap.tlog", "uriBaseId": "SRCROOT"}
     assert run["originalUriBaseIds"]["SRCROOT"]["uri"] == tmp_path.resolve().as_uri() + "/"
     assert any(r["ruleId"] == "OFB003" for r in run["results"])
+
+
+@pytest.mark.parametrize("render", ["sarif", "junit"])
+def test_a_recordings_text_cannot_forge_lines_in_ci_views(render: str) -> None:
+    """A message carrying a line break, a bidi override and 5,000 characters (a hostile topic
+    name) stays one line of bounded length, without the override, in SARIF and JUnit alike."""
+    forged = "\nFAKE LINE  OFB000 error\u202e" + "B" * 5000
+    report = Report(
+        files=[
+            FileReport(
+                path="flight.tlog",
+                format="tlog",
+                profile=Profile(),
+                findings=[Finding("OFB101", "keepalive-below-2hz", Severity.ERROR, forged, 1.0)],
+            )
+        ]
+    )
+    if render == "sarif":
+        text = sarif_log(report, Settings())["runs"][0]["results"][0]["message"]["text"]
+    else:
+        failure = ET.fromstring(junit_render(report, Settings())).find(".//failure")
+        assert failure is not None and failure.text is not None
+        finding_line, rule_line = failure.text.splitlines()  # one line a finding, then the rule
+        assert rule_line.startswith("rule: ")
+        text = finding_line
+    assert "\n" not in text and "\u202e" not in text and len(text) <= 2000
+    assert "\\x0aFAKE LINE" in text
