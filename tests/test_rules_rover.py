@@ -99,6 +99,14 @@ def test_wrong_control_flag(row: tr.RoverCombination) -> None:
     assert finding.end_s == pytest.approx(0.9)
 
 
+@pytest.mark.parametrize("row", COMBOS, ids=[r.name for r in COMBOS])
+def test_rover_setpoints_under_direct_actuator_are_a_mismatch(row: tr.RoverCombination) -> None:
+    """direct_actuator runs no rover controller: the published combination is ignored."""
+    found = lint(drive(row.publish, row.nan, flags={"direct_actuator": True}))
+    (finding,) = codes(found, "OFB503")
+    assert row.name in finding.message and "direct_actuator" in finding.message
+
+
 def test_extra_control_flag_is_a_mismatch() -> None:
     flags = {"velocity": True, "attitude": True}
     found = lint(drive({tr.SPEED, tr.ATTITUDE}, flags=flags))

@@ -126,8 +126,9 @@ class RoverCombination(Check):
             return
         if not isinstance(event, ControlMode):
             return
-        flag = event.first_flag()
-        if not self.ctx.state.in_offboard or flag in (None, self.tables.direct_actuator_flag):
+        # direct_actuator too: rover setpoints published under it are ignored by PX4, so they
+        # do not match the flag their combination needs (OFB503)
+        if not self.ctx.state.in_offboard or event.first_flag() is None:
             self._clear()
             return
         published = {k for k, (t, _) in self.last.items() if event.t - t <= self.window}
