@@ -137,6 +137,17 @@ def test_ofb104_stale_trajectory_under_live_keepalive_ros2_only() -> None:
     assert codes(lint_events(events, fmt="tlog"), "OFB104") == []
 
 
+def test_ofb104_a_stretch_ends_when_the_setpoint_comes_back() -> None:
+    """TrajectorySetpoint silent from 2.00 to 2.60 s under a 20 Hz keep-alive: 0.60 s, not
+    the time to the next keep-alive after it came back."""
+    times = [t for t in every(0.0, 5.0, 0.05) if not 2.0 < t < 2.6]
+    sp = [TrajectorySetpoint(t=t + 0.01, position=(0.0, 0.0, -2.0)) for t in times]
+    events = [status(0.0, OFFBOARD), *ocm(every(0.0, 5.0, 0.05)), *sp]
+    (found,) = codes(lint_events(events, fmt="mcap"), "OFB104")
+    assert "not published for 0.60 s" in found.message
+    assert found.end_s == pytest.approx(2.61)
+
+
 def test_ofb105_marginal_rate_and_p99() -> None:
     times = every(0.0, 20.0, 0.2)
     shifted = [t + (0.25 if i % 10 == 5 else 0) for i, t in enumerate(times)]  # one 450 ms gap

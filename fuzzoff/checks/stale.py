@@ -74,7 +74,9 @@ class StaleSetpoints(Check):
                 oldest, kind = min(published)
                 oldest = max(oldest, self.ocm_since)  # quiet only counts under a live keep-alive
                 if event.t - oldest <= self.stale:
-                    self._close(event.t)  # one alternative is being served
+                    # one alternative is served again: the stretch ended when its last kind
+                    # came back (``oldest``), not at this keep-alive
+                    self._close(oldest)
                     return
                 stale.append((oldest, SETPOINT_NAMES.get(kind, kind)))
         if stale and self.episode is None:
