@@ -1,0 +1,54 @@
+"""``fuzzoff fuzz`` and ``fuzzoff replay`` given what they cannot use: one line naming what is
+wrong and exit status 2, never a traceback, a hang or a success that checked nothing."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from tests.helpers import run_cli
+
+# A planted fault (the loss rules off) that the first examples already break.
+PLANTED = ["fuzz", "--px4", "1.15", "--vehicle", "mc", "--transport", "ros2", "--seed", "7"]
+PLANTED += ["--examples", "300", "--property", "explained", "--ignore", "OFB103,OFB101", "-q"]
+
+
+def _one_error_line(stderr: str) -> str:
+    lines = [line for line in stderr.splitlines() if line.strip()]
+    assert len(lines) == 1 and "Traceback" not in stderr, stderr
+    return lines[0]
+
+
+@pytest.mark.parametrize("save_dir", ["afile", "afile/sub"])
+def test_a_save_dir_that_cannot_be_made_is_refused_before_the_campaign(
+    tmp_path: Path, save_dir: str
+) -> None:
+    (tmp_path / "afile").write_text("x")
+    out = run_cli([*PLANTED, "--save-dir", save_dir], cwd=tmp_path)
+    assert out.returncode == 2
+    assert "--save-dir" in _one_error_line(out.stderr) and "afile is not a folder" in out.stderr
+    assert out.stdout == "", "the campaign did not run"
+
+
+def test_a_missing_save_dir_is_not_left_behind_when_nothing_is_found(tmp_path: Path) -> None:
+    args = ["fuzz", "--examples", "2", "--property", "invariants", "-q"]
+    out = run_cli([*args, "--save-dir", "new/deeper"], cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    assert not (tmp_path / "new").exists()
+
+
+def test_a_save_that_fails_after_the_campaign_still_reports_the_counterexample(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    def disk_full(*_: object, **__: object) -> Path:
+        raise OSError(28, "No space left on device", str(tmp_path / "x.mcap"))
+
+    monkeypatch.setattr("fuzzoff.commands.fuzz.save", disk_full)
+    out = run_cli([*PLANTED, "--save-dir", str(tmp_path), "--format", "json"])
+    assert out.returncode == 2
+    line = _one_error_line(out.stderr)
+    assert "No space left on device" in line and "explained counterexample was not saved" in line
+    (prop,) = json.loads(out.stdout)["properties"]
+    assert prop["failed"] and prop["counterexample"] and prop["reproducer"] is None
