@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.helpers import run_cli
+from tests.helpers import run_cli, run_cli_process
 
 # A planted fault (the loss rules off) that the first examples already break.
 PLANTED = ["fuzz", "--px4", "1.15", "--vehicle", "mc", "--transport", "ros2", "--seed", "7"]
@@ -52,3 +52,21 @@ def test_a_save_that_fails_after_the_campaign_still_reports_the_counterexample(
     assert "No space left on device" in line and "explained counterexample was not saved" in line
     (prop,) = json.loads(out.stdout)["properties"]
     assert prop["failed"] and prop["counterexample"] and prop["reproducer"] is None
+
+
+@pytest.mark.parametrize("budget", ["nan", "inf"])
+def test_a_budget_that_is_not_a_finite_number_is_refused(budget: str) -> None:
+    args = ["fuzz", "--budget", budget, "--property", "invariants", "--no-save", "-q"]
+    out = run_cli_process(args, timeout=60)  # NaN never ran out: the campaign never stopped
+    assert out.returncode == 2
+    assert f"--budget {budget}" in _one_error_line(out.stderr)
+
+
+def test_a_budget_too_small_for_one_example_is_not_all_held() -> None:
+    args = ["fuzz", "--budget", "1e-9", "--property", "invariants", "--no-save", "-q"]
+    out = run_cli(args)
+    assert out.returncode == 2
+    assert "ran no example of invariants" in _one_error_line(out.stderr)
+    assert "all held" not in out.stdout and "no example of invariants ran" in out.stdout
+    data = json.loads(run_cli([*args, "--format", "json"]).stdout)
+    assert data["unchecked"] == ["invariants"] and data["properties"][0]["examples"] == 0

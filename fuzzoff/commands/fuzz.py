@@ -8,6 +8,7 @@ be saved (the report still gives its counterexample).
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 from pathlib import Path
@@ -77,8 +78,8 @@ def _config(args: argparse.Namespace) -> CampaignConfig:
         raise ConfigError(str(exc)) from None
     if args.examples is not None and args.examples < 1:
         raise ConfigError("--examples must be at least 1")
-    if args.budget is not None and args.budget <= 0:
-        raise ConfigError("--budget must be positive")
+    if args.budget is not None and not (math.isfinite(args.budget) and args.budget > 0):
+        raise ConfigError(f"--budget {args.budget:g}: expected a finite number of seconds above 0")
     ns = argparse.Namespace(ignore=args.ignore)
     settings = settings_from_args(ns)
     examples = args.examples if args.examples is not None else (None if args.budget else 100)
@@ -195,6 +196,13 @@ def run(args: argparse.Namespace) -> int:
     write_output(_render(args.format, result, saved, margins), args.output)
     if save_error is not None:
         print(f"error: {save_error}", file=sys.stderr)
+        return 2
+    if result.unchecked:
+        # Nothing was checked, so nothing held: not 0 (a CI job must not pass on it), and not
+        # 1 either (no counterexample): the budget given was too small to run anything.
+        budget = f"--budget {args.budget:g} s " if args.budget is not None else ""
+        names = ", ".join(result.unchecked)
+        print(f"error: {budget}ran no example of {names}: nothing was checked", file=sys.stderr)
         return 2
     return 1 if result.failed else 0
 

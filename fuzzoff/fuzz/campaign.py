@@ -214,6 +214,11 @@ class CampaignResult:
         return sum(r.examples for r in self.results)
 
     @property
+    def unchecked(self) -> list[str]:
+        """The properties no example was checked on (a time budget spent before the first)."""
+        return [r.name for r in self.results if r.examples == 0]
+
+    @property
     def seconds(self) -> float:
         return sum(r.seconds for r in self.results)
 

@@ -33,6 +33,7 @@ def to_json(result: CampaignResult, saved: dict[str, Path], margins: list[Any]) 
             "from": None if cfg.base is None else cfg.base.describe(),
         },
         "failed": result.failed,
+        "unchecked": result.unchecked,
         "examples": result.examples,
         "seconds": round(result.seconds, 3),
         "properties": [],
@@ -54,7 +55,7 @@ def to_junit(result: CampaignResult, saved: dict[str, Path]) -> str:
         tests=str(len(result.results)),
         failures=str(failures),
         errors="0",
-        skipped="0",
+        skipped=str(len(result.unchecked)),
         time=f"{result.seconds:.3f}",
     )
     for r in result.results:
@@ -69,6 +70,8 @@ def to_junit(result: CampaignResult, saved: dict[str, Path]) -> str:
                 text += f"\nreproducer: {saved[r.name]}"
             failure = ET.SubElement(case, "failure", message=printable(r.problems[0], 300))
             failure.text = text
+        elif r.examples == 0:
+            ET.SubElement(case, "skipped", message="no example ran within the time budget")
         out = ET.SubElement(case, "system-out")
         out.text = f"{r.claim}: {r.examples} examples in {r.seconds:.2f} s"
     root = ET.Element("testsuites")
@@ -126,6 +129,8 @@ def to_sarif(result: CampaignResult, saved: dict[str, Path]) -> str:
 def _line(r: PropertyResult) -> str:
     rate = f"{r.examples / r.seconds:.0f}/s" if r.seconds else "-"
     verdict = "FAILED" if r.failed else ("counted" if r.name == "docs-stricter" else "held")
+    if not r.examples:
+        verdict = "not run"
     return f"  {r.name:<14} {verdict:<8} {r.examples:>6} examples {r.seconds:7.2f} s {rate:>7}"
 
 
@@ -150,9 +155,13 @@ def to_terminal(result: CampaignResult, saved: dict[str, Path], margins: list[An
             lines.append(f"  margin {m.family:<7} none up to the largest size tried")
         else:
             lines.append(f"  margin {m.family:<7} {p.describe()} changes the gate's outcome")
-    failed = sum(1 for r in result.results if r.failed)
-    lines.append(
-        f"{result.examples} examples in {result.seconds:.1f} s; "
-        + (f"{failed} propert{'y' if failed == 1 else 'ies'} failed" if failed else "all held")
-    )
+    lines.append(f"{result.examples} examples in {result.seconds:.1f} s; {_verdict(result)}")
     return "\n".join(lines) + "\n"
+
+
+def _verdict(result: CampaignResult) -> str:
+    failed = sum(1 for r in result.results if r.failed)
+    verdicts = [f"{failed} propert{'y' if failed == 1 else 'ies'} failed"] if failed else []
+    if result.unchecked:
+        verdicts.append(f"no example of {', '.join(result.unchecked)} ran")
+    return "; ".join(verdicts) or "all held"
