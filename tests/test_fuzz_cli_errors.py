@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.helpers import run_cli, run_cli_process
+from tests.helpers import CORPORA, run_cli, run_cli_process
 
 # A planted fault (the loss rules off) that the first examples already break.
 PLANTED = ["fuzz", "--px4", "1.15", "--vehicle", "mc", "--transport", "ros2", "--seed", "7"]
@@ -70,3 +70,27 @@ def test_a_budget_too_small_for_one_example_is_not_all_held() -> None:
     assert "all held" not in out.stdout and "no example of invariants ran" in out.stdout
     data = json.loads(run_cli([*args, "--format", "json"]).stdout)
     assert data["unchecked"] == ["invariants"] and data["properties"][0]["examples"] == 0
+
+
+def test_from_an_incomplete_recording_fuzzes_the_readable_part_and_exits_2() -> None:
+    cut = CORPORA / "mcap" / "truncated.mcap"
+    lint = run_cli(["lint", str(cut), "--format", "json"])
+    assert lint.returncode == 2
+    args = ["fuzz", "--from", str(cut), "--examples", "3", "--property", "invariants"]
+    out = run_cli([*args, "--no-save", "-q", "--format", "json"])
+    assert out.returncode == 2
+    assert _one_error_line(out.stderr) == lint.stderr.strip(), "the reader's line, as lint says it"
+    report = json.loads(out.stdout)
+    assert report["properties"][0]["examples"] == 3, "the readable part was fuzzed"
+    assert report["campaign"]["from_problems"] == [out.stderr.strip().removeprefix("fuzzoff: ")]
+    text = run_cli([*args, "--no-save", "-q"]).stdout
+    assert "--from incomplete" in text
+
+
+def test_from_a_folder_of_recordings_is_a_usage_error(tmp_path: Path) -> None:
+    for name in ("a.mcap", "b.mcap"):
+        (tmp_path / name).write_bytes((CORPORA / "mcap" / "stream_lost.mcap").read_bytes())
+    out = run_cli(["fuzz", "--from", str(tmp_path), "--examples", "1", "--no-save", "-q"])
+    assert out.returncode == 2
+    line = _one_error_line(out.stderr)
+    assert str(tmp_path) in line and "not a ROS 2 bag" in line and "one recording" in line

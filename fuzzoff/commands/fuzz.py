@@ -23,7 +23,8 @@ from fuzzoff.fuzz.properties import PROPERTIES
 from fuzzoff.fuzz.reproducers import DEFAULT_DIR, save
 from fuzzoff.fuzz.scenario import TRANSPORTS
 from fuzzoff.profiles import ProfileError, px4_profile_for, vehicle_type_for
-from fuzzoff.sources import SourceError
+from fuzzoff.report.sanitize import printable
+from fuzzoff.sources import SourceError, is_bag_folder
 
 
 def add_parser(sub: Any) -> None:
@@ -95,12 +96,18 @@ def _config(args: argparse.Namespace) -> CampaignConfig:
         known=tuple(KNOWN) if args.known else (),
     )
     if args.from_:
-        from fuzzoff.fuzz.mutate import scenario_from_recording, sent_keepalives
+        from fuzzoff.fuzz.mutate import read_base, sent_keepalives
 
         config.properties = _from_properties(args.property)
+        path = Path(args.from_)
+        if path.is_dir() and not is_bag_folder(path):
+            raise ConfigError(
+                f"--from {args.from_}: a folder that is not a ROS 2 bag (no metadata.yaml); "
+                "--from takes one recording"
+            )
         try:
-            config.base = scenario_from_recording(
-                Path(args.from_), px4, vehicle, parse_params(args.param)
+            config.base, config.base_problems = read_base(
+                path, px4, vehicle, parse_params(args.param)
             )
         except SourceError as exc:
             raise ConfigError(exc.line()) from None
@@ -196,6 +203,11 @@ def run(args: argparse.Namespace) -> int:
     write_output(_render(args.format, result, saved, margins), args.output)
     if save_error is not None:
         print(f"error: {save_error}", file=sys.stderr)
+        return 2
+    if config.base_problems:
+        # As lint: the campaign ran on the part that could be read; the status says the rest.
+        for line in config.base_problems:
+            print(f"fuzzoff: {printable(line)}", file=sys.stderr)
         return 2
     if result.unchecked:
         # Nothing was checked, so nothing held: not 0 (a CI job must not pass on it), and not

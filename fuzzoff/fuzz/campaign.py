@@ -109,6 +109,9 @@ class CampaignConfig:
     for new ones; each one's count is in ``PropertyResult.known``."""
     base: Scenario | None = None
     """``--from``: mutate this scenario (a user's recording) instead of drawing new streams."""
+    base_problems: list[str] = field(default_factory=list)
+    """The parts of the ``--from`` recording that could not be read (``base`` is the part
+    before them), one line each as ``fuzzoff lint`` reports them."""
 
 
 def _targets(scenario: Scenario) -> None:

@@ -31,6 +31,7 @@ def to_json(result: CampaignResult, saved: dict[str, Path], margins: list[Any]) 
             "examples": cfg.examples,
             "budget_s": cfg.budget_s,
             "from": None if cfg.base is None else cfg.base.describe(),
+            "from_problems": cfg.base_problems,
         },
         "failed": result.failed,
         "unchecked": result.unchecked,
@@ -136,6 +137,8 @@ def _line(r: PropertyResult) -> str:
 
 def to_terminal(result: CampaignResult, saved: dict[str, Path], margins: list[Any]) -> str:
     lines = [f"fuzzoff fuzz, seed {result.config.seed}"]
+    for problem in result.config.base_problems:
+        lines.append(f"  --from incomplete, the part before this was fuzzed: {printable(problem)}")
     for r in result.results:
         lines.append(_line(r))
         for p in r.problems:
