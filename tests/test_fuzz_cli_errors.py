@@ -4,7 +4,10 @@ wrong and exit status 2, never a traceback, a hang or a success that checked not
 from __future__ import annotations
 
 import json
+import shutil
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -94,3 +97,63 @@ def test_from_a_folder_of_recordings_is_a_usage_error(tmp_path: Path) -> None:
     assert out.returncode == 2
     line = _one_error_line(out.stderr)
     assert str(tmp_path) in line and "not a ROS 2 bag" in line and "one recording" in line
+
+
+REPRODUCER = CORPORA / "fuzz" / "explained-1.15-mc-ros2-24600598.expected.json"
+
+
+def _reproducer(tmp_path: Path, change: Callable[[dict[str, Any]], None]) -> Path:
+    """A copy of a committed reproducer with one field changed."""
+    spec = json.loads(REPRODUCER.read_text())
+    change(spec)
+    shutil.copy(REPRODUCER.parent / spec["recording"], tmp_path)
+    path = tmp_path / REPRODUCER.name
+    path.write_text(json.dumps(spec))
+    return path
+
+
+def _set(*keys: str, value: Any) -> Callable[[dict[str, Any]], None]:
+    def change(spec: dict[str, Any]) -> None:
+        for key in keys[:-1]:
+            spec = spec[key]
+        spec[keys[-1]] = value
+
+    return change
+
+
+def _drop_severity(spec: dict[str, Any]) -> None:
+    del spec["findings"][0]["severity"]
+
+
+@pytest.mark.parametrize(
+    ("change", "field"),
+    [
+        (_set("scenario", "params", value={"COM_OF_LOSS_T": "a"}), "scenario.params.COM_OF_LOSS_T"),
+        (_set("scenario", "px4", value="foo"), "scenario.px4"),
+        (_set("scenario", "vehicle", value="heli"), "scenario.vehicle"),
+        (_set("scenario", "transport", value="can"), "scenario.transport"),
+        (_set("scenario", "ignore", value=5), "scenario.ignore"),
+        (_set("scenario", "ignore", value=["OFB999"]), "scenario.ignore"),
+        (_set("scenario", value="x"), "scenario"),
+        (_drop_severity, "findings[0]"),
+        (_set("findings", value="x"), "findings"),
+        (_set("findings", value=[{"code": "OFB101", "severity": "fatal"}]), "findings[0].severity"),
+        (_set("property", value="nope"), "property"),
+        (_set("cut_fraction", value="half"), "cut_fraction"),
+    ],
+)
+def test_replay_of_a_malformed_reproducer_names_the_file_and_the_field(
+    tmp_path: Path, change: Callable[[dict[str, Any]], None], field: str
+) -> None:
+    path = _reproducer(tmp_path, change)
+    out = run_cli(["replay", str(path)])
+    assert out.returncode == 2, out.stdout
+    assert _one_error_line(out.stderr).startswith(f"error: {path}: {field}: ")
+
+
+def test_replay_takes_a_full_px4_release_as_the_options_do(tmp_path: Path) -> None:
+    path = _reproducer(tmp_path, _set("scenario", "px4", value="1.15.4"))
+    out = run_cli(["replay", str(path), "--format", "json"])
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    assert data["findings_match"] and not data["property_still_fails"]

@@ -68,10 +68,11 @@ def compare(expected: list[dict[str, Any]], actual: list[dict[str, Any]]) -> lis
 
 def run(args: argparse.Namespace) -> int:
     try:
-        spec, recording = load(Path(args.path))
+        reproducer = load(Path(args.path))
     except ReproducerError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    recording = reproducer.recording
     if not recording.exists():
         print(f"error: {recording}: the reproducer's recording is missing", file=sys.stderr)
         return 2
@@ -81,19 +82,11 @@ def run(args: argparse.Namespace) -> int:
     from fuzzoff.fuzz.reproducers import expected_findings
     from fuzzoff.fuzz.scenario import Scenario
 
-    info = spec.get("scenario") or {}
-    scenario = Scenario(
-        px4=str(info.get("px4", "1.15")),
-        vehicle=str(info.get("vehicle", "mc")),
-        transport=info.get("transport", "ros2"),
-        events=(),
-        params={str(k): float(v) for k, v in dict(info.get("params", {})).items()},
-    )
-    ignore = frozenset(str(c) for c in info.get("ignore", []))
-    report = lint_file(recording, scenario.settings(Settings(ignore=ignore)))
-    differ = compare(list(spec.get("findings", [])), expected_findings(report))
-    still = recheck(spec, recording)
-    prop = spec.get("property")
+    scenario = reproducer.scenario or Scenario("1.15", "mc", "ros2", events=())
+    report = lint_file(recording, scenario.settings(Settings(ignore=reproducer.ignore)))
+    differ = compare(reproducer.findings, expected_findings(report))
+    still = recheck(reproducer)
+    prop = reproducer.prop
     data = {
         "reproducer": str(args.path),
         "recording": str(recording),
