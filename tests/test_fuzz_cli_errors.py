@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import shutil
+import socket
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -157,3 +158,35 @@ def test_replay_takes_a_full_px4_release_as_the_options_do(tmp_path: Path) -> No
     assert out.returncode == 0, out.stderr
     data = json.loads(out.stdout)
     assert data["findings_match"] and not data["property_still_fails"]
+
+
+TLOG_REPRODUCER = CORPORA / "fuzz" / "explained-1.16-mc-mavlink-480969c1.expected.json"
+
+
+def test_replay_to_a_host_that_cannot_be_resolved_is_one_line() -> None:
+    target = "udp:nonexistent.invalid:14540"  # .invalid never resolves (RFC 6761)
+    out = run_cli(["replay", str(TLOG_REPRODUCER), "--to", target])
+    assert out.returncode == 2
+    assert "cannot resolve host 'nonexistent.invalid'" in _one_error_line(out.stderr)
+
+
+def test_replay_to_an_ipv6_address_in_brackets_sends_there() -> None:
+    try:
+        listener = socket.socket(socket.AF_INET6, socket.SOCK_DGRAM)
+        listener.bind(("::1", 0))
+    except OSError:
+        pytest.skip("no IPv6 loopback here")
+    with listener:
+        listener.settimeout(5.0)
+        port = listener.getsockname()[1]
+        target = f"udp:[::1]:{port}"
+        out = run_cli(["replay", str(TLOG_REPRODUCER), "--to", target, "--speed", "20"])
+        assert out.returncode == 0, out.stderr
+        assert f"to [::1]:{port}" in out.stdout
+        assert listener.recv(4096)[:1] in (b"\xfd", b"\xfe"), "a MAVLink packet arrived"
+
+
+def test_replay_to_an_ipv6_address_without_brackets_says_how_to_write_it() -> None:
+    out = run_cli(["replay", str(TLOG_REPRODUCER), "--to", "udp:::1:14540"])
+    assert out.returncode == 2
+    assert "in brackets" in _one_error_line(out.stderr)

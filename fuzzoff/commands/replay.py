@@ -30,7 +30,11 @@ TIME_TOLERANCE_S = 0.05
 def add_parser(sub: Any) -> None:
     parser = add_command(sub, "replay")
     parser.add_argument("path", metavar="REPRODUCER", help="NAME.expected.json or its recording")
-    parser.add_argument("--to", metavar="udp:HOST:PORT", help="stream the MAVLink packets there")
+    parser.add_argument(
+        "--to",
+        metavar="udp:HOST:PORT",
+        help="stream the MAVLink packets there (an IPv6 address in brackets: udp:[::1]:14540)",
+    )
     parser.add_argument("--speed", type=float, default=1.0, help="time scale for --to (2 = 2x)")
     parser.add_argument("--format", choices=("terminal", "json"), default="terminal")
     parser.add_argument("--output", "-o", metavar="FILE")
@@ -112,10 +116,10 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _stream(recording: Path, args: argparse.Namespace) -> int:
-    from fuzzoff.fuzz.udp import TargetError, parse_target, sent_packets, stream
+    from fuzzoff.fuzz.udp import TargetError, sent_packets, stream, target_for
 
     try:
-        host, port = parse_target(args.to)
+        target = target_for(args.to)
     except TargetError as exc:
         raise ConfigError(str(exc)) from None
     if args.speed <= 0:
@@ -127,6 +131,10 @@ def _stream(recording: Path, args: argparse.Namespace) -> int:
     except (OSError, ValueError) as exc:
         print(f"error: {recording}: not a readable tlog: {exc}", file=sys.stderr)
         return 2
-    count = stream(packets, host, port, speed=args.speed)
-    print(f"sent {count} packets to {host}:{port} over {packets[-1].t if packets else 0:.2f} s")
+    try:
+        count = stream(packets, target, speed=args.speed)
+    except OSError as exc:
+        print(f"error: --to {args.to!r}: cannot send: {exc.strerror or exc}", file=sys.stderr)
+        return 2
+    print(f"sent {count} packets to {target} over {packets[-1].t if packets else 0:.2f} s")
     return 0
