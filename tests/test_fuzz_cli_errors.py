@@ -190,3 +190,13 @@ def test_replay_to_an_ipv6_address_without_brackets_says_how_to_write_it() -> No
     out = run_cli(["replay", str(TLOG_REPRODUCER), "--to", "udp:::1:14540"])
     assert out.returncode == 2
     assert "in brackets" in _one_error_line(out.stderr)
+
+
+@pytest.mark.parametrize("speed", ["nan", "inf", "1e-300", "0", "-2", "1000"])
+def test_replay_speed_outside_its_range_is_a_usage_error(speed: str) -> None:
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sink:
+        sink.bind(("127.0.0.1", 0))
+        target = f"udp:127.0.0.1:{sink.getsockname()[1]}"
+        out = run_cli(["replay", str(TLOG_REPRODUCER), "--to", target, "--speed", speed])
+    assert out.returncode == 2
+    assert f"--speed {speed}: expected 0.01 to 100" in _one_error_line(out.stderr)

@@ -25,6 +25,9 @@ from fuzzoff.fuzz.reproducers import ReproducerError, load, recheck
 from fuzzoff.report.sanitize import printable
 
 TIME_TOLERANCE_S = 0.05
+MIN_SPEED, MAX_SPEED = 0.01, 100.0
+"""``--speed`` range: a reproducer of a minute takes at most 100 minutes; above 100x the gaps
+the gate reacts to (tens of milliseconds) are shorter than the sleep they are timed with."""
 
 
 def add_parser(sub: Any) -> None:
@@ -35,7 +38,12 @@ def add_parser(sub: Any) -> None:
         metavar="udp:HOST:PORT",
         help="stream the MAVLink packets there (an IPv6 address in brackets: udp:[::1]:14540)",
     )
-    parser.add_argument("--speed", type=float, default=1.0, help="time scale for --to (2 = 2x)")
+    parser.add_argument(
+        "--speed",
+        type=float,
+        default=1.0,
+        help=f"time scale for --to, from {MIN_SPEED:g} to {MAX_SPEED:g} (2 = twice as fast)",
+    )
     parser.add_argument("--format", choices=("terminal", "json"), default="terminal")
     parser.add_argument("--output", "-o", metavar="FILE")
     parser.set_defaults(run=run)
@@ -71,6 +79,8 @@ def compare(expected: list[dict[str, Any]], actual: list[dict[str, Any]]) -> lis
 
 
 def run(args: argparse.Namespace) -> int:
+    if not MIN_SPEED <= args.speed <= MAX_SPEED:  # NaN too
+        raise ConfigError(f"--speed {args.speed:g}: expected {MIN_SPEED:g} to {MAX_SPEED:g}")
     try:
         reproducer = load(Path(args.path))
     except ReproducerError as exc:
@@ -122,8 +132,6 @@ def _stream(recording: Path, args: argparse.Namespace) -> int:
         target = target_for(args.to)
     except TargetError as exc:
         raise ConfigError(str(exc)) from None
-    if args.speed <= 0:
-        raise ConfigError("--speed must be positive")
     if recording.suffix != ".tlog":
         raise ConfigError(f"{recording}: --to streams MAVLink: only a .tlog reproducer")
     try:
