@@ -12,7 +12,7 @@ from typing import Any
 
 import pytest
 
-from tests.helpers import CORPORA, run_cli, run_cli_process
+from tests.helpers import CORPORA, ROOT, run_cli, run_cli_process
 
 # A planted fault (the loss rules off) that the first examples already break.
 PLANTED = ["fuzz", "--px4", "1.15", "--vehicle", "mc", "--transport", "ros2", "--seed", "7"]
@@ -200,3 +200,17 @@ def test_replay_speed_outside_its_range_is_a_usage_error(speed: str) -> None:
         out = run_cli(["replay", str(TLOG_REPRODUCER), "--to", target, "--speed", speed])
     assert out.returncode == 2
     assert f"--speed {speed}: expected 0.01 to 100" in _one_error_line(out.stderr)
+
+
+def test_fuzz_writes_nothing_into_the_working_folder(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Hypothesis keeps caches (the constants it collects from local source files) in
+    ``.hypothesis/`` of the working folder even with its database off. A new process: the
+    caches are written once per process, so an in-process run after other tests writes none."""
+    monkeypatch.setenv("PYTHONPATH", str(ROOT))  # this checkout's fuzzoff, from any folder
+    monkeypatch.delenv("HYPOTHESIS_STORAGE_DIRECTORY", raising=False)
+    args = ["fuzz", "--examples", "3", "--property", "invariants", "--no-save", "-q"]
+    out = run_cli_process(args, cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
