@@ -9,6 +9,7 @@ import socket
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
+from urllib.parse import unquote
 
 import pytest
 
@@ -214,3 +215,17 @@ def test_fuzz_writes_nothing_into_the_working_folder(
     out = run_cli_process(args, cwd=tmp_path)
     assert out.returncode == 0, out.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == []
+
+
+def test_fuzz_sarif_locates_a_reproducer_with_a_percent_encoded_uri_as_lint_does(
+    tmp_path: Path,
+) -> None:
+    out = run_cli([*PLANTED, "--save-dir", "saved é x", "--format", "sarif"], cwd=tmp_path)
+    assert out.returncode == 1, out.stderr
+    (run,) = json.loads(out.stdout)["runs"]
+    (result,) = run["results"]
+    location = result["locations"][0]["physicalLocation"]["artifactLocation"]
+    assert location["uriBaseId"] == "SRCROOT"
+    assert location["uri"].startswith("saved%20%C3%A9%20x/explained-")
+    assert run["originalUriBaseIds"]["SRCROOT"]["uri"] == tmp_path.resolve().as_uri() + "/"
+    assert (tmp_path / unquote(location["uri"])).is_file()

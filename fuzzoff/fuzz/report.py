@@ -14,6 +14,7 @@ from typing import Any
 from fuzzoff import __version__
 from fuzzoff.fuzz.campaign import CampaignResult, PropertyResult
 from fuzzoff.report.sanitize import printable
+from fuzzoff.report.sarif import BASE_ID, artifact_uri
 
 SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
 
@@ -81,7 +82,8 @@ def to_junit(result: CampaignResult, saved: dict[str, Path]) -> str:
     return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
 
 
-def to_sarif(result: CampaignResult, saved: dict[str, Path]) -> str:
+def to_sarif(result: CampaignResult, saved: dict[str, Path], root: Path | None = None) -> str:
+    root = (root or Path.cwd()).resolve()
     rules = [
         {
             "id": f"fuzz/{r.name}",
@@ -105,8 +107,10 @@ def to_sarif(result: CampaignResult, saved: dict[str, Path]) -> str:
             },
         }
         if r.name in saved:
-            uri = saved[r.name].as_posix()
-            item["locations"] = [{"physicalLocation": {"artifactLocation": {"uri": uri}}}]
+            # As lint writes it: relative to the working folder (SRCROOT), percent-encoded.
+            uri, base = artifact_uri(str(saved[r.name]), root)
+            location = {"uri": uri, **({"uriBaseId": base} if base else {})}
+            item["locations"] = [{"physicalLocation": {"artifactLocation": location}}]
         results.append(item)
     doc = {
         "$schema": SCHEMA,
@@ -120,6 +124,7 @@ def to_sarif(result: CampaignResult, saved: dict[str, Path]) -> str:
                         "rules": rules,
                     }
                 },
+                "originalUriBaseIds": {BASE_ID: {"uri": root.as_uri() + "/"}},
                 "results": results,
             }
         ],
