@@ -10,6 +10,7 @@ import json
 import threading
 import xml.etree.ElementTree as ET
 from pathlib import Path
+from urllib.parse import unquote, urlparse
 
 import pytest
 
@@ -153,7 +154,8 @@ def test_fuzz_command_exits_1_and_saves_a_reproducer(tmp_path: Path) -> None:
     (result,) = sarif["runs"][0]["results"]
     assert result["ruleId"] == "fuzz/explained"
     uri = result["locations"][0]["physicalLocation"]["artifactLocation"]["uri"]
-    assert Path(uri).exists() and uri.endswith(".expected.json")
+    assert uri.startswith("file:///") and uri.endswith(".expected.json")
+    assert Path(unquote(urlparse(uri).path)).exists()
 
 
 def test_fuzz_rejects_bad_usage() -> None:

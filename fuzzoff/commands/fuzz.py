@@ -1,12 +1,15 @@
 """``fuzzoff fuzz``: a seeded fuzz campaign against the gate model and the rules (docs/fuzz.md).
 
 Exit status: 0 every property held, 1 a counterexample was found (saved as a reproducer under
-``--save-dir``), 2 usage error or an unreadable ``--from`` recording.
+``--save-dir``), 2 usage error, an unreadable ``--from`` recording, or a reproducer that could not
+be saved (the report still gives its counterexample).
 """
 
 from __future__ import annotations
 
 import argparse
+import math
+import os
 import sys
 from pathlib import Path
 from typing import Any
@@ -20,7 +23,8 @@ from fuzzoff.fuzz.properties import PROPERTIES
 from fuzzoff.fuzz.reproducers import DEFAULT_DIR, save
 from fuzzoff.fuzz.scenario import TRANSPORTS
 from fuzzoff.profiles import ProfileError, px4_profile_for, vehicle_type_for
-from fuzzoff.sources import SourceError
+from fuzzoff.report.sanitize import printable
+from fuzzoff.sources import SourceError, is_bag_folder
 
 
 def add_parser(sub: Any) -> None:
@@ -75,8 +79,8 @@ def _config(args: argparse.Namespace) -> CampaignConfig:
         raise ConfigError(str(exc)) from None
     if args.examples is not None and args.examples < 1:
         raise ConfigError("--examples must be at least 1")
-    if args.budget is not None and args.budget <= 0:
-        raise ConfigError("--budget must be positive")
+    if args.budget is not None and not (math.isfinite(args.budget) and args.budget > 0):
+        raise ConfigError(f"--budget {args.budget:g}: expected a finite number of seconds above 0")
     ns = argparse.Namespace(ignore=args.ignore)
     settings = settings_from_args(ns)
     examples = args.examples if args.examples is not None else (None if args.budget else 100)
@@ -92,12 +96,18 @@ def _config(args: argparse.Namespace) -> CampaignConfig:
         known=tuple(KNOWN) if args.known else (),
     )
     if args.from_:
-        from fuzzoff.fuzz.mutate import scenario_from_recording, sent_keepalives
+        from fuzzoff.fuzz.mutate import read_base, sent_keepalives
 
         config.properties = _from_properties(args.property)
+        path = Path(args.from_)
+        if path.is_dir() and not is_bag_folder(path):
+            raise ConfigError(
+                f"--from {args.from_}: a folder that is not a ROS 2 bag (no metadata.yaml); "
+                "--from takes one recording"
+            )
         try:
-            config.base = scenario_from_recording(
-                Path(args.from_), px4, vehicle, parse_params(args.param)
+            config.base, config.base_problems = read_base(
+                path, px4, vehicle, parse_params(args.param)
             )
         except SourceError as exc:
             raise ConfigError(exc.line()) from None
@@ -177,19 +187,68 @@ class _Progress:
 
 def run(args: argparse.Namespace) -> int:
     config = _config(args)
+    if not args.no_save:
+        check_save_dir(Path(args.save_dir))
     with _Progress(not args.quiet) as progress:
         result = run_campaign(config, progress.example, progress.done)
-    saved = {} if args.no_save else _save_all(result, Path(args.save_dir))
+    saved: dict[str, Path] = {}
+    save_error = None
+    if not args.no_save:
+        saved, save_error = _save_all(result, Path(args.save_dir))
     margins = []
     if config.base is not None:
         from fuzzoff.fuzz.mutate import margins as find_margins
 
         margins = find_margins(config.base)
     write_output(_render(args.format, result, saved, margins), args.output)
+    if save_error is not None:
+        print(f"error: {save_error}", file=sys.stderr)
+        return 2
+    if config.base_problems:
+        # As lint: the campaign ran on the part that could be read; the status says the rest.
+        for line in config.base_problems:
+            print(f"fuzzoff: {printable(line)}", file=sys.stderr)
+        return 2
+    if result.unchecked:
+        # Nothing was checked, so nothing held: not 0 (a CI job must not pass on it), and not
+        # 1 either (no counterexample): the budget given was too small to run anything.
+        budget = f"--budget {args.budget:g} s " if args.budget is not None else ""
+        names = ", ".join(result.unchecked)
+        print(f"error: {budget}ran no example of {names}: nothing was checked", file=sys.stderr)
+        return 2
     return 1 if result.failed else 0
 
 
-def _save_all(result: CampaignResult, directory: Path) -> dict[str, Path]:
+def check_save_dir(directory: Path) -> None:
+    """Refuse a ``--save-dir`` that cannot hold reproducers before the campaign runs, not after
+    it. The folders it lacks are made and removed again, so that the system says what is wrong
+    (a file on the way, a folder that cannot be written) and a campaign that finds nothing
+    leaves nothing behind."""
+    made: list[Path] = []
+    folder = directory
+    while not folder.is_dir() and folder != folder.parent:
+        if folder.exists() or folder.is_symlink():
+            raise ConfigError(f"--save-dir {directory}: {folder} is not a folder")
+        made.append(folder)
+        folder = folder.parent
+    try:
+        for missing in reversed(made):
+            missing.mkdir()
+        if not os.access(directory, os.W_OK | os.X_OK):
+            raise ConfigError(f"--save-dir {directory}: the folder cannot be written")
+    except OSError as exc:
+        raise ConfigError(
+            f"--save-dir {directory}: cannot create {exc.filename}: {exc.strerror or exc}"
+        ) from None
+    finally:
+        for missing in made:
+            if missing.is_dir():
+                missing.rmdir()
+
+
+def _save_all(result: CampaignResult, directory: Path) -> tuple[dict[str, Path], str | None]:
+    """The reproducers saved, by property, and why the rest could not be where ``directory``
+    failed (the counterexamples are still in the report)."""
     saved = {}
     for r in result.results:
         if r.failed and r.counterexample is not None:
@@ -204,7 +263,14 @@ def _save_all(result: CampaignResult, directory: Path) -> dict[str, Path]:
                 )
             except ValueError as exc:  # an event its transport's writer cannot carry
                 print(f"fuzzoff: the {r.name} counterexample was not saved: {exc}", file=sys.stderr)
-    return saved
+            except OSError as exc:
+                reason = exc.strerror or str(exc)
+                where = f" ({exc.filename})" if exc.filename else ""
+                return saved, (
+                    f"--save-dir {directory}: the {r.name} counterexample was not saved: "
+                    f"{reason}{where}; it is in the report"
+                )
+    return saved, None
 
 
 def _render(fmt: str, result: CampaignResult, saved: dict[str, Path], margins: list[Any]) -> str:

@@ -25,13 +25,25 @@ from fuzzoff.fuzz.reproducers import ReproducerError, load, recheck
 from fuzzoff.report.sanitize import printable
 
 TIME_TOLERANCE_S = 0.05
+MIN_SPEED, MAX_SPEED = 0.01, 100.0
+"""``--speed`` range: a reproducer of a minute takes at most 100 minutes; above 100x the gaps
+the gate reacts to (tens of milliseconds) are shorter than the sleep they are timed with."""
 
 
 def add_parser(sub: Any) -> None:
     parser = add_command(sub, "replay")
     parser.add_argument("path", metavar="REPRODUCER", help="NAME.expected.json or its recording")
-    parser.add_argument("--to", metavar="udp:HOST:PORT", help="stream the MAVLink packets there")
-    parser.add_argument("--speed", type=float, default=1.0, help="time scale for --to (2 = 2x)")
+    parser.add_argument(
+        "--to",
+        metavar="udp:HOST:PORT",
+        help="stream the MAVLink packets there (an IPv6 address in brackets: udp:[::1]:14540)",
+    )
+    parser.add_argument(
+        "--speed",
+        type=float,
+        default=1.0,
+        help=f"time scale for --to, from {MIN_SPEED:g} to {MAX_SPEED:g} (2 = twice as fast)",
+    )
     parser.add_argument("--format", choices=("terminal", "json"), default="terminal")
     parser.add_argument("--output", "-o", metavar="FILE")
     parser.set_defaults(run=run)
@@ -67,11 +79,14 @@ def compare(expected: list[dict[str, Any]], actual: list[dict[str, Any]]) -> lis
 
 
 def run(args: argparse.Namespace) -> int:
+    if not MIN_SPEED <= args.speed <= MAX_SPEED:  # NaN too
+        raise ConfigError(f"--speed {args.speed:g}: expected {MIN_SPEED:g} to {MAX_SPEED:g}")
     try:
-        spec, recording = load(Path(args.path))
+        reproducer = load(Path(args.path))
     except ReproducerError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    recording = reproducer.recording
     if not recording.exists():
         print(f"error: {recording}: the reproducer's recording is missing", file=sys.stderr)
         return 2
@@ -81,19 +96,11 @@ def run(args: argparse.Namespace) -> int:
     from fuzzoff.fuzz.reproducers import expected_findings
     from fuzzoff.fuzz.scenario import Scenario
 
-    info = spec.get("scenario") or {}
-    scenario = Scenario(
-        px4=str(info.get("px4", "1.15")),
-        vehicle=str(info.get("vehicle", "mc")),
-        transport=info.get("transport", "ros2"),
-        events=(),
-        params={str(k): float(v) for k, v in dict(info.get("params", {})).items()},
-    )
-    ignore = frozenset(str(c) for c in info.get("ignore", []))
-    report = lint_file(recording, scenario.settings(Settings(ignore=ignore)))
-    differ = compare(list(spec.get("findings", [])), expected_findings(report))
-    still = recheck(spec, recording)
-    prop = spec.get("property")
+    scenario = reproducer.scenario or Scenario("1.15", "mc", "ros2", events=())
+    report = lint_file(recording, scenario.settings(Settings(ignore=reproducer.ignore)))
+    differ = compare(reproducer.findings, expected_findings(report))
+    still = recheck(reproducer)
+    prop = reproducer.prop
     data = {
         "reproducer": str(args.path),
         "recording": str(recording),
@@ -119,14 +126,12 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _stream(recording: Path, args: argparse.Namespace) -> int:
-    from fuzzoff.fuzz.udp import TargetError, parse_target, sent_packets, stream
+    from fuzzoff.fuzz.udp import TargetError, sent_packets, stream, target_for
 
     try:
-        host, port = parse_target(args.to)
+        target = target_for(args.to)
     except TargetError as exc:
         raise ConfigError(str(exc)) from None
-    if args.speed <= 0:
-        raise ConfigError("--speed must be positive")
     if recording.suffix != ".tlog":
         raise ConfigError(f"{recording}: --to streams MAVLink: only a .tlog reproducer")
     try:
@@ -134,6 +139,10 @@ def _stream(recording: Path, args: argparse.Namespace) -> int:
     except (OSError, ValueError) as exc:
         print(f"error: {recording}: not a readable tlog: {exc}", file=sys.stderr)
         return 2
-    count = stream(packets, host, port, speed=args.speed)
-    print(f"sent {count} packets to {host}:{port} over {packets[-1].t if packets else 0:.2f} s")
+    try:
+        count = stream(packets, target, speed=args.speed)
+    except OSError as exc:
+        print(f"error: --to {args.to!r}: cannot send: {exc.strerror or exc}", file=sys.stderr)
+        return 2
+    print(f"sent {count} packets to {target} over {packets[-1].t if packets else 0:.2f} s")
     return 0

@@ -11,16 +11,19 @@ toward the loss timeout, the keep-alive before the switch toward the documented 
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import re
+import tempfile
 import time
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
 from hypothesis import HealthCheck, Phase, given, seed, settings, target
 from hypothesis import strategies as st
+from hypothesis.configuration import set_hypothesis_home_dir
 from hypothesis.errors import Found
 
 from fuzzoff.config import Settings
@@ -109,6 +112,9 @@ class CampaignConfig:
     for new ones; each one's count is in ``PropertyResult.known``."""
     base: Scenario | None = None
     """``--from``: mutate this scenario (a user's recording) instead of drawing new streams."""
+    base_problems: list[str] = field(default_factory=list)
+    """The parts of the ``--from`` recording that could not be read (``base`` is the part
+    before them), one line each as ``fuzzoff lint`` reports them."""
 
 
 def _targets(scenario: Scenario) -> None:
@@ -214,6 +220,11 @@ class CampaignResult:
         return sum(r.examples for r in self.results)
 
     @property
+    def unchecked(self) -> list[str]:
+        """The properties no example was checked on (a time budget spent before the first)."""
+        return [r.name for r in self.results if r.examples == 0]
+
+    @property
     def seconds(self) -> float:
         return sum(r.seconds for r in self.results)
 
@@ -237,12 +248,28 @@ def run_campaign(
     """Every selected property in turn, the time budget split evenly between them."""
     share = None if config.budget_s is None else config.budget_s / len(config.properties)
     results = []
-    for name in config.properties:
-        result = run_property(PROPERTIES[name], config, share, on_example)
-        results.append(result)
-        if on_property is not None:
-            on_property(result)
+    with _hypothesis_storage():
+        for name in config.properties:
+            result = run_property(PROPERTIES[name], config, share, on_example)
+            results.append(result)
+            if on_property is not None:
+                on_property(result)
     return CampaignResult(config, results)
+
+
+@contextlib.contextmanager
+def _hypothesis_storage() -> Iterator[None]:
+    """Hypothesis's storage directory in a temporary folder, removed afterwards. With the
+    example database off, Hypothesis still caches there what it reads from the source of local
+    modules (``.hypothesis/constants``) and its Unicode tables; by default that is
+    ``.hypothesis/`` in the working folder, where fuzzoff must write nothing. Afterwards the
+    default is back (``HYPOTHESIS_STORAGE_DIRECTORY``, else the working folder)."""
+    with tempfile.TemporaryDirectory(prefix="fuzzoff-hypothesis-") as folder:
+        set_hypothesis_home_dir(folder)
+        try:
+            yield
+        finally:
+            set_hypothesis_home_dir(None)
 
 
 def counts_total(results: list[PropertyResult]) -> Counter[str]:

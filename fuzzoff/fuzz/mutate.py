@@ -38,10 +38,18 @@ UNIT = {"stall": "s", "drop": "messages", "jitter": "s", "skew": "s"}
 def scenario_from_recording(
     path: Path, px4: str | None, vehicle: str | None, params: dict[str, float]
 ) -> Scenario:
+    """The recording's events as a scenario (see ``read_base``)."""
+    return read_base(path, px4, vehicle, params)[0]
+
+
+def read_base(
+    path: Path, px4: str | None, vehicle: str | None, params: dict[str, float]
+) -> tuple[Scenario, list[str]]:
     """The recording's events as a scenario (transport from its events; profile as given, else
-    as the recording says, else PX4 1.15 multicopter like ``fuzzoff lint``). ``SourceError``
-    when the recording cannot be read."""
-    events, info = read_with_info(path)
+    as the recording says, else PX4 1.15 multicopter like ``fuzzoff lint``), and the parts of
+    the recording that could not be read (the scenario is what came before them), one line
+    each. ``SourceError`` when the recording cannot be read at all."""
+    events, info, problems = read_with_info(path)
     if px4 is None:
         try:
             px4 = px4_profile_for(info.px4_version) if info.px4_version else DEFAULT_PX4
@@ -57,9 +65,10 @@ def scenario_from_recording(
     # ``apply`` leaves every perturbed copy): a recording has events at one instant (a
     # HEARTBEAT gives a status and the vehicle's identity), and were only the copies settled,
     # a perturbation of size 0 would already move them, and so the outcome the margin measures.
-    return Scenario(
+    scenario = Scenario(
         px4=px4, vehicle=vehicle, transport=transport, events=tuple(settle(events)), params=params
     )
+    return scenario, problems
 
 
 def sent_keepalives(scenario: Scenario) -> int:

@@ -13,7 +13,7 @@ from pathlib import Path
 from fuzzoff.events import Event
 from fuzzoff.fuzz.scenario import Scenario
 from fuzzoff.sources import open_source
-from fuzzoff.sources.base import RecordingInfo
+from fuzzoff.sources.base import RecordingInfo, path_text
 from fuzzoff.sources.px4_msgs import release_for
 
 FORMATS_FOR: dict[str, tuple[str, ...]] = {
@@ -57,12 +57,15 @@ def read(path: Path) -> list[Event]:
     return read_with_info(path)[0]
 
 
-def read_with_info(path: Path) -> tuple[list[Event], RecordingInfo]:
-    """The events and what the reader says about the recording (PX4 version, vehicle type)."""
+def read_with_info(path: Path) -> tuple[list[Event], RecordingInfo, list[str]]:
+    """The events, what the reader says about the recording (PX4 version, vehicle type) and
+    the parts it could not read, one line each as ``fuzzoff lint`` gives them (the events are
+    those before the first such part)."""
     source = open_source(path)
     source.open()
     try:
         info = source.probe()
-        return list(source.events()), info
+        events = list(source.events())
     finally:
         source.close()
+    return events, info, [problem.line(path_text(path)) for problem in source.problems]

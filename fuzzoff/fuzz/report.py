@@ -14,6 +14,7 @@ from typing import Any
 from fuzzoff import __version__
 from fuzzoff.fuzz.campaign import CampaignResult, PropertyResult
 from fuzzoff.report.sanitize import printable
+from fuzzoff.report.sarif import BASE_ID, artifact_uri
 
 SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
 
@@ -31,8 +32,10 @@ def to_json(result: CampaignResult, saved: dict[str, Path], margins: list[Any]) 
             "examples": cfg.examples,
             "budget_s": cfg.budget_s,
             "from": None if cfg.base is None else cfg.base.describe(),
+            "from_problems": cfg.base_problems,
         },
         "failed": result.failed,
+        "unchecked": result.unchecked,
         "examples": result.examples,
         "seconds": round(result.seconds, 3),
         "properties": [],
@@ -54,7 +57,7 @@ def to_junit(result: CampaignResult, saved: dict[str, Path]) -> str:
         tests=str(len(result.results)),
         failures=str(failures),
         errors="0",
-        skipped="0",
+        skipped=str(len(result.unchecked)),
         time=f"{result.seconds:.3f}",
     )
     for r in result.results:
@@ -69,6 +72,8 @@ def to_junit(result: CampaignResult, saved: dict[str, Path]) -> str:
                 text += f"\nreproducer: {saved[r.name]}"
             failure = ET.SubElement(case, "failure", message=printable(r.problems[0], 300))
             failure.text = text
+        elif r.examples == 0:
+            ET.SubElement(case, "skipped", message="no example ran within the time budget")
         out = ET.SubElement(case, "system-out")
         out.text = f"{r.claim}: {r.examples} examples in {r.seconds:.2f} s"
     root = ET.Element("testsuites")
@@ -77,7 +82,8 @@ def to_junit(result: CampaignResult, saved: dict[str, Path]) -> str:
     return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
 
 
-def to_sarif(result: CampaignResult, saved: dict[str, Path]) -> str:
+def to_sarif(result: CampaignResult, saved: dict[str, Path], root: Path | None = None) -> str:
+    root = (root or Path.cwd()).resolve()
     rules = [
         {
             "id": f"fuzz/{r.name}",
@@ -101,8 +107,10 @@ def to_sarif(result: CampaignResult, saved: dict[str, Path]) -> str:
             },
         }
         if r.name in saved:
-            uri = saved[r.name].as_posix()
-            item["locations"] = [{"physicalLocation": {"artifactLocation": {"uri": uri}}}]
+            # As lint writes it: relative to the working folder (SRCROOT), percent-encoded.
+            uri, base = artifact_uri(str(saved[r.name]), root)
+            location = {"uri": uri, **({"uriBaseId": base} if base else {})}
+            item["locations"] = [{"physicalLocation": {"artifactLocation": location}}]
         results.append(item)
     doc = {
         "$schema": SCHEMA,
@@ -116,6 +124,7 @@ def to_sarif(result: CampaignResult, saved: dict[str, Path]) -> str:
                         "rules": rules,
                     }
                 },
+                "originalUriBaseIds": {BASE_ID: {"uri": root.as_uri() + "/"}},
                 "results": results,
             }
         ],
@@ -126,11 +135,15 @@ def to_sarif(result: CampaignResult, saved: dict[str, Path]) -> str:
 def _line(r: PropertyResult) -> str:
     rate = f"{r.examples / r.seconds:.0f}/s" if r.seconds else "-"
     verdict = "FAILED" if r.failed else ("counted" if r.name == "docs-stricter" else "held")
+    if not r.examples:
+        verdict = "not run"
     return f"  {r.name:<14} {verdict:<8} {r.examples:>6} examples {r.seconds:7.2f} s {rate:>7}"
 
 
 def to_terminal(result: CampaignResult, saved: dict[str, Path], margins: list[Any]) -> str:
     lines = [f"fuzzoff fuzz, seed {result.config.seed}"]
+    for problem in result.config.base_problems:
+        lines.append(f"  --from incomplete, the part before this was fuzzed: {printable(problem)}")
     for r in result.results:
         lines.append(_line(r))
         for p in r.problems:
@@ -150,9 +163,13 @@ def to_terminal(result: CampaignResult, saved: dict[str, Path], margins: list[An
             lines.append(f"  margin {m.family:<7} none up to the largest size tried")
         else:
             lines.append(f"  margin {m.family:<7} {p.describe()} changes the gate's outcome")
-    failed = sum(1 for r in result.results if r.failed)
-    lines.append(
-        f"{result.examples} examples in {result.seconds:.1f} s; "
-        + (f"{failed} propert{'y' if failed == 1 else 'ies'} failed" if failed else "all held")
-    )
+    lines.append(f"{result.examples} examples in {result.seconds:.1f} s; {_verdict(result)}")
     return "\n".join(lines) + "\n"
+
+
+def _verdict(result: CampaignResult) -> str:
+    failed = sum(1 for r in result.results if r.failed)
+    verdicts = [f"{failed} propert{'y' if failed == 1 else 'ies'} failed"] if failed else []
+    if result.unchecked:
+        verdicts.append(f"no example of {', '.join(result.unchecked)} ran")
+    return "; ".join(verdicts) or "all held"

@@ -17,15 +17,25 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from fuzzoff.catalog import expand_selectors
 from fuzzoff.config import Settings
 from fuzzoff.engine import lint_file
-from fuzzoff.findings import FileReport
+from fuzzoff.findings import FileReport, Severity
 from fuzzoff.fuzz import recordings
 from fuzzoff.fuzz.properties import PROPERTIES, FuzzContext
-from fuzzoff.fuzz.scenario import RECORDING_FORMAT, Scenario
+from fuzzoff.fuzz.scenario import RECORDING_FORMAT, TRANSPORTS, Scenario
+from fuzzoff.profiles import (
+    DEFAULT_PX4,
+    DEFAULT_VEHICLE,
+    ProfileError,
+    px4_profile_for,
+    vehicle_type_for,
+)
 
 DEFAULT_DIR = Path("corpora/fuzz")
 
@@ -98,8 +108,25 @@ class ReproducerError(ValueError):
     """The file is not a reproducer (one line naming the file and what is wrong)."""
 
 
-def load(path: Path) -> tuple[dict[str, Any], Path]:
-    """(the expected.json contents, the recording's path) for a reproducer given by either."""
+@dataclass(frozen=True, slots=True)
+class Reproducer:
+    """A reproducer as ``load`` checked it: every field replay uses has its type and value."""
+
+    path: Path
+    """The ``expected.json``."""
+    recording: Path
+    findings: list[dict[str, Any]]
+    prop: str | None
+    """The property it broke (None: only its findings are checked)."""
+    scenario: Scenario | None
+    """Profile, transport and parameters, without events (None when the file has none)."""
+    ignore: frozenset[str]
+    cut_fraction: float | None
+
+
+def load(path: Path) -> Reproducer:
+    """The reproducer given by its ``expected.json`` or its recording, checked field by field
+    (``ReproducerError`` naming the file and the first bad field)."""
     if not path.name.endswith(".expected.json"):
         stem = path.name[: -len(path.suffix)] if path.suffix else path.name
         path = path.parent / f"{stem}.expected.json"
@@ -107,32 +134,128 @@ def load(path: Path) -> tuple[dict[str, Any], Path]:
             raise ReproducerError(f"{path}: no such file beside the recording")
     try:
         spec = json.loads(path.read_text())
-    except (OSError, json.JSONDecodeError) as exc:
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise ReproducerError(f"{path}: not a readable reproducer: {exc}") from None
     if not isinstance(spec, dict) or "recording" not in spec:
         raise ReproducerError(f"{path}: no 'recording' key")
-    return spec, path.parent / str(spec["recording"])
+    try:
+        return _checked(path, spec)
+    except _Bad as bad:
+        raise ReproducerError(f"{path}: {bad.field}: {bad.problem}") from None
 
 
-def recheck(spec: dict[str, Any], recording: Path) -> list[str]:
+class _Bad(Exception):
+    def __init__(self, field: str, problem: str) -> None:
+        super().__init__(field, problem)
+        self.field = field
+        self.problem = problem
+
+
+def _checked(path: Path, spec: dict[str, Any]) -> Reproducer:
+    recording = spec["recording"]
+    if not isinstance(recording, str) or not recording:
+        raise _Bad("recording", f"{recording!r} is not a file name")
+    prop = spec.get("property")
+    if prop is not None and prop not in PROPERTIES:
+        raise _Bad("property", f"unknown property {prop!r}: one of {', '.join(PROPERTIES)}")
+    info = spec.get("scenario")
+    if info is not None and not isinstance(info, dict):
+        raise _Bad("scenario", "expected an object (px4, vehicle, transport, params, ignore)")
+    if prop is not None and not info:
+        raise _Bad("scenario", f"missing: property {prop} cannot be checked again without it")
+    cut = spec.get("cut_fraction")
+    if cut is not None and not (_is_number(cut) and 0.0 <= cut <= 1.0):
+        raise _Bad("cut_fraction", f"{cut!r} is not a number from 0 to 1")
+    return Reproducer(
+        path=path,
+        recording=path.parent / recording,
+        findings=_findings(spec.get("findings", [])),
+        prop=prop,
+        scenario=None if not info else _scenario(info),
+        ignore=_ignore(info.get("ignore", []) if info else []),
+        cut_fraction=None if cut is None else float(cut),
+    )
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def _text(value: Any, field: str) -> str:
+    if not isinstance(value, str):
+        raise _Bad(field, f"{value!r} is not text")
+    return value
+
+
+def _findings(value: Any) -> list[dict[str, Any]]:
+    if not isinstance(value, list):
+        raise _Bad("findings", "expected a list of findings")
+    for i, finding in enumerate(value):
+        field = f"findings[{i}]"
+        if not isinstance(finding, dict):
+            raise _Bad(field, "expected an object (code, severity, time_s)")
+        for key in ("code", "severity"):
+            if key not in finding:
+                raise _Bad(field, f"no {key!r}")
+        _text(finding["code"], f"{field}.code")
+        try:
+            Severity.parse(_text(finding["severity"], f"{field}.severity"))
+        except ValueError as exc:
+            raise _Bad(f"{field}.severity", str(exc)) from None
+        time_s = finding.get("time_s")
+        if time_s is not None and not _is_number(time_s):
+            raise _Bad(f"{field}.time_s", f"{time_s!r} is not a number or null")
+        if "vehicle" in finding:
+            _text(finding["vehicle"], f"{field}.vehicle")
+    return value
+
+
+def _scenario(info: dict[str, Any]) -> Scenario:
+    """The scenario's profile as ``--px4``/``--vehicle`` would take it (``1.15.4`` is 1.15)."""
+    try:
+        px4 = px4_profile_for(_text(info.get("px4", DEFAULT_PX4), "scenario.px4"))
+    except ProfileError as exc:
+        raise _Bad("scenario.px4", str(exc)) from None
+    try:
+        vehicle = vehicle_type_for(_text(info.get("vehicle", DEFAULT_VEHICLE), "scenario.vehicle"))
+    except ProfileError as exc:
+        raise _Bad("scenario.vehicle", str(exc)) from None
+    transport = info.get("transport", "ros2")
+    if transport not in TRANSPORTS:
+        raise _Bad("scenario.transport", f"{transport!r} is not one of {', '.join(TRANSPORTS)}")
+    params = info.get("params", {})
+    if not isinstance(params, dict):
+        raise _Bad("scenario.params", "expected an object of NAME: number")
+    for name, value in params.items():
+        if not _is_number(value):
+            raise _Bad(f"scenario.params.{name}", f"{value!r} is not a finite number")
+    numbers = {str(k): float(v) for k, v in params.items()}
+    return Scenario(px4=px4, vehicle=vehicle, transport=transport, events=(), params=numbers)
+
+
+def _ignore(value: Any) -> frozenset[str]:
+    if not isinstance(value, list) or not all(isinstance(c, str) for c in value):
+        raise _Bad("scenario.ignore", f"{value!r} is not a list of rule codes")
+    try:
+        return frozenset(expand_selectors(value))
+    except ValueError as exc:
+        raise _Bad("scenario.ignore", str(exc)) from None
+
+
+def recheck(reproducer: Reproducer) -> list[str]:
     """Run the reproducer's property again on the recording's events: [] = it holds now."""
     from fuzzoff.fuzz.mutate import scenario_from_recording
 
-    prop = spec.get("property")
-    info = spec.get("scenario") or {}
-    if prop not in PROPERTIES or not info:
+    if reproducer.prop is None or reproducer.scenario is None:
         return []
+    info = reproducer.scenario
     scenario = scenario_from_recording(
-        recording,
-        str(info["px4"]),
-        str(info["vehicle"]),
-        {str(k): float(v) for k, v in dict(info.get("params", {})).items()},
+        reproducer.recording, info.px4, info.vehicle, dict(info.params)
     )
-    ignore = frozenset(info.get("ignore", []))
-    ctx = FuzzContext(settings=Settings(ignore=ignore), recorded_answers=True)
+    ctx = FuzzContext(settings=Settings(ignore=reproducer.ignore), recorded_answers=True)
     try:
-        if "cut_fraction" in spec:
-            ctx.cut_fraction = float(spec["cut_fraction"])
-        return PROPERTIES[str(prop)].check(scenario, ctx)
+        if reproducer.cut_fraction is not None:
+            ctx.cut_fraction = reproducer.cut_fraction
+        return PROPERTIES[reproducer.prop].check(scenario, ctx)
     finally:
         ctx.close()

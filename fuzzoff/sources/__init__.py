@@ -80,6 +80,12 @@ def _detect_bag_folder(path: Path) -> str:
 _BAG_PART = re.compile(r"^(?P<stem>.+)_(?P<n>\d+)\.(?:db3|mcap)$")
 
 
+def is_bag_folder(path: Path) -> bool:
+    """A folder that is one ROS 2 bag (with its metadata.yaml, or a bag whose recorder
+    crashed before writing it), not a folder of recordings to search."""
+    return (path / "metadata.yaml").is_file() or _is_bag_without_metadata(path)
+
+
 def _is_bag_without_metadata(path: Path) -> bool:
     """A rosbag2 folder whose metadata.yaml was never written (the recorder crashed): rosbag2
     names its data files ``<folder>_<n>.db3|mcap``. Such a folder is one bag, not one
@@ -181,7 +187,7 @@ def _children_to_search(folder: Path, found: list[Path]) -> list[Path] | None:
     """The folder's children in name order, or None when the folder is a recording itself (a
     bag folder) or cannot be listed: then it goes to ``found``, and linting it says why."""
     try:
-        if (folder / "metadata.yaml").is_file() or _is_bag_without_metadata(folder):
+        if is_bag_folder(folder):
             found.append(folder)
             return None
         return sorted(c for c in folder.iterdir() if not c.name.startswith("."))
@@ -198,6 +204,7 @@ __all__ = [
     "SourceProblem",
     "detect_format",
     "find_recordings",
+    "is_bag_folder",
     "open_source",
     "recordings_in",
 ]
