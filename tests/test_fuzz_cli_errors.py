@@ -229,3 +229,15 @@ def test_fuzz_sarif_locates_a_reproducer_with_a_percent_encoded_uri_as_lint_does
     assert location["uri"].startswith("saved%20%C3%A9%20x/explained-")
     assert run["originalUriBaseIds"]["SRCROOT"]["uri"] == tmp_path.resolve().as_uri() + "/"
     assert (tmp_path / unquote(location["uri"])).is_file()
+
+
+@pytest.mark.parametrize("content", [b"", b"%PDF-1.4 not a recording\n" * 40])
+def test_replay_of_a_reproducer_whose_recording_is_not_readable_is_one_line(
+    tmp_path: Path, content: bytes
+) -> None:
+    path = _reproducer(tmp_path, lambda spec: None)
+    recording = tmp_path / json.loads(path.read_text())["recording"]
+    recording.write_bytes(content)
+    out = run_cli(["replay", str(path)])
+    assert out.returncode == 2
+    assert _one_error_line(out.stderr).startswith(f"fuzzoff: {recording}: ")

@@ -23,6 +23,7 @@ from fuzzoff.commands._common import write_output
 from fuzzoff.config import ConfigError, Settings
 from fuzzoff.fuzz.reproducers import ReproducerError, load, recheck
 from fuzzoff.report.sanitize import printable
+from fuzzoff.sources.base import SourceError
 
 TIME_TOLERANCE_S = 0.05
 MIN_SPEED, MAX_SPEED = 0.01, 100.0
@@ -99,7 +100,11 @@ def run(args: argparse.Namespace) -> int:
     scenario = reproducer.scenario or Scenario("1.15", "mc", "ros2", events=())
     report = lint_file(recording, scenario.settings(Settings(ignore=reproducer.ignore)))
     differ = compare(reproducer.findings, expected_findings(report))
-    still = recheck(reproducer)
+    try:
+        still = recheck(reproducer)
+    except SourceError as exc:  # the recording is not one fuzzoff can read (empty, foreign)
+        print(f"fuzzoff: {printable(exc.line())}", file=sys.stderr)
+        return 2
     prop = reproducer.prop
     data = {
         "reproducer": str(args.path),
