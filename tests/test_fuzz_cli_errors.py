@@ -107,8 +107,8 @@ REPRODUCER = CORPORA / "fuzz" / "explained-1.15-mc-ros2-24600598.expected.json"
 def _reproducer(tmp_path: Path, change: Callable[[dict[str, Any]], None]) -> Path:
     """A copy of a committed reproducer with one field changed."""
     spec = json.loads(REPRODUCER.read_text())
-    change(spec)
     shutil.copy(REPRODUCER.parent / spec["recording"], tmp_path)
+    change(spec)
     path = tmp_path / REPRODUCER.name
     path.write_text(json.dumps(spec))
     return path
@@ -142,6 +142,8 @@ def _drop_severity(spec: dict[str, Any]) -> None:
         (_set("findings", value=[{"code": "OFB101", "severity": "fatal"}]), "findings[0].severity"),
         (_set("property", value="nope"), "property"),
         (_set("cut_fraction", value="half"), "cut_fraction"),
+        (_set("recording", value="../../etc/passwd"), "recording"),
+        (_set("recording", value="/etc/passwd"), "recording"),
     ],
 )
 def test_replay_of_a_malformed_reproducer_names_the_file_and_the_field(

@@ -153,8 +153,9 @@ class _Bad(Exception):
 
 def _checked(path: Path, spec: dict[str, Any]) -> Reproducer:
     recording = spec["recording"]
-    if not isinstance(recording, str) or not recording:
-        raise _Bad("recording", f"{recording!r} is not a file name")
+    if not isinstance(recording, str) or not recording or Path(recording).name != recording:
+        # beside the JSON file, as saved: a path could make replay read or send any file
+        raise _Bad("recording", f"{recording!r} is not a file name beside the reproducer")
     prop = spec.get("property")
     if prop is not None and prop not in PROPERTIES:
         raise _Bad("property", f"unknown property {prop!r}: one of {', '.join(PROPERTIES)}")
