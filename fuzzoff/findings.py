@@ -85,7 +85,7 @@ class FileReport:
             "profile": {
                 "px4": self.profile.px4,
                 "vehicle": self.profile.vehicle,
-                "detected": self.profile.px4_source == self.profile.vehicle_source == "recording",
+                "detected": self.profile.detected,
                 "px4_detected": self.profile.px4_source == "recording",
                 "vehicle_detected": self.profile.vehicle_source == "recording",
                 "px4_source": self.profile.px4_source,

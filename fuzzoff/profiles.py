@@ -122,7 +122,8 @@ class Profile:
 
     @property
     def detected(self) -> bool:
-        return self.px4_detected and self.vehicle_detected
+        """Both halves read from the recording (not set by the user, not assumed)."""
+        return self.px4_source == self.vehicle_source == "recording"
 
     @property
     def px4_source(self) -> str:
@@ -142,10 +143,11 @@ class Profile:
 
     def describe(self) -> str:
         px4 = f"PX4 {self.px4}"
-        if self.px4_release and px4_profile_for(self.px4_release) == self.px4:
+        named = px4_profile_for(self.px4_release) if self.px4_release else None
+        if named == self.px4:
             px4 += f" ({self.px4_release})"
         px4 += f" {SOURCE_WORDS[self.px4_source]}"
-        if self.px4_forced and self.px4_release and px4_profile_for(self.px4_release) != self.px4:
+        if self.px4_forced and named not in (None, self.px4):
             px4 += f" (the recording says {self.px4_release})"
         return f"{px4}, {self.vehicle} {SOURCE_WORDS[self.vehicle_source]}"
 

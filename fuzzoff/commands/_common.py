@@ -79,21 +79,25 @@ def settings_from_args(args: argparse.Namespace) -> Settings:
     return load_settings(Path.cwd(), overrides)
 
 
-def existing_paths(paths: list[str]) -> list[str]:
-    """The paths as given, after checking each names something: an empty one (an unset shell
-    variable) would otherwise mean the current folder."""
+def existing_paths(paths: list[str]) -> None:
+    """Check each path names something: an empty one (an unset shell variable) would otherwise
+    mean the current folder."""
     for p in paths:
         if not p or not Path(p).exists():
             raise ConfigError(f"no such file or folder: {p or repr(p)}")
-    return paths
+
+
+def _output_file(output: str | None) -> Path | None:
+    """The file ``--output`` names; None for standard output (not given, or ``-``)."""
+    return None if output is None or output == "-" else Path(output)
 
 
 def check_output(output: str | None, inputs: list[str]) -> None:
     """Refuse, before any work, an ``--output`` that is a folder or one of the recordings read
     (the report would replace the flight log)."""
-    if output is None or output == "-":
+    path = _output_file(output)
+    if path is None:
         return
-    path = Path(output)
     if path.is_dir():
         raise ConfigError(f"--output {output} is a folder: name a file")
     if path.exists() and any(path.samefile(p) for p in inputs if Path(p).exists()):
@@ -102,10 +106,10 @@ def check_output(output: str | None, inputs: list[str]) -> None:
 
 def write_output(text: str, output: str | None) -> None:
     """The report to ``output`` (parents created), or to standard output for None or ``-``."""
-    if output is None or output == "-":
+    path = _output_file(output)
+    if path is None:
         write_stdout(text)
         return
-    path = Path(output)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(text, encoding="utf-8")
@@ -136,7 +140,7 @@ def render_rich(draw: Callable[[Console], None], output: str | None = None) -> N
     from rich.console import Console
 
     buffer = io.StringIO()
-    if output is None or output == "-":
+    if _output_file(output) is None:
         screen = Console(highlight=False)
         console = Console(
             file=buffer,

@@ -14,15 +14,11 @@ import xml.etree.ElementTree as ET
 from fuzzoff.catalog import Rule, load_catalog
 from fuzzoff.config import Settings
 from fuzzoff.findings import FileReport, Finding, Report
-from fuzzoff.report.sanitize import printable
+from fuzzoff.report.sanitize import CI_TEXT_LIMIT, printable
 
 _NOT_XML = re.compile("[^\t\n\r\x20-\x7e\xa0-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
 _NOT_CHECKABLE = re.compile(r"^(OFB\d{3}) \(")
 """The code at the start of an OFB002 message (engine.run_events writes ``CODE (name) ...``)."""
-
-
-TEXT_LIMIT = 2000
-"""Longest finding text in a CI view (JUnit, SARIF): a recording can make a message any length."""
 
 
 def xml_text(text: str) -> str:
@@ -37,7 +33,7 @@ def finding_line(finding: Finding) -> str:
         parts.append(f"vehicle {finding.vehicle!r}")
     if finding.where is not None and finding.where.topic:
         parts.append(f"at {finding.where}")
-    return xml_text(printable(" | ".join(parts), TEXT_LIMIT))
+    return xml_text(printable(" | ".join(parts), CI_TEXT_LIMIT))
 
 
 def not_checkable(file: FileReport) -> dict[str, str]:

@@ -21,8 +21,7 @@ from fuzzoff import __version__
 from fuzzoff.catalog import Rule, load_catalog, render_page
 from fuzzoff.config import Settings
 from fuzzoff.findings import Finding, Report, Severity
-from fuzzoff.report.junit import TEXT_LIMIT
-from fuzzoff.report.sanitize import printable
+from fuzzoff.report.sanitize import CI_TEXT_LIMIT, printable
 
 SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
 INFORMATION_URI = "https://fuzzoff.dev"
@@ -87,7 +86,7 @@ def message_text(finding: Finding) -> str:
         where.append(f"on {finding.where}")
     suffix = f" ({', '.join(where)})" if where else " (whole recording)"
     # one line, no bidi overrides, bounded: CI views show it as the recording wrote it
-    return printable(finding.message + suffix, TEXT_LIMIT)
+    return printable(finding.message + suffix, CI_TEXT_LIMIT)
 
 
 def region(finding: Finding) -> dict[str, int]:
