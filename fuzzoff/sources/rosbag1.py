@@ -167,7 +167,7 @@ class Rosbag1Source(Source):
                 yield conn, timestamp, raw
             return
         except Exception as exc:  # rosbags ReaderError, asserts, codec errors
-            detail = str(exc).rstrip(".") if isinstance(exc, ReaderError) else type(exc).__name__
+            detail = _failure(exc)
         salvage = SalvageReader(self.path)
         same = {(c.topic, c.msgtype): c for c in self._wanted}
         resumed = 0
@@ -258,7 +258,7 @@ class Rosbag1Source(Source):
                 if event is not None:
                     yield event
         except Exception as exc:  # rosbags ReaderError, asserts, codec errors on corrupt chunks
-            detail = str(exc).rstrip(".") if isinstance(exc, ReaderError) else type(exc).__name__
+            detail = _failure(exc)
             where = f"{last[0].topic} #{last[1]}" if last is not None else None
             t_last = last[2] if last is not None else None
             after = "after the message" if last is not None else "before the first message"
@@ -270,6 +270,12 @@ class Rosbag1Source(Source):
                 SourceProblem(first_bad.what + more, first_bad.where, first_bad.time_s)
             )
         self.stats["messages_decoded"] = self._done
+
+
+def _failure(exc: Exception) -> str:
+    """What stopped a read, in a few words: rosbags' own message, else the exception's type
+    (an assert or a codec error says nothing a user can act on)."""
+    return str(exc).rstrip(".") if isinstance(exc, ReaderError) else type(exc).__name__
 
 
 def _decoder(store: Any, msgtype: str) -> Callable[[bytes], Any]:
