@@ -356,19 +356,57 @@ def test_many_corrupt_regions_give_bounded_lines(good: Path) -> None:
     assert source.problems[-1].what == "15 more unreadable parts not listed"
 
 
-def test_unknown_message_ids_are_counted_and_reported(good: Path) -> None:
-    # a well-framed MAVLink 2 packet whose id (42424) the common dialect does not define
-    packet = bytes([0xFD, 2, 0, 0, 0, 1, 1, 0xB8, 0xA5, 0x00, 7, 7, 0xAA, 0xBB])
+def _unknown_record(payload_len: int, declared_len: int | None = None) -> bytes:
+    """A MAVLink 2 packet of id 42424, which no dialect defines, with any CRC (none to check)."""
+    declared = payload_len if declared_len is None else declared_len
+    header = bytes([0xFD, declared, 0, 0, 0, 1, 1, 0xB8, 0xA5, 0x00])
+    packet = header + bytes(range(7, 7 + payload_len)) + b"\xaa\xbb"
+    return struct.pack(">Q", DEFAULT_START_US + 250_000) + packet
+
+
+def test_unknown_message_ids_are_ordinary_traffic(good: Path) -> None:
+    # PX4 sends ids newer than pymavlink's dialect (8, 380, 410, 411): counted, not a problem
     data = good.read_bytes()
     offsets = _records(good)
-    record = struct.pack(">Q", DEFAULT_START_US + 250_000) + packet
     bad = good.with_name("unknown.tlog")
-    bad.write_bytes(data[: offsets[3]] + record + data[offsets[3] :])
+    bad.write_bytes(data[: offsets[3]] + _unknown_record(2) + data[offsets[3] :])
     source, events = read(bad)
     assert len(events) == len(offsets)
+    assert source.problems == []
     assert source.stats["unknown"] == {"UNKNOWN_42424": 1}
+    assert source.stats["messages"]["UNKNOWN_42424"] == 1
+    code, report, _ = _lint(bad)
+    assert code == 0 and report["complete"] is True
+
+
+@pytest.mark.parametrize("declared", [0, 1, 5, 40])
+def test_an_unknown_id_whose_length_misses_the_next_record_is_corrupt(
+    good: Path, declared: int
+) -> None:
+    # no CRC to check it with: its framing must hold, or the bytes are reported as corrupt
+    data = good.read_bytes()
+    offsets = _records(good)
+    bad = good.with_name("badlength.tlog")
+    bad.write_bytes(data[: offsets[3]] + _unknown_record(2, declared) + data[offsets[3] :])
+    source, events = read(bad)
+    assert source.stats["bad_data"] == 1
     (problem,) = source.problems
-    assert "42424" in problem.what and problem.where == f"byte {offsets[3]}"
+    assert "corrupt data (bad length)" in problem.what
+    assert problem.where is not None and problem.where.startswith(f"bytes {offsets[3]}-")
+    assert len(events) == len(offsets) - 1 or len(events) == len(offsets)
+    assert "UNKNOWN_42424" not in source.stats["unknown"]
+
+
+def test_an_unknown_id_at_the_end_must_end_the_file(good: Path) -> None:
+    data = good.read_bytes()
+    ends_well = good.with_name("ends.tlog")
+    ends_well.write_bytes(data + _unknown_record(2))
+    source, _ = read(ends_well)
+    assert source.problems == [] and source.stats["unknown"] == {"UNKNOWN_42424": 1}
+    overlong = good.with_name("overlong.tlog")
+    overlong.write_bytes(data + _unknown_record(2) + b"\x00\x01\x02")
+    source, _ = read(overlong)
+    assert source.problems and "UNKNOWN_42424" not in source.stats["unknown"]
 
 
 def test_unreadable_files_raise_one_clear_error(tmp_path: Path) -> None:

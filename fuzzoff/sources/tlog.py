@@ -112,7 +112,8 @@ def _text(raw: Any) -> str:
 
 
 class TlogSource(Source):
-    """A .tlog read with pymavlink (dialect ``common``), one sequential pass per call."""
+    """A .tlog read with pymavlink (dialect ``development``, PX4's), one sequential pass per
+    call. Packets of ids the dialect does not know are ordinary traffic, counted in the stats."""
 
     format = "tlog"
 
@@ -238,20 +239,6 @@ class TlogSource(Source):
                     f"bytes {region.start}-{region.end}",
                     t_of(region.ts_us),
                 )
-            )
-        for msgid, count in sorted(stats.unknown.items()):
-            offset, ts = stats.unknown_first[msgid]
-            lines.append(
-                SourceProblem(
-                    f"{count} packet(s) of message id {msgid} (UNKNOWN_{msgid}) unknown to "
-                    "the MAVLink common dialect, not read",
-                    f"byte {offset}",
-                    t_of(ts),
-                )
-            )
-        if stats.unknown_other:
-            lines.append(
-                SourceProblem(f"{stats.unknown_other} more packets of unknown message ids")
             )
         if len(lines) > MAX_PROBLEM_LINES:
             rest = lines[MAX_PROBLEM_LINES:]
@@ -388,7 +375,7 @@ class _Decoder:
     def _attitude(self, m: Any, t: float, where: Where) -> Iterable[Event]:
         if self._from_autopilot(m):
             return self._ignore(m, "from the autopilot")
-        thrust_body = getattr(m, "thrust_body", None)  # not in pymavlink 2.4.50's common
+        thrust_body = getattr(m, "thrust_body", None)  # not in pymavlink 2.4.50's dialects
         return [
             SetAttitudeTarget(
                 t=t,

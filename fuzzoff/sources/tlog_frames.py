@@ -22,6 +22,16 @@ CRC_EXTRA, payload unpacking) and every other known packet only has its CRC chec
 pymavlink's ``x25crc``, so corruption anywhere is still found. After a bad record the reader
 resynchronises on the next record whose timestamp is plausible and whose CRC is good, and
 reports the skipped bytes as one corrupt region.
+
+The dialect is pymavlink's ``development``: PX4 is built with MAVLink's development dialect
+(``common`` plus the messages still being standardised), and every PX4 release here sends some
+of them (CURRENT_MODE 436, GNSS_INTEGRITY 441) on every link. Not ``all``: it adds ArduPilot's
+and other vendors' dialects, which give the dialect id range (150-229 and beyond) meanings PX4
+never uses, so a vendor packet there would be CRC-checked against a foreign CRC_EXTRA and
+called corrupt, or decoded with a foreign meaning. A packet whose id the dialect does not know
+(PX4 also sends ids newer than pymavlink's copy of the dialect: 8, 380, 410, 411 in 1.14-1.18)
+is ordinary traffic: it has no CRC_EXTRA to check it with, so it is accepted when its framing
+holds (its length leads to the next record's start byte, or to the end of the file) and counted.
 """
 
 from __future__ import annotations
@@ -36,13 +46,16 @@ from typing import Any, BinaryIO
 
 os.environ.setdefault("MAVLINK20", "1")  # formats.md 7.2: before any pymavlink import
 
-from pymavlink.dialects.v20 import common as mavlink
+from pymavlink.dialects.v20 import development as mavlink
 
 CHUNK = 1 << 20
 """Bytes read at a time; memory stays at a few chunks whatever the file size."""
 
 MAX_RECORD = 8 + 10 + 255 + 2 + 13
 """Largest record: timestamp, MAVLink 2 header, payload, CRC, signature."""
+
+LOOKAHEAD = MAX_RECORD + 9
+"""Bytes kept in the buffer past a record's start: the record and the next one's start byte."""
 
 BACKWARD_US = 100_000
 """A record may be this much older than the one before it without a second look."""
@@ -88,6 +101,7 @@ class FrameStats:
     packets: int = 0
     by_id: Counter[int] = field(default_factory=Counter)
     unknown: Counter[int] = field(default_factory=Counter)
+    """Packets of ids the dialect does not define, well framed (so not corrupt), not decoded."""
     unknown_first: dict[int, tuple[int, int]] = field(default_factory=dict)
     """Unknown id -> (offset, timestamp) of its first packet."""
     unknown_other: int = 0
@@ -183,7 +197,7 @@ class Framer:
         n = 0
         first = True
         while True:
-            if pos + 18 > n or (pos + MAX_RECORD > n and not self.eof):
+            if pos + 18 > n or (pos + LOOKAHEAD > n and not self.eof):
                 if not self.eof:
                     pos = self._fill(pos)
                     buf = self.buf
@@ -228,8 +242,9 @@ class Framer:
                     continue
             elif verify or first:
                 if msgid not in _CRC_EXTRA:
-                    if first:
-                        pos, buf, n = self._resync(pos, "no MAVLink packet")
+                    if not self._framed(buf, end, ts, n):
+                        why = "no MAVLink packet" if first else "bad length"
+                        pos, buf, n = self._resync(pos, why)
                         continue
                     self._unknown(msgid, pos, ts)
                 elif not crc_ok(buf, pos, end, msgid):
@@ -248,6 +263,18 @@ class Framer:
             pos = end
             self.consumed = self.base + pos
         self.consumed = stats.size
+
+    def _framed(self, buf: bytes, end: int, ts: int, n: int) -> bool:
+        """Does the record ending at ``end`` (one with no CRC to check) end where the next
+        begins: a MAVLink start byte 8 bytes on, under a timestamp in line with this one, or
+        the end of the file? A corrupt length or start byte seldom passes both."""
+        if end + 9 > n:
+            return self.eof and end == n
+        if buf[end + 8] not in (0xFD, 0xFE):
+            return False
+        back, forward = RESYNC_WINDOW_US
+        next_ts: int = _TS.unpack_from(buf, end)[0]
+        return ts - back <= next_ts <= ts + forward
 
     def _unknown(self, msgid: int, pos: int, ts: int) -> None:
         stats = self.stats
