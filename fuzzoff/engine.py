@@ -13,9 +13,9 @@ from typing import Any
 
 from fuzzoff.catalog import get_rule
 from fuzzoff.checks import CheckContext, load_all
-from fuzzoff.checks.base import STREAM_TYPES, Check, StreamBatch
+from fuzzoff.checks.base import SENT_STREAM_RULES, STREAM_TYPES, Check, StreamBatch
 from fuzzoff.config import Settings
-from fuzzoff.events import Event, VehicleStatus, is_keepalive
+from fuzzoff.events import Command, Event, VehicleStatus, is_keepalive
 from fuzzoff.findings import FileReport, Finding, Report, Severity
 from fuzzoff.gate import GateModel, GateTransition
 from fuzzoff.profiles import (
@@ -96,7 +96,8 @@ class VehicleRun:
             mode_recorded="vehicle_status" in info.kinds,
             own_system=int(vehicle) if vehicle.isdecimal() else None,
         )
-        self.gate = GateModel(profile, settings.params, vehicle)
+        stream = info.stream_recorded
+        self.gate = GateModel(profile, settings.params, vehicle, stream_recorded=stream)
         self.ctx = CheckContext(
             profile=profile,
             settings=settings,
@@ -104,7 +105,12 @@ class VehicleRun:
             vehicle=vehicle,
             state=self.state,
             gate=self.gate,
+            stream_recorded=stream,
         )
+        self.offboard_seen = False
+        """Only kept without a recorded stream: did the vehicle show OFFBOARD, or was it asked
+        to switch there (then the stream rules would have had something to judge)?"""
+        self._watch_offboard = not stream
         self.checks = [cls(self.ctx) for cls in load_all() if cls.wanted(self.ctx)]
         self.handlers: dict[type, list[Callable[[Event], None]]] = {}
         self.batched = [c for c in self.checks if batching and _takes_runs(c)]
@@ -178,6 +184,11 @@ class VehicleRun:
             state.set_predicted(gate.in_offboard, event.t)
         if self.timeline is not None:
             self._record(event)
+        if self._watch_offboard and (
+            state.in_offboard or (isinstance(event, Command) and event.is_offboard_switch)
+        ):
+            self.offboard_seen = True
+            self._watch_offboard = False
         handlers = self.handlers.get(cls)
         if handlers is None:
             handlers = self._handlers_for(cls)
@@ -285,6 +296,9 @@ def _run_events(
         findings.extend(run.finish(t_end))
         for code, needs in run.ctx.not_checkable.items():
             not_checkable.setdefault(code, needs)
+    unseen = sorted(v for v, run in runs.items() if run.offboard_seen)
+    if unseen and settings.enabled("OFB002"):
+        findings.append(_stream_not_recorded(unseen, settings))
     if not runs:
         # No event at all: every rule that needs a stream is not checkable.
         empty = VehicleRun("", profile, settings, info, None)
@@ -308,6 +322,29 @@ def _run_events(
         "kinds": dict(sorted(kinds.items())),
     }
     return findings, stats
+
+
+def _stream_not_recorded(vehicles: list[str], settings: Settings) -> Finding:
+    """The one OFB002 of a recording without the sent stream that shows offboard in use."""
+    codes = ", ".join(c for c in SENT_STREAM_RULES if settings.enabled(c))
+    who = ", ".join(vehicles)
+    return Finding(
+        code="OFB002",
+        name=get_rule("OFB002").name,
+        severity=settings.severity_of("OFB002", Severity.INFO),
+        message=(
+            f"the recording shows offboard in use on vehicle {who} but holds no setpoint and "
+            "no command from a companion: a ground station's log (PX4 does not forward the "
+            f"messages addressed to itself). The stream rules ({codes}) cannot be checked "
+            "here: they need the companion's side of the link (a tlog recorded on the "
+            "companion or by a router forwarding its messages, the /fmu/in topics, or the "
+            "vehicle's ULog). Modes, acks and PX4's failsafe messages are still checked: the "
+            "gate model takes the offboard signal as present and counts a loss only where "
+            "PX4's own failsafe is recorded. If this is the companion's own log, it sent no "
+            "setpoint at all"
+        ),
+        vehicle=vehicles[0] if len(vehicles) == 1 else "",
+    )
 
 
 def _takes_runs(check: Check) -> bool:

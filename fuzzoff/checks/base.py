@@ -42,6 +42,21 @@ from fuzzoff.tables.control_mode import FlagRow, row_for
 
 REGISTRY: list[type[Check]] = []
 
+SENT_STREAM_RULES: tuple[str, ...] = (
+    "OFB101",
+    "OFB102",
+    "OFB103",
+    "OFB104",
+    "OFB105",
+    "OFB106",
+    "OFB107",
+    "OFB203",
+    "OFB303",
+)
+"""The rules that judge the keep-alive and setpoint stream as sent. On a recording that cannot
+hold it (``RecordingInfo.stream_recorded``) they are not run: its absence there says nothing
+about the sender, and the engine says so in one OFB002."""
+
 
 @dataclass(slots=True)
 class CheckContext:
@@ -56,6 +71,8 @@ class CheckContext:
     findings: list[Finding] = field(default_factory=list)
     not_checkable: dict[str, str] = field(default_factory=dict)
     """code -> what the recording would need (becomes one OFB002 finding per code)."""
+    stream_recorded: bool = True
+    """False: the recording holds no sent stream, and ``SENT_STREAM_RULES`` are off."""
     _rows: dict[str | None, FlagRow | None] = field(default_factory=dict)
 
     def row_for(self, first_flag: str | None) -> FlagRow | None:
@@ -68,6 +85,8 @@ class CheckContext:
             return row
 
     def enabled(self, code: str) -> bool:
+        if not self.stream_recorded and code in SENT_STREAM_RULES:
+            return False
         try:
             rule = get_rule(code)
         except KeyError:  # a check without a catalog page never reports (a test catches it)

@@ -145,6 +145,8 @@ def _framework(px4: str, vehicle: str, params: dict[str, float], est: Estimates)
             final = _degrade(chosen, est, vehicle, _CHAIN_14)
         return _finish(chosen, final, "5.1", False, note, rc)
     # 1.17: replace a stick mode by NAV_RCL_ACT first; main: after the stick chain.
+    if not est.rc_recorded:
+        note += f"; manual control assumed {'present' if rc else 'absent'} ({RC_PRESENT})"
     if px4 == "1.17" and chosen in _STICK and not rc:
         return _replace(px4, vehicle, params, est, chosen, note, rc)
     final = _degrade(chosen, est, vehicle, _CHAIN_14)

@@ -39,6 +39,7 @@ from fuzzoff.events import (
     SetAttitudeTarget,
     SetPositionTargetGlobal,
     SetPositionTargetLocal,
+    StatusText,
     TrajectorySetpoint,
     VehicleStatus,
 )
@@ -52,6 +53,7 @@ from fuzzoff.gate.requests import Decision, arm_decision, decode_mode, switch_de
 from fuzzoff.gate.signal import (
     INF,
     LOOP_PERIOD,
+    UnseenSignal,
     estimate_failure,
     make_signal,
     px4_stamp,
@@ -67,11 +69,19 @@ EMPTY: list[GateTransition] = []
 
 TERMINATION = 13
 NOT_OFFBOARD = "no OFFBOARD on either side: other modes' own rules are not modelled; followed"
+FAILSAFE_TEXT_WINDOW_S = 3.0
+"""A failsafe STATUSTEXT this long before a recorded change out of OFFBOARD explains it (PX4
+sends the text at once; the 1 Hz HEARTBEAT shows the new mode up to a second later)."""
 
 
 class GateModel:
     def __init__(
-        self, profile: Profile, params: Mapping[str, float] | None = None, vehicle: str = ""
+        self,
+        profile: Profile,
+        params: Mapping[str, float] | None = None,
+        vehicle: str = "",
+        *,
+        stream_recorded: bool = True,
     ) -> None:
         self.profile = profile
         self.px4 = profile.px4
@@ -81,7 +91,14 @@ class GateModel:
         self.recorded_params: dict[str, float] = {}
         self.params = default_params(self.px4) | self.overrides
         self.est = Estimates()
+        self.stream_recorded = stream_recorded
+        """False: the recording cannot show the keep-alive (a ground station's tlog). The
+        signal is then taken as present, and lost only where PX4's own failsafe is recorded."""
         self.signal = make_signal(self.px4, self.params)
+        if not stream_recorded:
+            self.signal = UnseenSignal(self.signal.timeout)
+        self._failsafe_text_at = -INF
+        """When PX4 last said a failsafe began (STATUSTEXT), for a recording without stream."""
         self.tick_based = at_least(self.px4, "1.14")
         self._flags_ignored = self.px4 in ("legacy", "1.11")
         """Before 1.13 any keep-alive counts, whatever its flags (2.2)."""
@@ -142,6 +159,7 @@ class GateModel:
             Command: self._on_command,
             CommandAck: self._on_ack,
             Parameter: self._on_parameter,
+            StatusText: self._on_status_text,
         }
 
     # ------------------------------------------------------------------ public state
@@ -504,7 +522,7 @@ class GateModel:
             return
         self.params[name] = event.value
         self._verdicts.clear()
-        if name == "COM_OF_LOSS_T":
+        if name == "COM_OF_LOSS_T" and self.stream_recorded:
             if self.px4 == "legacy":
                 self.signal.loss_extra = max(0.0, event.value)  # type: ignore[attr-defined]
             else:
@@ -699,11 +717,61 @@ class GateModel:
 
     # ------------------------------------------------------------------ the recording
 
+    def _on_status_text(self, text: StatusText) -> None:
+        self._dirty = False
+        if not self.stream_recorded and "failsafe" in text.text.lower():
+            self._failsafe_text_at = text.t
+
+    def _recorded_loss(self, status: VehicleStatus) -> None:
+        """Without the stream, PX4's own failsafe is the loss: OFFBOARD left with no command
+        for it, while PX4 says a failsafe is active (``failsafe`` in the status, or a
+        STATUSTEXT just before)."""
+        t = status.t
+        if (
+            status.nav_state is None
+            or status.nav_state == NAV_STATE_OFFBOARD
+            or not self.signal.available
+            or self.user_intention != NAV_STATE_OFFBOARD
+            or self.compare.recent_command(t)
+        ):
+            return
+        text_before = 0.0 <= t - self._failsafe_text_at <= FAILSAFE_TEXT_WINDOW_S
+        if not (status.failsafe is True or text_before):
+            return
+        said = f"STATUSTEXT at {self._failsafe_text_at:.2f} s" if text_before else "its status"
+        self.signal.mark_lost()
+        self._signal_changed(t)
+        reason = f"PX4's recorded failsafe ({said}; the stream is not in the recording)"
+        self._emit(
+            t,
+            "signal_lost",
+            f"offboard signal lost: {reason}",
+            self.signal.spec,
+            cause=status,
+            reason=reason,
+        )
+        self._refresh(t, cause=status)
+
+    def _recorded_back(self, status: VehicleStatus) -> None:
+        """Without the stream: the vehicle shown in OFFBOARD again is the signal back."""
+        t = status.t
+        if status.nav_state == NAV_STATE_OFFBOARD and self.signal.keepalive(t, True):
+            self._signal_changed(t)
+            self._emit(
+                t,
+                "signal_available",
+                "recorded: OFFBOARD again (the stream is not in the recording)",
+                self.signal.spec,
+            )
+            self._refresh(t)
+
     def _on_status(self, status: VehicleStatus) -> None:
         if not self._started:
             self._start(status)
             return
         self.compare.remember(status)
+        if not self.stream_recorded:
+            self._recorded_loss(status)
         if (
             self._failsafe_due != INF
             and status.nav_state is not None
@@ -717,6 +785,8 @@ class GateModel:
         armed, intention = self._unseen_inputs(status)
         if armed or intention is not None:
             self._adopt(status.t, status, intention, silent=True)
+        if not self.stream_recorded:
+            self._recorded_back(status)
         self.compare.observe(status, self._nav)
 
     def _unseen_inputs(self, status: VehicleStatus) -> tuple[bool, int | None]:
@@ -762,6 +832,14 @@ class GateModel:
         if intention is None:
             intention = status.nav_state
         self.user_intention = intention
+        if not self.stream_recorded:
+            self._emit(
+                t,
+                "signal_available",
+                "offboard signal taken as present: the recording holds no keep-alive sent to "
+                "the vehicle; only a failsafe PX4 recorded counts as its loss",
+                self.signal.spec,
+            )
         # Assumption: a recording that starts in OFFBOARD starts with a live stream.
         if (
             status.nav_state == NAV_STATE_OFFBOARD

@@ -252,6 +252,31 @@ class LegacySignal(Signal):
         return self.last + LEGACY_TIMEOUT + extra
 
 
+class UnseenSignal(Signal):
+    """The signal of a recording that cannot show the keep-alive (a ground station's tlog):
+    taken as available, never lost by a timeout; only PX4's own recorded failsafe drops it
+    (``mark_lost``) and the vehicle shown in OFFBOARD again brings it back (``keepalive``)."""
+
+    spec = "2"
+
+    def __init__(self, timeout: float) -> None:
+        super().__init__(timeout)
+        self.available = True
+        self.timed_out = True
+
+    def keepalive(self, t: float, good: bool, stamp: float | None = None) -> bool:
+        if self.available:
+            return False
+        self.available = True
+        return True
+
+    def lost_at(self) -> float:
+        return INF
+
+    def ok_now(self, t: float, good: bool) -> bool:
+        return self.available
+
+
 def make_signal(px4: str, params: dict[str, float]) -> Signal:
     timeout = max(0.0, float(params.get("COM_OF_LOSS_T", 1.0)))
     if px4 == "legacy":

@@ -69,6 +69,11 @@ class RecordingInfo:
     message_count: int | None = None
     sampled_intervals: dict[str, float] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
+    stream_recorded: bool = True
+    """Does the recording hold the stream sent to the vehicle, or at least the link that would
+    carry it? False only where the reader can tell it does not: a ground station's tlog, with
+    no setpoint and no command from a companion (PX4 does not forward messages addressed to
+    itself), where the absence of a stream says nothing about the sender."""
 
     @property
     def sampled(self) -> bool:

@@ -19,6 +19,7 @@ from fuzzoff.events import (
     Command,
     CommandAck,
     Event,
+    FailsafeFlags,
     Parameter,
     SetAttitudeTarget,
     SetPositionTargetGlobal,
@@ -34,8 +35,11 @@ from fuzzoff.sources.base import RecordingInfo, Source, SourceError, SourceProbl
 from fuzzoff.sources.tlog_frames import Framer, FrameStats, message_name
 
 HEARTBEAT = 0
+SYS_STATUS = 1
 SET_MODE = 11
 PARAM_VALUE = 22
+RC_CHANNELS = 65
+MANUAL_CONTROL = 69
 COMMAND_INT = 75
 COMMAND_LONG = 76
 COMMAND_ACK = 77
@@ -58,17 +62,27 @@ WANTED = frozenset(
         SET_POSITION_TARGET_GLOBAL_INT,
         AUTOPILOT_VERSION,
         STATUSTEXT,
+        SYS_STATUS,
+        RC_CHANNELS,
+        MANUAL_CONTROL,
     }
 )
 """The only message ids decoded; the rest are framed and CRC-checked, not decoded."""
 
-PROBE_WANTED = frozenset({HEARTBEAT, AUTOPILOT_VERSION})
+PROBE_WANTED = frozenset({HEARTBEAT, AUTOPILOT_VERSION, COMMAND_LONG, COMMAND_INT, SET_MODE})
+"""The probe's decodes: who is who, the release, and who sends commands (rare messages)."""
+KEEPALIVE_IDS = frozenset(
+    {SET_POSITION_TARGET_LOCAL_NED, SET_POSITION_TARGET_GLOBAL_INT, SET_ATTITUDE_TARGET}
+)
 
 MAV_COMP_ID_AUTOPILOT1 = 1
 MAV_AUTOPILOT_PX4 = 12
 MAV_TYPE_GCS = 6
 MAV_MODE_FLAG_CUSTOM_MODE_ENABLED = 1
 MAV_MODE_FLAG_SAFETY_ARMED = 128
+MAV_SYS_STATUS_SENSOR_RC_RECEIVER = 1 << 16
+"""SYS_STATUS bit PX4 sets present and healthy while it has manual control (RC or a MAVLink
+joystick: its ``manual_control_signal_lost`` is false)."""
 INT_PARAM_TYPES = frozenset({1, 2, 3, 4, 5, 6})
 """MAV_PARAM_TYPE UINT8..INT32: the float's four bytes hold the integer (PX4's encoding)."""
 
@@ -155,9 +169,13 @@ class TlogSource(Source):
         info = RecordingInfo(str(self.path), self.format)
         framer = Framer(self._file(), self._size, PROBE_WANTED, verify=False)
         autopilots = self._autopilots
+        ground_stations: set[tuple[int, int]] = set()
+        commanders: set[tuple[int, int]] = set()
         for _offset, _ts, msgid, msg in framer.records():
             sender = (msg.get_srcSystem(), msg.get_srcComponent())
             if msgid == HEARTBEAT:
+                if msg.type == MAV_TYPE_GCS:
+                    ground_stations.add(sender)
                 if sender[1] == MAV_COMP_ID_AUTOPILOT1 or (
                     msg.autopilot == MAV_AUTOPILOT_PX4 and msg.type != MAV_TYPE_GCS
                 ):
@@ -168,6 +186,8 @@ class TlogSource(Source):
                 autopilots.add(sender)
                 if info.px4_version is None:
                     info.px4_version = decode_px4_version(msg.flight_sw_version)
+            elif msgid != AUTOPILOT_VERSION and sender[1] != MAV_COMP_ID_AUTOPILOT1:
+                commanders.add(sender)
         stats = framer.stats
         if stats.packets == 0:
             self._fatal = True
@@ -184,6 +204,13 @@ class TlogSource(Source):
             )
         if info.px4_version is None:
             info.notes.append("no AUTOPILOT_VERSION in the log: PX4 version unknown")
+        companions = commanders - autopilots - ground_stations
+        if not any(stats.by_id.get(i) for i in KEEPALIVE_IDS) and not companions:
+            info.stream_recorded = False
+            info.notes.append(
+                "no setpoint and no command from a companion in the log (a ground station's "
+                "log?): the stream sent to the vehicle is not in this recording"
+            )
         info.message_count = stats.packets
         for msgid, kinds in _KIND_OF_ID.items():
             if stats.by_id.get(msgid):
@@ -293,7 +320,14 @@ class _Decoder:
             PARAM_VALUE: self._param,
             AUTOPILOT_VERSION: self._version,
             STATUSTEXT: self._statustext,
+            SYS_STATUS: self._sys_status,
+            RC_CHANNELS: self._rc_channels,
+            MANUAL_CONTROL: self._manual_control,
         }
+        self.manual: dict[int, bool] = {}
+        """Vehicle sysid -> manual control present, as last said (events only on a change)."""
+        self.sys_status: set[int] = set()
+        """Vehicles whose SYS_STATUS was seen: PX4's own verdict on manual control wins."""
 
     def decode(self, msgid: int, msg: Any, t: float, offset: int) -> Iterable[Event]:
         i = self.index.get(msgid, 0)
@@ -508,6 +542,50 @@ class _Decoder:
             px4_version=decode_px4_version(m.flight_sw_version),
         )
         return (info,)
+
+    # -- manual control (RC or joystick) ------------------------------------------------------
+
+    def _manual(self, sysid: int, present: bool, t: float, where: Where) -> Iterable[Event]:
+        """A ``FailsafeFlags`` with only ``manual_control_signal_lost``, when it changes."""
+        if self.manual.get(sysid) == present:
+            return ()
+        self.manual[sysid] = present
+        flags = FailsafeFlags(
+            t=t, vehicle=str(sysid), where=where, manual_control_signal_lost=not present
+        )
+        return (flags,)
+
+    def _sys_status(self, m: Any, t: float, where: Where) -> Iterable[Event]:
+        """PX4's verdict: the RC receiver bit present and healthy while it has manual control."""
+        if not self._from_autopilot(m):
+            return self._ignore(m, "not from an autopilot")
+        sysid = m.get_srcSystem()
+        self.sys_status.add(sysid)
+        bit = MAV_SYS_STATUS_SENSOR_RC_RECEIVER
+        present = bool(m.onboard_control_sensors_present & m.onboard_control_sensors_health & bit)
+        return self._manual(sysid, present, t, where)
+
+    def _rc_channels(self, m: Any, t: float, where: Where) -> Iterable[Event]:
+        """PX4 sends RC_CHANNELS while an RC receiver delivers: present, where no SYS_STATUS
+        says otherwise."""
+        if not self._from_autopilot(m):
+            return self._ignore(m, "not from an autopilot")
+        sysid = m.get_srcSystem()
+        if sysid in self.sys_status:
+            return ()
+        return self._manual(sysid, True, t, where)
+
+    def _manual_control(self, m: Any, t: float, where: Where) -> Iterable[Event]:
+        """A joystick on the ground station (MANUAL_CONTROL to the vehicle): present, where no
+        SYS_STATUS says otherwise."""
+        if self._from_autopilot(m):
+            return self._ignore(m, "from the autopilot")
+        out: list[Event] = []
+        for vehicle in self._targets(m.target):
+            sysid = int(vehicle)
+            if sysid not in self.sys_status:
+                out.extend(self._manual(sysid, True, t, where))
+        return out
 
     def _statustext(self, m: Any, t: float, where: Where) -> Iterable[Event]:
         if not self._from_autopilot(m):
