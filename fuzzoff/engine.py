@@ -417,8 +417,11 @@ def lint_file(
             Finding("OFB001", unreadable.name, Severity.ERROR, line, time_s=problem.time_s)
         )
     report.complete = not source.problems
-    if not (profile.px4_detected and profile.vehicle_detected) and settings.enabled("OFB003"):
-        findings.append(_assumed(profile))
+    vehicle_assumed = info.vehicle_assumed if settings.vehicle is None else None
+    if settings.enabled("OFB003") and (
+        not (profile.px4_detected and profile.vehicle_detected) or vehicle_assumed
+    ):
+        findings.append(_assumed(profile, vehicle_assumed))
     findings = [f for f in findings if settings.enabled(f.code)]
     findings.sort(key=_sort_key)
     report.findings = findings
@@ -443,12 +446,14 @@ def _problem(exc: SourceError) -> SourceProblem:
     return SourceProblem(exc.what, exc.where)
 
 
-def _assumed(profile: Profile) -> Finding:
+def _assumed(profile: Profile, vehicle_assumed: str | None = None) -> Finding:
     missing = []
     if not profile.px4_detected:
         missing.append(f"PX4 version (assumed {profile.px4}; set --px4)")
     if not profile.vehicle_detected:
         missing.append(f"vehicle type (assumed {profile.vehicle}; set --vehicle)")
+    elif vehicle_assumed:
+        missing.append(f"vehicle type fully: it says {vehicle_assumed}")
     rule = get_rule("OFB003")
     return Finding(
         "OFB003",

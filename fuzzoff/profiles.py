@@ -183,4 +183,8 @@ MAV_TYPE_VEHICLE: dict[int, str] = {
 }
 
 # vehicle_status.vehicle_type -> vehicle type (is_vtol checked first by callers).
-PX4_VEHICLE_TYPE: dict[int, str] = {1: "mc", 2: "fw", 3: "rover-differential"}
+ROVER_ASSUMED = "rover-differential"
+"""The rover kind taken where a recording says "rover" but not which kind (``vehicle_type``
+3, rover topics): the kind ``--vehicle rover`` also means."""
+
+PX4_VEHICLE_TYPE: dict[int, str] = {1: "mc", 2: "fw", 3: ROVER_ASSUMED}

@@ -69,6 +69,9 @@ class RecordingInfo:
     message_count: int | None = None
     sampled_intervals: dict[str, float] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
+    vehicle_assumed: str | None = None
+    """What part of ``vehicle_type`` the recording does not say, and what was assumed for it
+    (a rover whose kind is not recorded): reported as OFB003 unless ``--vehicle`` is given."""
     stream_recorded: bool = True
     """Does the recording hold the stream sent to the vehicle, or at least the link that would
     carry it? False only where the reader can tell it does not: a ground station's tlog, with

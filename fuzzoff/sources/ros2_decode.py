@@ -387,6 +387,14 @@ class Ros2Decoding:
     def kinds(self) -> set[str]:
         return {d.kind for d in self.decoders}
 
+    def rover_topics(self) -> list[str]:
+        """Topics of PX4's rover setpoints (``Rover*Setpoint``, 1.16+): a rover's recording."""
+        return sorted(
+            d.topic
+            for d in self.decoders
+            if isinstance(d, TopicDecoder) and d.message.startswith("Rover")
+        )
+
     def vehicles(self) -> list[str]:
         return sorted({d.vehicle for d in self.decoders})
 

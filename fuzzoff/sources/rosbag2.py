@@ -21,6 +21,7 @@ from rosbags.rosbag2 import Reader
 from ruamel.yaml import YAML
 
 from fuzzoff.events import Event
+from fuzzoff.profiles import ROVER_ASSUMED
 from fuzzoff.sources import mcap_indexed, px4_msgs
 from fuzzoff.sources.base import RecordingInfo, Source, SourceError, SourceProblem
 from fuzzoff.sources.mavros import mavros_topic
@@ -217,9 +218,26 @@ class Rosbag2Source(Source):
         info.vehicles = self.decoding.vehicles()
         info.px4_version = self.decoding.detected_release()
         info.vehicle_type = self._vehicle
+        self._rover(info)
         info.notes.extend(self._notes)
         self._info = info
         return info
+
+    def _rover(self, info: RecordingInfo) -> None:
+        """A rover's kind is in no ROS 2 topic: PX4's ``VehicleStatus`` says only "rover"
+        (``vehicle_type`` 3), and the rover setpoint topics (``/fmu/in/rover_*``) serve all
+        three kinds. Either makes the recording a rover's; the kind is assumed, and said."""
+        topics = self.decoding.rover_topics()
+        if info.vehicle_type not in (None, ROVER_ASSUMED) or not (
+            topics or info.vehicle_type == ROVER_ASSUMED
+        ):
+            return
+        info.vehicle_type = ROVER_ASSUMED
+        said = f"its {', '.join(topics)} topics" if topics else "its VehicleStatus"
+        info.vehicle_assumed = (
+            f"a rover ({said}) but not which kind (assumed {ROVER_ASSUMED}; set --vehicle "
+            "rover-ackermann, rover-differential or rover-mecanum)"
+        )
 
     def _presample(self, reader: Any) -> None:
         """Choose bundled definitions now, from each topic's first message, so the release
