@@ -9,12 +9,13 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import re
 import sys
 from collections.abc import Sequence
 
 from fuzzoff import __version__
 from fuzzoff.commands import SUMMARIES, add_command
-from fuzzoff.config import ConfigError
+from fuzzoff.config import ConfigError, did_you_mean
 
 
 class UsageError(Exception):
@@ -23,7 +24,28 @@ class UsageError(Exception):
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message: str) -> None:  # type: ignore[override]
-        raise UsageError(f"{self.prog}: {message}")
+        raise UsageError(f"{self.prog}: {message}{self._suggestion(message)}")
+
+    def _suggestion(self, message: str) -> str:
+        """A did-you-mean for a mistyped option, command or choice, as ruff gives."""
+        unknown = re.match(r"unrecognized arguments: (\S+)", message)
+        if unknown and unknown.group(1).startswith("-"):
+            word = unknown.group(1).split("=", 1)[0]
+            return did_you_mean(word, self._option_strings())
+        choice = re.search(r"invalid choice: '?([^' ]*)'? \(choose from (.*)\)", message)
+        if choice:
+            choices = re.findall(r"[\w-]+", choice.group(2))
+            return did_you_mean(choice.group(1), choices)
+        return ""
+
+    def _option_strings(self) -> list[str]:
+        """This parser's options and those of the subcommand parsers it holds."""
+        found = list(self._option_string_actions)
+        for action in self._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                for parser in action.choices.values():
+                    found.extend(parser._option_string_actions)
+        return found
 
 
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:

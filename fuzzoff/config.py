@@ -2,15 +2,22 @@
 
 Keys (ruff-like): ``px4``, ``vehicle``, ``select``, ``extend-select``, ``ignore``, ``fail-on``,
 ``severity`` (table code -> level), ``options`` (table code -> table of thresholds),
-``params`` (PX4 parameter overrides for the gate model). An unknown key, code or option is a
-usage error, never ignored.
+``params`` (PX4 parameter overrides for the gate model), ``per-file-ignores`` (glob -> codes).
+An unknown key, code or option is a usage error, never ignored.
+
+As in ruff, each recording is judged with the nearest configuration above it (a ``rover/``
+folder may carry its own ``fuzzoff.toml``); the command line applies on top of every one. A
+recording with no configuration above it takes the one found from the current folder.
 """
 
 from __future__ import annotations
 
+import functools
 import math
+import os
+import re
 import tomllib
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
 from difflib import get_close_matches
 from pathlib import Path
@@ -19,7 +26,14 @@ from typing import Any
 from fuzzoff.catalog import expand_selectors, get_rule, load_catalog
 from fuzzoff.findings import Severity
 from fuzzoff.gate.params import GATE_PARAMS
-from fuzzoff.profiles import ProfileError, px4_profile_for, vehicle_type_for
+from fuzzoff.profiles import (
+    PX4_PROFILE_NOTES,
+    PX4_PROFILES,
+    VEHICLE_TYPES,
+    ProfileError,
+    px4_profile_for,
+    vehicle_type_for,
+)
 
 
 class ConfigError(ValueError):
@@ -36,7 +50,150 @@ KNOWN_KEYS = {
     "severity",
     "options",
     "params",
+    "per-file-ignores",
 }
+
+NEWEST_RELEASE = (1, 18)
+"""The newest PX4 release modelled: the ``main`` profile follows v1.18.0-beta1 (gate spec 0)."""
+OLDEST_RELEASE = (1, 5)
+"""The oldest release modelled (``legacy``: v1.5-v1.10)."""
+_RELEASE = re.compile(r"^v?(\d+)\.(\d+)(?:\.(\d+))?")
+
+
+def did_you_mean(word: str, choices: Iterable[str]) -> str:
+    """`` (did you mean X?)`` for the closest choice, or nothing."""
+    close = get_close_matches(word, list(choices), n=1, cutoff=0.6)
+    return f" (did you mean {close[0]}?)" if close else ""
+
+
+def user_px4_profile(text: str) -> tuple[str, str | None]:
+    """The profile for a PX4 version the user names, and a note when its name differs.
+
+    A release that does not exist or is not modelled is an error, not a guess: ``2.0`` is no
+    PX4 release and ``1.19`` would be judged by a model of 1.18. ``1.18`` is the ``main``
+    profile (gate spec 0), ``1.12`` the ``1.13`` one, ``1.5``-``1.10`` ``legacy``: the note
+    says so.
+    """
+    name = text.strip()
+    if name in PX4_PROFILES:
+        return name, None
+    match = _RELEASE.match(name)
+    if match is None:
+        raise ProfileError(
+            f"unknown PX4 version {text!r}{did_you_mean(name, PX4_PROFILES)}: give a release "
+            f"such as 1.15.4, or one of {', '.join(PX4_PROFILES)}"
+        )
+    release = (int(match.group(1)), int(match.group(2)))
+    shown = f"{release[0]}.{release[1]}"
+    if release > NEWEST_RELEASE:
+        raise ProfileError(
+            f"PX4 {text} is not modelled: the newest release modelled is 1.18 (profile main); "
+            "give --px4 main to judge with it"
+        )
+    if release < OLDEST_RELEASE:
+        raise ProfileError(
+            f"PX4 {text} is not modelled: the oldest release modelled is 1.5 (profile legacy)"
+        )
+    profile = px4_profile_for(name)
+    if profile == shown:
+        return profile, None
+    return profile, f"PX4 {shown} is judged with profile {profile} ({PX4_PROFILE_NOTES[profile]})"
+
+
+def user_vehicle_type(text: str) -> str:
+    """A vehicle type the user names. ``rover`` alone is refused: the rover kinds take
+    setpoints differently (gate spec 10), and a guess would judge the wrong one."""
+    if text.strip().lower() == "rover":
+        rovers = ", ".join(v for v in VEHICLE_TYPES if v.startswith("rover"))
+        raise ProfileError(f"vehicle type 'rover' names no rover kind: give one of {rovers}")
+    try:
+        return vehicle_type_for(text)
+    except ProfileError:
+        raise ProfileError(
+            f"unknown vehicle type {text!r}{did_you_mean(text.strip().lower(), VEHICLE_TYPES)}:"
+            f" one of {', '.join(VEHICLE_TYPES)}"
+        ) from None
+
+
+@dataclass(frozen=True, slots=True)
+class FileIgnore:
+    """One ``per-file-ignores`` entry: codes turned off in the recordings its glob matches.
+
+    As in ruff, a pattern without a slash matches a recording's name in any folder; one with a
+    slash matches its path relative to the configuration's folder (``*`` stays within a
+    folder, ``**`` spans folders); a leading ``!`` turns off the codes everywhere the rest of
+    the pattern does not match."""
+
+    pattern: str
+    folder: str
+    codes: frozenset[str]
+
+    def matches(self, recording: str | Path) -> bool:
+        negated = self.pattern.startswith("!")
+        pattern = self.pattern[1:] if negated else self.pattern
+        path = Path(os.path.abspath(recording))
+        if "/" not in pattern:
+            hit = glob_regex(pattern).fullmatch(path.name) is not None
+        else:
+            try:
+                relative = path.relative_to(os.path.abspath(self.folder)).as_posix()
+            except ValueError:
+                relative = path.as_posix()
+            target = path.as_posix() if pattern.startswith("/") else relative
+            hit = glob_regex(pattern.removeprefix("./")).fullmatch(target) is not None
+        return hit != negated
+
+
+@functools.lru_cache(maxsize=256)
+def glob_regex(pattern: str) -> re.Pattern[str]:
+    """A glob as a regular expression: ``*``/``?`` within one path part, ``**`` across parts,
+    ``[...]`` classes (``[!...]`` negated) and ``{a,b}`` alternatives."""
+    out: list[str] = []
+    i, depth = 0, 0
+    while i < len(pattern):
+        c = pattern[i]
+        if pattern.startswith("**/", i):
+            out.append("(?:.*/)?")
+            i += 3
+            continue
+        if pattern.startswith("**", i):
+            out.append(".*")
+            i += 2
+            continue
+        if c == "*":
+            out.append("[^/]*")
+        elif c == "?":
+            out.append("[^/]")
+        elif c == "[" and "]" in pattern[i + 2 :]:
+            end = pattern.index("]", i + 2)
+            body = pattern[i + 1 : end]
+            if body.startswith("!"):
+                body = "^" + body[1:]
+            out.append("[" + body.replace("\\", "\\\\") + "]")
+            i = end
+        elif c == "{":
+            out.append("(?:")
+            depth += 1
+        elif c == "}" and depth:
+            out.append(")")
+            depth -= 1
+        elif c == "," and depth:
+            out.append("|")
+        else:
+            out.append(re.escape(c))
+        i += 1
+    if depth:
+        raise ValueError(f"unclosed {{ in {pattern!r}")
+    return re.compile("".join(out))
+
+
+@dataclass(frozen=True, slots=True)
+class Discovery:
+    """What a run needs to find each recording's settings: the command line's values, laid over
+    the nearest configuration above the recording (``Settings.for_recording``)."""
+
+    overrides: tuple[tuple[str, Any], ...]
+    cache: dict[str, Settings] = field(default_factory=dict, compare=False, hash=False)
 
 
 @dataclass(frozen=True, slots=True)
@@ -54,6 +211,13 @@ class Settings:
     options: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
     params: Mapping[str, float] = field(default_factory=dict)
     config_file: str | None = None
+    per_file_ignores: tuple[FileIgnore, ...] = ()
+    param_origins: Mapping[str, str] = field(default_factory=dict)
+    """Parameter -> where its value was set: ``--param`` or the configuration file's path."""
+    notes: tuple[str, ...] = ()
+    """What the user should hear about their settings (``--px4 1.18`` is judged as ``main``)."""
+    discovery: Discovery | None = None
+    """Set for a command-line run: each recording then takes its nearest configuration."""
 
     def enabled(self, code: str) -> bool:
         if code in self.ignore:
@@ -69,6 +233,31 @@ class Settings:
 
     def severity_of(self, code: str, default: Severity) -> Severity:
         return self.severity.get(code, default)
+
+    def param_origin(self, name: str) -> str:
+        """How a report words where a parameter set by the user came from."""
+        origin = self.param_origins.get(name)
+        if origin is None:
+            return "set by the user"  # Settings(params=...) from the Python API
+        if origin == "--param":
+            return "set with --param"
+        return f"set in {Path(origin).name}"
+
+    def for_recording(self, recording: str | Path) -> Settings:
+        """The settings one recording is judged with: its nearest configuration (for a
+        command-line run), the command line on top, then the ``per-file-ignores`` it matches."""
+        settings = self
+        if self.discovery is not None:
+            settings = _nearest_settings(self, self.discovery, Path(recording))
+        ignored = frozenset(
+            code
+            for rule in settings.per_file_ignores
+            if rule.matches(recording)
+            for code in rule.codes
+        )
+        if ignored - settings.ignore:
+            settings = replace(settings, ignore=settings.ignore | ignored)
+        return settings
 
 
 def find_config(start: Path) -> Path | None:
@@ -170,21 +359,34 @@ def _param_name(name: str, where: str) -> str:
 def settings_from_table(
     table: Mapping[str, Any], where: str, base: Settings | None = None
 ) -> Settings:
-    """Apply a ``[tool.fuzzoff]``-shaped table (or CLI values in the same shape) to ``base``."""
+    """Apply a ``[tool.fuzzoff]``-shaped table (or CLI values in the same shape) to ``base``.
+
+    ``where`` names the file, or is ``command line`` (keys are then named as options)."""
     settings = base or Settings()
-    unknown = set(table) - KNOWN_KEYS
+    unknown = sorted(set(table) - KNOWN_KEYS)
     if unknown:
         known = ", ".join(sorted(KNOWN_KEYS))
-        raise ConfigError(f"{where}: unknown key(s) {', '.join(sorted(unknown))}; known: {known}")
+        raise ConfigError(
+            f"{where}: unknown key {unknown[0]}{did_you_mean(unknown[0], KNOWN_KEYS)}"
+            + (f" (and {', '.join(unknown[1:])})" if unknown[1:] else "")
+            + f"; known: {known}"
+        )
+    cli = where == "command line"
+    key = "px4"
     try:
         if table.get("px4") is not None:
             px4 = _text(table["px4"], "px4", where, "1.15")
-            settings = replace(settings, px4=px4_profile_for(px4))
+            profile, note = user_px4_profile(px4)
+            settings = replace(settings, px4=profile)
+            if note:
+                source = "--px4" if cli else f"{where}: px4"
+                settings = replace(settings, notes=(*settings.notes, f"{source}: {note}"))
+        key = "vehicle"
         if table.get("vehicle") is not None:
             vehicle = _text(table["vehicle"], "vehicle", where, "mc")
-            settings = replace(settings, vehicle=vehicle_type_for(vehicle))
+            settings = replace(settings, vehicle=user_vehicle_type(vehicle))
     except ProfileError as exc:
-        raise ConfigError(f"{where}: {exc}") from None
+        raise ConfigError(f"{'--' + key if cli else where}: {exc}") from None
     if table.get("select") is not None:
         settings = replace(settings, select=frozenset(_codes(table["select"], "select", where)))
     if table.get("extend-select") is not None:
@@ -217,14 +419,18 @@ def settings_from_table(
             try:
                 rule = get_rule(code)
             except KeyError:
-                raise ConfigError(f"{where}: options: unknown rule {code!r}") from None
+                codes = list(load_catalog())
+                raise ConfigError(
+                    f"{where}: options: unknown rule {code!r}{did_you_mean(code, codes)}"
+                ) from None
             for name, value in _table(values, f"options.{code}", where).items():
                 try:
                     default = rule.option(name).default
                 except KeyError:
-                    known = ", ".join(o.name for o in rule.options) or "none"
+                    names = [o.name for o in rule.options]
                     raise ConfigError(
-                        f"{where}: options.{code}: unknown option {name!r} (known: {known})"
+                        f"{where}: options.{code}: unknown option {name!r}"
+                        f"{did_you_mean(name, names)} (known: {', '.join(names) or 'none'})"
                     ) from None
                 options.setdefault(rule.code, {})[name] = _option_value(
                     value, default, f"{where}: options.{code}.{name}"
@@ -232,29 +438,99 @@ def settings_from_table(
         settings = replace(settings, options=options)
     if table.get("params") is not None:
         params = dict(settings.params)
+        origins = dict(settings.param_origins)
         for name, value in _table(table["params"], "params", where).items():
             if not isinstance(value, (int, float)) or isinstance(value, bool):
                 raise ConfigError(f"{where}: params.{name} must be a number")
             if not math.isfinite(value):
                 raise ConfigError(f"{where}: params.{name} must be a finite number")
-            params[_param_name(str(name), where)] = float(value)
-        settings = replace(settings, params=params)
+            upper = _param_name(str(name), where)
+            params[upper] = float(value)
+            origins[upper] = "--param" if cli else where
+        settings = replace(settings, params=params, param_origins=origins)
+    if table.get("per-file-ignores") is not None:
+        settings = replace(
+            settings, per_file_ignores=(*settings.per_file_ignores, *_file_ignores(table, where))
+        )
     return settings
 
 
+def _file_ignores(table: Mapping[str, Any], where: str) -> list[FileIgnore]:
+    """``per-file-ignores = { "GLOB" = ["CODE", ...] }``, patterns relative to the file's
+    folder."""
+    folder = str(Path(where).parent) if where != "command line" else os.getcwd()
+    out = []
+    for pattern, codes in _table(table["per-file-ignores"], "per-file-ignores", where).items():
+        try:
+            glob_regex(pattern.removeprefix("!"))
+        except (ValueError, re.error) as exc:
+            raise ConfigError(
+                f"{where}: per-file-ignores: bad pattern {pattern!r}: {exc}"
+            ) from None
+        chosen = _codes(codes, f"per-file-ignores.{pattern!r}", where)
+        out.append(FileIgnore(pattern, folder, frozenset(chosen)))
+    return out
+
+
 def load_settings(
-    start: Path | None = None, overrides: Mapping[str, Any] | None = None
+    start: Path | None = None,
+    overrides: Mapping[str, Any] | None = None,
+    *,
+    per_recording: bool = False,
 ) -> Settings:
-    """Settings from the nearest config file, then ``overrides`` (the command line) on top."""
+    """Settings from the nearest config file, then ``overrides`` (the command line) on top.
+
+    ``per_recording`` (command-line runs): ``Settings.for_recording`` then looks for each
+    recording's own nearest configuration, as ruff does for each source file."""
+    clean = {k: v for k, v in (overrides or {}).items() if v is not None}
+    settings = _settings_from(find_config((start or Path.cwd()).resolve()), clean)
+    if per_recording:
+        settings = replace(settings, discovery=Discovery(tuple(sorted(clean.items()))))
+    return settings
+
+
+def _settings_from(config: Path | None, overrides: Mapping[str, Any]) -> Settings:
     settings = Settings()
-    config = find_config((start or Path.cwd()).resolve())
     if config is not None:
         settings = settings_from_table(read_config_table(config), str(config), settings)
         settings = replace(settings, config_file=str(config))
     if overrides:
-        clean = {k: v for k, v in overrides.items() if v is not None}
-        if "select" in clean:
+        if "select" in overrides:
             # as in ruff: --select names the rules outright, the file's ignore included
             settings = replace(settings, ignore=frozenset())
-        settings = settings_from_table(clean, "command line", settings)
+        settings = settings_from_table(overrides, "command line", settings)
     return settings
+
+
+def _nearest_settings(run: Settings, discovery: Discovery, recording: Path) -> Settings:
+    """The settings of the nearest configuration above ``recording``; the run's own when there
+    is none, or when it is the run's. ``fail-on`` stays the run's: a run has one exit status."""
+    folder = os.path.abspath(recording)
+    if not os.path.isdir(folder):
+        folder = os.path.dirname(folder)
+    found = discovery.cache.get(folder)
+    if found is None:
+        config = find_config(Path(folder))
+        if config is None or str(config) == run.config_file:
+            found = run
+        else:
+            found = discovery.cache.get(str(config))
+            if found is None:
+                found = _settings_from(config, dict(discovery.overrides))
+                found = replace(found, fail_on=run.fail_on, notes=_fail_on_note(found, run))
+                discovery.cache[str(config)] = found
+        discovery.cache[folder] = found
+    return found
+
+
+def _fail_on_note(nested: Settings, run: Settings) -> tuple[str, ...]:
+    table = read_config_table(Path(nested.config_file or ""))
+    if "fail-on" not in table or nested.fail_on is run.fail_on:
+        return nested.notes
+    where = run.config_file or "the default"
+    return (
+        *nested.notes,
+        f"{nested.config_file}: fail-on is not used: one run has one exit status, set by "
+        f"--fail-on or the configuration of the folder fuzzoff runs in ({where}: "
+        f"{run.fail_on.label})",
+    )

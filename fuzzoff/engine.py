@@ -370,7 +370,7 @@ def lint_file(
     """Lint one recording. Never raises for a bad file: it becomes OFB001 and ``complete=False``.
 
     ``batching=False`` gives every check the stream one message at a time (see ``run_events``)."""
-    settings = settings or Settings()
+    settings = (settings or Settings()).for_recording(path)
     path = Path(path)
     name = path_text(path)
     unreadable = get_rule("OFB001")

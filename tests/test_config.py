@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -141,3 +142,210 @@ def test_select_on_the_command_line_overrides_the_files_ignore(tmp_path: Path) -
     assert "OFB101" in codes_of(run_cli([*args, "--select", "OFB101"], cwd=tmp_path).stdout)
     extended = run_cli([*args, "--extend-select", "OFB101"], cwd=tmp_path)
     assert "OFB101" not in codes_of(extended.stdout)
+
+
+# --- each recording's nearest configuration, per-file-ignores, as ruff ------------------------
+
+
+def _lint_json(args: list[str], cwd: Path) -> tuple[int, dict[str, dict[str, Any]], str]:
+    """Run lint as JSON from ``cwd``: the exit status, each file by name, the standard error."""
+    result = run_cli(["lint", *args, "--format", "json"], cwd=cwd)
+    files = {Path(f["path"]).name: f for f in json.loads(result.stdout)["files"]}
+    return result.returncode, files, result.stderr
+
+
+def _codes(file: dict[str, Any]) -> set[str]:
+    return {f["code"] for f in file["findings"]}
+
+
+def _flights(root: Path) -> tuple[Path, Path]:
+    """root/a.tlog and root/rover/b.tlog, both the corpus's 0.7 s gap (OFB101 on each)."""
+    (root / "rover").mkdir(parents=True)
+    a, b = root / "a.tlog", root / "rover" / "b.tlog"
+    a.write_bytes(GAP.read_bytes())
+    b.write_bytes(GAP.read_bytes())
+    return a, b
+
+
+def test_each_recording_takes_the_nearest_configuration_above_it(tmp_path: Path) -> None:
+    _flights(tmp_path)
+    (tmp_path / "fuzzoff.toml").write_text('ignore = ["OFB101"]\n')
+    (tmp_path / "rover" / "pyproject.toml").write_text(
+        '[tool.fuzzoff]\nvehicle = "rover-ackermann"\n'
+    )
+    _, files, _ = _lint_json(["."], tmp_path)
+    assert "OFB101" not in _codes(files["a.tlog"])
+    assert files["a.tlog"]["profile"]["vehicle"] == "mc"
+    # rover/ has its own settings: the root's ignore does not reach it (as in ruff)
+    assert "OFB101" in _codes(files["b.tlog"])
+    assert files["b.tlog"]["profile"]["vehicle"] == "rover-ackermann"
+    assert files["b.tlog"]["profile"]["vehicle_source"] == "user"
+    # the same from inside rover/, naming the other recording by its path
+    _, files, _ = _lint_json([str(tmp_path / "a.tlog"), "."], tmp_path / "rover")
+    assert "OFB101" not in _codes(files["a.tlog"]) and "OFB101" in _codes(files["b.tlog"])
+
+
+def test_the_command_line_applies_over_every_configuration(tmp_path: Path) -> None:
+    _flights(tmp_path)
+    (tmp_path / "rover" / "fuzzoff.toml").write_text('vehicle = "rover-ackermann"\n')
+    _, files, _ = _lint_json([".", "--vehicle", "fw", "--ignore", "OFB101"], tmp_path)
+    assert {f["profile"]["vehicle"] for f in files.values()} == {"fw"}
+    assert not any("OFB101" in _codes(f) for f in files.values())
+
+
+def test_a_recording_with_no_configuration_above_it_takes_the_current_folders(
+    tmp_path: Path,
+) -> None:
+    flights, project = tmp_path / "flights", tmp_path / "project"
+    flights.mkdir()
+    project.mkdir()
+    (flights / "a.tlog").write_bytes(GAP.read_bytes())
+    (project / "fuzzoff.toml").write_text('ignore = ["OFB101"]\n')
+    _, files, _ = _lint_json([str(flights)], project)
+    assert "OFB101" not in _codes(files["a.tlog"])
+
+
+def test_a_mistake_in_a_nested_configuration_stops_the_run_before_any_work(
+    tmp_path: Path,
+) -> None:
+    _flights(tmp_path)
+    (tmp_path / "rover" / "fuzzoff.toml").write_text('vehicle = "rover"\n')
+    result = run_cli(["lint", "."], cwd=tmp_path)
+    assert result.returncode == 2 and result.stdout == ""
+    assert f"{tmp_path / 'rover' / 'fuzzoff.toml'}: vehicle type 'rover' names no rover kind" in (
+        result.stderr
+    )
+
+
+def test_fail_on_is_the_runs_and_a_nested_one_says_it_is_not_used(tmp_path: Path) -> None:
+    _flights(tmp_path)
+    (tmp_path / "rover" / "fuzzoff.toml").write_text('fail-on = "error"\n')
+    status, _, stderr = _lint_json(["."], tmp_path)
+    assert status == 1  # the 0.7 s gaps are warnings; the run's fail level is warning
+    assert stderr.count("fail-on is not used") == 1
+    assert "rover" in stderr and "warning" in stderr
+
+
+@pytest.mark.parametrize(
+    ("pattern", "ignored_in"),
+    [
+        ("a.tlog", {"a.tlog"}),  # no slash: the name, in any folder
+        ("*.tlog", {"a.tlog", "b.tlog"}),
+        ("rover/*", {"b.tlog"}),  # a slash: relative to the configuration's folder
+        ("*/b.tlog", {"b.tlog"}),
+        ("**/b.tlog", {"b.tlog"}),
+        ("*.{ulg,tlog}", {"a.tlog", "b.tlog"}),
+        ("!rover/**", {"a.tlog"}),  # negated: everywhere else
+        ("r*/a.tlog", set()),
+    ],
+)
+def test_per_file_ignores_follow_ruffs_globs(
+    tmp_path: Path, pattern: str, ignored_in: set[str]
+) -> None:
+    _flights(tmp_path)
+    (tmp_path / "pyproject.toml").write_text(
+        f'[tool.fuzzoff.per-file-ignores]\n{json.dumps(pattern)} = ["OFB1"]\n'
+    )
+    _, files, _ = _lint_json(["."], tmp_path)
+    without = {
+        name for name, f in files.items() if not any(c.startswith("OFB1") for c in _codes(f))
+    }
+    assert without == ignored_in
+    assert all("OFB701" in _codes(f) for f in files.values())  # other rules untouched
+
+
+def test_per_file_ignores_mistakes_are_usage_errors(tmp_path: Path) -> None:
+    (tmp_path / "fuzzoff.toml").write_text('per-file-ignores = { "*.tlog" = ["OFB9"] }\n')
+    result = run_cli(["lint", str(GAP)], cwd=tmp_path)
+    assert result.returncode == 2 and "OFB9" in result.stderr
+    (tmp_path / "fuzzoff.toml").write_text('per-file-ignores = { "*.{tlog" = ["OFB1"] }\n')
+    result = run_cli(["lint", str(GAP)], cwd=tmp_path)
+    assert result.returncode == 2 and "bad pattern" in result.stderr
+
+
+def test_lint_without_a_path_lints_the_current_folder(tmp_path: Path) -> None:
+    _flights(tmp_path)
+    status, files, _ = _lint_json([], tmp_path)
+    assert status == 1 and set(files) == {"a.tlog", "b.tlog"}
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    result = run_cli(["lint"], cwd=empty)
+    assert result.returncode == 2 and "no recordings in ." in result.stderr
+
+
+@pytest.mark.parametrize(
+    ("args", "hint"),
+    [
+        (["lint", "--statistcs", "x"], "did you mean --statistics?"),
+        (["lint", "--fail-on=warnng", "x"], "did you mean warning?"),
+        (["lint", "--format", "htm", "x"], "did you mean html?"),
+        (["lnt", "x"], "did you mean lint?"),
+        (["lint", "--px4", "mian", "x"], "did you mean main?"),
+        (["lint", "--vehicle", "rover-ackerman", "x"], "did you mean rover-ackermann?"),
+    ],
+)
+def test_a_mistyped_option_gets_a_did_you_mean(args: list[str], hint: str) -> None:
+    result = run_cli(args)
+    assert result.returncode == 2 and hint in result.stderr
+    assert result.stderr.count("\n") == 1
+
+
+@pytest.mark.parametrize(
+    ("text", "hint"),
+    [
+        ('selct = ["OFB1"]', "unknown key selct (did you mean select?)"),
+        ("per-file-ignore = {}", "did you mean per-file-ignores?"),
+        ("options = { OFB104 = { stale_ss = 0.3 } }", "did you mean stale_s?"),
+        ("options = { OFB1044 = { stale_s = 0.3 } }", "did you mean OFB104?"),
+    ],
+)
+def test_a_mistyped_key_gets_a_did_you_mean(tmp_path: Path, text: str, hint: str) -> None:
+    (tmp_path / "fuzzoff.toml").write_text(text + "\n")
+    result = run_cli(["lint", str(GAP)], cwd=tmp_path)
+    assert result.returncode == 2 and hint in result.stderr
+
+
+@pytest.mark.parametrize(
+    ("value", "complaint"),
+    [
+        ("2.0", "PX4 2.0 is not modelled: the newest release modelled is 1.18 (profile main)"),
+        ("1.19.0", "PX4 1.19.0 is not modelled"),
+        ("1.4", "PX4 1.4 is not modelled: the oldest release modelled is 1.5"),
+    ],
+)
+def test_a_px4_release_that_is_not_modelled_is_an_error(value: str, complaint: str) -> None:
+    result = run_cli(["lint", str(GAP), "--px4", value])
+    assert result.returncode == 2 and f"error: --px4: {complaint}" in result.stderr
+
+
+@pytest.mark.parametrize(
+    ("value", "profile"),
+    [("1.18", "main"), ("1.18.0", "main"), ("1.12", "1.13"), ("1.7", "legacy")],
+)
+def test_a_release_judged_by_another_profile_says_which(value: str, profile: str) -> None:
+    result = run_cli(["lint", str(GAP), "--px4", value, "--format", "json"])
+    assert json.loads(result.stdout)["files"][0]["profile"]["px4"] == profile
+    assert (
+        f"fuzzoff: --px4: PX4 {'.'.join(value.split('.')[:2])} is judged with profile {profile}"
+        in (result.stderr)
+    )
+    plain = run_cli(["lint", str(GAP), "--px4", "1.15.4", "--format", "json"])
+    assert "judged with profile" not in plain.stderr
+
+
+def test_vehicle_rover_alone_is_an_error_naming_the_kinds() -> None:
+    result = run_cli(["lint", str(GAP), "--vehicle", "rover"])
+    assert result.returncode == 2
+    assert "rover-ackermann, rover-differential, rover-mecanum" in result.stderr
+
+
+def test_params_say_where_they_were_set(tmp_path: Path) -> None:
+    def ofb701(args: list[str]) -> str:
+        result = run_cli(["lint", str(GAP), "--format", "json", *args], cwd=tmp_path)
+        found = json.loads(result.stdout)["files"][0]["findings"]
+        return next(f["message"] for f in found if f["code"] == "OFB701")
+
+    (tmp_path / "pyproject.toml").write_text("[tool.fuzzoff]\nparams = { COM_OF_LOSS_T = 0.5 }\n")
+    assert "COM_OF_LOSS_T 0.5 s (set in pyproject.toml)" in ofb701([])
+    assert "command line" not in ofb701([])
+    assert "COM_OF_LOSS_T 0.4 s (set with --param)" in ofb701(["--param", "COM_OF_LOSS_T=0.4"])

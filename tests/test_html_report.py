@@ -130,7 +130,9 @@ def test_loss_timeout_from_the_recording_when_the_engine_records_it() -> None:
     profile = Profile("1.15", "mc")
     assert loss_timeout(timeline, profile, Settings()) == (0.7, "from the recording")
     forced = replace(Settings(), params={"COM_OF_LOSS_T": 0.7})
-    assert loss_timeout(timeline, profile, forced) == (0.7, "--param / configuration")
+    assert loss_timeout(timeline, profile, forced) == (0.7, "set by the user")
+    from_file = replace(forced, param_origins={"COM_OF_LOSS_T": "/flights/pyproject.toml"})
+    assert loss_timeout(timeline, profile, from_file) == (0.7, "set in pyproject.toml")
     assert loss_timeout(Timeline(), profile, Settings()) == (1.0, "PX4 1.15 default")
 
 

@@ -45,7 +45,7 @@ class GateDisagrees(Check):
 def _param_source(ctx: CheckContext, name: str) -> str:
     gate = ctx.gate
     if name in gate.overrides:
-        return "set on the command line"
+        return ctx.settings.param_origin(name)
     if name in gate.recorded_params:
         return "from the recording"
     return "PX4 default"

@@ -76,7 +76,26 @@ def settings_from_args(args: argparse.Namespace) -> Settings:
     params = parse_params(getattr(args, "param", []) or [])
     if params:
         overrides["params"] = params
-    return load_settings(Path.cwd(), overrides)
+    settings = load_settings(Path.cwd(), overrides, per_recording=True)
+    print_notes(settings)
+    return settings
+
+
+def print_notes(settings: Settings) -> None:
+    """What the user should know about their settings, one line each on standard error."""
+    for note in settings.notes:
+        print(f"fuzzoff: {note}", file=sys.stderr)
+
+
+def settings_per_recording(settings: Settings, recordings: list[str]) -> None:
+    """Read every recording's nearest configuration before any work: a mistake in one is a
+    usage error now, not a failure halfway through the run. Their notes are printed once."""
+    seen = set(settings.notes)
+    for recording in recordings:
+        for note in settings.for_recording(recording).notes:
+            if note not in seen:
+                seen.add(note)
+                print(f"fuzzoff: {note}", file=sys.stderr)
 
 
 def existing_paths(paths: list[str]) -> None:

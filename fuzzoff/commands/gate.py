@@ -90,9 +90,15 @@ def timeline_rows(timeline: Timeline, controllers: bool = True) -> list[Row]:
 def gate_report(
     path: str, settings_args: argparse.Namespace, controllers: bool = True
 ) -> tuple[FileReport, dict[str, list[Row]]]:
-    settings = settings_from_args(settings_args)
+    settings = settings_from_args(settings_args).for_recording(path)
     # Only the gate's own rule: the timeline needs the model, not every check.
-    settings = dataclasses.replace(settings, select=frozenset({"OFB202"}), ignore=frozenset())
+    settings = dataclasses.replace(
+        settings,
+        select=frozenset({"OFB202"}),
+        ignore=frozenset(),
+        per_file_ignores=(),
+        discovery=None,
+    )
     timelines: dict[str, Timeline] = {}
     report = lint_file(path, settings, timelines=timelines)
     rows = {v: timeline_rows(tl, controllers) for v, tl in sorted(timelines.items())}

@@ -16,6 +16,7 @@ from fuzzoff.commands._common import (
     existing_paths,
     render_rich,
     settings_from_args,
+    settings_per_recording,
     write_output,
 )
 from fuzzoff.config import ConfigError, Settings
@@ -29,7 +30,12 @@ from fuzzoff.sources import RECORDING_SUFFIXES, find_recordings
 
 def add_parser(sub: Any) -> None:
     parser = add_command(sub, "lint")
-    parser.add_argument("paths", nargs="+", metavar="PATH", help="files, bag folders or folders")
+    parser.add_argument(
+        "paths",
+        nargs="*",
+        metavar="PATH",
+        help="files, bag folders or folders (default: the current folder)",
+    )
     add_profile_options(parser)
     add_rule_options(parser)
     add_output_options(parser)
@@ -68,6 +74,8 @@ def run(args: argparse.Namespace) -> int:
     settings = settings_from_args(args)
     if args.jobs < 1:
         raise ConfigError("--jobs must be at least 1")
+    # As ruff: no path means the current folder.
+    args.paths = args.paths or ["."]
     existing_paths(args.paths)
     # A folder with nothing to lint is a mistake (a wrong path, a recording step that failed):
     # passing it would turn a CI job green without looking at a single flight.
@@ -79,6 +87,7 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(f"no recordings in {empty[0]} (searched for {suffixes} and bag folders)")
     paths = [str(f) for _, recordings in found for f in recordings]
     check_output(args.output, paths)
+    settings_per_recording(settings, paths)
     if args.format == "terminal":
         report = _lint_on_terminal(args, paths, settings)
     else:

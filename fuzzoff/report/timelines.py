@@ -28,13 +28,14 @@ def loss_timeout(timeline: Timeline, profile: Profile, settings: Settings) -> tu
     if not isinstance(value, int | float):
         value = GateModel(profile, settings.params).loss_timeout
     if "COM_OF_LOSS_T" in settings.params:
-        return float(value), "--param / configuration"
+        return float(value), settings.param_origin("COM_OF_LOSS_T")
     if "COM_OF_LOSS_T" in recorded:
         return float(value), "from the recording"
     return float(value), f"PX4 {profile.px4} default"
 
 
 def lint_one(path: str | Path, settings: Settings) -> FileReport:
+    settings = settings.for_recording(path)
     timelines: dict[str, Timeline] = {}
     report = lint_file(path, settings, timelines=timelines)
     report.extras["timelines"] = timelines

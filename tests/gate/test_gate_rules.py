@@ -33,7 +33,7 @@ def test_ofb701_legacy_names_the_fixed_500ms() -> None:
 def test_ofb701_names_where_each_value_comes_from() -> None:
     events = [Parameter(t=0.0, name="COM_OBL_RC_ACT", value=3.0), in_offboard(), *stream(0, 1)]
     (summary,) = _lint("1.15", events, "OFB701", COM_OF_LOSS_T=0.5)
-    assert "COM_OF_LOSS_T 0.5 s (set on the command line)" in summary.message
+    assert "COM_OF_LOSS_T 0.5 s (set by the user)" in summary.message
     assert "COM_OBL_RC_ACT 3 (from the recording)" in summary.message
     assert "AUTO_RTL" in summary.message
 
