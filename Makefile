@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 MULTITOOL := build/node/node_modules/.bin/sarif-multitool
 
-.PHONY: install demo test test-tools check bench fuzz clean
+.PHONY: install demo test test-tools test-lowest check bench fuzz clean
 
 $(STAMP): pyproject.toml
 	$(PY) -m venv $(VENV)
@@ -33,6 +33,27 @@ test-tools: $(MULTITOOL)
 
 test: $(STAMP) test-tools
 	$(BIN)/python -m pytest -q -n 2
+
+# The oldest versions pyproject.toml allows, from a built wheel: first the plain install alone,
+# run from outside the source tree (lint, gate, rule and profiles without Hypothesis; fuzz says
+# how to add it), then with the fuzz extra the tests that exercise every dependency (readers,
+# reports, fuzz campaigns). CI runs it after `make test`: about 3 minutes.
+LOWEST := build/lowest
+LOWEST_TESTS := tests/test_corpora.py tests/test_terminal_report.py tests/test_html_report.py \
+	tests/test_fuzz_campaigns.py tests/test_cli.py tests/test_config.py tests/test_packaging.py
+
+test-lowest:
+	rm -rf $(LOWEST)
+	$(PY) -m venv $(LOWEST)/venv
+	$(LOWEST)/venv/bin/pip install -q --upgrade pip
+	$(LOWEST)/venv/bin/pip wheel -q --no-deps -w $(LOWEST)/dist .
+	$(PY) tests/lower_bounds.py > $(LOWEST)/constraints.txt
+	$(LOWEST)/venv/bin/pip install -q -c $(LOWEST)/constraints.txt $(LOWEST)/dist/fuzzoff-*.whl
+	cd $(LOWEST) && venv/bin/python $(CURDIR)/tests/wheel_smoke.py $(CURDIR)/corpora
+	$(LOWEST)/venv/bin/pip install -q -c $(LOWEST)/constraints.txt \
+		"$$(ls $(LOWEST)/dist/fuzzoff-*.whl)[fuzz]" pytest pytest-xdist junitparser
+	$(LOWEST)/venv/bin/pip list --format freeze
+	$(LOWEST)/venv/bin/python -m pytest -q -n 2 -p no:cacheprovider $(LOWEST_TESTS)
 
 check: $(STAMP)
 	$(BIN)/ruff check fuzzoff tests bench corpora

@@ -12,6 +12,7 @@ import importlib
 import re
 import sys
 from collections.abc import Sequence
+from typing import Any
 
 from fuzzoff import __version__
 from fuzzoff.commands import SUMMARIES, add_command
@@ -62,11 +63,30 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     sub.required = True
     for name in sorted(SUMMARIES):
         if only is None or only == name:
-            module = importlib.import_module(f"fuzzoff.commands.{name}")
-            module.add_parser(sub)
+            _import_command(name).add_parser(sub)
         elif only not in SUMMARIES:
             add_command(sub, name)
     return parser
+
+
+EXTRAS = {"hypothesis": "fuzz"}
+"""A dependency left out of the plain install -> the extra that brings it."""
+
+
+def _import_command(name: str) -> Any:
+    """The subcommand's module; one that needs an extra the install left out is a usage error
+    saying how to add it (``fuzz`` needs Hypothesis: a plain ``pip install fuzzoff`` stays
+    lean for ``lint``)."""
+    try:
+        return importlib.import_module(f"fuzzoff.commands.{name}")
+    except ModuleNotFoundError as exc:
+        missing = (exc.name or "").partition(".")[0]
+        if missing not in EXTRAS:
+            raise
+        raise UsageError(
+            f"fuzzoff {name} needs {missing}, which a plain install leaves out: "
+            f"pip install 'fuzzoff[{EXTRAS[missing]}]'"
+        ) from None
 
 
 def main(argv: Sequence[str] | None = None) -> int:
