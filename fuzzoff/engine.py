@@ -15,7 +15,17 @@ from fuzzoff.catalog import get_rule
 from fuzzoff.checks import CheckContext, load_all
 from fuzzoff.checks.base import SENT_STREAM_RULES, STREAM_TYPES, Check, StreamBatch
 from fuzzoff.config import Settings
-from fuzzoff.events import Command, Event, VehicleStatus, is_keepalive
+from fuzzoff.events import (
+    Command,
+    CommandAck,
+    Event,
+    SetPositionTargetLocal,
+    StatusText,
+    TrajectorySetpoint,
+    VehiclePosition,
+    VehicleStatus,
+    is_keepalive,
+)
 from fuzzoff.findings import FileReport, Finding, Report, Severity
 from fuzzoff.gate import GateModel, GateTransition
 from fuzzoff.profiles import (
@@ -77,6 +87,18 @@ class Timeline:
     loss_timeout: float | None = None
     """The gate's effective loss timeout (recording's COM_OF_LOSS_T, overrides, defaults)."""
     recorded_params: dict[str, float] = field(default_factory=dict)
+    notes: list[Event] = field(default_factory=list)
+    """The vehicle's text messages, the commands sent and their acks (at most ``NOTE_LIMIT``)."""
+    positions: list[tuple[float, float, float, float]] = field(default_factory=list)
+    """(t, x, y, z) of the vehicle's local position, NED metres, one per ``SAMPLE_S`` at most."""
+    setpoint_positions: list[tuple[float, float, float, float]] = field(default_factory=list)
+    """(t, x, y, z) of the position setpoints (trajectory setpoints, local NED MAVLink ones)."""
+
+
+NOTE_LIMIT = 5000
+"""Text messages, commands and acks a timeline keeps per vehicle (a recording may flood them)."""
+SAMPLE_S = 0.05
+"""Shortest time between two kept samples of a plotted series (20 Hz is plenty for a plot)."""
 
 
 class VehicleRun:
@@ -218,6 +240,14 @@ class VehicleRun:
             series = self.timeline.setpoint_kinds.setdefault(event.kind, [])
             if not series or event.t - series[-1] >= 0.05:
                 series.append(event.t)
+        if isinstance(event, NOTED):
+            if len(self.timeline.notes) < NOTE_LIMIT:
+                self.timeline.notes.append(event)
+        elif isinstance(event, VehiclePosition):
+            _sample(self.timeline.positions, event.t, (event.x, event.y, event.z))
+        elif _plotted_position(event):
+            assert isinstance(event, TrajectorySetpoint | SetPositionTargetLocal)
+            _sample(self.timeline.setpoint_positions, event.t, event.position)
 
     def finish(self, t_end: float) -> list[Finding]:
         self._flush()
@@ -228,6 +258,30 @@ class VehicleRun:
             self.timeline.loss_timeout = self.gate.loss_timeout
             self.timeline.recorded_params = dict(self.gate.recorded_params)
         return self.ctx.findings
+
+
+NOTED = (StatusText, Command, CommandAck)
+POSITION_IGNORED = 0b111
+"""``type_mask`` bits of SET_POSITION_TARGET_LOCAL_NED that ignore x, y, z."""
+
+
+def _plotted_position(event: Event) -> bool:
+    """A trajectory setpoint, or a MAVLink one in MAV_FRAME_LOCAL_NED (1) whose type mask does
+    not ignore the position (other frames are not in the vehicle's local frame)."""
+    if isinstance(event, TrajectorySetpoint):
+        return True
+    return (
+        isinstance(event, SetPositionTargetLocal)
+        and event.coordinate_frame == 1
+        and not event.type_mask & POSITION_IGNORED
+    )
+
+
+def _sample(
+    series: list[tuple[float, float, float, float]], t: float, xyz: tuple[float, float, float]
+) -> None:
+    if any(math.isfinite(v) for v in xyz) and (not series or t - series[-1][0] >= SAMPLE_S):
+        series.append((t, *xyz))
 
 
 def run_events(
@@ -377,6 +431,7 @@ def lint_file(
     try:
         source = open_source(path)
         source.px4_hint = settings.px4
+        source.plot_data = timelines is not None
         source.open()
     except SourceError as exc:
         report = FileReport(name, "unknown", resolve_profile(RecordingInfo(name, "?"), settings))
@@ -426,6 +481,8 @@ def lint_file(
     findings.sort(key=_sort_key)
     report.findings = findings
     report.stats = {**stats, **source.stats}
+    if source.start_time_s is not None:
+        report.stats["start_unix_s"] = round(source.start_time_s, 6)
     if info.notes:
         report.stats["notes"] = info.notes
     if progress is not None:

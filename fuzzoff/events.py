@@ -570,6 +570,20 @@ class StatusText(Event):
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
+class VehiclePosition(Event):
+    """Where the vehicle estimates it is, local NED in metres (ULog ``vehicle_local_position``,
+    MAVLink ``LOCAL_POSITION_NED``). Read only for the HTML report's plots (``Source.plot_data``):
+    no rule judges it."""
+
+    kind: ClassVar[str] = "vehicle_position"
+
+    x: float = NAN
+    y: float = NAN
+    z: float = NAN
+    origin: Origin = "vehicle"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Dropout(Event):
     """The logger itself lost data here (ULog dropout record) for ``duration_s``."""
 
@@ -596,6 +610,7 @@ ALL_EVENT_TYPES: tuple[type[Event], ...] = (
     Parameter,
     VehicleInfo,
     StatusText,
+    VehiclePosition,
     Dropout,
 )
 

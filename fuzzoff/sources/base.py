@@ -95,6 +95,12 @@ class Source(abc.ABC):
         self.px4_hint: str | None = None
         """The user's ``--px4`` profile, set before ``open()``: readers that must choose message
         definitions the recording does not carry (Humble-era ROS 2 bags) start from it."""
+        self.plot_data = False
+        """Set before ``events()`` for the HTML report: readers then also yield what only its
+        plots show (``VehiclePosition``); a plain lint does not pay for it."""
+        self.start_time_s: float | None = None
+        """The recording's first time on the wall clock (UNIX seconds), where it has one; set
+        by ``events()``. ``t`` of every event counts from it."""
 
     def __enter__(self) -> Source:
         self.open()
@@ -121,6 +127,12 @@ class Source(abc.ABC):
     @abc.abstractmethod
     def events(self) -> Iterator[Event]:
         """The normalised events in recording-time order; streaming where the library can."""
+
+    def set_start(self, unix_s: float | None) -> None:
+        """Keep ``unix_s`` as the start time if it reads as a wall clock (after 2001): a
+        simulation clock or a boot clock starts near 0 and says nothing about the date."""
+        if unix_s is not None and 1e9 < unix_s < 1e10:
+            self.start_time_s = unix_s
 
     def progress(self) -> float | None:
         """Fraction of the file consumed so far, where the reader can tell."""

@@ -152,6 +152,7 @@ class Rosbag1Source(Source):
         reader = self._reader
         if reader is None or not self._wanted:
             return
+        self.set_start(reader.start_time / 1e9 if reader.message_count else None)
         yield from self._convert(self._indexed_then_in_file_order(reader), [reader.start_time])
 
     def _indexed_then_in_file_order(

@@ -534,6 +534,8 @@ class Rosbag2Source(Source):
         return out
 
     def _finish(self) -> None:
+        if self._t0 is not None:
+            self.set_start(self._t0 / 1e9)
         self.problems.extend(self.decoding.problems())
         self.stats["messages"] = self._messages
         if self._info is not None:

@@ -26,6 +26,7 @@ from fuzzoff.events import (
     SetPositionTargetLocal,
     StatusText,
     VehicleInfo,
+    VehiclePosition,
     VehicleStatus,
     Where,
 )
@@ -48,6 +49,7 @@ SET_POSITION_TARGET_LOCAL_NED = 84
 SET_POSITION_TARGET_GLOBAL_INT = 86
 AUTOPILOT_VERSION = 148
 STATUSTEXT = 253
+LOCAL_POSITION_NED = 32
 
 WANTED = frozenset(
     {
@@ -68,6 +70,9 @@ WANTED = frozenset(
     }
 )
 """The only message ids decoded; the rest are framed and CRC-checked, not decoded."""
+
+PLOT_WANTED = WANTED | {LOCAL_POSITION_NED}
+"""With ``plot_data``: also the vehicle's position, for the HTML report."""
 
 PROBE_WANTED = frozenset({HEARTBEAT, AUTOPILOT_VERSION, COMMAND_LONG, COMMAND_INT, SET_MODE})
 """The probe's decodes: who is who, the release, and who sends commands (rare messages)."""
@@ -224,13 +229,15 @@ class TlogSource(Source):
         if self._fatal:
             return  # the probe already raised the one SourceError for this file
         self.probe()
-        framer = self._framer = Framer(self._file(), self._size, WANTED, verify=True)
+        wanted = PLOT_WANTED if self.plot_data else WANTED
+        framer = self._framer = Framer(self._file(), self._size, wanted, verify=True)
         decoder = _Decoder(self._autopilots, self._vehicles())
         first_ts: int | None = None
         try:
             for offset, ts, msgid, msg in framer.records():
                 if first_ts is None:
                     first_ts = framer.stats.first_ts or ts
+                    self.set_start(first_ts / 1e6)
                 t = (ts - first_ts) / 1e6
                 yield from decoder.decode(msgid, msg, t, offset)
         finally:
@@ -323,6 +330,7 @@ class _Decoder:
             SYS_STATUS: self._sys_status,
             RC_CHANNELS: self._rc_channels,
             MANUAL_CONTROL: self._manual_control,
+            LOCAL_POSITION_NED: self._position,
         }
         self.manual: dict[int, bool] = {}
         """Vehicle sysid -> manual control present, as last said (events only on a change)."""
@@ -586,6 +594,12 @@ class _Decoder:
             if sysid not in self.sys_status:
                 out.extend(self._manual(sysid, True, t, where))
         return out
+
+    def _position(self, m: Any, t: float, where: Where) -> Iterable[Event]:
+        if not self._from_autopilot(m):
+            return self._ignore(m, "not from an autopilot")
+        vehicle = str(m.get_srcSystem())
+        return (VehiclePosition(t=t, vehicle=vehicle, where=where, x=m.x, y=m.y, z=m.z),)
 
     def _statustext(self, m: Any, t: float, where: Where) -> Iterable[Event]:
         if not self._from_autopilot(m):

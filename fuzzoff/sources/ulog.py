@@ -26,7 +26,9 @@ from fuzzoff.sources.base import RecordingInfo, Source, SourceError
 from fuzzoff.sources.ulog_load import Loaded, load
 from fuzzoff.sources.ulog_topics import (
     EXTRA_TOPICS,
+    GPS_TOPICS,
     MAIN_STATE_TO_NAV,
+    PLOT_TOPICS,
     TOPICS,
     Chunk,
     Context,
@@ -34,6 +36,7 @@ from fuzzoff.sources.ulog_topics import (
 )
 
 LOADED_TOPICS: tuple[str, ...] = (*TOPICS, *EXTRA_TOPICS)
+PLOT_LOADED_TOPICS: tuple[str, ...] = (*LOADED_TOPICS, *PLOT_TOPICS, *GPS_TOPICS)
 CHUNK_ROWS = 4096
 """Rows turned into Python values at a time (bounds memory on long logs)."""
 
@@ -139,7 +142,8 @@ class UlogSource(Source):
             raise self._failed
         if self._loaded is None:
             try:
-                self._loaded = load(self.path, LOADED_TOPICS)
+                topics = PLOT_LOADED_TOPICS if self.plot_data else LOADED_TOPICS
+                self._loaded = load(self.path, topics)
             except SourceError as exc:
                 self._failed = exc
                 raise
@@ -228,11 +232,14 @@ class UlogSource(Source):
         ulog = self._load().ulog
         t0 = int(ulog.start_timestamp)
         context = self._context(info)
-        ranks = {name: rank for rank, name in enumerate(TOPICS, start=10)}
+        specs = {**TOPICS, **PLOT_TOPICS} if self.plot_data else TOPICS
+        ranks = {name: rank for rank, name in enumerate(specs, start=10)}
         topics: list[_Stream] = []
         datasets = self._datasets()
+        if self.plot_data:
+            self.set_start(_utc_start(datasets, t0))
         for d in datasets:
-            spec = TOPICS.get(d.name)
+            spec = specs.get(d.name)
             if spec is None:
                 continue
             rank = ranks[d.name] * 256 + d.multi_id
@@ -369,6 +376,18 @@ class UlogSource(Source):
         if not self._total:
             return None
         return min(1.0, self._yielded / self._total)
+
+
+def _utc_start(datasets: list[Any], t0: int) -> float | None:
+    """The log's start on the wall clock from the first GPS fix that carries a UTC time."""
+    for d in datasets:
+        if d.name in GPS_TOPICS and "time_utc_usec" in d.data:
+            utc = d.data["time_utc_usec"]
+            found = np.flatnonzero(utc > 0)
+            if len(found):
+                i = int(found[0])
+                return (int(utc[i]) - (int(d.data["timestamp"][i]) - t0)) / 1e6
+    return None
 
 
 def _seconds(ts: int, t0: int) -> float:

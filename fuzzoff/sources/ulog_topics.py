@@ -605,3 +605,18 @@ TOPICS: dict[str, TopicSpec] = {
 
 EXTRA_TOPICS = ("commander_state",)
 """Loaded but not turned into events of their own (merged into ``vehicle_status``)."""
+
+
+def local_position(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
+    for t, w, ts, x, y, z in zip(c.t, c.where, c.ts, c.f("x"), c.f("y"), c.f("z"), strict=True):
+        yield ev.VehiclePosition(t=t, where=w, sender_time_us=ts, x=x, y=y, z=z)
+
+
+PLOT_TOPICS: dict[str, TopicSpec] = {
+    "vehicle_local_position": TopicSpec(ev.VehiclePosition.kind, local_position),
+}
+"""Loaded only for the HTML report's plots (``Source.plot_data``); after ``TOPICS`` in order."""
+
+GPS_TOPICS = ("vehicle_gps_position",)
+"""Loaded for the plots too: the first fix with a UTC time dates the log (a ULog's own clock
+is the time since boot)."""
