@@ -14,7 +14,8 @@ What becomes what (the inverse of ``fuzzoff.sources.tlog``):
 * ``VehicleInfo`` -> AUTOPILOT_VERSION for ``px4_version``; its ``mav_type`` becomes the
   ``type`` of the autopilot's HEARTBEATs from then on (one is written at once if no
   ``VehicleStatus`` follows at the same time);
-* ``CommandAck``, ``Parameter``, ``StatusText`` -> COMMAND_ACK, PARAM_VALUE, STATUSTEXT.
+* ``CommandAck``, ``Parameter``, ``StatusText`` -> COMMAND_ACK, PARAM_VALUE, STATUSTEXT;
+* ``VehiclePosition`` -> LOCAL_POSITION_NED from the autopilot (velocities 0).
 
 A GCS HEARTBEAT is written at time 0 so that the recording starts where the events' clock does.
 """
@@ -43,6 +44,7 @@ from fuzzoff.events import (
     SetPositionTargetLocal,
     StatusText,
     VehicleInfo,
+    VehiclePosition,
     VehicleStatus,
 )
 from fuzzoff.modes import nav_state_to_custom_mode
@@ -76,6 +78,7 @@ SUPPORTED: tuple[type[Event], ...] = (
     StatusText,
     VehicleInfo,
     VehicleStatus,
+    VehiclePosition,
 )
 """The event kinds a tlog carries (what ``fuzzoff.sources.tlog`` emits)."""
 
@@ -239,6 +242,11 @@ class _Writer:
         if isinstance(event, StatusText):
             msg = mavlink.MAVLink_statustext_message(
                 event.severity, event.text.encode("utf-8")[:50], 0, 0
+            )
+            return [self.link(self.autopilot_of(event)).pack(msg)]
+        if isinstance(event, VehiclePosition):
+            msg = mavlink.MAVLink_local_position_ned_message(
+                _boot_ms(event), event.x, event.y, event.z, 0.0, 0.0, 0.0
             )
             return [self.link(self.autopilot_of(event)).pack(msg)]
         raise ValueError(f"a tlog cannot carry {type(event).__name__} events")
