@@ -141,6 +141,26 @@ class Browser:
                 if message["method"] == method:
                     return message
 
+    def set_width(self, width: int, height: int = 900) -> None:
+        """The page's viewport, as a window of that size would give it."""
+        self.call(
+            "Emulation.setDeviceMetricsOverride",
+            {"width": width, "height": height, "deviceScaleFactor": 1, "mobile": False},
+        )
+
+    def wait_until(self, expression: str, timeout: float = 10.0) -> Any:
+        """Evaluate ``expression`` until it is truthy (the page's script runs after load)."""
+        deadline = time.monotonic() + timeout
+        while True:
+            value = self.evaluate(expression)
+            if value or time.monotonic() > deadline:
+                return value
+            time.sleep(0.05)
+
+    def mouse(self, kind: str, x: float, y: float, **more: Any) -> None:
+        """One mouse event at page coordinates (``mousePressed``, ``mouseWheel``, ...)."""
+        self.call("Input.dispatchMouseEvent", {"type": kind, "x": x, "y": y, **more})
+
     def open(self, url: str) -> None:
         for domain in ("Page", "Runtime", "Log", "Network"):
             self.call(f"{domain}.enable")
@@ -153,10 +173,16 @@ class Browser:
             raise CdpError(f"{expression}: {result['exceptionDetails']}")
         return result["result"].get("value")
 
-    def screenshot(self, path: Path) -> None:
-        data = self.call(
-            "Page.captureScreenshot", {"format": "png", "captureBeyondViewport": True}
-        )["data"]
+    def screenshot(self, path: Path, element: str | None = None, *, whole: bool = True) -> None:
+        """The whole page (or what the window shows), or what the JavaScript ``element`` names."""
+        params: dict[str, Any] = {"format": "png", "captureBeyondViewport": whole}
+        if element is not None:
+            x, y, w, h = self.evaluate(
+                f"(() => {{ const r = ({element}).getBoundingClientRect();"
+                " return [r.x + scrollX, r.y + scrollY, r.width, r.height]; })()"
+            )
+            params["clip"] = {"x": x, "y": y, "width": w, "height": h, "scale": 1}
+        data = self.call("Page.captureScreenshot", params)["data"]
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_bytes(base64.b64decode(data))
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from fuzzoff.engine import Timeline
-from fuzzoff.events import Event, SetPositionTargetLocal, VehicleStatus, Where
+from fuzzoff.events import Event, SetPositionTargetLocal, StatusText, VehicleStatus, Where
 from fuzzoff.findings import FileReport, Finding, Report, Severity
 from fuzzoff.gate import GateTransition
 from fuzzoff.profiles import Profile
@@ -40,6 +40,7 @@ def hostile_timeline() -> Timeline:
         "trajectory": [i * 0.1 for i in range(80)] + [9.5 + i * 0.1 for i in range(105)],
         f"kind{IMG}": [1.0, 1.1, 1.2, 15.0],
     }
+    tl.notes = [StatusText(t=9.0, vehicle=VEHICLE, severity=2, text=f"failsafe {HOSTILE}")]
     return tl
 
 

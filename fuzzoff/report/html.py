@@ -1,13 +1,18 @@
 """``--format html``: one self-contained page that opens offline.
 
-No network request and no script: a Content-Security-Policy forbids both, styles are inline and
-the plots are inline SVG (``svg_timeline``). Each rule that has findings is embedded as its page
-(``catalog.render_page`` through markdown-it with raw HTML off), so the links work offline.
-Everything from a recording (paths, topics, messages, vehicle names) is escaped where it is written.
+An index of the recordings (sortable, filterable by severity, rule and name), then per recording
+a summary, a zoomable timeline per vehicle (``html_plot`` builds the data, ``timeline.js`` draws
+it with uPlot, both inline) and the findings table, then the page of every rule that has
+findings (``catalog.render_page`` through markdown-it with raw HTML off), so the links work
+offline. The page fetches nothing and runs only its own two scripts (``html_assets``).
+Everything from a recording (paths, topics, messages, vehicle names, status texts) is escaped
+where it is written into markup, or travels as escaped JSON that the script puts on the page
+as text.
 """
 
 from __future__ import annotations
 
+import datetime
 from collections import Counter
 from html import escape
 
@@ -19,16 +24,13 @@ from fuzzoff.config import Settings
 from fuzzoff.engine import Timeline
 from fuzzoff.findings import FileReport, Finding, Report, Severity
 from fuzzoff.profiles import SOURCE_WORDS
+from fuzzoff.report.html_assets import CSP, report_csp, scripts, uplot_css
+from fuzzoff.report.html_plot import Marker, as_script_data, loss_line, vehicle_plot
 from fuzzoff.report.html_style import CSS
 from fuzzoff.report.sanitize import printable
-from fuzzoff.report.svg_timeline import Marker, timeline_svg
 from fuzzoff.report.timelines import loss_timeout
 
-CSP = (
-    "default-src 'none'; style-src 'unsafe-inline'; img-src data:; "
-    "base-uri 'none'; form-action 'none'"
-)
-"""Forbids every script and every request: the page cannot reach the network even by mistake."""
+__all__ = ["CSP", "e", "render", "rule_article"]
 
 TEXT_LIMIT = 4000
 """Longest text shown from a recording (a message, a path) before it is cut."""
@@ -39,6 +41,11 @@ VERDICT = {0: "passed", 1: "failed", 2: "incomplete input"}
 def e(text: object) -> str:
     """Escaped for element text and double-quoted attributes; control characters shown as \\xNN."""
     return escape(printable(str(text), TEXT_LIMIT), quote=True)
+
+
+def vehicle_name(vehicle: str) -> str:
+    """A vehicle as a reader names it: its MAVLink system id or ROS namespace, as it is."""
+    return f"vehicle {vehicle}" if vehicle else "vehicle (no namespace / id)"
 
 
 def _rule(code: str) -> Rule | None:
@@ -65,16 +72,27 @@ def _profile(file: FileReport) -> str:
     return f"PX4 <b>{e(p.px4)}</b>{release}, {px4}; vehicle <b>{e(p.vehicle)}</b>, {vehicle}"
 
 
+def start_text(file: FileReport) -> str:
+    """The recording's start on the wall clock, in UTC, or why it is not known."""
+    start = file.stats.get("start_unix_s")
+    if not isinstance(start, int | float):
+        return "not in the recording (its clock counts from boot or simulation start)"
+    moment = datetime.datetime.fromtimestamp(start, datetime.UTC)
+    return moment.strftime("%Y-%m-%d %H:%M:%S.%f")[:-3] + " UTC"
+
+
 def _summary(file: FileReport, timelines: dict[str, Timeline]) -> str:
     counts = Counter(f.severity for f in file.findings)
     stats = file.stats
+    vehicles = ", ".join(vehicle_name(v).removeprefix("vehicle ") for v in timelines)
     rows = [
         ("format", e(file.format)),
         ("profile", _profile(file)),
         ("complete", "yes" if file.complete else '<b class="error">no: part could not be read</b>'),
+        ("start", e(start_text(file))),
         ("duration", f"{float(stats.get('duration_s') or 0.0):.3f} s"),
         ("events", e(stats.get("events", 0))),
-        ("vehicles", e(", ".join(repr(v) for v in timelines) or "none")),
+        ("vehicles", e(vehicles or "none")),
         (
             "findings",
             f'<span class="error">{counts[Severity.ERROR]} error</span>, '
@@ -91,15 +109,20 @@ def _summary(file: FileReport, timelines: dict[str, Timeline]) -> str:
 
 
 def _plots(
-    file: FileReport, markers: list[Marker], timelines: dict[str, Timeline], settings: Settings
+    index: int,
+    file: FileReport,
+    markers: list[Marker],
+    timelines: dict[str, Timeline],
+    settings: Settings,
 ) -> str:
     if not timelines:
         return '<p class="none">No timeline: the recording has no events fuzzoff could read.</p>'
     stored = file.extras.get("loss_timeouts", {})
     t_end = float(file.stats.get("duration_s") or 0.0)
+    start = file.stats.get("start_unix_s")
     vehicles = list(timelines)
     out = []
-    for vehicle in vehicles:
+    for k, vehicle in enumerate(vehicles):
         mine = [
             m
             for m in markers
@@ -107,15 +130,22 @@ def _plots(
             or (m.finding.vehicle not in timelines and vehicle == vehicles[0])
         ]
         tl = timelines[vehicle]
-        loss, source = stored.get(vehicle) or loss_timeout(tl, file.profile, settings)
-        name = f"vehicle {vehicle!r}" if vehicle else "vehicle (no namespace / id)"
-        svg = timeline_svg(
-            tl, mine, t_end=t_end, loss_timeout=loss, label=f"{file.path}: {name} timeline"
-        )
+        seconds, source = stored.get(vehicle) or loss_timeout(tl, file.profile, settings)
+        recorded = tl.recorded_params.get("COM_OF_LOSS_T")
+        loss = loss_line(seconds, source, file.profile, recorded)
+        name = vehicle_name(vehicle)
+        data = vehicle_plot(tl, mine, t_end=t_end, loss=loss, name=name)
+        ident = f"plot-{index}-{k}"
+        marks = " ".join(m.ident for m in mine if m.finding.time_s is not None)
+        start_attr = f' data-start="{start!r}"' if isinstance(start, int | float) else ""
         out.append(
-            f"<figure><figcaption><b>{e(name)}</b>: keep-alive interval with the 500 ms (2 Hz) "
-            f"line and the loss timeout COM_OF_LOSS_T = {loss:g} s ({e(source)}); modes and "
-            f"setpoint kinds below; a triangle per finding (click it).</figcaption>{svg}</figure>"
+            f'<figure class="timeline" tabindex="0" data-plot="{ident}" data-marks="{e(marks)}"'
+            f'{start_attr} aria-label="{e(file.path)}: {e(name)} timeline">'
+            f"<figcaption><b>{e(name)}</b>: {e(loss.caption)}.</figcaption>"
+            '<p class="needs-js none">The timeline is drawn by the report\'s own script, '
+            "which this viewer did not run; the findings below do not need it.</p>"
+            f'<script type="application/json" id="{ident}">{as_script_data(data)}</script>'
+            "</figure>"
         )
     return "".join(out)
 
@@ -123,7 +153,7 @@ def _plots(
 COLUMNS = ("time", "rule", "severity", "vehicle", "message", "location")
 
 
-def _findings_table(markers: list[Marker]) -> str:
+def _findings_table(markers: list[Marker], timed: set[str]) -> str:
     if not markers:
         return '<p class="none">No findings.</p>'
     rows = []
@@ -132,7 +162,7 @@ def _findings_table(markers: list[Marker]) -> str:
         rule = _rule(f.code)
         sev = f.severity.label
         when = e(_time(f))
-        if f.time_s is not None:
+        if m.ident in timed:
             when = f'<a href="#mark-{e(m.ident)}">{when}</a>'
         code = f'<a href="#rule-{e(f.code)}">{e(f.code)}</a>'
         if rule is not None:
@@ -143,13 +173,10 @@ def _findings_table(markers: list[Marker]) -> str:
             f'<td class="sev {sev}">{sev}</td><td>{e(f.vehicle)}</td><td>{e(f.message)}</td>'
             f"<td><code>{where}</code></td></tr>"
         )
-    head = (
-        "<tr><th>time</th><th>rule</th><th>severity</th><th>vehicle</th><th>message</th>"
-        "<th>location</th></tr>"
-    )
+    head = "".join(f"<th>{name}</th>" for name in COLUMNS)
     cols = "".join(f'<col class="c-{name}">' for name in COLUMNS)
     return (
-        f'<table class="findings"><colgroup>{cols}</colgroup><thead>{head}</thead>'
+        f'<table class="findings"><colgroup>{cols}</colgroup><thead><tr>{head}</tr></thead>'
         f"<tbody>{''.join(rows)}</tbody></table>"
     )
 
@@ -157,11 +184,12 @@ def _findings_table(markers: list[Marker]) -> str:
 def _file_section(index: int, file: FileReport, settings: Settings) -> str:
     timelines: dict[str, Timeline] = file.extras.get("timelines", {})
     markers = [Marker(f"{index}-{i}", f) for i, f in enumerate(file.findings)]
+    timed = {m.ident for m in markers if m.finding.time_s is not None and timelines}
     return (
         f'<section class="file" id="file-{index}"><h2>{e(file.path)}</h2>'
         f"{_summary(file, timelines)}<h3>Timeline</h3>"
-        f"{_plots(file, markers, timelines, settings)}"
-        f"<h3>Findings</h3>{_findings_table(markers)}</section>"
+        f"{_plots(index, file, markers, timelines, settings)}"
+        f"<h3>Findings</h3>{_findings_table(markers, timed)}</section>"
     )
 
 
@@ -179,26 +207,97 @@ def rule_article(rule: Rule) -> str:
     )
 
 
-def _contents(report: Report, fail_on: Severity) -> str:
-    items = []
-    for i, file in enumerate(report.files):
-        worst = file.worst()
-        css = worst.label if worst is not None else "ok"
-        label = worst.label if worst is not None else "no findings"
-        items.append(
-            f'<li><a href="#file-{i}">{e(file.path)}</a> <span class="sev {css}">{label}</span> '
-            f"({len(file.findings)} findings)</li>"
-        )
+INDEX_COLUMNS = (
+    ("recording", "text"),
+    ("format", "text"),
+    ("PX4", "text"),
+    ("vehicle", "text"),
+    ("duration s", "number"),
+    ("errors", "number"),
+    ("warnings", "number"),
+    ("info", "number"),
+    ("rules", "text"),
+    ("read", "text"),
+)
+
+
+def _index_row(i: int, file: FileReport) -> str:
+    worst = file.worst()
+    counts = Counter(f.severity for f in file.findings)
+    codes = sorted({f.code for f in file.findings})
+    duration = float(file.stats.get("duration_s") or 0.0)
+    label = worst.label if worst is not None else "none"
+    cells = [
+        f'<a href="#file-{i}">{e(file.path)}</a>',
+        e(file.format),
+        e(file.profile.px4),
+        e(file.profile.vehicle),
+        f"{duration:.1f}",
+        str(counts[Severity.ERROR]),
+        str(counts[Severity.WARNING]),
+        str(counts[Severity.INFO]),
+        " ".join(f'<a href="#rule-{e(c)}">{e(c)}</a>' for c in codes),
+        "yes" if file.complete else '<b class="error">no</b>',
+    ]
+    sort_keys = {4: f"{duration:.6f}"}
+    tds = "".join(
+        f'<td data-sort="{sort_keys[k]}">{cell}</td>' if k in sort_keys else f"<td>{cell}</td>"
+        for k, cell in enumerate(cells)
+    )
+    return (
+        f'<tr class="sev-{label}" data-file="file-{i}" data-worst="{label}" '
+        f'data-rules="{e(" ".join(codes))}" data-path="{e(file.path)}">{tds}</tr>'
+    )
+
+
+def _index(report: Report, fail_on: Severity) -> str:
     if not report.files:
         return '<p class="none">No recordings were found in the paths given.</p>'
     status = report.exit_status(fail_on)
     total = Counter(f.severity for f in report.findings)
-    return (
+    verdict = (
         f'<p class="verdict v{status}">Result: {VERDICT[status]} (fail level {fail_on.label}); '
         f"{len(report.files)} recordings, {total[Severity.ERROR]} errors, "
         f"{total[Severity.WARNING]} warnings, {total[Severity.INFO]} info.</p>"
-        f'<ol class="contents">{"".join(items)}</ol>'
     )
+    codes = sorted({f.code for f in report.findings})
+    options = "".join(f'<option value="{e(c)}">{e(c)}</option>' for c in codes)
+    controls = (
+        '<div class="index-controls" hidden>'
+        '<label>severity <select name="severity"><option value="">any</option>'
+        '<option value="error">with errors</option>'
+        '<option value="warning">warnings or worse</option>'
+        '<option value="info">any finding</option>'
+        '<option value="none">no findings</option></select></label>'
+        f'<label>rule <select name="rule"><option value="">any</option>{options}</select></label>'
+        '<label>name <input name="text" type="search" placeholder="part of the path"></label>'
+        '<span class="count"></span></div>'
+    )
+    head = "".join(
+        f'<th data-type="{kind}"><button type="button" title="sort">{name}</button></th>'
+        for name, kind in INDEX_COLUMNS
+    )
+    rows = "".join(_index_row(i, f) for i, f in enumerate(report.files))
+    return (
+        f"{verdict}{controls}"
+        f'<div class="index-wrap"><table class="index"><thead><tr>{head}</tr></thead>'
+        f"<tbody>{rows}</tbody></table></div>"
+    )
+
+
+HELP = (
+    '<details class="help"><summary>Reading a timeline</summary><p>Per vehicle, top to bottom: '
+    "a marker per finding (a number is a group of findings too close to tell apart: click it "
+    "to zoom in); the time since the previous keep-alive message, on a log axis, with the "
+    "500 ms (2 Hz) line of the docs and the loss-timeout line of the PX4 version (during a gap "
+    "the line rises as the newest keep-alive ages); the vehicle's position beside the position "
+    "setpoints, where the recording has them; bands for the offboard signal as the gate model "
+    "holds it, the recorded mode (paler while disarmed), the mode the model predicts, and each "
+    "kind of setpoint sent; then PX4's text messages (failsafe ones marked) and the commands "
+    "with their acks. Drag across a plot to zoom in, Ctrl + wheel to zoom, Shift + wheel or "
+    "the arrows to move, double-click for the whole recording; the plots of a vehicle move "
+    "together. Times count from the recording's first message.</p></details>"
+)
 
 
 def render(report: Report, settings: Settings) -> str:
@@ -207,13 +306,15 @@ def render(report: Report, settings: Settings) -> str:
     rules = [r for r in (_rule(c) for c in codes) if r is not None]
     articles = "".join(rule_article(r) for r in rules)
     rules_section = f'<section id="rules"><h2>Rules</h2>{articles}</section>' if rules else ""
+    uplot, app = scripts()
     return (
         "<!DOCTYPE html>\n"
         '<html lang="en"><head><meta charset="utf-8">'
-        f'<meta http-equiv="Content-Security-Policy" content="{CSP}">'
+        f'<meta http-equiv="Content-Security-Policy" content="{report_csp()}">'
         '<meta name="viewport" content="width=device-width, initial-scale=1">'
-        f"<title>fuzzoff report</title><style>{CSS}</style></head><body>"
+        f"<title>fuzzoff report</title><style>{uplot_css()}{CSS}</style></head><body>"
         f"<header><h1>fuzzoff report</h1><p>fuzzoff {e(__version__)}</p></header>"
-        f"<main>{_contents(report, settings.fail_on)}{sections}{rules_section}</main>"
+        f"<main>{_index(report, settings.fail_on)}{HELP}{sections}{rules_section}</main>"
+        f"<script>{uplot}</script><script>{app}</script>"
         "</body></html>\n"
     )

@@ -5,51 +5,90 @@ CSS = """
 body { font: 14px/1.45 system-ui, sans-serif; margin: 0; color: #1b1b1b; background: #fafafa; }
 header { background: #263238; color: #fff; padding: 10px 24px; }
 header h1 { margin: 0; font-size: 20px; } header p { margin: 0; opacity: .7; }
-main { padding: 8px 24px 48px; max-width: 1100px; }
-h2 { font-size: 17px; word-break: break-all; border-bottom: 1px solid #ccc; margin-top: 32px; }
+main { padding: 8px 24px 48px; max-width: 1400px; }
+h2 { font-size: 17px; overflow-wrap: anywhere; border-bottom: 1px solid #ccc; margin-top: 32px; }
 h3 { font-size: 15px; margin: 18px 0 6px; }
 .error { color: var(--error); } .warning { color: var(--warning); } .info { color: var(--info); }
 .sev { font-weight: 600; } .sev.ok { color: var(--ok); }
 .verdict { font-weight: 600; } .verdict.v0 { color: var(--ok); }
 .verdict.v1, .verdict.v2 { color: var(--error); }
+[hidden] { display: none !important; }
 dl.summary { display: grid; grid-template-columns: max-content 1fr; gap: 2px 14px; margin: 0; }
-dl.summary dt { color: #555; } dl.summary dd { margin: 0; word-break: break-all; }
-ul.problems li { color: var(--error); word-break: break-all; }
-figure { margin: 8px 0 16px; } figcaption { color: #444; margin-bottom: 4px; }
+dl.summary dt { color: #555; } dl.summary dd { margin: 0; overflow-wrap: anywhere; }
+ul.problems li { color: var(--error); overflow-wrap: anywhere; }
+.none { color: #777; font-style: italic; }
+a.ext { text-decoration: none; }
+tr:target { background: #fff3b0; }
+details.help { margin: 10px 0; color: #444; } details.help summary { cursor: pointer; }
+
+.index-controls { display: flex; flex-wrap: wrap; gap: 6px 16px; align-items: center;
+  margin: 6px 0; }
+.index-controls .count { color: #555; }
+.index-wrap { overflow-x: auto; max-height: 60vh; overflow-y: auto; border: 1px solid #ddd;
+  background: #fff; }
+table.index { border-collapse: collapse; width: 100%; font-size: 13px; }
+table.index th { position: sticky; top: 0; background: #eceff1; text-align: left;
+  white-space: nowrap; }
+table.index th button { font: inherit; font-weight: 600; background: none; border: 0;
+  padding: 4px 6px; cursor: pointer; }
+table.index th[aria-sort=ascending] button::after { content: " ▲"; }
+table.index th[aria-sort=descending] button::after { content: " ▼"; }
+table.index td { padding: 2px 6px; border-top: 1px solid #eee; vertical-align: top; }
+table.index td:first-child { overflow-wrap: anywhere; min-width: 16em; }
+table.index td:first-child { border-left: 4px solid transparent; }
+table.index tr.sev-error td:first-child { border-left-color: var(--error); }
+table.index tr.sev-warning td:first-child { border-left-color: var(--warning); }
+table.index tr.sev-info td:first-child { border-left-color: var(--info); }
+table.index tr.sev-error td:nth-child(6), table.index tr.sev-warning td:nth-child(7) {
+  font-weight: 700; }
+
 table.findings { border-collapse: collapse; width: 100%; table-layout: fixed; }
 col.c-time { width: 8em; } col.c-rule { width: 5.5em; } col.c-severity { width: 5.5em; }
 col.c-vehicle { width: 12%; } col.c-location { width: 22%; }
 table.findings th, table.findings td { border-bottom: 1px solid #ddd; padding: 3px 6px;
   text-align: left; vertical-align: top; }
 table.findings td { overflow-wrap: anywhere; }
-tr:target { background: #fff3b0; }
-.none { color: #777; font-style: italic; }
 article.rule { background: #fff; border: 1px solid #ddd; padding: 4px 14px; margin: 10px 0; }
+article.rule pre { overflow-x: auto; }
 article.rule:target { border-color: #f9a825; box-shadow: 0 0 0 3px #fff3b0; }
-a.ext { text-decoration: none; }
-svg.timeline { max-width: 100%; height: auto; background: #fff; border: 1px solid #ddd; }
-svg text { font: 11px system-ui, sans-serif; fill: #333; }
-svg .lbl, svg .tick { text-anchor: end; } svg .ttick { text-anchor: middle; }
-svg .rate-l { text-anchor: end; font-weight: 600; } svg .loss-l { font-weight: 600; }
-svg .panel { fill: #fcfcfc; stroke: #bbb; } svg .band-bg { fill: #f1f1f1; }
-svg .grid { stroke: #e4e4e4; } svg .axis { stroke: #666; }
-svg .series { fill: none; stroke: #1565c0; stroke-width: 1.2; }
-svg .tail { fill: none; stroke: #1565c0; stroke-dasharray: 4 3; }
-svg .rate { stroke: #b26a00; stroke-dasharray: 6 3; } svg .rate-l { fill: #b26a00; }
-svg .loss { stroke: #c62828; stroke-dasharray: 2 2; } svg .loss-l { fill: #c62828; }
-svg .seg { fill: #fff; font-size: 10px; pointer-events: none; }
-svg .m-offboard { fill: #2e7d32; } svg .m-unknown { fill: #9e9e9e; }
-svg .m-0 { fill: #5c6bc0; } svg .m-1 { fill: #8d6e63; } svg .m-2 { fill: #00838f; }
-svg .m-3 { fill: #6a1b9a; } svg .m-4 { fill: #ef6c00; } svg .m-5 { fill: #455a64; }
-svg .disarmed { opacity: .45; }
-svg .s-ok { fill: #66bb6a; } svg .s-lost { fill: #e57373; } svg .sp { fill: #42a5f5; }
-svg .mark line { stroke-width: 1.2; opacity: .8; } svg .mark .span { opacity: .10; }
-svg .mark.error line { stroke: var(--error); } svg .mark.error path,
-svg .mark.error .span { fill: var(--error); }
-svg .mark.warning line { stroke: var(--warning); } svg .mark.warning path,
-svg .mark.warning .span { fill: var(--warning); }
-svg .mark.info line { stroke: var(--info); } svg .mark.info path,
-svg .mark.info .span { fill: var(--info); }
-svg .mark:target line, svg .mark:hover line { stroke-width: 3.5; opacity: 1; }
-svg .mark:target path { stroke: #000; }
+
+figure.timeline { margin: 8px 0 16px; background: #fff; border: 1px solid #ddd;
+  padding: 6px 8px; }
+figure.timeline:focus { outline: 2px solid #90caf9; }
+figure.timeline figcaption { color: #444; margin-bottom: 4px; overflow-wrap: anywhere; }
+.toolbar { display: flex; flex-wrap: wrap; gap: 4px; align-items: center; margin: 4px 0; }
+.toolbar button { font: inherit; padding: 0 8px; border: 1px solid #bbb; background: #f5f5f5;
+  border-radius: 3px; cursor: pointer; }
+.toolbar .range { color: #444; margin-left: 8px; font-variant-numeric: tabular-nums; }
+.plots { position: relative; }
+.uplot { width: auto; }
+.u-legend { font-size: 12px; text-align: left; }
+.u-legend .u-series th { font-weight: normal; }
+.lane { position: relative; overflow: hidden; }
+.lane.marks { height: 20px; }
+.mark { position: absolute; top: 0; transform: translateX(-50%); text-decoration: none;
+  font: 600 10px/16px system-ui, sans-serif; color: #fff; text-align: center; }
+.mark:not(.group)::before { content: ""; display: block; width: 0; height: 0;
+  border-left: 6px solid transparent; border-right: 6px solid transparent;
+  border-top: 12px solid var(--info); margin-top: 4px; }
+.mark.warning:not(.group)::before { border-top-color: var(--warning); }
+.mark.error:not(.group)::before { border-top-color: var(--error); }
+.mark.group { min-width: 16px; height: 16px; padding: 0 3px; border-radius: 8px; margin-top: 2px;
+  background: var(--info); }
+.mark.group.warning { background: var(--warning); } .mark.group.error { background: var(--error); }
+.mark:target::before { border-top-color: #000 !important; }
+.mark:target, .mark:hover { z-index: 2; filter: drop-shadow(0 0 2px #f9a825); }
+.lane.notes { height: 36px; font-size: 11px; }
+.note { position: absolute; top: 0; height: 18px; white-space: nowrap; line-height: 16px; }
+.note.row2 { top: 18px; }
+.note .tick { display: inline-block; width: 2px; height: 14px; vertical-align: middle;
+  background: #607d8b; margin-right: 3px; }
+.note .label { color: #333; display: inline-block; overflow: hidden; text-overflow: ellipsis;
+  vertical-align: middle; }
+.note.error .tick { background: var(--error); } .note.warning .tick { background: var(--warning); }
+.note.ok .tick { background: var(--ok); }
+.note.failsafe .label { color: var(--error); font-weight: 600; }
+.note.cmd .tick { background: #37474f; width: 3px; }
+.readout { min-height: 1.45em; color: #333; font-size: 12px; overflow-wrap: anywhere;
+  font-variant-numeric: tabular-nums; }
 """

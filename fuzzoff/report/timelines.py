@@ -21,12 +21,15 @@ def loss_timeout(timeline: Timeline, profile: Profile, settings: Settings) -> tu
 
     An engine that copies the gate's final ``loss_timeout`` and ``recorded_params`` onto the
     timeline gives the recording's own value; without them the value is ``--param`` /
-    configuration, else the profile's default (what the gate model starts from).
+    configuration, else the profile's default (what the gate model starts from). Before 1.11
+    the timeout is a fixed 500 ms whatever COM_OF_LOSS_T says (gate spec 2.3).
     """
     recorded = getattr(timeline, "recorded_params", None) or {}
     value = getattr(timeline, "loss_timeout", None)
     if not isinstance(value, int | float):
         value = GateModel(profile, settings.params).loss_timeout
+    if profile.px4 == "legacy":
+        return float(value), "fixed in PX4 before 1.11"  # COM_OF_LOSS_T is not the timeout
     if "COM_OF_LOSS_T" in settings.params:
         return float(value), settings.param_origin("COM_OF_LOSS_T")
     if "COM_OF_LOSS_T" in recorded:
