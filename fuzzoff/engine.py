@@ -420,10 +420,12 @@ def lint_file(
     progress: Progress | None = None,
     timelines: dict[str, Timeline] | None = None,
     batching: bool = True,
+    plot_data: bool = False,
 ) -> FileReport:
     """Lint one recording. Never raises for a bad file: it becomes OFB001 and ``complete=False``.
 
-    ``batching=False`` gives every check the stream one message at a time (see ``run_events``)."""
+    ``batching=False`` gives every check the stream one message at a time (see ``run_events``);
+    ``plot_data`` has the reader add what only the HTML report's plots show (positions)."""
     settings = (settings or Settings()).for_recording(path)
     path = Path(path)
     name = path_text(path)
@@ -431,7 +433,7 @@ def lint_file(
     try:
         source = open_source(path)
         source.px4_hint = settings.px4
-        source.plot_data = timelines is not None
+        source.plot_data = plot_data
         source.open()
     except SourceError as exc:
         report = FileReport(name, "unknown", resolve_profile(RecordingInfo(name, "?"), settings))

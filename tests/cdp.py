@@ -164,6 +164,8 @@ class Browser:
     def open(self, url: str) -> None:
         for domain in ("Page", "Runtime", "Log", "Network"):
             self.call(f"{domain}.enable")
+        # a load event of the page before must not count as this one's
+        self.events = [e for e in self.events if e["method"] != "Page.loadEventFired"]
         self.call("Page.navigate", {"url": url})
         self.wait_for("Page.loadEventFired")
 

@@ -17,6 +17,7 @@ dl.summary { display: grid; grid-template-columns: max-content 1fr; gap: 2px 14p
 dl.summary dt { color: #555; } dl.summary dd { margin: 0; overflow-wrap: anywhere; }
 ul.problems li { color: var(--error); overflow-wrap: anywhere; }
 .none { color: #777; font-style: italic; }
+.js .needs-js { display: none; }
 a.ext { text-decoration: none; }
 tr:target { background: #fff3b0; }
 details.help { margin: 10px 0; color: #444; } details.help summary { cursor: pointer; }
@@ -34,7 +35,14 @@ table.index th button { font: inherit; font-weight: 600; background: none; borde
 table.index th[aria-sort=ascending] button::after { content: " ▲"; }
 table.index th[aria-sort=descending] button::after { content: " ▼"; }
 table.index td { padding: 2px 6px; border-top: 1px solid #eee; vertical-align: top; }
-table.index td:first-child { overflow-wrap: anywhere; min-width: 16em; }
+table.index td:first-child { overflow-wrap: anywhere; min-width: 14em; }
+table.index td:nth-child(9) { min-width: 9em; }
+@media (max-width: 900px) {
+  table.index th:nth-child(2), table.index td:nth-child(2),
+  table.index th:nth-child(4), table.index td:nth-child(4),
+  table.index th:nth-child(10), table.index td:nth-child(10) { display: none; }
+  main { padding: 8px 12px 48px; }
+}
 table.index td:first-child { border-left: 4px solid transparent; }
 table.index tr.sev-error td:first-child { border-left-color: var(--error); }
 table.index tr.sev-warning td:first-child { border-left-color: var(--warning); }

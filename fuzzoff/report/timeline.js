@@ -6,6 +6,7 @@
  */
 (() => {
   "use strict";
+  document.documentElement.classList.add("js"); // the timelines will be drawn: no "needs JS" note
 
   const AXIS = 118; // width of every plot's left axis, so their plotting areas line up
   const MARK_GAP = 14; // markers closer than this (px) are drawn as one group

@@ -40,7 +40,7 @@ def loss_timeout(timeline: Timeline, profile: Profile, settings: Settings) -> tu
 def lint_one(path: str | Path, settings: Settings) -> FileReport:
     settings = settings.for_recording(path)
     timelines: dict[str, Timeline] = {}
-    report = lint_file(path, settings, timelines=timelines)
+    report = lint_file(path, settings, timelines=timelines, plot_data=True)
     report.extras["timelines"] = timelines
     report.extras["loss_timeouts"] = {
         vehicle: loss_timeout(tl, report.profile, settings) for vehicle, tl in timelines.items()
