@@ -185,13 +185,14 @@ def crowded_file() -> FileReport:
 @pytest.fixture(scope="module")
 def user_report(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """Recordings with what a user meets: a gap, a real log with PX4's messages and positions,
-    a ROS 2 flight, and a crowd of findings."""
+    a ROS 2 flight, PX4 1.17's ground-station log of a failsafe, and a crowd of findings."""
     folder = tmp_path_factory.mktemp("user")
     paths = [
         gap_recording(folder / "gap.tlog"),
         CORPORA / "real" / "sample_px4_events.ulg",
         CORPORA / "tlog" / "stream_lost_in_offboard.tlog",
         CORPORA / "mcap" / "stream_lost.mcap",
+        CORPORA / "tlog" / "px4_1_17_0_loss.gcs.tlog",  # PX4 1.17 SITL's own failsafe message
     ]
     files = [lint_one(p, Settings()) for p in paths if p.exists()]
     page = folder / "report.html"
@@ -209,7 +210,7 @@ OVERLAPS = """(() => {
   const out = {};
   document.querySelectorAll('figure.timeline').forEach((fig, k) => {
     if (!fig.querySelector('.uplot')) return;
-    const labels = boxes(fig.querySelectorAll('.note:not([hidden]) .label'));
+    const labels = boxes(fig.querySelectorAll('.note:not([hidden]) .label, .row-name'));
     const ticks = boxes(fig.querySelectorAll('.note:not([hidden]) .tick'));
     const marks = boxes(fig.querySelectorAll('.mark'));
     const texts = boxes(fig.querySelectorAll('figcaption, .toolbar > *, .readout'));
@@ -245,6 +246,14 @@ def test_what_a_user_sees_at_two_widths(browser: Browser, user_report: Path, wid
     assert any(label == "takeoff" or label.startswith("mode ") for label in labels)
     assert "2024-03-18" in browser.evaluate(f"{real}.closest('section').innerText")
     assert browser.evaluate(f"{real}.querySelector('.position') !== null")
+    # PX4's failsafe message has a row of its own, and its label is whole
+    failsafe = browser.evaluate(
+        "[...document.querySelectorAll('.note.failsafe')].filter((n) => !n.hidden)"
+        ".map((n) => { const l = n.querySelector('.label');"
+        " return [l.hidden, l.textContent, l.scrollWidth <= l.clientWidth + 1]; })"
+    )
+    assert failsafe and all(not hidden and whole for hidden, _, whole in failsafe)
+    assert any(text.startswith("Failsafe activated") for _, text, _ in failsafe)
     browser.evaluate(f"{real}.scrollIntoView()")
     browser.screenshot(ARTIFACTS / f"html-report-{width}-real.png", real)
     _zoom_changes_the_visible_range(browser, width)
@@ -309,7 +318,7 @@ def test_the_index_sorts_and_filters(browser: Browser, user_report: Path) -> Non
         return values
 
     total = len(column(0))
-    assert total == 5
+    assert total == 6
     errors = "document.querySelector('table.index th:nth-child(6) button')"
     browser.evaluate(f"{errors}.click()")
     ascending = [int(v) for v in column(5)]

@@ -86,9 +86,10 @@ figure.timeline figcaption { color: #444; margin-bottom: 4px; overflow-wrap: any
 .mark.group.warning { background: var(--warning); } .mark.group.error { background: var(--error); }
 .mark:target::before { border-top-color: #000 !important; }
 .mark:target, .mark:hover { z-index: 2; filter: drop-shadow(0 0 2px #f9a825); }
-.lane.notes { height: 36px; font-size: 11px; }
+.lane.notes { font-size: 11px; margin-top: 4px; }
 .note { position: absolute; top: 0; height: 18px; white-space: nowrap; line-height: 16px; }
-.note.row2 { top: 18px; }
+.row-name { position: absolute; left: 0; text-align: right; color: #555; line-height: 16px;
+  white-space: nowrap; overflow: hidden; text-overflow: ellipsis; }
 .note .tick { display: inline-block; width: 2px; height: 14px; vertical-align: middle;
   background: #607d8b; margin-right: 3px; }
 .note .label { color: #333; display: inline-block; overflow: hidden; text-overflow: ellipsis;

@@ -45,6 +45,9 @@
     return `${d.toISOString().slice(11, 23)} UTC`;
   };
 
+  const ROWS = ["failsafes, errors", "PX4 messages", "commands"];
+  const noteRow = (n) => (n[1] === "cmd" || n[1] === "ack" ? 2 : n[1] === "failsafe" || n[2] === "error" ? 0 : 1);
+
   class Timeline {
     constructor(fig) {
       this.fig = fig;
@@ -96,6 +99,17 @@
       this.notes.setAttribute("aria-label", "PX4 messages, commands and acks");
       this.body.append(this.notes);
       if (!d.notes.length) this.notes.append(el("span", "none", "no text messages or commands recorded"));
+      // only the rows that have something, one under the other
+      this.rowTop = {};
+      ROWS.forEach((name, row) => {
+        if (!d.notes.some((n) => noteRow(n) === row)) return;
+        this.rowTop[row] = 18 * Object.keys(this.rowTop).length;
+        const caption = el("span", "row-name", name);
+        caption.style.top = `${this.rowTop[row]}px`;
+        caption.style.width = `${AXIS - 6}px`;
+        this.notes.append(caption);
+      });
+      this.notes.style.height = `${Math.max(18, 18 * Object.keys(this.rowTop).length)}px`;
       if (d.more_notes) fig.append(el("p", "none", `${d.more_notes} more messages not drawn`));
       this.readout = el("div", "readout", "\u00a0");
       this.body.append(this.readout);
@@ -118,7 +132,10 @@
       });
       const measure = document.createElement("canvas").getContext("2d");
       measure.font = FONT;
-      this.noteWidths = d.notes.map((n) => measure.measureText(n[3]).width + 8);
+      this.noteWidths = d.notes.map((n) => {
+        measure.font = n[1] === "failsafe" ? `600 ${FONT}` : FONT; // failsafe labels are bold
+        return measure.measureText(n[3]).width + 8;
+      });
       this.groupEls = [];
       fig.addEventListener("wheel", (e) => this.wheel(e), { passive: false });
       fig.addEventListener("keydown", (e) => this.key_(e));
@@ -481,18 +498,18 @@
     }
 
     layoutNotes(plotWidth) {
-      // two rows: PX4's messages above, the commands and their acks below; a label is shown
-      // only where it covers no other item of its row (zoom in to read the others)
+      // three rows: PX4's failsafe and error messages, its other messages, the commands with
+      // their acks; a label runs at most up to the next item of its row (zoom in for the rest)
       const right = this.plots[0].over.offsetLeft + plotWidth;
-      const rows = { top: [], bottom: [] };
+      const rows = { 0: [], 1: [], 2: [] };
       this.data.notes.forEach((n, i) => {
         const item = this.noteEls[i];
         item.hidden = !this.inView(n[0]);
         if (item.hidden) return;
-        const row = n[1] === "cmd" || n[1] === "ack" ? "bottom" : "top";
+        const row = noteRow(n);
         const x = this.x(n[0]);
         item.style.left = `${x}px`;
-        item.classList.toggle("row2", row === "bottom");
+        item.style.top = `${this.rowTop[row]}px`;
         rows[row].push([x, i]);
       });
       for (const items of Object.values(rows)) {
