@@ -39,6 +39,14 @@ def main() -> None:
     recording = str(CORPORA / "tlog" / "stream_lost_in_offboard.tlog")
     lint = run("lint", recording, "--format", "json")
     expect("lint runs (exit 1: the recording has errors)", lint.returncode == 1, lint.stderr)
+    page = Path("report.html").resolve()
+    html = run("lint", recording, "--format", "html", "--output", str(page))
+    text = page.read_text(encoding="utf-8") if page.exists() else ""
+    expect(
+        "the HTML report carries its plotting library and script",
+        html.returncode == 1 and "uPlot" in text and "zoomable timelines" in text,
+        html.stderr,
+    )
     gate = run("gate", recording)
     expect("gate runs", gate.returncode == 0, gate.stderr)
     rule = run("rule", "OFB101")
