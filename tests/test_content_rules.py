@@ -30,7 +30,7 @@ from fuzzoff.events import (
     TrajectorySetpoint,
 )
 from fuzzoff.findings import Finding, Severity
-from tests.streams import OFFBOARD, POSCTL, codes, every, ocm, status, switch
+from tests.streams import OFFBOARD, POSCTL, ack, codes, every, ocm, status, switch
 from tests.streams import lint_events as _lint_events
 
 NAN = math.nan
@@ -184,6 +184,53 @@ def test_ofb203_one_finding_per_stretch_with_count() -> None:
     (found,) = codes(lint_events(events), "OFB203")
     assert found.time_s == 0.0 and "10 messages" in found.message
     assert "POSCTL" in found.message or "Position" in found.message
+
+
+def test_ofb203_armed_in_another_mode_with_no_request_is_an_error() -> None:
+    events = [status(0.0, POSCTL), *ocm(every(0.0, 5.0, 0.1))]
+    events += _repeat(0.0, 5.0, 10.0, position=(0.0, 0.0, -2.0))
+    (found,) = codes(lint_events(events), "OFB203")
+    assert found.severity is Severity.ERROR and "no offboard request followed" in found.message
+
+
+def test_ofb203_px4_ros_com_publishes_from_its_first_cycle_while_disarmed() -> None:
+    """px4_ros_com offboard_control: OffboardControlMode and TrajectorySetpoint every 100 ms
+    from the first cycle, the switch and the arm at the 11th (rules.md: info)."""
+    events = [status(0.0, POSCTL, armed=False), *ocm(every(0.0, 3.0, 0.1))]
+    events += _repeat(0.0, 3.0, 10.0, position=(0.0, 0.0, -5.0))
+    events += [switch(1.0), ack(1.005, 0), status(1.02, OFFBOARD, armed=True)]
+    (found,) = codes(lint_events(events), "OFB203")
+    assert found.severity is Severity.INFO and "disarmed" in found.message
+    assert found.time_s == 0.0 and found.end_s == pytest.approx(1.0)
+
+
+def test_ofb203_the_run_up_of_a_request_while_armed_is_info_and_a_broken_one_an_error() -> None:
+    run_up = [status(0.0, POSCTL), *ocm(every(0.0, 4.0, 0.1))]
+    run_up += _repeat(0.0, 4.0, 10.0, position=(0.0, 0.0, -5.0))
+    run_up += [switch(2.0), ack(2.005, 0), status(2.01, OFFBOARD)]
+    (found,) = codes(lint_events(run_up), "OFB203")
+    assert found.severity is Severity.INFO and "ran up to the offboard request" in found.message
+    # the keep-alive stops for 2 s after the setpoints: the request that follows is not theirs
+    broken = [status(0.0, POSCTL), *ocm(every(0.0, 1.0, 0.1)), *ocm(every(3.0, 4.0, 0.1))]
+    broken += _repeat(0.0, 1.0, 10.0, position=(0.0, 0.0, -5.0))
+    broken += [switch(3.5), ack(3.505, 0), status(3.51, OFFBOARD)]
+    (found,) = codes(lint_events(broken), "OFB203")
+    assert found.severity is Severity.ERROR and found.end_s == pytest.approx(1.0)
+
+
+def test_ofb203_the_stream_resuming_after_a_loss_until_px4_returns_is_info() -> None:
+    times = [t for t in every(0.0, 8.0, 0.05) if not 3.0 < t < 5.0]
+    events = [status(0.0, OFFBOARD), *ocm(times)]
+    events += [TrajectorySetpoint(t=t + 0.001, position=(0.0, 0.0, -5.0)) for t in times]
+    events += [status(4.05, POSCTL), status(5.02, OFFBOARD)]  # PX4's fallback, then its return
+    (found,) = codes(lint_events(events), "OFB203")
+    assert found.severity is Severity.INFO and found.time_s == pytest.approx(5.001)
+
+
+def test_ofb203_an_external_mode_is_the_companions_own() -> None:
+    """px4-ros2-interface-lib modes publish their setpoints while PX4 runs them (EXTERNAL1)."""
+    events = [status(0.0, 23), *_repeat(0.0, 5.0, 20.0, velocity=(1.0, 0.0, 0.0))]
+    assert codes(lint_events(events), "OFB203") == []
 
 
 def test_ofb203_uses_the_gate_prediction_without_a_recorded_mode() -> None:
