@@ -14,6 +14,7 @@ from fuzzoff.config import Settings
 from fuzzoff.events import (
     ActuatorMotors,
     AttitudeSetpoint,
+    Command,
     ControlMode,
     Event,
     FailsafeFlags,
@@ -503,6 +504,73 @@ def test_ofb404_recording_that_starts_in_flight_is_not_a_takeoff() -> None:
         TrajectorySetpoint(t=0.2, velocity=(0.0, 0.0, 1.0)),
     ]
     assert codes(lint_events(events), "OFB404") == []
+
+
+def test_ofb404_a_climb_in_enu_from_the_ground_is_an_error() -> None:
+    events = _on_ground_then(TrajectorySetpoint(t=0.2, position=(0.0, 0.0, 5.0)))
+    (found,) = codes(lint_events(events), "OFB404")
+    assert found.severity is Severity.ERROR and "on the ground" in found.message
+
+
+TAKEOFF, LOITER = 17, 4
+
+
+@pytest.mark.parametrize(
+    "takeoff",
+    [
+        [status(1.0, TAKEOFF), status(6.0, LOITER)],  # MAVSDK action.takeoff(): AUTO_TAKEOFF
+        [status(1.0, POSCTL)],  # a pilot's takeoff in Position mode
+        [Command(t=1.0, command=22)],  # MAV_CMD_NAV_TAKEOFF, no status recorded for it
+    ],
+)
+def test_ofb404_a_first_offboard_descent_after_a_takeoff_is_not_enu(takeoff: list[Event]) -> None:
+    events = [status(0.0, LOITER, armed=False), status(0.5, LOITER, armed=True), *takeoff]
+    events += [status(8.0, OFFBOARD), ControlMode(t=8.0, velocity=True)]
+    events += [TrajectorySetpoint(t=8.1 + 0.05 * k, velocity=(0.0, 0.0, 0.5)) for k in range(40)]
+    assert codes(lint_events(events), "OFB404") == []
+
+
+def test_ofb404_enu_height_when_the_recording_starts_in_the_air() -> None:
+    """The missed case: ENU z up (z = +10 for 10 m) while airborne: PX4 descends to 10 m
+    below the origin, into the ground."""
+    events: list[Event] = [status(0.0, OFFBOARD, armed=True), ControlMode(t=0.0, position=True)]
+    events += [TrajectorySetpoint(t=0.1 * k, position=(0.0, 0.0, 10.0)) for k in range(1, 30)]
+    (found,) = codes(lint_events(events), "OFB404")
+    assert found.severity is Severity.ERROR
+    assert "below the local origin" in found.message and "29 messages" in found.message
+    # NED heights while airborne are fine, and so is a landing at the origin
+    ned = [status(0.0, OFFBOARD, armed=True), ControlMode(t=0.0, position=True)]
+    ned += [TrajectorySetpoint(t=0.1 * k, position=(0.0, 0.0, -10.0 + k)) for k in range(1, 11)]
+    assert codes(lint_events(ned), "OFB404") == []
+
+
+def test_ofb404_enu_height_after_an_auto_takeoff_is_an_error() -> None:
+    events = [status(0.0, LOITER, armed=False), status(0.5, TAKEOFF), status(5.0, LOITER)]
+    events += [status(8.0, OFFBOARD), ControlMode(t=8.0, position=True)]
+    events += [TrajectorySetpoint(t=8.1 + 0.05 * k, position=(0.0, 0.0, 2.5)) for k in range(9)]
+    (found,) = codes(lint_events(events), "OFB404")
+    assert found.time_s == pytest.approx(8.1) and found.severity is Severity.ERROR
+
+
+def test_ofb404_pxs_own_setpoints_in_a_ulog_are_not_judged() -> None:
+    """A clean SITL flight's ULog: PX4's flight task writes trajectory_setpoint in AUTO_LOITER
+    on the ground (a push down). On 1.16 the receiver acks the switch ACCEPTED 6 ms before
+    Commander's verdict, and vehicle_status says OFFBOARD only later: none of that is the
+    companion's."""
+    events: list[Event] = [status(0.0, LOITER, armed=False), ControlMode(t=0.0, origin="vehicle")]
+    events += [ControlMode(t=0.1 * k, position=True, origin="vehicle") for k in range(1, 40)]
+    own = [
+        TrajectorySetpoint(t=0.02 + 0.05 * k, velocity=(0.0, 0.0, 0.7), origin="vehicle")
+        for k in range(32)  # until 1.57 s: after the acks, before the status says OFFBOARD
+    ]
+    events += own
+    events += [switch(1.5), ack(1.502, 0), ack(1.508, 0), status(1.6, OFFBOARD, armed=False)]
+    events += [status(2.0, OFFBOARD, armed=True)]
+    events += [
+        TrajectorySetpoint(t=2.02 + 0.1 * k, position=(0.0, 0.0, -3.0), origin="vehicle")
+        for k in range(20)
+    ]
+    assert codes(lint_events(events, px4="1.16", fmt="ulog"), "OFB404") == []
 
 
 def test_ofb404_thrust_pointing_down_on_a_multicopter() -> None:
