@@ -14,6 +14,7 @@ from fuzzoff.config import Settings
 from fuzzoff.events import (
     ActuatorMotors,
     AttitudeSetpoint,
+    Command,
     ControlMode,
     Event,
     FailsafeFlags,
@@ -30,7 +31,7 @@ from fuzzoff.events import (
     TrajectorySetpoint,
 )
 from fuzzoff.findings import Finding, Severity
-from tests.streams import OFFBOARD, POSCTL, codes, every, ocm, status, switch
+from tests.streams import OFFBOARD, POSCTL, ack, codes, every, ocm, status, switch
 from tests.streams import lint_events as _lint_events
 
 NAN = math.nan
@@ -127,11 +128,11 @@ def _repeat(t0: float, t1: float, hz: float, **fields: Any) -> list[Event]:
     return [TrajectorySetpoint(t=round(t, 6), **fields) for t in every(t0, t1, 1 / hz)]
 
 
-@pytest.mark.parametrize(("duration", "flagged"), [(3.0, False), (3.05, True)])
+@pytest.mark.parametrize(("duration", "flagged"), [(10.0, False), (10.05, True)])
 def test_ofb107_freeze_edge(duration: float, flagged: bool) -> None:
     events = [
         status(0.0, OFFBOARD),
-        *ocm(every(0.0, 4.0, 0.05), velocity=True),
+        *ocm(every(0.0, 11.0, 0.05), velocity=True),
         *_repeat(0.0, duration, 20.0, velocity=(1.0, 0.0, 0.0)),
         TrajectorySetpoint(t=duration + 0.05, velocity=(0.5, 0.0, 0.0)),
     ]
@@ -140,35 +141,140 @@ def test_ofb107_freeze_edge(duration: float, flagged: bool) -> None:
     if flagged:
         assert found[0].time_s == pytest.approx(0.0)
         assert found[0].end_s == pytest.approx(duration)
+        assert found[0].severity is Severity.ERROR
+        assert "velocity 1.00 m/s" in found[0].message
+
+
+def test_ofb107_a_velocity_of_2mps_frozen_for_20s_is_an_error() -> None:
+    events = [
+        status(0.0, OFFBOARD),
+        *ocm(every(0.0, 20.0, 0.05), velocity=True),
+        *_repeat(0.0, 20.0, 20.0, velocity=(2.0, 0.0, NAN)),
+    ]
+    (found,) = codes(lint_events(events), "OFB107")
+    assert found.severity is Severity.ERROR
+    assert "velocity 2.00 m/s" in found.message and "20.00 s" in found.message
+
+
+@pytest.mark.parametrize(
+    "fields",
+    [
+        {"position": (20.0, 0.0, -5.0)},  # a held position (px4_ros_com, MAVROS offb_node)
+        {"position": (20.0, 0.0, -5.0), "velocity": (1.0, 0.0, 0.0)},  # position wins per axis
+        {"velocity": (0.0, 0.0, 0.0)},  # a zero velocity (MAVSDK's "stay")
+        {"velocity": (0.0, 0.0, 0.0), "yaw": 1.5},
+        {"acceleration": (0.0, 0.0, 0.0)},
+    ],
+)
+def test_ofb107_a_hold_is_never_flagged(fields: dict[str, Any]) -> None:
+    """A ten-minute hold at 10 Hz: what a stopped controller should leave behind."""
+    events = [status(0.0, OFFBOARD), *ocm(every(0.0, 600.0, 0.1))]
+    events += _repeat(0.0, 600.0, 10.0, **fields)
+    assert codes(lint_events(events), "OFB107") == []
+
+
+def test_ofb107_a_turn_on_the_spot_is_bounded_and_judged_after_turning_s() -> None:
+    def spin(seconds: float, **fields: Any) -> list[Event]:
+        events = [status(0.0, OFFBOARD), *ocm(every(0.0, seconds, 0.1))]
+        return events + _repeat(0.0, seconds, 10.0, yawspeed=0.5, **fields)
+
+    assert codes(lint_events(spin(20.0, position=(0, 0, -5.0))), "OFB107") == []
+    (found,) = codes(lint_events(spin(61.0, velocity=(0.0, 0.0, 0.0))), "OFB107")
+    assert "yaw rate" in found.message and "bounded" in found.message
+    # a yaw angle given with the rate: PX4 turns to it and stops
+    assert codes(lint_events(spin(61.0, position=(0, 0, -5.0), yaw=1.0)), "OFB107") == []
+
+
+def _mavsdk_body(seconds: float, forward: float, yaw_rate: float) -> list[Event]:
+    """MAVSDK's set_velocity_body re-sent at 20 Hz: BODY_NED, position and acceleration and
+    yaw ignored (offboard_impl.cpp send_velocity_body)."""
+    mask = 1 | 2 | 4 | 64 | 128 | 256 | 1024
+    events: list[Event] = [status(0.0, OFFBOARD)]
+    events += [
+        SetPositionTargetLocal(
+            t=round(t, 6),
+            coordinate_frame=8,
+            type_mask=mask,
+            velocity=(forward, 0.0, 0.0),
+            yaw_rate=yaw_rate,
+        )
+        for t in every(0.0, seconds, 0.05)
+    ]
+    return events
+
+
+def test_ofb107_mavsdk_example_circle_is_bounded_and_stays_clean() -> None:
+    # "Fly a circle": 5 m/s forward with 30 deg/s of yaw for 15 s, identical at 20 Hz
+    assert codes(lint_events(_mavsdk_body(15.0, 5.0, math.radians(30)), fmt="tlog"), "OFB107") == []
+    (found,) = codes(lint_events(_mavsdk_body(61.0, 5.0, math.radians(30)), fmt="tlog"), "OFB107")
+    assert "bounded" in found.message
+    # the same forward velocity without the yaw rate is a straight line
+    (straight,) = codes(lint_events(_mavsdk_body(10.5, 5.0, 0.0), fmt="tlog"), "OFB107")
+    assert "body velocity 5.00 m/s" in straight.message
+
+
+def test_ofb107_judges_mavlink_setpoints_too() -> None:
+    position = [status(0.0, OFFBOARD)]
+    position += [
+        SetPositionTargetLocal(t=round(t, 6), type_mask=0b110111111000, position=(0, 0, -3))
+        for t in every(0.0, 12.0, 0.05)
+    ]
+    assert codes(lint_events(position, fmt="tlog"), "OFB107") == []  # a held position
+    velocity = [status(0.0, OFFBOARD)]
+    velocity += [
+        SetPositionTargetLocal(t=round(t, 6), type_mask=0b110111000111, velocity=(0, 0, -2.0))
+        for t in every(0.0, 12.0, 0.05)
+    ]
+    (found,) = codes(lint_events(velocity, fmt="tlog"), "OFB107")
+    assert "velocity 2.00 m/s" in found.message
+
+
+@pytest.mark.parametrize(
+    ("q", "thrust", "flagged"),
+    [
+        ((1.0, 0.0, 0.0, 0.0), 0.6, False),  # level at a hover thrust
+        ((1.0, 0.0, 0.0, 0.0), 0.9, True),  # level, climbing
+        ((0.966, 0.259, 0.0, 0.0), 0.6, True),  # 30 degrees of roll (MAVSDK's example, 2 s)
+    ],
+)
+def test_ofb107_attitude_tilt_and_thrust(
+    q: tuple[float, float, float, float], thrust: float, flagged: bool
+) -> None:
+    events: list[Event] = [status(0.0, OFFBOARD)]
+    events += [
+        SetAttitudeTarget(t=round(t, 6), type_mask=7, q=q, thrust=thrust)
+        for t in every(0.0, 12.0, 0.05)
+    ]
+    assert bool(codes(lint_events(events, fmt="tlog"), "OFB107")) is flagged
+
+
+def test_ofb107_rover_speed_is_a_motion_and_a_placeholder_is_not() -> None:
+    events: list[Event] = [status(0.0, OFFBOARD), *ocm(every(0.0, 12.0, 0.1), velocity=True)]
+    events += [RoverSpeedSetpoint(t=round(t, 6), speed_body_x=1.5) for t in every(0, 12, 0.1)]
+    events += [RoverAttitudeSetpoint(t=round(t, 6), yaw_setpoint=0.3) for t in every(0, 12, 0.1)]
+    found = codes(lint_events(events, px4="1.16", vehicle="rover-differential"), "OFB107")
+    assert [f.where.topic if f.where else "" for f in found] == ["rover_speed"] or len(found) == 1
+    assert "rover speed 1.50 m/s" in found[0].message
 
 
 def test_ofb107_realistic_near_miss_with_estimator_noise_stays_clean() -> None:
-    # A live position hold: the controller's output jitters by micrometres at 20 Hz.
-    events: list[Event] = [status(0.0, OFFBOARD), *ocm(every(0.0, 10.0, 0.1))]
-    for i, t in enumerate(every(0.0, 10.0, 0.05)):
+    # A live velocity controller: its output jitters by micrometres per second at 20 Hz.
+    events: list[Event] = [status(0.0, OFFBOARD), *ocm(every(0.0, 30.0, 0.1), velocity=True)]
+    for i, t in enumerate(every(0.0, 30.0, 0.05)):
         jitter = 1e-6 * ((i * 7919) % 13 - 6)
-        events.append(TrajectorySetpoint(t=round(t, 6), position=(1.0 + jitter, 2.0, -5.0)))
+        events.append(TrajectorySetpoint(t=round(t, 6), velocity=(1.0 + jitter, 2.0, 0.0)))
     assert codes(lint_events(events), "OFB107") == []
 
 
 def test_ofb107_gap_restarts_and_outside_offboard_does_not_count() -> None:
     gap = [
         status(0.0, OFFBOARD),
-        *_repeat(0.0, 2.0, 20.0, position=(0.0, 0.0, -2.0)),
-        *_repeat(3.5, 5.5, 20.0, position=(0.0, 0.0, -2.0)),
+        *_repeat(0.0, 8.0, 20.0, velocity=(1.0, 0.0, 0.0)),
+        *_repeat(9.5, 17.5, 20.0, velocity=(1.0, 0.0, 0.0)),
     ]
     assert codes(lint_events(gap), "OFB107") == []
-    outside = [status(0.0, POSCTL), *_repeat(0.0, 5.0, 20.0, position=(0.0, 0.0, -2.0))]
+    outside = [status(0.0, POSCTL), *_repeat(0.0, 15.0, 20.0, velocity=(1.0, 0.0, 0.0))]
     assert codes(lint_events(outside), "OFB107") == []
-
-
-def test_ofb107_judges_mavlink_setpoints_too() -> None:
-    events: list[Event] = [status(0.0, OFFBOARD)]
-    events += [
-        SetPositionTargetLocal(t=round(t, 6), type_mask=0b110111111000, position=(0, 0, -3))
-        for t in every(0.0, 4.0, 0.05)
-    ]
-    assert len(codes(lint_events(events, fmt="tlog"), "OFB107")) == 1
 
 
 # --- OFB203 -------------------------------------------------------------------------------
@@ -184,6 +290,53 @@ def test_ofb203_one_finding_per_stretch_with_count() -> None:
     (found,) = codes(lint_events(events), "OFB203")
     assert found.time_s == 0.0 and "10 messages" in found.message
     assert "POSCTL" in found.message or "Position" in found.message
+
+
+def test_ofb203_armed_in_another_mode_with_no_request_is_an_error() -> None:
+    events = [status(0.0, POSCTL), *ocm(every(0.0, 5.0, 0.1))]
+    events += _repeat(0.0, 5.0, 10.0, position=(0.0, 0.0, -2.0))
+    (found,) = codes(lint_events(events), "OFB203")
+    assert found.severity is Severity.ERROR and "no offboard request followed" in found.message
+
+
+def test_ofb203_px4_ros_com_publishes_from_its_first_cycle_while_disarmed() -> None:
+    """px4_ros_com offboard_control: OffboardControlMode and TrajectorySetpoint every 100 ms
+    from the first cycle, the switch and the arm at the 11th (rules.md: info)."""
+    events = [status(0.0, POSCTL, armed=False), *ocm(every(0.0, 3.0, 0.1))]
+    events += _repeat(0.0, 3.0, 10.0, position=(0.0, 0.0, -5.0))
+    events += [switch(1.0), ack(1.005, 0), status(1.02, OFFBOARD, armed=True)]
+    (found,) = codes(lint_events(events), "OFB203")
+    assert found.severity is Severity.INFO and "disarmed" in found.message
+    assert found.time_s == 0.0 and found.end_s == pytest.approx(1.0)
+
+
+def test_ofb203_the_run_up_of_a_request_while_armed_is_info_and_a_broken_one_an_error() -> None:
+    run_up = [status(0.0, POSCTL), *ocm(every(0.0, 4.0, 0.1))]
+    run_up += _repeat(0.0, 4.0, 10.0, position=(0.0, 0.0, -5.0))
+    run_up += [switch(2.0), ack(2.005, 0), status(2.01, OFFBOARD)]
+    (found,) = codes(lint_events(run_up), "OFB203")
+    assert found.severity is Severity.INFO and "ran up to the offboard request" in found.message
+    # the keep-alive stops for 2 s after the setpoints: the request that follows is not theirs
+    broken = [status(0.0, POSCTL), *ocm(every(0.0, 1.0, 0.1)), *ocm(every(3.0, 4.0, 0.1))]
+    broken += _repeat(0.0, 1.0, 10.0, position=(0.0, 0.0, -5.0))
+    broken += [switch(3.5), ack(3.505, 0), status(3.51, OFFBOARD)]
+    (found,) = codes(lint_events(broken), "OFB203")
+    assert found.severity is Severity.ERROR and found.end_s == pytest.approx(1.0)
+
+
+def test_ofb203_the_stream_resuming_after_a_loss_until_px4_returns_is_info() -> None:
+    times = [t for t in every(0.0, 8.0, 0.05) if not 3.0 < t < 5.0]
+    events = [status(0.0, OFFBOARD), *ocm(times)]
+    events += [TrajectorySetpoint(t=t + 0.001, position=(0.0, 0.0, -5.0)) for t in times]
+    events += [status(4.05, POSCTL), status(5.02, OFFBOARD)]  # PX4's fallback, then its return
+    (found,) = codes(lint_events(events), "OFB203")
+    assert found.severity is Severity.INFO and found.time_s == pytest.approx(5.001)
+
+
+def test_ofb203_an_external_mode_is_the_companions_own() -> None:
+    """px4-ros2-interface-lib modes publish their setpoints while PX4 runs them (EXTERNAL1)."""
+    events = [status(0.0, 23), *_repeat(0.0, 5.0, 20.0, velocity=(1.0, 0.0, 0.0))]
+    assert codes(lint_events(events), "OFB203") == []
 
 
 def test_ofb203_uses_the_gate_prediction_without_a_recorded_mode() -> None:
@@ -353,6 +506,73 @@ def test_ofb404_recording_that_starts_in_flight_is_not_a_takeoff() -> None:
     assert codes(lint_events(events), "OFB404") == []
 
 
+def test_ofb404_a_climb_in_enu_from_the_ground_is_an_error() -> None:
+    events = _on_ground_then(TrajectorySetpoint(t=0.2, position=(0.0, 0.0, 5.0)))
+    (found,) = codes(lint_events(events), "OFB404")
+    assert found.severity is Severity.ERROR and "on the ground" in found.message
+
+
+TAKEOFF, LOITER = 17, 4
+
+
+@pytest.mark.parametrize(
+    "takeoff",
+    [
+        [status(1.0, TAKEOFF), status(6.0, LOITER)],  # MAVSDK action.takeoff(): AUTO_TAKEOFF
+        [status(1.0, POSCTL)],  # a pilot's takeoff in Position mode
+        [Command(t=1.0, command=22)],  # MAV_CMD_NAV_TAKEOFF, no status recorded for it
+    ],
+)
+def test_ofb404_a_first_offboard_descent_after_a_takeoff_is_not_enu(takeoff: list[Event]) -> None:
+    events = [status(0.0, LOITER, armed=False), status(0.5, LOITER, armed=True), *takeoff]
+    events += [status(8.0, OFFBOARD), ControlMode(t=8.0, velocity=True)]
+    events += [TrajectorySetpoint(t=8.1 + 0.05 * k, velocity=(0.0, 0.0, 0.5)) for k in range(40)]
+    assert codes(lint_events(events), "OFB404") == []
+
+
+def test_ofb404_enu_height_when_the_recording_starts_in_the_air() -> None:
+    """The missed case: ENU z up (z = +10 for 10 m) while airborne: PX4 descends to 10 m
+    below the origin, into the ground."""
+    events: list[Event] = [status(0.0, OFFBOARD, armed=True), ControlMode(t=0.0, position=True)]
+    events += [TrajectorySetpoint(t=0.1 * k, position=(0.0, 0.0, 10.0)) for k in range(1, 30)]
+    (found,) = codes(lint_events(events), "OFB404")
+    assert found.severity is Severity.ERROR
+    assert "below the local origin" in found.message and "29 messages" in found.message
+    # NED heights while airborne are fine, and so is a landing at the origin
+    ned = [status(0.0, OFFBOARD, armed=True), ControlMode(t=0.0, position=True)]
+    ned += [TrajectorySetpoint(t=0.1 * k, position=(0.0, 0.0, -10.0 + k)) for k in range(1, 11)]
+    assert codes(lint_events(ned), "OFB404") == []
+
+
+def test_ofb404_enu_height_after_an_auto_takeoff_is_an_error() -> None:
+    events = [status(0.0, LOITER, armed=False), status(0.5, TAKEOFF), status(5.0, LOITER)]
+    events += [status(8.0, OFFBOARD), ControlMode(t=8.0, position=True)]
+    events += [TrajectorySetpoint(t=8.1 + 0.05 * k, position=(0.0, 0.0, 2.5)) for k in range(9)]
+    (found,) = codes(lint_events(events), "OFB404")
+    assert found.time_s == pytest.approx(8.1) and found.severity is Severity.ERROR
+
+
+def test_ofb404_pxs_own_setpoints_in_a_ulog_are_not_judged() -> None:
+    """A clean SITL flight's ULog: PX4's flight task writes trajectory_setpoint in AUTO_LOITER
+    on the ground (a push down). On 1.16 the receiver acks the switch ACCEPTED 6 ms before
+    Commander's verdict, and vehicle_status says OFFBOARD only later: none of that is the
+    companion's."""
+    events: list[Event] = [status(0.0, LOITER, armed=False), ControlMode(t=0.0, origin="vehicle")]
+    events += [ControlMode(t=0.1 * k, position=True, origin="vehicle") for k in range(1, 40)]
+    own = [
+        TrajectorySetpoint(t=0.02 + 0.05 * k, velocity=(0.0, 0.0, 0.7), origin="vehicle")
+        for k in range(32)  # until 1.57 s: after the acks, before the status says OFFBOARD
+    ]
+    events += own
+    events += [switch(1.5), ack(1.502, 0), ack(1.508, 0), status(1.6, OFFBOARD, armed=False)]
+    events += [status(2.0, OFFBOARD, armed=True)]
+    events += [
+        TrajectorySetpoint(t=2.02 + 0.1 * k, position=(0.0, 0.0, -3.0), origin="vehicle")
+        for k in range(20)
+    ]
+    assert codes(lint_events(events, px4="1.16", fmt="ulog"), "OFB404") == []
+
+
 def test_ofb404_thrust_pointing_down_on_a_multicopter() -> None:
     events = [
         status(0.0, OFFBOARD),
@@ -499,7 +719,7 @@ def test_ofb107_an_all_nan_rover_setpoint_published_on_purpose_is_not_frozen() -
 
 @settings(max_examples=60, deadline=None)
 @given(
-    st.lists(st.tuples(st.integers(1, 3), st.integers(1, 90)), min_size=1, max_size=8),
+    st.lists(st.tuples(st.integers(1, 3), st.integers(1, 300)), min_size=1, max_size=8),
     st.sampled_from([0.02, 0.05]),
 )
 def test_ofb107_sampled_comparison_finds_the_same_runs_as_comparing_every_message(
@@ -518,7 +738,7 @@ def test_ofb107_sampled_comparison_finds_the_same_runs_as_comparing_every_messag
     start = 0
     for i in range(1, len(values) + 1):
         if i == len(values) or values[i] != values[start]:
-            if times[i - 1] - times[start] > 3.0:
+            if times[i - 1] - times[start] > 10.0:
                 expected.append((times[start], times[i - 1]))
             start = i
     found = [(f.time_s, f.end_s) for f in codes(lint_events(events), "OFB107")]

@@ -13,7 +13,7 @@ import pytest
 from tests.helpers import CORPORA, run_cli, run_cli_process
 
 GOOD = CORPORA / "tlog" / "good_offboard.tlog"
-GAP = CORPORA / "tlog" / "keepalive_gap_0_7s.tlog"
+GAP = CORPORA / "tlog" / "stream_lost_in_offboard.tlog"  # findings at the default fail level
 
 
 def _linted(*args: str | Path) -> list[str]:

@@ -249,7 +249,7 @@ def tilted_quat(roll: float) -> tuple[float, float, float, float]:
         ("1.16", 7, yaw_quat(1.0), Severity.ERROR),
         ("1.15", 7, yaw_quat(1.0), Severity.ERROR),
         ("main", 128, yaw_quat(0.0), Severity.ERROR),
-        ("1.14", 7, yaw_quat(1.0), None),
+        ("1.14", 7, yaw_quat(1.0), Severity.WARNING),  # only this release takes it
         ("1.13", 7, tilted_quat(0.1), Severity.WARNING),
         ("1.14", 128, yaw_quat(0.0), Severity.ERROR),
     ],

@@ -29,7 +29,15 @@ def flying(*gaps_at: tuple[float, float]) -> list:
 
 @pytest.mark.parametrize(
     ("gap", "expected"),
-    [(0.49, None), (0.5, Severity.WARNING), (0.95, Severity.WARNING), (1.2, Severity.ERROR)],
+    [
+        (0.49, None),
+        (0.5, Severity.INFO),  # the docs' 2 Hz only: no release with a 1 s timeout acts on it
+        (0.79, Severity.INFO),
+        (0.8, Severity.WARNING),  # 80 % of COM_OF_LOSS_T: kept, but only just
+        (0.95, Severity.WARNING),
+        (1.0, Severity.ERROR),  # PX4 takes the signal for lost
+        (1.2, Severity.ERROR),
+    ],
 )
 def test_ofb101_gap_edges_on_1_15(gap: float, expected: Severity | None) -> None:
     events = [status(0.0, OFFBOARD), *ocm([0.0, 0.1, 0.2, 0.2 + gap, 0.3 + gap])]
@@ -57,6 +65,20 @@ def test_ofb101_counts_a_gap_in_the_second_before_a_request() -> None:
     events = [status(0.0, POSCTL), *ocm([0.0, 0.1, 0.8, 0.9, 1.0]), switch(1.05)]
     (found,) = codes(lint_events(events), "OFB101")
     assert "before an offboard request" in found.message
+    # PX4 judges only the newest keep-alive at the request: the docs' rule alone
+    assert found.severity is Severity.INFO
+    assert "OFB102" in found.message
+
+
+def test_ofb101_near_loss_tier_follows_a_lowered_loss_timeout() -> None:
+    from fuzzoff.events import Parameter
+
+    # COM_OF_LOSS_T 0.6 s: a 0.5 s gap is 83 % of it (warning), 0.6 s is a loss (error)
+    for gap, expected in ((0.5, Severity.WARNING), (0.6, Severity.ERROR)):
+        events = [Parameter(t=0.0, name="COM_OF_LOSS_T", value=0.6), status(0.0, OFFBOARD)]
+        events += ocm([0.0, 0.1, 0.1 + gap, 0.2 + gap])
+        (found,) = codes(lint_events(events), "OFB101")
+        assert found.severity is expected, gap
 
 
 def test_ofb101_judges_ulog_gaps_against_the_logging_interval() -> None:
@@ -81,10 +103,10 @@ def test_ofb101_mavlink_setpoints_for_another_system_are_not_keepalive() -> None
     assert len(codes(lint_events(only_other, fmt="tlog"), "OFB101")) == 1
 
 
-def test_ofb102_switch_on_first_setpoint_is_a_warning_with_what_px4_does() -> None:
+def test_ofb102_switch_on_first_setpoint_is_info_with_what_px4_does() -> None:
     events = [status(0.0, POSCTL), *ocm([1.0, 1.02, 1.04]), switch(1.048)]
     (found,) = codes(lint_events(events), "OFB102")
-    assert found.severity is Severity.WARNING
+    assert found.severity is Severity.INFO  # no release enforces the one second (D1)
     assert "0.05 s of unbroken keep-alive" in found.message
     assert "PX4 1.15 would: accept it" in found.message
 
@@ -93,7 +115,26 @@ def test_ofb102_no_stream_at_all_and_disarmed_on_1_14_is_accepted_by_px4() -> No
     events = [status(0.0, POSCTL, armed=False), switch(1.0)]
     (found,) = codes(lint_events(events, px4="1.14"), "OFB102")
     assert "no keep-alive at all" in found.message
-    assert "accept it" in found.message
+    assert "accept it" in found.message and "checked at arming" in found.message
+    assert found.severity is Severity.INFO
+
+
+def test_ofb102_is_an_error_where_the_gate_model_rejects_the_request() -> None:
+    # armed, the last keep-alive 1.5 s old: PX4 1.15 rejects the switch
+    events = [status(0.0, POSCTL), *ocm(every(0.0, 1.0, 0.1)), switch(2.5)]
+    (found,) = codes(lint_events(events), "OFB102")
+    assert found.severity is Severity.ERROR and "reject it" in found.message
+
+
+def test_ofb102_ten_setpoints_at_10hz_with_a_millisecond_of_jitter() -> None:
+    """px4_ros_com: 10 setpoints at 10 Hz, then the switch and the arm in the 11th cycle; the
+    timer fires a millisecond early (rules.md: info at most, the switch is accepted)."""
+    times = [round(0.1 * k + (0.001 if k == 0 else 0.0), 6) for k in range(20)]
+    # the commands go out in the 11th cycle before its keep-alive, as in the source
+    events = [status(0.0, POSCTL, armed=False), *ocm(times), switch(0.9995)]
+    found = codes(lint_events(events), "OFB102")
+    assert [f.severity for f in found] == [Severity.INFO]
+    assert "only 1.00 s" in found[0].message and "accept it" in found[0].message
 
 
 def test_ofb102_clean_after_one_second_of_stream() -> None:
@@ -218,6 +259,42 @@ def test_ofb101_silence_in_offboard_until_the_vehicle_leaves_counts_up_to_the_sw
     (found,) = codes(lint_events(events), "OFB101")
     assert found.end_s == pytest.approx(5.7)
     assert "0.70 s" in found.message
+
+
+HOLD_MODE = (1.0, 4.0, 3.0, 0.0, 0.0, 0.0, 0.0)
+"""DO_SET_MODE to Hold (custom main mode AUTO, sub mode LOITER), as MAVSDK's stop() sends it."""
+LOITER = 4
+
+
+def _mavsdk_stop(acks: list[tuple[float, int]]) -> list:
+    """MAVSDK offboard stop(): the setpoints stop, then DO_SET_MODE to Hold; PX4 acks it 20 ms
+    after the last setpoint and the next 1 Hz HEARTBEAT shows Hold a second later."""
+    setpoints = [SetPositionTargetLocal(t=t, type_mask=0b110111000111) for t in every(0, 10, 0.05)]
+    heartbeats = [status(float(k), OFFBOARD) for k in range(11)]
+    stop = Command(t=10.001, command=176, params=HOLD_MODE)
+    answer = [ack(t, result) for t, result in acks]
+    later = [status(float(k), LOITER) for k in range(11, 16)]
+    return [*heartbeats, *setpoints, stop, *answer, *later]
+
+
+@pytest.mark.parametrize(
+    ("px4", "acks"),
+    [("1.15", [(10.02, 0)]), ("1.16", [(10.02, 0), (10.026, 0)])],
+)
+def test_ofb101_the_window_ends_at_the_accepted_ack_of_a_switch_away(
+    px4: str, acks: list[tuple[float, int]]
+) -> None:
+    found = lint_events(_mavsdk_stop(acks), px4=px4, fmt="tlog")
+    assert codes(found, "OFB101") == [] and codes(found, "OFB103") == []
+
+
+def test_ofb101_commanders_rejection_after_the_receivers_ack_keeps_the_window_open() -> None:
+    # 1.16: the receiver acks ACCEPTED, Commander rejects: the vehicle stays in OFFBOARD with no
+    # keep-alive, so the silence is a loss
+    events = [e for e in _mavsdk_stop([(10.02, 0), (10.026, 1)]) if e.t < 11.0]
+    events += [status(float(k), OFFBOARD) for k in range(11, 16)]
+    found = codes(lint_events(events, px4="1.16", fmt="tlog"), "OFB101")
+    assert [f.severity for f in found] == [Severity.ERROR]
 
 
 def test_pxs_automatic_return_after_a_loss_is_not_a_request() -> None:

@@ -15,8 +15,10 @@ stream rules the flights also touch):
   that contradicts the model (6.5 s).
 * ``no_offboard`` (1.15): a POSCTL flight with no offboard use: OFB701, OFB702, OFB202 clean.
 * ``rc_lost_117_return`` (1.17.0): no manual control; on loss 1.17 replaces Position by
-  NAV_RCL_ACT (Return): the log shows AUTO_RTL; OFB702 says the configured Position is replaced,
-  OFB202 clean.
+  NAV_RCL_ACT (Return): the log shows AUTO_RTL; OFB702 says the configured Position was replaced
+  when the loss ran the fallback (an error at the loss, rules.md), OFB202 clean.
+* ``no_rc_117_clean`` (1.17.0): the same vehicle without manual control (every SITL run, every
+  autonomous setup) flying offboard with no loss: OFB702 is a configuration note (info), exit 0.
 * ``signal_flag_agrees`` (1.15): ``loss_and_resume_agrees`` with PX4's own verdict logged at
   10 Hz (``failsafe_flags.offboard_control_signal_lost``): lost from the 6.0 s check pass,
   available again from 8.0 s, as the model says: OFB202 clean.
@@ -129,11 +131,15 @@ def valid(rc: bool = True) -> FailsafeFlags:
     )
 
 
-def offboard_flight(during_gap: tuple[int, bool], rc: bool = True) -> list[Event]:
+def offboard_flight(
+    during_gap: tuple[int, bool], rc: bool = True, gap: bool = True
+) -> list[Event]:
+    """The flight; without ``gap`` the stream never stops (``during_gap`` should then say
+    OFFBOARD)."""
+    flown = [*stream(0.0, STOP_T), *stream(RESUME_T, END_T)] if gap else stream(0.0, END_T)
     events = [
         valid(rc),
-        *stream(0.0, STOP_T),
-        *stream(RESUME_T, END_T),
+        *flown,
         *commands(),
         *statuses(during_gap),
     ]
@@ -213,10 +219,21 @@ def cases() -> list[Case]:
             [
                 *NOT_CHECKABLE_115,
                 ("OFB701", "info", SWITCH_T),
-                ("OFB702", "warning", SWITCH_T),
                 *GAP,
+                ("OFB702", "error", 6.01),  # the loss ran NAV_RCL_ACT instead of Position
             ],
             ["OFB202"],
+            px4_version="1.17.0",
+        ),
+        Case(
+            "no_rc_117_clean",
+            offboard_flight((OFFBOARD, False), rc=False, gap=False),
+            [
+                *NOT_CHECKABLE_115,
+                ("OFB701", "info", SWITCH_T),
+                ("OFB702", "info", SWITCH_T),  # a configuration note: no loss happened
+            ],
+            ["OFB101", "OFB103", "OFB202"],
             px4_version="1.17.0",
         ),
         Case(

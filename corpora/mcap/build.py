@@ -12,11 +12,11 @@ of these topics lacks) and OFB701 (the loss parameters assumed, at the offboard 
 * ``good_flight``: OffboardControlMode at 20 Hz for 2 s, accepted switch, setpoints only in
   offboard, NAV_LAND; nothing else.
 * ``keepalive_gap_0_7s``: OffboardControlMode pauses 0.75 s in offboard (setpoints go on):
-  OFB101 warning (under COM_OF_LOSS_T = 1 s, PX4 1.15 keeps offboard).
+  OFB101 info (under 80 % of COM_OF_LOSS_T = 1 s: PX4 1.15 keeps offboard, the docs' 2 Hz only).
 * ``stream_lost``: the program stalls for 3.55 s in offboard (both topics stop); PX4's status
   shows POSCTL from 7.0 s: OFB101 error and OFB103 at the loss (5.95 s + 1 s).
 * ``switch_50ms_after_first_ocm``: the switch 50 ms after the first OffboardControlMode:
-  OFB102 warning (PX4 1.15 accepts it).
+  OFB102 info (PX4 1.15 accepts it: no release enforces the docs' second).
 * ``switch_rejected``: the ack says TEMPORARILY_REJECTED: OFB201, and OFB202 as the gate model
   expected PX4 1.15 to accept a switch after 2 s of stream.
 * ``wrong_release_payload``: the good flight whose VehicleControlMode payloads are 1.15's while
@@ -102,8 +102,9 @@ def main() -> None:
         (
             "keepalive_gap_0_7s",
             Flight(ocm_gaps=[(6.0, 6.7)]),
-            [finding("OFB101", "warning", 5.95)],
-            1,
+            # 70 % of COM_OF_LOSS_T: the docs' 2 Hz alone, PX4 keeps the signal (info)
+            [finding("OFB101", "info", 5.95)],
+            0,
         ),
         (
             "stream_lost",
@@ -114,8 +115,9 @@ def main() -> None:
         (
             "switch_50ms_after_first_ocm",
             Flight(switch_at=0.05),
-            [finding("OFB102", "warning", 0.05)],
-            1,
+            # the docs' second, which no release enforces: PX4 accepts the switch (info)
+            [finding("OFB102", "info", 0.05)],
+            0,
         ),
         (
             "switch_rejected",

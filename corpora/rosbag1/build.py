@@ -104,8 +104,8 @@ def main() -> None:
         exit_status=0,
         args=[],
     )
-    # Bad: a 0.8 s gap in offboard (6.0 -> 6.8). OFB101 at the gap's start: 0.8 s > 500 ms, but
-    # PX4 1.15 tolerates it (COM_OF_LOSS_T 1.0 s), so the rule says warning, not error.
+    # Bad: a 0.8 s gap in offboard (6.0 -> 6.8). OFB101 at the gap's start: 0.8 s > 500 ms, and
+    # 80 % of PX4 1.15's COM_OF_LOSS_T (1.0 s): PX4 keeps offboard, but only just (a warning).
     short = flight(
         [(0.0, "POSCTL"), (3.0, "OFFBOARD"), (11.0, "AUTO.LAND")],
         setpoints(1.0, 12.0, gaps=((6.0, 6.8),)),
@@ -131,16 +131,17 @@ def main() -> None:
         ],
         exit_status=1,
     )
-    # Bad: setpoints start at 3.0 s, OFFBOARD shown at 3.5 s: 0.5 s of stream before the
-    # switch. OFB102 (a warning: PX4 1.15 accepts the switch once its signal is available).
+    # Setpoints start at 3.0 s, OFFBOARD shown at 3.5 s: 0.5 s of stream before the switch.
+    # OFB102 says the docs' second, which no release enforces: PX4 1.15 accepts the switch once
+    # its signal is available (info).
     early = flight(
         [(0.0, "POSCTL"), (3.0, "OFFBOARD"), (11.0, "AUTO.LAND")], setpoints(3.0, 12.0), 12.0
     )
     write_rosbag1(HERE / "offboard_switch_early.bag", early)
     expected(
         "offboard_switch_early",
-        [{"code": "OFB102", "severity": "warning", "time_s": 3.5}],
-        exit_status=1,
+        [{"code": "OFB102", "severity": "info", "time_s": 3.5}],
+        exit_status=0,
     )
     # Truncated: the good flight cut in half (a recorder killed mid-write, then the file copied).
     data = (HERE / "offboard_good.bag").read_bytes()

@@ -80,13 +80,14 @@ class Flight:
     ocm_stamp: Callable[[float], int] = stamp
     ocm_flags: Callable[[float], Fields] | None = None
     extra: list[Event] = field(default_factory=list)
+    end: float = END_T
 
     def events(self) -> list[Event]:
         out: list[Event] = []
-        for t in ticks(0.0, END_T, OCM_PERIOD):
+        for t in ticks(0.0, self.end, OCM_PERIOD):
             flags = self.ocm_flags(t) if self.ocm_flags else self.flags
             out.append(ControlMode(t=t, sender_time_us=self.ocm_stamp(t), **flags))
-        for t in ticks(0.0, END_T, STATUS_PERIOD):
+        for t in ticks(0.0, self.end, STATUS_PERIOD):
             nav = OFFBOARD if t >= SWITCH_T + 0.05 else POSCTL
             out.append(VehicleStatus(t=t, nav_state=nav, armed=t >= ARM_T + 0.05))
         out += [
@@ -95,7 +96,7 @@ class Flight:
             Command(t=ARM_T, command=400, params=(1.0, 0, 0, 0, 0, 0, 0), from_external=True),
             CommandAck(t=ARM_T + 0.02, command=400, result=0),
         ]
-        for t in ticks(self.setpoints_from, END_T, SETPOINT_PERIOD):
+        for t in ticks(self.setpoints_from, self.end, SETPOINT_PERIOD):
             out += self.setpoint(t)
         out += self.extra
         return sorted(out, key=lambda e: e.t)
@@ -147,6 +148,8 @@ class Case:
     params: dict[str, float] = field(default_factory=dict)
     request: float | None = None
     """Time of the offboard request (for OFB701), where it is not the flights' 1.5 s."""
+    offboard: bool = True
+    """The vehicle uses offboard (OFB701 states its loss behaviour)."""
     note: str = ""
 
     @property
@@ -225,22 +228,63 @@ def mcap_cases() -> list[Case]:
         )
     )
 
-    # OFB107: at 2.5 s the planner dies; the library re-sends its last setpoint for 3.45 s.
-    def dead_planner(t: float) -> list[Event]:
-        return [replace(sp, t=t) for sp in climb(min(t, 2.5))]
+    # OFB107: velocity control; at 2.5 s the planner dies while commanding 2 m/s, and the
+    # library re-sends its last setpoint until 14 s: 11.5 s of the same motion (over 10 s).
+    def cruise(t: float) -> list[Event]:
+        return [TrajectorySetpoint(t=t, velocity=(2.0, 0.2 * math.sin(t), 0.0), yaw=0.0)]
 
+    def dead_planner(t: float) -> list[Event]:
+        return [replace(sp, t=t) for sp in cruise(min(t, 2.5))]
+
+    velocity = {"velocity": True}
     cases.append(
         Case(
             "ofb107_planner_dies",
-            Flight(POSITION, dead_planner).events(),
-            [("OFB107", "warning", 2.5)],
+            Flight(velocity, dead_planner, end=14.0).events(),
+            [("OFB107", "error", 2.5)],
             [],
         )
     )
 
-    # OFB203: the px4_ros_com pattern: setpoints from the first second, before the switch.
+    # ...and the same planner stopping with a hold (zero velocity), which is never reported.
+    def planner_holds(t: float) -> list[Event]:
+        if t < 2.5:
+            return cruise(t)
+        return [TrajectorySetpoint(t=t, velocity=(0.0, 0.0, 0.0), yaw=0.0)]
+
+    cases.append(
+        Case(
+            "ofb107_planner_leaves_a_hold",
+            Flight(velocity, planner_holds, end=14.0).events(),
+            [],
+            ["OFB107"],
+        )
+    )
+
+    # OFB203: the px4_ros_com pattern: setpoints from the first second, before the switch,
+    # while disarmed: nothing flies them (info).
     early = Flight(POSITION, climb, setpoints_from=0.0).events()
-    cases.append(Case("ofb203_setpoints_before_switch", early, [("OFB203", "error", 0.0)], []))
+    cases.append(Case("ofb203_setpoints_before_switch", early, [("OFB203", "info", 0.0)], []))
+    # OFB203: a pilot flies in POSCTL while the companion publishes setpoints and never asks
+    # for offboard: they fight PX4's own flight task (error).
+    fighting: list[Event] = [
+        ControlMode(t=t, position=True, sender_time_us=stamp(t))
+        for t in ticks(0.0, END_T, OCM_PERIOD)
+    ]
+    fighting += [
+        VehicleStatus(t=t, nav_state=POSCTL, armed=True) for t in ticks(0.0, END_T, STATUS_PERIOD)
+    ]
+    fighting += [e for t in ticks(1.0, END_T, SETPOINT_PERIOD) for e in climb(t)]
+    fighting.sort(key=lambda e: e.t)
+    cases.append(
+        Case(
+            "ofb203_setpoints_in_position_mode",
+            fighting,
+            [("OFB203", "error", 1.0)],
+            [],
+            offboard=False,
+        )
+    )
 
     # OFB301: the first 0.3 s of OffboardControlMode declare nothing.
     def empty_first(t: float) -> Fields:
@@ -346,11 +390,12 @@ def mcap_cases() -> list[Case]:
         Case(
             "ofb404_enu_takeoff",
             Flight(POSITION, enu_takeoff).events(),
-            [("OFB404", "warning", 1.8)],
+            [("OFB404", "error", 1.8)],
             [],
             note="the first setpoint with |z| over 0.5 m: 2 * (t - 1.5) > 0.5 first at 1.8 s",
         )
     )
+    cases += takeoff_cases(enu_takeoff)
 
     # OFB405: attitude control with a quaternion that is not normalised from 4 s.
     def scaled_quat(t: float) -> list[Event]:
@@ -516,13 +561,77 @@ def ulog_cases() -> list[Case]:
         Case(
             "ofb305_position_estimate_lost",
             [*(failsafe(e) for e in logged), valid, lost],
-            [("OFB305", "error", 4.0), ("OFB702", "warning", 4.0), ("OFB103", "error", 4.01)],
+            # the loss ran the fallback ALTCTL instead of the configured POSCTL: OFB702 error
+            [("OFB305", "error", 4.0), ("OFB103", "error", 4.01), ("OFB702", "error", 4.01)],
             [],
             fmt="ulg",
         )
     )
     cases += legacy_cases()
     return cases
+
+
+def takeoff_cases(enu_takeoff: Callable[[float], list[Event]]) -> list[Case]:
+    """OFB404 after a takeoff in another mode (PX4 AUTO_TAKEOFF from 0.5 s, Hold from 4.0 s,
+    then the switch to OFFBOARD at 6.0 s): a first offboard descent is an ordinary command
+    there (clean); a height written in ENU flies the vehicle into the ground (error)."""
+    takeoff, hold = 17, 4
+    switch = 6.0
+
+    def flight(setpoint: Callable[[float], list[Event]]) -> list[Event]:
+        out: list[Event] = [
+            ControlMode(t=t, position=True, sender_time_us=stamp(t))
+            for t in ticks(0.0, 12.0, OCM_PERIOD)
+        ]
+        for t in ticks(0.0, 12.0, STATUS_PERIOD):
+            nav = (
+                POSCTL
+                if t < 0.5
+                else takeoff
+                if t < 4.0
+                else hold
+                if t < switch + 0.05
+                else OFFBOARD
+            )
+            out.append(VehicleStatus(t=t, nav_state=nav, armed=t >= 0.45))
+        out += [
+            Command(t=0.4, command=400, params=(1.0, 0, 0, 0, 0, 0, 0), from_external=True),
+            CommandAck(t=0.42, command=400, result=0),
+            Command(t=0.5, command=22, params=(0.0,) * 7, from_external=True),
+            CommandAck(t=0.52, command=22, result=0),
+            Command(t=switch, command=176, params=(1.0, 6.0, 0, 0, 0, 0, 0), from_external=True),
+            CommandAck(t=switch + 0.02, command=176, result=0),
+        ]
+        for t in ticks(switch + 0.05, 12.0, SETPOINT_PERIOD):
+            out += setpoint(t)
+        return sorted(out, key=lambda e: e.t)
+
+    def descend(t: float) -> list[Event]:
+        # from the 2.5 m takeoff height down to 1 m, then a hold there
+        z = min(-1.0, -2.5 + 0.5 * (t - switch))
+        return [TrajectorySetpoint(t=t, position=(0.0, 0.0, z), yaw=0.0)]
+
+    def enu_hold(t: float) -> list[Event]:
+        return [TrajectorySetpoint(t=t, position=(0.0, 0.0, 2.5), yaw=0.0)]
+
+    return [
+        Case(
+            "ofb404_descent_after_takeoff",
+            flight(descend),
+            [],
+            ["OFB404"],
+            request=switch,
+            note="a first offboard command below the takeoff height, in NED",
+        ),
+        Case(
+            "ofb404_enu_height_after_takeoff",
+            flight(enu_hold),
+            [("OFB404", "error", switch + 0.05)],
+            [],
+            request=switch,
+            note="2.5 m written in ENU (z = +2.5): 2.5 m below the origin",
+        ),
+    ]
 
 
 def _as_logged(event: Event) -> Event:
@@ -630,7 +739,8 @@ def context_findings(case: Case) -> list[tuple[str, str, float | None]]:
     request = (
         case.request if case.request is not None else 1.6 if case.px4 == "legacy" else SWITCH_T
     )
-    return [("OFB002", "info", None)] * not_checkable + [("OFB701", "info", request)]
+    summary = [("OFB701", "info", request)] if case.offboard else []
+    return [("OFB002", "info", None)] * not_checkable + summary
 
 
 def write(case: Case) -> None:

@@ -9,7 +9,7 @@ as sent, so its cases are tlogs (``fuzzoff.writers.tlog``: MAVLink setpoints are
   5.5 s (0.5 s threshold) to the end of offboard.
 * ``ofb104_good``: the same flight with the setpoints going on: clean.
 * ``ofb105_2hz_stream``: MAVLink setpoints every 450 ms in OFFBOARD: above 2 Hz but marginal:
-  OFB105 over the offboard stretch.
+  OFB105 (info: no PX4 release acts on the 2 Hz margin) over the offboard stretch.
 * ``ofb105_good``: 20 Hz setpoints with a little jitter: clean.
 
 Every flight switches to OFFBOARD after 2 s of stream (accepted) and is a multicopter whose PX4
@@ -144,7 +144,8 @@ def main() -> None:
         "ofb105_2hz_stream.tlog": (
             mavlink_flight(period=0.45, jitter=0.0),
             [
-                {"code": "OFB105", "severity": "warning", "time_s": 2.25, "vehicle": "1"},
+                # info: no release acts on the 2 Hz margin (0.45 s gaps, 45 % of COM_OF_LOSS_T)
+                {"code": "OFB105", "severity": "info", "time_s": 2.25, "vehicle": "1"},
                 *context_tlog,
             ],
             ["OFB101", "OFB102", "OFB103", "OFB201"],

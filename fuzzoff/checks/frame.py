@@ -1,12 +1,23 @@
 """OFB404 (heuristic): setpoints that look like ENU/FLU where PX4 expects NED/FRD.
 
-Two signs of a frame mix-up that a real flight almost never shows:
+Three signs of a frame mix-up that a real flight almost never shows, each an error because the
+vehicle would fly into the ground (or push into it instead of climbing):
 
-* the first sizeable vertical command after arming (or of the recording, where arming is not
-  recorded) points down: a position more than ``z_m`` below the start point (``z`` > 0 in NED)
-  or a vertical velocity above ``vz_mps`` (``vz`` > 0 is descending): a climb written in ENU;
-* a multicopter attitude or rates setpoint whose ``thrust_body`` z is above ``thrust_z``
-  (FRD thrust points up as negative z): thrust written in FLU.
+* from the ground, the first sizeable vertical command points down: a position more than ``z_m``
+  below the start point (``z`` > 0 in NED) or a vertical velocity above ``vz_mps`` (``vz`` > 0 is
+  descending): a climb written in ENU;
+* in the air, a position target more than ``z_m`` below the local origin: a height written in
+  ENU (a descent by velocity is an ordinary command there, so only positions are judged);
+* a multicopter attitude or rates setpoint whose ``thrust_body`` z is above ``thrust_z`` (FRD
+  thrust points up as negative z): thrust written in FLU.
+
+"On the ground" is the vehicle disarmed (recorded, else as the gate model has it), or the start
+of a recording whose arming is not recorded. A takeoff in any mode leaves it: the vehicle armed
+in a mode in which it can take off (auto takeoff, a mission, a pilot mode) or a takeoff command;
+a recording that starts armed starts in the air. Only the external controller's setpoints are
+judged: as sent, or a ULog's logged copy while the recorded status says OFFBOARD (PX4's own
+flight tasks write ``trajectory_setpoint`` in its other modes, and an ack of a switch is not yet
+the switch: PX4 1.16 and 1.17 ack one first from the receiver).
 """
 
 from __future__ import annotations
@@ -14,11 +25,14 @@ from __future__ import annotations
 import math
 from itertools import repeat
 from operator import attrgetter, gt, itemgetter
+from typing import Literal
 
 from fuzzoff.checks._external import Episodes, external_only, from_external
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import (
+    NAV_STATE_OFFBOARD,
     AttitudeSetpoint,
+    Command,
     Event,
     RatesSetpoint,
     SetPositionTargetLocal,
@@ -33,8 +47,35 @@ IGNORE_Z = 4
 IGNORE_V = 8 | 16 | 32
 IGNORE_VZ = 32
 
+MAV_CMD_NAV_TAKEOFF = 22
+MAV_CMD_NAV_VTOL_TAKEOFF = 84
+
+TAKEOFF_MODES = frozenset(
+    {
+        0,  # MANUAL
+        1,  # ALTCTL
+        2,  # POSCTL
+        3,  # AUTO_MISSION
+        6,  # POSITION_SLOW
+        10,  # ACRO
+        15,  # STAB
+        16,  # RATTITUDE
+        17,  # AUTO_TAKEOFF
+        19,  # AUTO_FOLLOW_TARGET
+        21,  # ORBIT
+        22,  # AUTO_VTOL_TAKEOFF
+        *range(23, 31),  # EXTERNAL1-8
+    }
+)
+"""nav_states in which an armed vehicle can have taken off (by itself or by a pilot). Hold,
+Return, Land, Descend and Termination do not take off."""
+
+Place = Literal["ground", "air"]
+
 _THRUST_Z = attrgetter("thrust_body")
-_Z = itemgetter(2)
+_POSITION_Z = itemgetter(2)
+_POSITION = attrgetter("position")
+_ORIGIN = attrgetter("origin")
 
 
 def vertical_command(event: Event) -> tuple[float, float]:
@@ -53,6 +94,10 @@ def vertical_command(event: Event) -> tuple[float, float]:
     return math.nan, math.nan
 
 
+def _position_z(event: Event) -> float:
+    return vertical_command(event)[0]
+
+
 class FrameConventionSuspect(Check):
     codes = ("OFB404",)
     wants = (
@@ -61,6 +106,7 @@ class FrameConventionSuspect(Check):
         AttitudeSetpoint,
         RatesSetpoint,
         VehicleStatus,
+        Command,
         GateTransition,
     )
 
@@ -70,68 +116,150 @@ class FrameConventionSuspect(Check):
         self.vz_mps = float(ctx.option("OFB404", "vz_mps"))
         self.thrust_z = float(ctx.option("OFB404", "thrust_z"))
         self.thrust = Episodes(ctx, "OFB404")
-        self.takeoff_pending = True
-        """Waiting for the first sizeable vertical command since the vehicle was on the ground."""
+        self.below = Episodes(ctx, "OFB404")
+        self.where: Place = "ground"
+        """On the ground (the first sizeable vertical command is judged) or in the air (or
+        maybe: a position below the origin is judged)."""
+        self.decided = False
+        """On the ground: the first sizeable vertical command has been judged."""
+        self.flagged = False
+        """A climb written in ENU was reported since the vehicle was last on the ground: the
+        same stream below the origin is that finding, not a new one."""
         self.armed: bool | None = None
         """The last recorded arming state (None: not recorded yet)."""
+        self.status_offboard = False
+        """The last recorded status says OFFBOARD (a ULog's logged setpoints count only then)."""
         self.thrust_types = (AttitudeSetpoint, RatesSetpoint)
-        self.takeoff_types = (TrajectorySetpoint, SetPositionTargetLocal)
+        self.vertical_types = (TrajectorySetpoint, SetPositionTargetLocal)
 
     def on_batch(self, batch: StreamBatch) -> None:
-        """Fast path: no external setpoint that could be the first vertical command (else
-        replay), and no thrust above the threshold: every thrust setpoint is then ``good``, which
-        only closes (reports) an open stretch at the first message of its kind."""
-        if self.takeoff_pending and external_only(self.ctx, batch.of(self.takeoff_types)):
-            self.replay(batch)
-            return
+        """Fast path: no external position or velocity setpoint that could be judged (on the
+        ground, the first sizeable command; in the air, none below the origin, and then every
+        one only closes an open stretch at its first message), and no thrust above the
+        threshold (every thrust setpoint is then ``good``: the same)."""
+        vertical = self._mine(batch.of(self.vertical_types))
+        if vertical:
+            if self.where == "ground" and not self.decided:
+                self.replay(batch)
+                return
+            if self.where == "air" and not self.flagged:
+                if self._any_below(vertical):
+                    self.replay(batch)
+                    return
+                if self.below.open:
+                    for kind in dict.fromkeys(event.kind for event in vertical):
+                        self.below.good(kind)
         if self.ctx.profile.vehicle != "mc":
             return
-        thrust = external_only(self.ctx, batch.of(self.thrust_types))
+        thrust = self._mine(batch.of(self.thrust_types))
         if not thrust:
             return
-        if any(map(gt, map(_Z, map(_THRUST_Z, thrust)), repeat(self.thrust_z))):
+        if any(map(gt, map(_POSITION_Z, map(_THRUST_Z, thrust)), repeat(self.thrust_z))):
             self.replay(batch)  # a bad one (or an infinite z, which is good: on_event decides)
             return
         if self.thrust.open:
             for kind in dict.fromkeys(event.kind for event in thrust):
                 self.thrust.good(kind)
 
+    def _any_below(self, events: list[Event]) -> bool:
+        """Could any of ``events`` be a position target below the origin (NaN never is)? The
+        raw z of every message first (a MAVLink mask or frame only takes positions away)."""
+        raw = map(_POSITION_Z, map(_POSITION, events))
+        if not any(map(gt, raw, repeat(self.z_m))):
+            return False
+        return any(map(gt, map(_position_z, events), repeat(self.z_m)))
+
+    def _mine(self, events: list[Event]) -> list[Event]:
+        """The external controller's messages among a run's: as sent, or logged while the
+        recorded status says OFFBOARD."""
+        external = external_only(self.ctx, events)
+        if not external or self.status_offboard or set(map(_ORIGIN, external)) == {"sent"}:
+            return external
+        return [e for e in external if e.origin == "sent"]
+
+    def _is_mine(self, event: Event) -> bool:
+        if event.origin != "sent" and not self.status_offboard:
+            return False
+        return from_external(self.ctx, event)
+
     def on_event(self, event: Event) -> None:
-        if isinstance(event, VehicleStatus) and event.armed is not None:
-            if not event.armed and self.armed is not False:
-                self.takeoff_pending = True  # on the ground (again)
-            elif event.armed and self.armed is None:
-                self.takeoff_pending = False  # the recording starts in flight
-            self.armed = event.armed
+        if isinstance(event, VehicleStatus):
+            self._status(event)
+            return
+        if isinstance(event, Command):
+            if event.command in (MAV_CMD_NAV_TAKEOFF, MAV_CMD_NAV_VTOL_TAKEOFF):
+                self._took_off()
             return
         if isinstance(event, GateTransition):
             if event.what == "disarmed" and self.armed is None:
-                self.takeoff_pending = True
+                self._on_ground()
             return
-        # from_external last: after take-off the usual setpoint needs no further look
+        if not self._is_mine(event):
+            return
         if isinstance(event, (AttitudeSetpoint, RatesSetpoint)):
-            if from_external(self.ctx, event):
-                self._thrust(event)
-        elif self.takeoff_pending and from_external(self.ctx, event):
-            self._takeoff(event)
+            self._thrust(event)
+        elif self.where == "ground":
+            if not self.decided:
+                self._from_ground(event)
+        elif not self.flagged:
+            self._in_the_air(event)
 
-    def _takeoff(self, event: Event) -> None:
+    def _status(self, event: VehicleStatus) -> None:
+        if event.nav_state is not None:
+            self.status_offboard = event.nav_state == NAV_STATE_OFFBOARD
+        if event.armed is None:
+            return
+        if not event.armed:
+            if self.armed is not False:
+                self._on_ground()
+        elif self.armed is None and self.where == "ground" and not self.decided:
+            self._took_off()  # the recording starts armed: in flight
+        elif event.nav_state in TAKEOFF_MODES:
+            self._took_off()
+        self.armed = event.armed
+
+    def _on_ground(self) -> None:
+        self.below.close_all()
+        self.where, self.decided, self.flagged = "ground", False, False
+
+    def _took_off(self) -> None:
+        self.where = "air"
+
+    def _from_ground(self, event: Event) -> None:
         z, vz = vertical_command(event)
         down = (math.isfinite(z) and z > self.z_m) or (math.isfinite(vz) and vz > self.vz_mps)
         up = (math.isfinite(z) and z < -self.z_m) or (math.isfinite(vz) and vz < -self.vz_mps)
         if not (down or up):
             return  # small commands (a zero setpoint before the switch) decide nothing
-        self.takeoff_pending = False
+        self.decided = True
         if not down:
+            self.where = "air"  # it climbs: what follows is judged as in the air
             return
+        self.flagged = True
         what = f"z = {z:g} m" if math.isfinite(z) and z > self.z_m else f"vz = {vz:g} m/s"
         self.ctx.report(
             "OFB404",
             f"the first vertical command since the vehicle was on the ground is {what}, "
             "downwards in NED: looks like a climb written in ENU (up positive); PX4 expects "
-            f"NED (thresholds z_m = {self.z_m:g}, vz_mps = {self.vz_mps:g})",
+            "NED and keeps the vehicle on the ground, pushing into it "
+            f"(thresholds z_m = {self.z_m:g}, vz_mps = {self.vz_mps:g})",
             event.t,
             event.where,
+        )
+
+    def _in_the_air(self, event: Event) -> None:
+        z = vertical_command(event)[0]
+        if not (math.isfinite(z) and z > self.z_m):
+            self.below.good(event.kind)
+            return
+        self.below.bad(
+            event.kind,
+            event.t,
+            event.where,
+            f"position target z = {z:g} m, below the local origin, after a takeoff (or in a "
+            "mode that takes off) since the vehicle was last on the ground: looks like a "
+            "height written in ENU (up positive); PX4 expects NED and flies the vehicle down "
+            f"towards it, into the ground (threshold z_m = {self.z_m:g})",
         )
 
     def _thrust(self, event: AttitudeSetpoint | RatesSetpoint) -> None:
@@ -146,8 +274,10 @@ class FrameConventionSuspect(Check):
             event.t,
             event.where,
             f"multicopter thrust_body z = {tz:g} points down in FRD: looks like thrust written "
-            f"in FLU (up positive); PX4 expects negative z for lift (threshold {self.thrust_z:g})",
+            "in FLU (up positive); PX4 expects negative z for lift, so the vehicle gets no lift "
+            f"and falls, or stays on the ground (threshold {self.thrust_z:g})",
         )
 
     def finish(self, t_end: float) -> None:
         self.thrust.close_all()
+        self.below.close_all()

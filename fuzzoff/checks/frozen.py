@@ -1,9 +1,12 @@
-"""OFB107: identical setpoint content for longer than a threshold while the stream keeps coming.
+"""OFB107: a command that moves the vehicle, held identical while the stream keeps coming.
 
 A heuristic for a dead controller behind a library that re-sends the last setpoint (MAVSDK
-does, at 20 Hz): the keep-alive stays healthy, so PX4 never fails safe. Judged per topic, in
-offboard, on the external controller's messages; a gap longer than ``max_gap_s`` or any change
-in content restarts the count.
+does, at 20 Hz): the keep-alive stays healthy, so PX4 never fails safe and flies the command on.
+Judged per topic, in offboard, on the external controller's messages; a gap longer than
+``max_gap_s`` or any change in content restarts the count. Only a command that moves the vehicle
+is reported (``_motion.held_motion``): a held position, a zero velocity or a hover is what a
+stopped controller should leave. A motion that takes the vehicle ever further (``straight``) is
+reported after ``freeze_s``, a bounded one (a circle, a turn on the spot) after ``turning_s``.
 """
 
 from __future__ import annotations
@@ -18,6 +21,7 @@ from typing import Any
 
 from fuzzoff.checks._external import external_only, from_external
 from fuzzoff.checks._keepalive import mode_note
+from fuzzoff.checks._motion import Hover, Motion, held_motion
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import MAVLINK_SETPOINTS, PX4_SETPOINTS, Event, VehicleStatus, Where
 from fuzzoff.gate import GateTransition
@@ -166,6 +170,8 @@ class _Run:
     start: float
     last: float
     where: Where
+    first: Event
+    """The run's first message (every message of the run has its content)."""
     count: int = 1
     content: str | None = None
     """``repr`` of ``raw`` once needed: equal text means equal content, NaN included."""
@@ -196,13 +202,19 @@ class SetpointFrozen(Check):
     def __init__(self, ctx: CheckContext) -> None:
         super().__init__(ctx)
         self.freeze = float(ctx.option("OFB107", "freeze_s"))
+        self.turning = float(ctx.option("OFB107", "turning_s"))
+        self.shortest = min(self.freeze, self.turning)
+        """No run this short is reported, whatever its content."""
+        self.hover = Hover(
+            float(ctx.option("OFB107", "hover_thrust")), float(ctx.option("OFB107", "hover_band"))
+        )
         self.max_gap = float(ctx.option("OFB107", "max_gap_s"))
         self.runs: dict[str, _Run] = {}
         self.setpoints = self.wants
         self.changing: dict[str, str | None] = {}
         """Per kind, how the last run was proven: the field that changed every time, or None
         (frozen content). Tried first on the next run."""
-        self.quiet_single = self.freeze >= 0
+        self.quiet_single = self.shortest >= 0
         """A run of one message (duration 0) is never reported: the moving fast path needs it."""
 
     def on_event(self, event: Event) -> None:
@@ -235,7 +247,7 @@ class SetpointFrozen(Check):
                 run.count += 1
                 return
         self._close(kind)
-        self.runs[kind] = _Run(raw, event.t, event.t, event.where, content=text)
+        self.runs[kind] = _Run(raw, event.t, event.t, event.where, event, content=text)
 
     def on_batch(self, batch: StreamBatch) -> None:
         """Fast path, per kind: content frozen for the whole run, or changing with every message
@@ -325,7 +337,7 @@ class SetpointFrozen(Check):
         if same and len(events) == 1:
             return _Plan(kind, 1, first.t, None)
         new_raw = raw if last is first else get(last)
-        return _Plan(kind, int(same), first.t, _Run(new_raw, last.t, last.t, last.where))
+        return _Plan(kind, int(same), first.t, _Run(new_raw, last.t, last.t, last.where, last))
 
     def _frozen(self, kind: str, events: list[Event], run: _Run | None) -> _Plan | None:
         """Every message has the same content (as tuples, or written alike: ``all_alike``) and
@@ -345,7 +357,7 @@ class SetpointFrozen(Check):
         if self._continues(raw, run, None):
             return None  # the first continues the open run, the others may not: replay
         self.changing[kind] = None
-        new = _Run(raw, times[0], times[-1], events[0].where, len(events))
+        new = _Run(raw, times[0], times[-1], events[0].where, events[0], len(events))
         return _Plan(kind, 0, times[0], new)
 
     def _closes(self, plans: list[_Plan]) -> int:
@@ -355,7 +367,7 @@ class SetpointFrozen(Check):
             run = self.runs.get(plan.kind)
             if plan.new is not None and run is not None:
                 last = plan.last if plan.extend else run.last
-                count += not last - run.start <= self.freeze  # as _close decides
+                count += self._motion(run, last) is not None  # as _close decides
         return count
 
     def _apply(self, plan: _Plan) -> None:
@@ -367,18 +379,34 @@ class SetpointFrozen(Check):
             self._close(plan.kind)
             self.runs[plan.kind] = plan.new
 
+    def _motion(self, run: _Run, last: float) -> Motion | None:
+        """The motion ``run`` commands when it is held longer than that motion's threshold
+        until ``last``, else None (a hold is never reported)."""
+        duration = last - run.start
+        if duration <= self.shortest:
+            return None
+        motion = held_motion(run.first, self.ctx.profile.vehicle, self.hover)
+        if motion is None:
+            return None
+        limit = self.freeze if motion.kind == "straight" else self.turning
+        return motion if duration > limit else None
+
     def _close(self, kind: str) -> None:
         run = self.runs.pop(kind, None)
-        if run is None or run.last - run.start <= self.freeze:
+        if run is None:
+            return
+        motion = self._motion(run, run.last)
+        if motion is None:
             return
         duration = run.last - run.start
         rate = (run.count - 1) / duration
+        bounded = " (a bounded motion)" if motion.kind == "turning" else ""
         self.ctx.report(
             "OFB107",
-            f"{run.where.topic or kind}: identical setpoint content for {duration:.2f} s "
-            f"({run.count} messages, {rate:.1f} Hz) in offboard: a controller that stopped "
-            f"while its library re-sends the last setpoint looks alive to PX4"
-            f"{mode_note(self.ctx)}",
+            f"{run.where.topic or kind}: the same {motion.what}{bounded} for {duration:.2f} s "
+            f"({run.count} identical messages, {rate:.1f} Hz) in offboard: a controller that "
+            f"stopped while its library re-sends the last setpoint keeps the vehicle moving, "
+            f"and PX4 sees a healthy stream{mode_note(self.ctx)}",
             run.start,
             run.where,
             end=run.last,

@@ -5,13 +5,16 @@
   model emits them only for differences that involve OFFBOARD (others are ``mode`` rows);
 * OFB701 loss-action-summary: once per vehicle that uses offboard, what the vehicle does on loss;
 * OFB702 loss-action-unavailable: the configured loss action cannot run as configured (a mode
-  whose estimate is missing, a stick mode without manual control).
+  whose estimate is missing, a stick mode without manual control): an ``error`` when a loss
+  happened and the fallback ran, else ``info`` (a configuration note: every SITL or autonomous
+  setup without RC has it on every flight).
 """
 
 from __future__ import annotations
 
 from fuzzoff.checks.base import Check, CheckContext
 from fuzzoff.events import Event, FailsafeFlags, Parameter, VehicleStatus
+from fuzzoff.findings import Severity
 from fuzzoff.gate import GateTransition
 from fuzzoff.gate.failsafe import LossAction
 from fuzzoff.gate.params import RC_PRESENT
@@ -123,16 +126,29 @@ class LossActionSummary(Check):
             self.ctx.report("OFB701", loss_summary(self.ctx), event.t)
 
 
+_Key = tuple[str, str | None, bool, str | None]
+
+
 class LossActionUnavailable(Check):
     codes = ("OFB702",)
     wants = (GateTransition, VehicleStatus, FailsafeFlags, Parameter)
 
     def __init__(self, ctx: CheckContext) -> None:
         super().__init__(ctx)
-        self.reported: set[tuple[str, str | None, bool, str | None]] = set()
+        self.noted: dict[_Key, tuple[float, str]] = {}
+        """Configuration notes waiting for the end: a loss that runs the fallback later makes
+        its error the one finding."""
+        self.ran: set[_Key] = set()
 
     def on_event(self, event: Event) -> None:
-        if not (self.ctx.gate.in_offboard or self.ctx.state.in_offboard):
+        gate = self.ctx.gate
+        # a loss on a vehicle the model knows disarmed runs no fallback that flies anything
+        loss = (
+            isinstance(event, GateTransition)
+            and event.what == "failsafe"
+            and event.armed is not False
+        )
+        if not (loss or gate.in_offboard or self.ctx.state.in_offboard):
             return
         if isinstance(event, GateTransition) and event.what not in (
             "failsafe",
@@ -141,7 +157,7 @@ class LossActionUnavailable(Check):
             "signal_available",
         ):
             return
-        action = self.ctx.gate.current_loss_action()
+        action = gate.current_loss_action()
         if not (action.degraded_from or action.stick_mode_without_rc or action.replaced_from):
             return
         key = (
@@ -150,10 +166,27 @@ class LossActionUnavailable(Check):
             action.stick_mode_without_rc,
             action.replaced_from,
         )
-        if key in self.reported:
+        if key in self.ran:
             return
-        self.reported.add(key)
-        self.ctx.report("OFB702", self._message(action), event.t)
+        if loss:
+            self.ran.add(key)
+            self.noted.pop(key, None)
+            message = f"the offboard signal was lost at {event.t:.2f} s and the fallback ran: "
+            self.ctx.report(
+                "OFB702", message + self._message(action), event.t, severity=Severity.ERROR
+            )
+        elif key not in self.noted:
+            self.noted[key] = (event.t, self._message(action))
+
+    def finish(self, t_end: float) -> None:
+        for t, message in self.noted.values():
+            self.ctx.report(
+                "OFB702",
+                f"configuration note, no offboard loss in this recording: {message}",
+                t,
+                severity=Severity.INFO,
+            )
+        self.noted.clear()
 
     def _rc_source(self) -> str:
         if self.ctx.gate.est.rc_recorded:

@@ -1,7 +1,9 @@
 """OFB101, OFB102, OFB105: the keep-alive stream's rate and its run-up to an offboard request.
 
 Seed 000 "Опис": a > 2 Hz proof of life, running for a second before an offboard request. The
-messages say both what the docs require and what the profile's PX4 does (gate spec 2, 3, D1/D2).
+messages say both what the docs require and what the profile's PX4 does (gate spec 2, 3, D1/D2),
+and the severity is what PX4 does (rules.md): a gap PX4 takes for a loss is an error, one of
+80 % of the loss timeout or more a warning, a shorter one (the docs' 2 Hz only) info.
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ from fuzzoff.checks._keepalive import (
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import (
     Command,
+    CommandAck,
     Dropout,
     Event,
     VehicleStatus,
@@ -31,6 +34,24 @@ from fuzzoff.events import (
 )
 from fuzzoff.findings import Severity
 from fuzzoff.gate import GateTransition
+from fuzzoff.state import DOUBLE_ACK_WINDOW_S
+
+NEAR_LOSS_FRACTION = 0.8
+"""A keep-alive gap of this share of the loss timeout or more is a warning (rules.md): PX4
+keeps the signal, but only just."""
+
+IN_OFFBOARD = "in OFFBOARD"
+ACROSS_SWITCH = "across the switch to OFFBOARD"
+BEFORE_REQUEST = "in the second before an offboard request"
+
+
+def gap_severity(gap: float, timeout: float) -> Severity:
+    """What a keep-alive gap in offboard does on a profile with this loss timeout."""
+    if gap >= timeout:
+        return Severity.ERROR
+    if gap >= NEAR_LOSS_FRACTION * timeout:
+        return Severity.WARNING
+    return Severity.INFO
 
 
 @dataclass(slots=True)
@@ -39,13 +60,17 @@ class _Gap:
     end: float
     proven: float
     where: Where
+    counts: float | None = None
+    """The part of the gap PX4 acts on, where that is less than the whole (a gap that ends
+    before a request: none; across a request PX4 refused: the keep-alive's age at it);
+    None: all of it."""
 
 
 class KeepaliveRate(Check):
     """OFB101: gaps of 500 ms or more in offboard, or in the second before an offboard request."""
 
     codes = ("OFB101",)
-    wants = (*KEEPALIVE_EVENTS, Command, VehicleStatus)
+    wants = (*KEEPALIVE_EVENTS, Command, CommandAck, VehicleStatus)
 
     def __init__(self, ctx: CheckContext) -> None:
         super().__init__(ctx)
@@ -58,13 +83,23 @@ class KeepaliveRate(Check):
         self.dropout_since_last = False
         self.last_where = Where("keep-alive")
         self.switches = RecordedSwitches(ctx)
-        self.request_in_gap = False
-        """An offboard request came while no keep-alive has arrived since ``last``."""
+        self.request_in_gap: float | None = None
+        """When an offboard request came while no keep-alive had arrived since ``last``."""
         self.recent: list[_Gap] = []
         """Gaps outside offboard, kept for ``window`` seconds in case a request follows."""
+        self.left_at: Event | None = None
+        """The ack of a switch away from OFFBOARD that ended the window while no keep-alive
+        came: judged once no second ack can undo it (1.16/1.17 ack a switch twice, and only
+        the last, Commander's, decides: gate spec 4.3)."""
 
     def on_event(self, event: Event) -> None:
         state = self.ctx.state
+        left = self.left_at
+        if left is not None and (
+            event is state.keepalive or event.t - left.t > DOUBLE_ACK_WINDOW_S
+        ):
+            self.left_at = None
+            self._silence_until_left(left)
         if event is state.keepalive:  # first: nearly every message is one
             last = self.last
             if last is not None and not self.dropout_since_last:
@@ -74,17 +109,23 @@ class KeepaliveRate(Check):
             self.last, self.last_where = event.t, event.where
             self.last_in_offboard = state.flying
             self.dropout_since_last = False
-            self.request_in_gap = False
+            self.request_in_gap = None
         elif isinstance(event, Dropout):
             self.dropout_since_last = True
-        elif isinstance(event, Command):
-            if event.is_offboard_switch or (event.is_arm and state.in_offboard):
-                self._request(event.t)
-        elif isinstance(event, VehicleStatus):
-            if self.switches.entered_by_request(event, self.last):
+        else:
+            if isinstance(event, Command):
+                if event.is_offboard_switch or (event.is_arm and state.in_offboard):
+                    self._request(event.t)
+            elif isinstance(event, VehicleStatus) and self.switches.entered_by_request(
+                event, self.last
+            ):
                 self._request(event.t)  # no commands recorded (MAVROS): the switch itself
-            if self.last_in_offboard and not state.flying:
-                self._left_offboard(event)
+            if isinstance(event, CommandAck):
+                self._ack(event, left)
+            elif self.last_in_offboard and not state.flying:
+                # left at a recorded status, or (no mode recorded) at the command itself
+                self.last_in_offboard = False
+                self._silence_until_left(event)
         if self.recent:
             self.recent = [g for g in self.recent if event.t - g.end <= self.window]
 
@@ -93,7 +134,7 @@ class KeepaliveRate(Check):
         gap outside offboard kept for a later request: just move ``last`` on. A gap kept in
         ``recent`` is trimmed by every message ``on_event`` sees, keep-alive or not (a MAVLink
         setpoint for another vehicle): replay then."""
-        if self.recent:
+        if self.recent or self.left_at is not None:
             self.replay(batch)
             return
         keepalives = batch.keepalives()
@@ -110,63 +151,96 @@ class KeepaliveRate(Check):
         self.last, self.last_where = newest.t, newest.where
         self.last_in_offboard = batch.state.flying
         self.dropout_since_last = False
-        self.request_in_gap = False
+        self.request_in_gap = None
+
+    def _ack(self, ack: CommandAck, left: Event | None) -> None:
+        if self.last_in_offboard and not self.ctx.state.flying:
+            # a switch away accepted at this ack: the window ends here, not at the next status
+            # message (PX4's HEARTBEAT is 1 Hz)
+            self.last_in_offboard = False
+            self.left_at = ack
+        elif left is not None and self.left_at is left and self.ctx.state.flying:
+            # Commander's ack after the receiver's rejects the switch: still in OFFBOARD
+            self.last_in_offboard = True
+            self.left_at = None
 
     def _gap(self, event: Event, last: float, proven: float) -> None:
         if proven >= self.max_gap:
             found = _Gap(last, event.t, proven, event.where)
+            state = self.ctx.state
             if self.last_in_offboard:
-                self._report(found, "in OFFBOARD")
-            elif self.request_in_gap or self.ctx.state.flying:
-                self._report(found, "across the switch to OFFBOARD")
+                self._report(found, IN_OFFBOARD)
+            elif self.request_in_gap is not None or state.flying:
+                # PX4 judges the newest keep-alive's age, whenever the silence began: flying in
+                # OFFBOARD at its end, the whole gap counts; else its age at the request
+                asked = self.request_in_gap
+                if not state.flying and asked is not None:
+                    # in OFFBOARD but disarmed (1.14+ accepts that switch): nothing flies
+                    found.counts = 0.0 if state.in_offboard else asked - last
+                self._report(found, ACROSS_SWITCH)
             else:
                 self.recent.append(found)
 
-    def _left_offboard(self, event: Event) -> None:
-        """The vehicle left OFFBOARD (or disarmed) with no keep-alive since ``last``: only the part
-        of the silence spent in OFFBOARD counts."""
-        assert self.last is not None
-        self.last_in_offboard = False
-        if self.dropout_since_last:
+    def _silence_until_left(self, event: Event) -> None:
+        """The vehicle left OFFBOARD (or disarmed) at ``event`` with no keep-alive since
+        ``last``: only the part of the silence spent in OFFBOARD counts."""
+        if self.last is None or self.dropout_since_last:
             return
         gap = proven_gap(self.ctx, event, event.t - self.last)
         if gap >= self.max_gap:
             self._report(
-                _Gap(self.last, event.t, gap, self.last_where), "in OFFBOARD (until it left)"
+                _Gap(self.last, event.t, gap, self.last_where), f"{IN_OFFBOARD} (until it left)"
             )
 
     def _request(self, t: float) -> None:
-        self.request_in_gap = self.last is not None  # a silence still open at the request
+        if self.last is not None and self.request_in_gap is None:
+            self.request_in_gap = t  # a silence still open at the request
         for found in self.recent:
             if t - found.end <= self.window:
-                self._report(found, "in the second before an offboard request")
+                found.counts = 0.0
+                self._report(found, BEFORE_REQUEST)
         self.recent.clear()
 
     def _report(self, gap: _Gap, context: str) -> None:
+        """Say both what the docs require and what PX4 does; the severity is what PX4 does
+        with the part of the gap it acts on (``_Gap.counts``, ``gap_severity``)."""
         ctx = self.ctx
         timeout = loss_timeout(ctx)
         sampled = " (logged gap minus the logger's interval)" if ctx.info.sampled else ""
-        docs = f"docs: keep-alive at > 2 Hz, gaps under {self.max_gap:.1f} s"
-        if ctx.profile.px4 != "legacy" and gap.proven < timeout:
+        head = (
+            f"keep-alive gap of {gap.proven:.2f} s{sampled} {context}{mode_note(ctx)}; "
+            f"docs: keep-alive at > 2 Hz, gaps under {self.max_gap:.1f} s; {px4_label(ctx)}"
+        )
+        flown = gap.proven if gap.counts is None else min(gap.proven, gap.counts)
+        severity = gap_severity(flown, timeout)
+        if severity is Severity.ERROR and gap.counts is not None:
             message = (
-                f"keep-alive gap of {gap.proven:.2f} s{sampled} {context}{mode_note(ctx)}; "
-                f"{docs}; {px4_label(ctx)} would: keep the offboard signal, it is lost only after "
-                f"a gap of COM_OF_LOSS_T = {timeout:.2f} s"
+                f"{head} refuses the request: its newest keep-alive was {flown:.2f} s old "
+                f"(loss timeout {timeout:.2f} s)"
             )
-            severity = Severity.WARNING
+        elif severity is Severity.ERROR:
+            message = f"{head} loses the offboard signal after {timeout:.2f} s"
+        elif gap.counts is not None and flown < self.max_gap:
+            message = (
+                f"{head} judges only the newest keep-alive's age at the request (loss timeout "
+                f"{timeout:.2f} s): OFB102 and OFB201 say what it does with the request"
+            )
         else:
+            margin = " (only just)" if severity is Severity.WARNING else ""
             message = (
-                f"keep-alive gap of {gap.proven:.2f} s{sampled} {context}{mode_note(ctx)}; "
-                f"{docs}; {px4_label(ctx)} loses the offboard signal after {timeout:.2f} s"
+                f"{head} would: keep the offboard signal{margin}, it is lost only after a gap "
+                f"of COM_OF_LOSS_T = {timeout:.2f} s"
             )
-            severity = Severity.ERROR
         ctx.report("OFB101", message, gap.start, gap.where, severity=severity, end=gap.end)
 
     def finish(self, t_end: float) -> None:
-        if self.last is not None and self.last_in_offboard and t_end - self.last >= self.max_gap:
+        left, self.left_at = self.left_at, None
+        if left is not None:
+            self._silence_until_left(left)
+        elif self.last is not None and self.last_in_offboard and t_end - self.last >= self.max_gap:
             self._report(
                 _Gap(self.last, t_end, t_end - self.last, self.last_where),
-                "in OFFBOARD (stream stopped, recording ends)",
+                f"{IN_OFFBOARD} (stream stopped, recording ends)",
             )
 
 
@@ -243,6 +317,7 @@ class StreamBeforeRequest(Check):
             assert self.run_start is not None
             had = f"only {t - self.run_start:.2f} s of unbroken keep-alive before it"
         verdict = self.gate_verdict.get(id(event))
+        severity = Severity.INFO  # the docs' second: no PX4 release enforces it (D1)
         if verdict is None:
             would = (
                 "the recording shows the vehicle's answer"
@@ -251,13 +326,18 @@ class StreamBeforeRequest(Check):
             )
         elif verdict.what.endswith("accepted"):
             would = "accept it"
+            if not fresh:
+                # accepted only because the vehicle is disarmed (1.14+, D8): 1.13 and legacy
+                # reject the same switch, and arming then needs a fresh keep-alive
+                would += " (disarmed: accepted without a fresh keep-alive, checked at arming)"
         else:
             would = f"reject it ({verdict.reason or verdict.message})"
+            severity = Severity.ERROR
         message = (
             f"{what} with {had}; docs: stream for at least {self.min_stream:.0f} s first; "
             f"{px4_label(self.ctx)} would: {would}"
         )
-        self.ctx.report("OFB102", message, t, event.where, severity=Severity.WARNING)
+        self.ctx.report("OFB102", message, t, event.where, severity=severity)
 
 
 @cache
@@ -315,7 +395,8 @@ class _Histogram:
 
 
 class KeepaliveMargin(Check):
-    """OFB105: above 2 Hz but with little margin, per offboard stretch (heuristic)."""
+    """OFB105: above 2 Hz but with little margin, per offboard stretch (heuristic; info: no
+    PX4 release acts on the 2 Hz margin, the margin it acts on is the loss timeout, OFB101)."""
 
     codes = ("OFB105",)
     wants = KEEPALIVE_EVENTS

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from fuzzoff.config import Settings
 from fuzzoff.engine import run_events
 from fuzzoff.events import Command, CommandAck, Event, Parameter
-from fuzzoff.findings import Finding
+from fuzzoff.findings import Finding, Severity
 from fuzzoff.gate import GateModel, GateTransition
 from fuzzoff.profiles import Profile
 from fuzzoff.sources.base import RecordingInfo
@@ -87,6 +89,24 @@ def test_ofb702_stick_mode_without_rc(px4: str, shown: str) -> None:
 def test_ofb702_silent_with_manual_control() -> None:
     events = [flags(0.0, manual_control_signal_lost=False), in_offboard(), *stream(0.0, 1.0)]
     assert [px4 for px4 in ("1.16", "1.17", "main") if _lint(px4, events, "OFB702")] == []
+
+
+def test_ofb702_without_a_loss_is_a_configuration_note() -> None:
+    """rules.md: every SITL run and every autonomous setup has no RC; without a loss in the
+    recording the fallback never ran: info."""
+    events = [flags(0.0, manual_control_signal_lost=True), in_offboard(), *stream(0.0, 30.0)]
+    for px4 in ("1.16", "1.17"):
+        (finding,) = _lint(px4, events, "OFB702")
+        assert finding.severity is Severity.INFO and "configuration note" in finding.message
+
+
+def test_ofb702_is_an_error_when_a_loss_ran_the_fallback() -> None:
+    events = [flags(0.0, manual_control_signal_lost=True), in_offboard()]
+    events += [*stream(0.0, 5.0), *stream(8.0, 10.0)]  # 3 s of silence: the loss failsafe
+    (finding,) = _lint("1.17", events, "OFB702")
+    assert finding.severity is Severity.ERROR
+    assert "lost at 6.0" in finding.message and "fallback ran" in finding.message
+    assert 6.0 <= (finding.time_s or 0) <= 6.2
 
 
 def test_ofb202_reports_once_per_episode() -> None:
@@ -169,3 +189,39 @@ def test_ofb202_still_reports_a_failsafe_from_offboard_the_vehicle_did_not_take(
     ]
     (finding,) = _lint("1.15", events, "OFB202")
     assert "recorded: OFFBOARD" in finding.message and "POSCTL" in finding.message
+
+
+def test_ofb701_once_per_vehicle_and_recording_for_a_bag_split_in_two_files(
+    tmp_path: Path,
+) -> None:
+    """rules.md: OFB701 is context, once per vehicle and recording, not once per file part of
+    a bag that ``ros2 bag record --max-bag-size`` split."""
+    import json
+    import shutil
+
+    from ruamel.yaml import YAML
+
+    from fuzzoff.writers.rosbag2 import write_rosbag2
+    from tests.helpers import run_cli
+
+    first = write_rosbag2(tmp_path / "a", [in_offboard(0.0), *stream(0.0, 4.9)])
+    second = write_rosbag2(
+        tmp_path / "b",
+        [in_offboard(0.0), *stream(0.0, 5.0)],
+        start_ns=1_700_000_005_000_000_000,
+    )
+    bag = tmp_path / "bag"
+    bag.mkdir()
+    shutil.copy(next(first.glob("*.db3")), bag / "bag_0.db3")
+    shutil.copy(next(second.glob("*.db3")), bag / "bag_1.db3")
+    yaml = YAML()
+    meta = yaml.load((first / "metadata.yaml").read_text())
+    info = meta["rosbag2_bagfile_information"]
+    info["relative_file_paths"] = ["bag_0.db3", "bag_1.db3"]
+    info["files"] = []
+    with (bag / "metadata.yaml").open("w") as fh:
+        yaml.dump(meta, fh)
+    result = run_cli(["lint", str(bag), "--format", "json", "--px4", "1.15", "--vehicle", "mc"])
+    (report,) = json.loads(result.stdout)["files"]
+    summaries = [f for f in report["findings"] if f["code"] == "OFB701"]
+    assert [f["severity"] for f in summaries] == ["info"]
