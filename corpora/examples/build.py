@@ -14,8 +14,8 @@ example client published, in PX4's clock), ``runs/RUN.ulg`` (PX4's own log of th
 * MAVROS (ROS 1 bag, ROS 2 bag): the client's ``setpoint_position/local`` poses and MAVROS's
   ``state``, one per PX4 HEARTBEAT, derived as MAVROS's sys_status plugin derives it.
 
-``--expected`` rewrites ``NAME.expected.json`` from today's ``fuzzoff lint`` (review it:
-``tests/test_examples_corpus.py`` says which of today's findings are right and which are not).
+``--expected`` rewrites ``NAME.expected.json`` from today's ``fuzzoff lint`` (review the diff:
+``tests/test_examples_corpus.py`` says what must hold on each recording).
 """
 
 from __future__ import annotations
