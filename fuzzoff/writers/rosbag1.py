@@ -15,12 +15,18 @@ Other events have no MAVROS topic and are left out. The topic namespace is the e
 ``vehicle`` when it is a ROS namespace (``/uav1`` -> ``/uav1/mavros``), else ``namespace``.
 ``header.stamp`` carries ``sender_time_us`` (zero when None, which reads back as None).
 A ``/fuzzoff/origin`` message at time 0 keeps the events' clock when the first event is later.
+
+``extra`` messages are written as given, on their own topics: a message a real node published
+that the inverse conversion does not produce (``setpoint_position/local`` as the PX4 docs'
+``offb_node`` publishes it, ``state`` with MAVROS's own stamp and flags). They are rosbags
+message objects of ``mavros_typestore()``'s types.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Iterable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -55,6 +61,17 @@ _TOPICS: dict[type[Event], tuple[str, str]] = {
     SetAttitudeTarget: ("setpoint_raw/attitude", "mavros_msgs/msg/AttitudeTarget"),
     VehicleStatus: ("state", "mavros_msgs/msg/State"),
 }
+
+
+@dataclass(frozen=True, slots=True)
+class Ros1Message:
+    """A message written as it is: ``t`` in seconds of the events' clock, the topic, the ROS
+    type name (``geometry_msgs/msg/PoseStamped``) and a rosbags message object of that type."""
+
+    t: float
+    topic: str
+    msgtype: str
+    message: Any
 
 
 def mavros_typestore() -> Any:
@@ -185,8 +202,10 @@ def write_rosbag1(
     *,
     start_ns: int = DEFAULT_START_NS,
     chunk_threshold: int | None = None,
+    extra: Iterable[Ros1Message] = (),
 ) -> Path:
-    """Write the MAVROS-expressible ``events`` (in time order) as a ROS 1 bag; returns the path."""
+    """Write the MAVROS-expressible ``events`` (in time order) and the ``extra`` messages as a
+    ROS 1 bag, in time order; returns the path."""
     path = Path(path)
     if path.exists():
         path.unlink()  # rosbags refuses to overwrite
@@ -196,23 +215,25 @@ def write_rosbag1(
     if chunk_threshold is not None:
         writer.chunk_threshold = chunk_threshold
     connections: dict[str, Any] = {}
+    items: list[tuple[float, str, str, Any]] = []
+    for event in events:
+        target = topic_for(event, namespace)
+        if target is not None:
+            items.append((event.t, target[0], target[1], event))
+    items.extend((m.t, m.topic, m.msgtype, m.message) for m in extra)
+    items.sort(key=lambda item: item[0])  # stable: events keep their order at equal times
     with writer:
-        first = True
-        for event in events:
-            target = topic_for(event, namespace)
-            if target is None:
-                continue
-            if first and event.t > 0:
-                origin = writer.add_connection(ORIGIN_TOPIC, "std_msgs/msg/Empty", typestore=store)
-                empty = store.types["std_msgs/msg/Empty"]()
-                writer.write(origin, start_ns, store.serialize_ros1(empty, "std_msgs/msg/Empty"))
-            first = False
-            topic, msgtype = target
+        if items and items[0][0] > 0:
+            origin = writer.add_connection(ORIGIN_TOPIC, "std_msgs/msg/Empty", typestore=store)
+            empty = store.types["std_msgs/msg/Empty"]()
+            writer.write(origin, start_ns, store.serialize_ros1(empty, "std_msgs/msg/Empty"))
+        for t, topic, msgtype, item in items:
             conn = connections.get(topic)
             if conn is None:
                 conn = connections[topic] = writer.add_connection(
                     topic, msgtype, typestore=store, latching=1 if topic.endswith("/state") else 0
                 )
-            raw = store.serialize_ros1(builder.build(event), msgtype)
-            writer.write(conn, start_ns + round(event.t * 1e9), raw)
+            message = builder.build(item) if isinstance(item, Event) else item
+            raw = store.serialize_ros1(message, msgtype)
+            writer.write(conn, start_ns + round(t * 1e9), raw)
     return path
