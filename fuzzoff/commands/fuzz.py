@@ -260,6 +260,7 @@ def _save_all(result: CampaignResult, directory: Path) -> tuple[dict[str, Path],
                     directory,
                     cut_fraction=r.cut_fraction,
                     base=result.config.settings,
+                    recorded_answers=result.config.base is not None,
                 )
             except ValueError as exc:  # an event its transport's writer cannot carry
                 print(f"fuzzoff: the {r.name} counterexample was not saved: {exc}", file=sys.stderr)
