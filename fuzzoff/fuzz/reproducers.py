@@ -327,13 +327,8 @@ def recording_problem(reproducer: Reproducer) -> str | None:
                 f"{path}: the recording is truncated: {len(data):,} of the {reproducer.size:,} "
                 "bytes it was saved with"
             )
-        if (
-            (reproducer.size is not None
-            and len(data) != reproducer.size)
-            or (
-                reproducer.sha256 is not None
-                and hashlib.sha256(data).hexdigest() != reproducer.sha256
-            )
+        if (reproducer.size is not None and len(data) != reproducer.size) or (
+            reproducer.sha256 is not None and hashlib.sha256(data).hexdigest() != reproducer.sha256
         ):
             return f"{path}: the recording changed since it was saved (recording_sha256 differs)"
         return None
