@@ -226,6 +226,24 @@ def _published(kind: str, px4: str) -> bool:
     return px4_msgs.definition(release_for(px4) or "main", _MESSAGE[kind]) is not None
 
 
+_WIRE_NAME = {"normalized_steering_angle": "normalized_steering_setpoint"}
+"""Event fields whose message field was renamed in a release (1.17's RoverSteeringSetpoint)."""
+
+
+def _carried(kind: str, px4: str, values: dict[str, Any]) -> dict[str, Any]:
+    """``values`` with NaN for the fields the release's message does not have (1.17 dropped
+    RoverSteeringSetpoint's ``normalized_speed_diff``): a recording of that release cannot
+    hold them, and its reader gives NaN, as PX4 would never see them."""
+    if kind not in _MESSAGE:
+        return values
+    name = _MESSAGE[kind]
+    text = px4_msgs.definition(release_for(px4) or "main", name)
+    if text is None:
+        return values
+    wire = px4_msgs.field_names(px4_msgs.type_name(name), text)
+    return {k: v if k in wire or _WIRE_NAME.get(k) in wire else fs.NAN for k, v in values.items()}
+
+
 def _ros2_setpoint_kinds(vehicle: str, px4: str) -> list[str]:
     kinds = ["trajectory", "trajectory", "attitude", "rates", "none"]
     if is_rover(vehicle) and at_least(px4, "1.16"):
@@ -269,12 +287,14 @@ def ros2_sent(draw: st.DrawFn, px4: str, vehicle: str, times: list[float]) -> li
     if not times:
         return out
     for offset, kind in enumerate(k for k in kinds if k != "none"):
-        out += draw(_setpoint_series(kind, times, 0.001 * (offset + 1)))
+        out += draw(_setpoint_series(kind, times, 0.001 * (offset + 1), px4))
     return out
 
 
 @st.composite
-def _setpoint_series(draw: st.DrawFn, kind: str, times: list[float], lag: float) -> list[ev.Event]:
+def _setpoint_series(
+    draw: st.DrawFn, kind: str, times: list[float], lag: float, px4: str
+) -> list[ev.Event]:
     """One setpoint topic following the keep-alive by ``lag``, maybe starting late or stopping
     early (stale setpoints under a live keep-alive: OFB104), frozen or moving."""
     if kind == "trajectory":
@@ -285,6 +305,7 @@ def _setpoint_series(draw: st.DrawFn, kind: str, times: list[float], lag: float)
         values = draw(fs.rates_setpoints())
     else:
         _, values = draw(fs.rover_setpoints(kind))
+        values = _carried(kind, px4, values)
     nth = fs.frozen_or_moving(values) if draw(st.booleans()) else (lambda i: values)
     whole = draw(st.sampled_from(["whole", "whole", "late", "early"]))
     start = draw(st.integers(0, len(times) - 1)) if whole == "late" else 0
