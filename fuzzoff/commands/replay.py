@@ -124,11 +124,14 @@ def run(args: argparse.Namespace) -> int:
         "property_still_fails": bool(still),
         "rechecked_on": "stream" if again.on_stream else "recording",
         "problems": still,
+        "setup": None if reproducer.setup is None else reproducer.setup.to_json(),
     }
     if args.format == "json":
         text = json.dumps(data, indent=2) + "\n"
     else:
         text = _terminal(recording, prop, verdict, differ, still, again.on_stream)
+        if reproducer.setup is not None:
+            text += f"  on a live PX4: {reproducer.setup.describe()}\n"
     write_output(text, args.output)
     return 1 if differ or still else 0
 

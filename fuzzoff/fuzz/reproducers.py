@@ -12,6 +12,8 @@ for MAVLink, ROS 1 bag for MAVROS). ``NAME.expected.json`` has the corpus keys o
   campaign judged it;
 * ``recording_bytes``, ``recording_sha256``: the recording as saved (a truncated or changed
   one is refused, not replayed);
+* ``setup``: what a sender sets on a live PX4 before it sends the stream (``Setup``): the PX4
+  parameters, whether a manual control is present, the starting state and the MAVLink ids;
 * ``cut_fraction``: for ``truncation``, where the recording was cut.
 
 ``make test`` replays the findings (a regression test of the rules on the reproducer);
@@ -35,7 +37,8 @@ from fuzzoff.engine import lint_file
 from fuzzoff.findings import FileReport, Severity
 from fuzzoff.fuzz import recordings, stream_file
 from fuzzoff.fuzz.properties import PROPERTIES, FuzzContext
-from fuzzoff.fuzz.scenario import RECORDING_FORMAT, TRANSPORTS, Scenario
+from fuzzoff.fuzz.scenario import AUTOPILOT, COMPANION, RECORDING_FORMAT, TRANSPORTS, Scenario
+from fuzzoff.gate.params import RC_PRESENT
 from fuzzoff.profiles import (
     DEFAULT_PX4,
     DEFAULT_VEHICLE,
@@ -45,6 +48,56 @@ from fuzzoff.profiles import (
 )
 
 DEFAULT_DIR = Path("corpora/fuzz")
+
+
+@dataclass(frozen=True, slots=True)
+class Setup:
+    """What a sender sets up on a live PX4 before it sends the stream, so that PX4 judges it
+    as the gate model did: the PX4 parameters (PARAM_SET, read back), a manual control (RC or
+    joystick) present or not, the state the stream starts from, and who addresses whom."""
+
+    params: dict[str, float]
+    """PX4 parameters by name (``COM_OF_LOSS_T``...; fuzzoff's own assumptions left out)."""
+    manual_control: bool
+    """The model assumed an RC or joystick present (``FUZZOFF_RC_PRESENT``, default 1)."""
+    start_armed: bool = False
+    """The model starts disarmed, in a mode other than OFFBOARD."""
+    autopilot: tuple[int, int] = AUTOPILOT
+    """The (sysid, compid) the stream's commands and setpoints address."""
+    companion: tuple[int, int] | None = None
+    """The (sysid, compid) the recording's MAVLink stream is sent from (None: not MAVLink)."""
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "params": dict(sorted(self.params.items())),
+            "manual_control": self.manual_control,
+            "start": {"armed": self.start_armed, "in_offboard": False},
+            "autopilot": {"system": self.autopilot[0], "component": self.autopilot[1]},
+            "companion": None
+            if self.companion is None
+            else {"system": self.companion[0], "component": self.companion[1]},
+        }
+
+    def describe(self) -> str:
+        params = ", ".join(f"{k}={v:g}" for k, v in sorted(self.params.items()))
+        return "; ".join(
+            [
+                f"PX4 parameters {params}" if params else "PX4 parameters at their defaults",
+                "manual control " + ("present" if self.manual_control else "absent"),
+                "start " + ("armed" if self.start_armed else "disarmed") + ", not in OFFBOARD",
+            ]
+        )
+
+
+def setup_for(scenario: Scenario) -> Setup:
+    """The setup the gate model judged ``scenario`` with."""
+    params = {k: float(v) for k, v in scenario.params.items() if k != RC_PRESENT}
+    mavlink = scenario.transport == "mavlink"
+    return Setup(
+        params=params,
+        manual_control=bool(scenario.params.get(RC_PRESENT, 1.0)),
+        companion=COMPANION if mavlink else None,
+    )
 
 
 def name_for(prop: str, scenario: Scenario) -> str:
@@ -110,6 +163,7 @@ def save(
         | {"ignore": sorted(settings.ignore)},
         "stream": stream.name,
         "recorded_answers": recorded_answers,
+        "setup": setup_for(scenario).to_json(),
         "findings": expected_findings(report),
     }
     if cut_fraction is not None:
@@ -147,6 +201,8 @@ class Reproducer:
     """What ``fuzzoff lint`` said of the recording when it was saved."""
     fixed: str | None = None
     """The note of a reproducer kept as a regression case after its problem was fixed."""
+    setup: Setup | None = None
+    """What a sender sets up on a live PX4 first (None: the reproducer has no scenario)."""
 
 
 def load(path: Path) -> Reproducer:
@@ -223,7 +279,48 @@ def _checked(path: Path, spec: dict[str, Any]) -> Reproducer:
         sha256=sha256,
         complete=complete,
         fixed=None if fixed is None else _text(fixed, "fixed"),
+        setup=None if scenario is None else _setup(spec.get("setup"), scenario),
     )
+
+
+def _setup(value: Any, scenario: Scenario) -> Setup:
+    """The reproducer's ``setup``; one saved before it was kept is what its scenario implies."""
+    if value is None:
+        return setup_for(scenario)
+    if not isinstance(value, dict):
+        raise _Bad("setup", "expected an object (params, manual_control, start, autopilot)")
+    params = value.get("params", {})
+    if not isinstance(params, dict):
+        raise _Bad("setup.params", "expected an object of NAME: number")
+    for name, number in params.items():
+        if not _is_number(number):
+            raise _Bad(f"setup.params.{name}", f"{number!r} is not a finite number")
+    manual = value.get("manual_control", True)
+    start = value.get("start", {})
+    armed = start.get("armed", False) if isinstance(start, dict) else None
+    if not isinstance(manual, bool):
+        raise _Bad("setup.manual_control", f"{manual!r} is not true or false")
+    if not isinstance(armed, bool):
+        raise _Bad("setup.start", f"{start!r} is not an object with 'armed' true or false")
+    return Setup(
+        params={str(k): float(v) for k, v in params.items()},
+        manual_control=manual,
+        start_armed=armed,
+        autopilot=_ids(value.get("autopilot"), "setup.autopilot") or AUTOPILOT,
+        companion=_ids(value.get("companion"), "setup.companion"),
+    )
+
+
+def _ids(value: Any, field: str) -> tuple[int, int] | None:
+    if value is None:
+        return None
+    ok = isinstance(value, dict) and all(
+        isinstance(value.get(k), int) and not isinstance(value.get(k), bool) and 0 <= value[k] < 256
+        for k in ("system", "component")
+    )
+    if not ok:
+        raise _Bad(field, f"{value!r} is not an object with 'system' and 'component' from 0 to 255")
+    return (value["system"], value["component"])
 
 
 HEX = frozenset("0123456789abcdef")

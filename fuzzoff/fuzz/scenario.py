@@ -22,6 +22,14 @@ from fuzzoff.sources.base import RecordingInfo
 TransportName = Literal["ros2", "mavlink", "mavros"]
 TRANSPORTS: tuple[TransportName, ...] = ("ros2", "mavlink", "mavros")
 
+AUTOPILOT = (1, 1)
+"""The vehicle every command and MAVLink setpoint addresses (PX4's default ``MAV_SYS_ID`` and
+``MAV_COMP_ID_AUTOPILOT1``): PX4 refuses a COMMAND_LONG to system 0 with FAILED before its
+offboard gate sees it, so a reproducer that broadcast its commands never reached the gate."""
+COMPANION = (245, 191)
+"""The companion's own MAVLink (sysid, compid): not 1, the autopilot's, which PX4 takes for
+itself; 191 is ``MAV_COMP_ID_ONBOARD_COMPUTER``."""
+
 RECORDING_FORMAT: dict[str, str] = {"ros2": "mcap", "mavlink": "tlog", "mavros": "rosbag1"}
 """The format a reproducer of each transport is saved in (task: MCAP for ROS 2, tlog for
 MAVLink; a MAVROS stream is a ROS 1 bag, since a tlog cannot say it came through MAVROS)."""

@@ -23,7 +23,7 @@ from hypothesis import strategies as st
 
 from fuzzoff import events as ev
 from fuzzoff.fuzz import strategies as fs
-from fuzzoff.fuzz.scenario import TRANSPORTS, Scenario, TransportName
+from fuzzoff.fuzz.scenario import AUTOPILOT, COMPANION, TRANSPORTS, Scenario, TransportName
 from fuzzoff.gate import GateModel
 from fuzzoff.gate.params import default_params, loss_timeout
 from fuzzoff.modes import mavros_mode_to_nav_state, nav_state_to_mavros_mode
@@ -35,11 +35,10 @@ MIN_STEP = 0.0001
 """Distinct receive times: events never share a timestamp (the readers' order for equal
 timestamps is the file's, which a writer need not keep)."""
 
-COMPANION = (1, 191)
 MODE_POSCTL = (1.0, 3.0)
+"""DO_SET_MODE params for POSCTL (custom main mode 3)."""
 STATUS_STEP = 0.05
 """How often the MAVROS state echo looks at the model between messages."""
-"""DO_SET_MODE params for POSCTL (custom main mode 3)."""
 
 
 def _cmd(t: float, command: int, params: Sequence[float], transport: TransportName) -> ev.Command:
@@ -51,6 +50,8 @@ def _cmd(t: float, command: int, params: Sequence[float], transport: TransportNa
             command=command,
             params=full,
             sender_time_us=round(t * 1e6),
+            target_system=AUTOPILOT[0],
+            target_component=AUTOPILOT[1],
             source_system=0,
             source_component=0,
             from_external=True,
@@ -61,6 +62,8 @@ def _cmd(t: float, command: int, params: Sequence[float], transport: TransportNa
         vehicle="1",
         command=command,
         params=full,
+        target_system=AUTOPILOT[0],
+        target_component=AUTOPILOT[1],
         source_system=COMPANION[0],
         source_component=COMPANION[1],
         from_external=True,
@@ -339,13 +342,13 @@ def mavlink_sent(draw: st.DrawFn, times: list[float], transport: TransportName) 
     build = _MAV_BUILD[kind]
     out: list[ev.Event] = []
     for i, t in enumerate(times):
-        extra: dict[str, Any]
+        extra: dict[str, Any] = {"target_system": AUTOPILOT[0], "target_component": AUTOPILOT[1]}
         if transport == "mavlink":
-            extra = {"source_system": COMPANION[0], "source_component": COMPANION[1]}
+            extra |= {"source_system": COMPANION[0], "source_component": COMPANION[1]}
             extra["sender_time_us"] = stamps[i] % (2**32 * 1000)
             extra["vehicle"] = "1"
         else:  # MAVROS addresses its target (tgt_system 1, tgt_component 1); ROS namespace ""
-            extra = {"target_system": 1, "target_component": 1, "vehicle": ""}
+            extra["vehicle"] = ""
         out.append(build(t=t, transport=transport, **extra, **nth(i)))
     return out
 
