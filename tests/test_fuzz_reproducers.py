@@ -5,6 +5,7 @@ a reproducer whose recording is truncated or changed is refused, not replayed.""
 from __future__ import annotations
 
 import json
+import re
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -15,6 +16,7 @@ from fuzzoff.engine import lint_file
 from fuzzoff.events import Command, ControlMode, Event, TrajectorySetpoint
 from fuzzoff.findings import Finding
 from fuzzoff.fuzz import properties, recordings, stream_file
+from fuzzoff.fuzz.known import KNOWN
 from fuzzoff.fuzz.mutate import scenario_from_recording
 from fuzzoff.fuzz.properties import PROPERTIES, FuzzContext
 from fuzzoff.fuzz.reproducers import save
@@ -246,3 +248,31 @@ def test_a_damaged_stream_file_is_one_line_naming_the_event_and_field(
     assert out.returncode == 2
     line = _one_error_line(out.stderr)
     assert line.startswith(f"error: {spec_path}: stream ({stream.name}): ") and field in line
+
+
+CORPUS = sorted((CORPORA / "fuzz").glob("*.expected.json"))
+
+
+@pytest.mark.parametrize("spec_path", CORPUS, ids=[p.name for p in CORPUS])
+def test_every_corpus_reproducer_replays_with_its_verdict(spec_path: Path) -> None:
+    """A reproducer kept as a regression case (``"fixed"``) replays as fixed; any other shows
+    one of fuzzoff's known problems and still fails, so a fix is noticed (then mark it fixed
+    and drop its entry from ``fuzzoff/fuzz/known.py``)."""
+    spec = json.loads(spec_path.read_text())
+    data = _replay(spec_path)
+    if "fixed" in spec:
+        assert data["verdict"] == "fixed", data["problems"]
+    else:
+        assert data["verdict"] == "still fails"
+        assert any(re.search(k, p) for k in KNOWN for p in data["problems"]), data["problems"]
+
+
+def test_every_known_problem_has_a_reproducer_that_still_fails() -> None:
+    shown = [
+        p
+        for path in CORPUS
+        if "fixed" not in (spec := json.loads(path.read_text()))
+        for p in spec["problems"]
+    ]
+    for pattern, what in KNOWN.items():
+        assert any(re.search(pattern, p) for p in shown), f"no reproducer shows: {what}"

@@ -47,7 +47,9 @@ from fuzzoff.profiles import (
     vehicle_type_for,
 )
 
-DEFAULT_DIR = Path("corpora/fuzz")
+DEFAULT_DIR = Path(".fuzzoff/reproducers")
+"""Where ``fuzzoff fuzz`` saves reproducers unless ``--save-dir`` says: a tool folder of the
+working folder (as ``.pytest_cache``), made only when a counterexample is saved."""
 
 
 @dataclass(frozen=True, slots=True)
