@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import re
+import socket
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -13,7 +14,13 @@ from typing import Any
 import pytest
 
 from fuzzoff.engine import lint_file
-from fuzzoff.events import Command, ControlMode, Event, TrajectorySetpoint
+from fuzzoff.events import (
+    Command,
+    ControlMode,
+    Event,
+    SetPositionTargetLocal,
+    TrajectorySetpoint,
+)
 from fuzzoff.findings import Finding
 from fuzzoff.fuzz import properties, recordings, stream_file
 from fuzzoff.fuzz.known import KNOWN
@@ -276,3 +283,35 @@ def test_every_known_problem_has_a_reproducer_that_still_fails() -> None:
     ]
     for pattern, what in KNOWN.items():
         assert any(re.search(pattern, p) for p in shown), f"no reproducer shows: {what}"
+
+
+def test_a_truncated_mavlink_reproducer_is_not_sent_to_a_live_px4(tmp_path: Path) -> None:
+    """``--to``: the recording is checked before anything is sent (it was sent, exit 0)."""
+    scenario = Scenario(
+        "1.15",
+        "mc",
+        "mavlink",
+        tuple(
+            SetPositionTargetLocal(
+                t=round(0.1 * i, 4),
+                vehicle="1",
+                type_mask=3576,
+                target_system=1,
+                target_component=1,
+                source_system=245,
+                source_component=191,
+            )
+            for i in range(10)
+        ),
+    )
+    spec_path = save("explained", scenario, ["x"], tmp_path)
+    recording = tmp_path / json.loads(spec_path.read_text())["recording"]
+    recording.write_bytes(recording.read_bytes()[:-40])
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sink:
+        sink.bind(("127.0.0.1", 0))
+        sink.settimeout(0.5)
+        out = run_cli(["replay", str(spec_path), "--to", f"udp:127.0.0.1:{sink.getsockname()[1]}"])
+        assert out.returncode == 2
+        assert "the recording is truncated" in _one_error_line(out.stderr)
+        with pytest.raises(TimeoutError):
+            sink.recv(4096)

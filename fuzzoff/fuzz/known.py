@@ -1,9 +1,11 @@
 """Known problems the campaigns found and that are not fixed yet (each with a reproducer).
 
-CI campaigns (tests/test_fuzz_campaigns.py) leave these out so the search goes on for new ones;
-``fuzzoff fuzz --known`` does the same. Each entry: a regular expression matched against a
-property's problem text -> what it is. Remove an entry when its reproducer under
-``corpora/fuzz/`` replays as fixed (``fuzzoff replay`` exits 0).
+Campaigns leave these out so that the search goes on for new ones (a user's campaign must not
+fail on fuzzoff's own problems), and count them; ``fuzzoff fuzz --include-known`` fails on them
+(for fuzzoff's developers), and tests/test_fuzz_reproducers.py checks that each reproducer
+still fails. Each entry: a regular expression matched against a property's problem text -> what
+it is. Remove an entry when its reproducer under ``corpora/fuzz/`` replays as fixed
+(``fuzzoff replay`` exits 0), and mark the reproducer ``"fixed"``.
 """
 
 from __future__ import annotations

@@ -66,7 +66,8 @@ def to_junit(result: CampaignResult, saved: dict[str, Path]) -> str:
             suite, "testcase", classname="fuzzoff.fuzz", name=r.name, time=f"{r.seconds:.3f}"
         )
         if r.failed:
-            text = "\n".join(r.problems)
+            text = f"{r.failed_examples} of {r.examples} examples failed; the first:\n"
+            text += "\n".join(r.problems)
             if r.counterexample is not None:
                 text += f"\ncounterexample: {r.counterexample.describe()}"
             if r.name in saved:
@@ -77,6 +78,9 @@ def to_junit(result: CampaignResult, saved: dict[str, Path]) -> str:
             ET.SubElement(case, "skipped", message="no example ran within the time budget")
         out = ET.SubElement(case, "system-out")
         out.text = f"{r.claim}: {r.examples} examples in {r.seconds:.2f} s"
+        for pattern, count in r.known.items():
+            out.text += f"\nleft out, a known problem of fuzzoff in {count} examples: "
+            out.text += KNOWN.get(pattern, pattern)
     root = ET.Element("testsuites")
     root.append(suite)
     ET.indent(root)
