@@ -5,11 +5,16 @@ flips; the README's example runs as shown."""
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
 import re
 import shlex
 from pathlib import Path
 
+import pytest
+
+from fuzzoff.cli import main
 from fuzzoff.fuzz.known import KNOWN
 from tests.helpers import ROOT, run_cli
 
@@ -118,3 +123,13 @@ def test_the_readme_fuzz_example_runs_as_shown() -> None:
         status = out.returncode
         got = [_SECONDS.sub("S", line) for line in out.stdout.splitlines()]
         assert got == [_SECONDS.sub("S", line) for line in shown], out.stdout
+
+
+@pytest.mark.parametrize("command", ["fuzz", "gate", "replay"])
+def test_help_says_what_the_exit_status_means(command: str) -> None:
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out), pytest.raises(SystemExit) as done:
+        main([command, "--help"])
+    assert done.value.code == 0
+    text = " ".join(out.getvalue().split())
+    assert "exit status" in text and "0 " in text and ", 1 " in text and ", 2 " in text

@@ -31,6 +31,11 @@ from fuzzoff.sources import SourceError, is_bag_folder
 
 def add_parser(sub: Any) -> None:
     parser = add_command(sub, "fuzz")
+    parser.epilog = (
+        "exit status: 0 every property held, 1 a counterexample was found (saved under "
+        f"--save-dir, default {DEFAULT_DIR}/), 2 a usage error, a --from recording that could "
+        "not be read completely, a budget that ran no example, or a reproducer not saved"
+    )
     parser.add_argument("--px4", metavar="VERSION", help="PX4 release or profile (default: all)")
     parser.add_argument("--vehicle", metavar="TYPE", help="vehicle type (default: all)")
     parser.add_argument("--transport", choices=TRANSPORTS, help="default: all")

@@ -34,6 +34,11 @@ the gate reacts to (tens of milliseconds) are shorter than the sleep they are ti
 
 def add_parser(sub: Any) -> None:
     parser = add_command(sub, "replay")
+    parser.epilog = (
+        "exit status (without --to): 0 the findings match and the property holds now (fixed), "
+        "1 the findings differ or the property still fails, 2 the reproducer or its recording "
+        "cannot be used (unreadable, missing, truncated or changed since it was saved)"
+    )
     parser.add_argument("path", metavar="REPRODUCER", help="NAME.expected.json or its recording")
     parser.add_argument(
         "--to",
