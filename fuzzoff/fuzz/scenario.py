@@ -52,11 +52,14 @@ class Scenario:
         return self.events[-1].t if self.events else 0.0
 
     def settings(self, base: Settings | None = None) -> Settings:
-        """``base`` (the campaign's rule selection) with this scenario's profile and params."""
-        from dataclasses import replace
-
+        """``base`` (the campaign's rule selection) with this scenario's profile and params.
+        Not looked up again per recording (``Settings.discovery``): the recordings of a
+        scenario are fuzzoff's own temporary files, and a configuration found above them
+        would replace the scenario's profile with the one detected from the file."""
         base = base or Settings()
-        return replace(base, px4=self.px4, vehicle=self.vehicle, params=dict(self.params))
+        return replace(
+            base, px4=self.px4, vehicle=self.vehicle, params=dict(self.params), discovery=None
+        )
 
     def lint_args(self) -> list[str]:
         """The ``fuzzoff lint`` arguments that judge a recording of this scenario the same way."""
