@@ -143,3 +143,20 @@ def test_the_command_judges_each_written_recording_with_its_scenarios_profile() 
     args = ["fuzz", "--examples", "12", "--seed", "7", "--no-save", "-q", "--format", "json"]
     out = run_cli([*args, "--property", "round-trip", "--property", "truncation"])
     assert out.returncode == 0, out.stdout
+
+
+def test_a_reproducer_keeps_the_rule_settings_of_the_campaigns_configuration(
+    tmp_path: Path,
+) -> None:
+    """The working folder's configuration lowers the loss rules to info, so a loss is left
+    unexplained: the reproducer keeps those severities, and its replay from another folder
+    checks the property with them (without them it said fixed)."""
+    (tmp_path / "fuzzoff.toml").write_text('severity = { OFB103 = "info", OFB101 = "info" }\n')
+    args = ["fuzz", "--px4", "1.15", "--vehicle", "mc", "--transport", "ros2", "--seed", "7"]
+    out = run_cli([*args, "--examples", "30", "--property", "explained", "-q"], cwd=tmp_path)
+    assert out.returncode == 1, out.stdout
+    (spec_path,) = (tmp_path / ".fuzzoff" / "reproducers").glob("*.expected.json")
+    spec = json.loads(spec_path.read_text())
+    assert spec["scenario"]["severity"] == {"OFB101": "info", "OFB103": "info"}
+    replay = run_cli(["replay", str(spec_path)], cwd=ROOT)
+    assert replay.returncode == 1 and "property explained: still fails" in replay.stdout

@@ -21,7 +21,7 @@ from typing import Any
 
 from fuzzoff.commands import add_command
 from fuzzoff.commands._common import write_output
-from fuzzoff.config import ConfigError, Settings
+from fuzzoff.config import ConfigError
 from fuzzoff.fuzz.reproducers import ReproducerError, load, recheck, recording_problem
 from fuzzoff.report.sanitize import printable
 from fuzzoff.sources.base import SourceError
@@ -109,7 +109,7 @@ def run(args: argparse.Namespace) -> int:
     from fuzzoff.fuzz.scenario import Scenario
 
     scenario = reproducer.scenario or Scenario("1.15", "mc", "ros2", events=())
-    report = lint_file(recording, scenario.settings(Settings(ignore=reproducer.ignore)))
+    report = lint_file(recording, scenario.settings(reproducer.rules))
     differ = compare(reproducer.findings, expected_findings(report))
     try:
         again = recheck(reproducer)

@@ -27,7 +27,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -121,6 +121,19 @@ def expected_findings(report: FileReport) -> list[dict[str, Any]]:
     return out
 
 
+def _rules_json(settings: Settings) -> dict[str, Any]:
+    """The campaign's rule settings beyond ``ignore`` (from its configuration file): the
+    property is checked again with them. Left out where they are the defaults."""
+    out: dict[str, Any] = {}
+    if settings.select:
+        out["select"] = sorted(settings.select)
+    if settings.severity:
+        out["severity"] = {code: sev.label for code, sev in sorted(settings.severity.items())}
+    if settings.options:
+        out["options"] = {code: dict(o) for code, o in sorted(settings.options.items())}
+    return out
+
+
 def exit_status(report: FileReport, settings: Settings) -> int:
     if not report.complete:
         return 2
@@ -162,7 +175,8 @@ def save(
         "property": prop,
         "problems": problems,
         "scenario": {k: v for k, v in scenario.to_json().items() if k != "events"}
-        | {"ignore": sorted(settings.ignore)},
+        | {"ignore": sorted(settings.ignore)}
+        | _rules_json(settings),
         "stream": stream.name,
         "recorded_answers": recorded_answers,
         "setup": setup_for(scenario).to_json(),
@@ -193,6 +207,9 @@ class Reproducer:
     """Profile, transport and parameters, without events (None when the file has none)."""
     ignore: frozenset[str]
     cut_fraction: float | None
+    rules: Settings = field(default_factory=Settings)
+    """The campaign's rule settings: ``ignore``, and ``select``, ``severity`` and ``options``
+    where its configuration set them."""
     stream: Scenario | None = None
     """The scenario with the events the property failed on (None: saved without them)."""
     recorded_answers: bool = False
@@ -275,6 +292,7 @@ def _checked(path: Path, spec: dict[str, Any]) -> Reproducer:
         scenario=scenario,
         ignore=_ignore(info.get("ignore", []) if info else []),
         cut_fraction=None if cut is None else float(cut),
+        rules=_rules(info or {}),
         stream=_stream(path, spec.get("stream"), scenario),
         recorded_answers=recorded_answers,
         size=size,
@@ -402,6 +420,33 @@ def _scenario(info: dict[str, Any]) -> Scenario:
     return Scenario(px4=px4, vehicle=vehicle, transport=transport, events=(), params=numbers)
 
 
+def _rules(info: dict[str, Any]) -> Settings:
+    select = info.get("select", [])
+    if not isinstance(select, list) or not all(isinstance(c, str) for c in select):
+        raise _Bad("scenario.select", f"{select!r} is not a list of rule codes")
+    severity = info.get("severity", {})
+    if not isinstance(severity, dict):
+        raise _Bad("scenario.severity", "expected an object of CODE: error, warning or info")
+    options = info.get("options", {})
+    if not isinstance(options, dict) or not all(isinstance(o, dict) for o in options.values()):
+        raise _Bad("scenario.options", "expected an object of CODE: {option: value}")
+    try:
+        chosen = frozenset(expand_selectors(select))
+        levels = {
+            code: Severity.parse(_text(v, f"scenario.severity.{code}"))
+            for code, v in severity.items()
+        }
+        expand_selectors(list(levels) + list(options))
+    except ValueError as exc:
+        raise _Bad("scenario.severity/options/select", str(exc)) from None
+    return Settings(
+        select=chosen,
+        ignore=_ignore(info.get("ignore", [])),
+        severity=levels,
+        options={str(code): dict(o) for code, o in options.items()},
+    )
+
+
 def _ignore(value: Any) -> frozenset[str]:
     if not isinstance(value, list) or not all(isinstance(c, str) for c in value):
         raise _Bad("scenario.ignore", f"{value!r} is not a list of rule codes")
@@ -463,9 +508,7 @@ def recheck(reproducer: Reproducer) -> Recheck:
             reproducer.recording, info.px4, info.vehicle, dict(info.params)
         )
         recorded_answers = True  # a reader's events: the recorded vehicle side
-    ctx = FuzzContext(
-        settings=Settings(ignore=reproducer.ignore), recorded_answers=recorded_answers
-    )
+    ctx = FuzzContext(settings=reproducer.rules, recorded_answers=recorded_answers)
     try:
         if reproducer.cut_fraction is not None:
             ctx.cut_fraction = reproducer.cut_fraction
