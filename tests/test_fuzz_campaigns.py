@@ -147,7 +147,7 @@ def test_fuzz_command_reports_json_junit_and_sarif(tmp_path: Path) -> None:
 def test_fuzz_command_exits_1_and_saves_a_reproducer(tmp_path: Path) -> None:
     args = ["fuzz", "--px4", "1.15", "--vehicle", "mc", "--transport", "ros2"]
     args += ["--examples", "300", "--seed", "7", "--property", "explained"]
-    args += ["--ignore", "OFB103,OFB101", "--known"]
+    args += ["--ignore", "OFB103,OFB101"]
     out = run_cli([*args, "--save-dir", str(tmp_path), "--format", "sarif", "-q"])
     assert out.returncode == 1, out.stderr
     sarif = json.loads(out.stdout)
@@ -210,7 +210,7 @@ def test_from_a_real_recording_measures_new_hazards_not_the_recordings_own(
     the stall margin is a new loss, near the 1 s timeout."""
     recording = CORPORA / "tlog" / "stream_lost_in_offboard.tlog"
     args = ["fuzz", "--from", str(recording), "--examples", "5", "--seed", "1"]
-    out = run_cli([*args, "--known", "--format", "json", "--no-save", "-q"])
+    out = run_cli([*args, "--format", "json", "--no-save", "-q"])
     assert out.returncode == 0, out.stderr
     report = json.loads(out.stdout)
     assert [p["property"] for p in report["properties"]] == [

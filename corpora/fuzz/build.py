@@ -4,11 +4,13 @@ Run as ``.venv/bin/python corpora/fuzz/build.py``. Each entry is a campaign (pro
 transport, seed) that finds the problem; the shrunk counterexample is saved here as a recording
 plus ``NAME.expected.json`` (what ``fuzzoff lint`` says about it, the property and the problem).
 ``make test`` replays the findings; ``fuzzoff replay NAME.expected.json`` re-checks the property
-(exit 0 once the problem is fixed: then drop the entry here and in known.py).
+(exit 0 once the problem is fixed: then drop the entry here and in known.py, and mark the
+reproducer ``"fixed"`` to keep it as a regression case; those are left as they are).
 """
 
 from __future__ import annotations
 
+import json
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -41,6 +43,14 @@ ENTRIES = (
         "mavlink",
         1,
     ),
+    Entry(
+        _MAV + r"PX4 [^)]*\): setpoint_dropped .*SET_POSITION_TARGET_GLOBAL_INT dropped, no "
+        r"keep-alive: no position, velocity or acceleration",
+        "explained",
+        "1.15",
+        None,
+        7,
+    ),
 )
 
 
@@ -64,10 +74,21 @@ def build(entry: Entry) -> Path:
     return save(entry.prop, result.counterexample, result.problems, HERE)
 
 
+def _stale() -> list[Path]:
+    """The files of the reproducers not kept as regression cases (``"fixed"``): rebuilt."""
+    out = []
+    for spec_path in HERE.glob("*.expected.json"):
+        spec = json.loads(spec_path.read_text())
+        if "fixed" in spec:
+            continue
+        out.append(spec_path)
+        out += [HERE / spec[key] for key in ("recording", "stream") if key in spec]
+    return out
+
+
 def main() -> None:
-    for old in HERE.glob("*"):
-        if old.name != "build.py" and old.is_file():
-            old.unlink()
+    for old in _stale():
+        old.unlink(missing_ok=True)
     for entry in ENTRIES:
         print(build(entry).relative_to(HERE.parent.parent))
 

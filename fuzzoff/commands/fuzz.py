@@ -1,8 +1,10 @@
 """``fuzzoff fuzz``: a seeded fuzz campaign against the gate model and the rules (docs/fuzz.md).
 
 Exit status: 0 every property held, 1 a counterexample was found (saved as a reproducer under
-``--save-dir``), 2 usage error, an unreadable ``--from`` recording, or a reproducer that could not
-be saved (the report still gives its counterexample).
+``--save-dir``, by default ``.fuzzoff/reproducers/`` in the working folder), 2 usage error, an
+unreadable ``--from`` recording, or a reproducer that could not be saved (the report still gives
+its counterexample). fuzzoff's own known problems (``fuzz.known``) are left out and counted,
+unless ``--include-known`` (for fuzzoff's developers).
 """
 
 from __future__ import annotations
@@ -29,6 +31,11 @@ from fuzzoff.sources import SourceError, is_bag_folder
 
 def add_parser(sub: Any) -> None:
     parser = add_command(sub, "fuzz")
+    parser.epilog = (
+        "exit status: 0 every property held, 1 a counterexample was found (saved under "
+        f"--save-dir, default {DEFAULT_DIR}/), 2 a usage error, a --from recording that could "
+        "not be read completely, a budget that ran no example, or a reproducer not saved"
+    )
     parser.add_argument("--px4", metavar="VERSION", help="PX4 release or profile (default: all)")
     parser.add_argument("--vehicle", metavar="TYPE", help="vehicle type (default: all)")
     parser.add_argument("--transport", choices=TRANSPORTS, help="default: all")
@@ -52,10 +59,13 @@ def add_parser(sub: Any) -> None:
     )
     parser.add_argument("--ignore", metavar="CODES", help="rules to switch off (fault planting)")
     parser.add_argument(
-        "--known",
+        "--include-known",
         action="store_true",
-        help="leave out the known problems listed in fuzzoff/fuzz/known.py (as CI does)",
+        help="for fuzzoff's developers: also fail on fuzzoff's own known problems "
+        "(fuzzoff/fuzz/known.py), which are otherwise left out and counted",
     )
+    # Leaving the known problems out was --known; it is the default now, still accepted.
+    parser.add_argument("--known", action="store_true", help=argparse.SUPPRESS)
     parser.add_argument(
         "--format", choices=("terminal", "json", "junit", "sarif"), default="terminal"
     )
@@ -63,8 +73,7 @@ def add_parser(sub: Any) -> None:
     parser.add_argument(
         "--save-dir",
         metavar="DIR",
-        default=str(DEFAULT_DIR),
-        help=f"where reproducers are saved (default {DEFAULT_DIR})",
+        help=f"where reproducers are saved (default {DEFAULT_DIR}/, made when one is)",
     )
     parser.add_argument("--no-save", action="store_true", help="do not save reproducers")
     parser.add_argument("--quiet", "-q", action="store_true", help="no progress display")
@@ -93,7 +102,7 @@ def _config(args: argparse.Namespace) -> CampaignConfig:
         seed=args.seed,
         properties=tuple(args.property or PROPERTIES),
         settings=settings,
-        known=tuple(KNOWN) if args.known else (),
+        known=() if args.include_known else tuple(KNOWN),
     )
     if args.from_:
         from fuzzoff.fuzz.mutate import read_base, sent_keepalives
@@ -187,8 +196,12 @@ class _Progress:
 
 def run(args: argparse.Namespace) -> int:
     config = _config(args)
+    label = f"--save-dir {args.save_dir}"
+    if args.save_dir is None:
+        args.save_dir = str(DEFAULT_DIR)
+        label = f"{DEFAULT_DIR} (where reproducers go: --save-dir DIR or --no-save to change)"
     if not args.no_save:
-        check_save_dir(Path(args.save_dir))
+        check_save_dir(Path(args.save_dir), label)
     with _Progress(not args.quiet) as progress:
         result = run_campaign(config, progress.example, progress.done)
     saved: dict[str, Path] = {}
@@ -219,27 +232,26 @@ def run(args: argparse.Namespace) -> int:
     return 1 if result.failed else 0
 
 
-def check_save_dir(directory: Path) -> None:
+def check_save_dir(directory: Path, label: str | None = None) -> None:
     """Refuse a ``--save-dir`` that cannot hold reproducers before the campaign runs, not after
     it. The folders it lacks are made and removed again, so that the system says what is wrong
     (a file on the way, a folder that cannot be written) and a campaign that finds nothing
-    leaves nothing behind."""
+    leaves nothing behind. ``label`` names the folder in the message."""
+    label = label or f"--save-dir {directory}"
     made: list[Path] = []
     folder = directory
     while not folder.is_dir() and folder != folder.parent:
         if folder.exists() or folder.is_symlink():
-            raise ConfigError(f"--save-dir {directory}: {folder} is not a folder")
+            raise ConfigError(f"{label}: {folder} is not a folder")
         made.append(folder)
         folder = folder.parent
     try:
         for missing in reversed(made):
             missing.mkdir()
         if not os.access(directory, os.W_OK | os.X_OK):
-            raise ConfigError(f"--save-dir {directory}: the folder cannot be written")
+            raise ConfigError(f"{label}: the folder cannot be written")
     except OSError as exc:
-        raise ConfigError(
-            f"--save-dir {directory}: cannot create {exc.filename}: {exc.strerror or exc}"
-        ) from None
+        raise ConfigError(f"{label}: cannot create {exc.filename}: {exc.strerror or exc}") from None
     finally:
         for missing in made:
             if missing.is_dir():
@@ -260,6 +272,7 @@ def _save_all(result: CampaignResult, directory: Path) -> tuple[dict[str, Path],
                     directory,
                     cut_fraction=r.cut_fraction,
                     base=result.config.settings,
+                    recorded_answers=result.config.base is not None,
                 )
             except ValueError as exc:  # an event its transport's writer cannot carry
                 print(f"fuzzoff: the {r.name} counterexample was not saved: {exc}", file=sys.stderr)

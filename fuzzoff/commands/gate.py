@@ -33,6 +33,11 @@ from fuzzoff.report.sanitize import printable
 
 def add_parser(sub: Any) -> None:
     parser = add_command(sub, "gate")
+    parser.epilog = (
+        "exit status: 0 the model and the recorded mode history agree (or the recording has no "
+        "mode), 1 they differ somewhere, 2 a usage error or a recording that could not be read "
+        "completely"
+    )
     parser.add_argument("path", metavar="PATH", help="a recording (any supported format)")
     add_profile_options(parser)
     parser.add_argument("--format", choices=("terminal", "json"), default="terminal")

@@ -1,10 +1,11 @@
 """``fuzzoff replay REPRODUCER``: re-check a saved reproducer, or stream it to a live PX4.
 
 Without ``--to``: lint the recording with the reproducer's arguments and compare with its
-expected findings (the corpus rule: same codes and severities, times within 0.05 s), then run
-the property it broke again. Exit 0 when the findings match and the property holds now (the bug
-is fixed), 1 when the findings differ or the property still fails, 2 when the reproducer cannot
-be read.
+expected findings (the corpus rule: same codes and severities, times within 0.05 s), then check
+the property it broke again, on the stream it failed on (``fuzz.reproducers.recheck``): "still
+fails" or "fixed". Exit 0 when the findings match and the property holds now (the bug is fixed),
+1 when the findings differ or the property still fails, 2 when the reproducer cannot be used
+(unreadable, or its recording missing, truncated or changed since it was saved).
 
 With ``--to udp:HOST:PORT``: send the recording's MAVLink stream (a tlog) to that endpoint at
 its recorded timing (``--speed`` to scale), e.g. to a PX4 SITL's offboard port.
@@ -20,8 +21,8 @@ from typing import Any
 
 from fuzzoff.commands import add_command
 from fuzzoff.commands._common import write_output
-from fuzzoff.config import ConfigError, Settings
-from fuzzoff.fuzz.reproducers import ReproducerError, load, recheck
+from fuzzoff.config import ConfigError
+from fuzzoff.fuzz.reproducers import ReproducerError, load, recheck, recording_problem
 from fuzzoff.report.sanitize import printable
 from fuzzoff.sources.base import SourceError
 
@@ -33,6 +34,11 @@ the gate reacts to (tens of milliseconds) are shorter than the sleep they are ti
 
 def add_parser(sub: Any) -> None:
     parser = add_command(sub, "replay")
+    parser.epilog = (
+        "exit status (without --to): 0 the findings match and the property holds now (fixed), "
+        "1 the findings differ or the property still fails, 2 the reproducer or its recording "
+        "cannot be used (unreadable, missing, truncated or changed since it was saved)"
+    )
     parser.add_argument("path", metavar="REPRODUCER", help="NAME.expected.json or its recording")
     parser.add_argument(
         "--to",
@@ -88,8 +94,13 @@ def run(args: argparse.Namespace) -> int:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     recording = reproducer.recording
-    if not recording.exists():
-        print(f"error: {recording}: the reproducer's recording is missing", file=sys.stderr)
+    try:
+        unusable = recording_problem(reproducer)
+    except SourceError as exc:  # the recording is not one fuzzoff can read (empty, foreign)
+        print(f"fuzzoff: {printable(exc.line())}", file=sys.stderr)
+        return 2
+    if unusable is not None:
+        print(f"error: {printable(unusable)}", file=sys.stderr)
         return 2
     if args.to:
         return _stream(recording, args)
@@ -98,36 +109,54 @@ def run(args: argparse.Namespace) -> int:
     from fuzzoff.fuzz.scenario import Scenario
 
     scenario = reproducer.scenario or Scenario("1.15", "mc", "ros2", events=())
-    report = lint_file(recording, scenario.settings(Settings(ignore=reproducer.ignore)))
+    report = lint_file(recording, scenario.settings(reproducer.rules))
     differ = compare(reproducer.findings, expected_findings(report))
     try:
-        still = recheck(reproducer)
+        again = recheck(reproducer)
     except SourceError as exc:  # the recording is not one fuzzoff can read (empty, foreign)
         print(f"fuzzoff: {printable(exc.line())}", file=sys.stderr)
         return 2
+    still = again.problems
     prop = reproducer.prop
+    verdict = None if prop is None else "still fails" if still else "fixed"
     data = {
         "reproducer": str(args.path),
         "recording": str(recording),
         "property": prop,
         "findings_match": not differ,
         "finding_differences": differ,
+        "verdict": verdict,
         "property_still_fails": bool(still),
+        "rechecked_on": "stream" if again.on_stream else "recording",
         "problems": still,
+        "setup": None if reproducer.setup is None else reproducer.setup.to_json(),
     }
     if args.format == "json":
         text = json.dumps(data, indent=2) + "\n"
     else:
-        lines = [f"{printable(str(recording))}:"]
-        lines.append("  findings: " + ("as expected" if not differ else "DIFFER"))
-        lines += [f"    {d}" for d in differ]
-        if prop:
-            verdict = "still fails" if still else "holds now (fixed?)"
-            lines.append(f"  property {prop}: {verdict}")
-            lines += [f"    {printable(p, 300)}" for p in still]
-        text = "\n".join(lines) + "\n"
+        text = _terminal(recording, prop, verdict, differ, still, again.on_stream)
+        if reproducer.setup is not None:
+            text += f"  on a live PX4: {reproducer.setup.describe()}\n"
     write_output(text, args.output)
     return 1 if differ or still else 0
+
+
+def _terminal(
+    recording: Path,
+    prop: str | None,
+    verdict: str | None,
+    differ: list[str],
+    still: list[str],
+    on_stream: bool,
+) -> str:
+    lines = [f"{printable(str(recording))}:"]
+    lines.append("  findings: " + ("as expected" if not differ else "DIFFER"))
+    lines += [f"    {d}" for d in differ]
+    if prop:
+        basis = "" if on_stream else " (checked on the recording's events: no stream saved)"
+        lines.append(f"  property {prop}: {verdict}{basis}")
+        lines += [f"    {printable(p, 300)}" for p in still]
+    return "\n".join(lines) + "\n"
 
 
 def _stream(recording: Path, args: argparse.Namespace) -> int:

@@ -63,7 +63,11 @@ class PropertyResult:
     counterexample: Scenario | None = None
     cut_fraction: float | None = None
     found_after: int | None = None
-    """Examples (including shrinking) until the first failure."""
+    """The first failing example: the how-manieth of the search."""
+    failed_examples: int = 0
+    """How many of the examples failed (only the first is shrunk and reported)."""
+    shrinks: int = 0
+    """The examples Hypothesis tried while shrinking the first failure (not in ``examples``)."""
     found_seconds: float | None = None
     counts: dict[str, dict[str, int]] = field(default_factory=dict)
     started: float = 0.0
@@ -83,6 +87,8 @@ class PropertyResult:
             "model_seconds": round(self.model_seconds, 3),
             "failed": self.failed,
             "problems": self.problems,
+            "failed_examples": self.failed_examples,
+            "shrink_steps": self.shrinks,
             "found_after_examples": self.found_after,
             "found_after_seconds": None
             if self.found_seconds is None
@@ -138,72 +144,126 @@ def run_property(
     budget_s: float | None,
     on_example: Callable[[PropertyResult], None] | None = None,
 ) -> PropertyResult:
+    """Check ``spec`` on the examples asked (``config.examples``, or as many as the budget
+    allows), all of them: a counterexample does not end the search. Then, when one failed, the
+    same seed again up to the first failing example, where Hypothesis stops and shrinks it (the
+    examples before it are the same: Hypothesis chooses each from the results before it)."""
     result = PropertyResult(spec.name, spec.claim)
     ctx = FuzzContext(settings=config.settings, recorded_answers=config.base is not None)
-    start = result.started = time.perf_counter()
+    result.started = time.perf_counter()
     known = [re.compile(k) for k in config.known]
-    failing: dict[str, Any] = {}
+    first: dict[str, Any] = {}
 
-    streams = (
-        scenarios(config.px4, config.vehicle, config.transport)
-        if config.base is None
-        else mutations(config.base)
-    )
-    strategy = st.tuples(streams, st.floats(0.0, 1.0))
-
-    def check(example: tuple[Scenario, float]) -> None:
-        scenario, cut = example
-        now = time.perf_counter()
-        if not failing and budget_s is not None and now - start > budget_s:
-            raise _Stop
-        if failing and now - failing["at"] > config.shrink_s:
+    def search(example: tuple[Scenario, float]) -> None:
+        if budget_s is not None and time.perf_counter() - result.started > budget_s:
             raise _Stop
         result.examples += 1
-        _targets(scenario)
-        ctx.cut_fraction = cut
-        t0 = time.perf_counter()
-        problems = spec.check(scenario, ctx)
-        result.model_seconds += time.perf_counter() - t0
-        if known and problems:
-            problems = _unknown(problems, known, result.known)
+        problems = _checked(spec, example, ctx, known, result)
         if on_example is not None:
             on_example(result)
         if problems and spec.fails:
-            if not failing:
-                failing["at"] = time.perf_counter()
+            result.failed_examples += 1
+            if not first:
+                first.update(scenario=example[0], cut=example[1], problems=problems)
                 result.found_after = result.examples
-                result.found_seconds = failing["at"] - start
-            failing.update(scenario=scenario, cut=cut, problems=problems)
-            raise AssertionError("\n".join(problems))
+                result.found_seconds = time.perf_counter() - result.started
 
-    max_examples = config.examples if config.examples is not None else 10**9
-    test = given(strategy)(check)
-    test = settings(
-        settings.get_profile(PROFILE_CI),
-        max_examples=max_examples,
-        phases=(Phase.generate, Phase.target, Phase.shrink),
-    )(test)
-    test = seed(config.seed)(test)
     try:
-        test()
-    except _Stop:
-        pass
-    except (AssertionError, Found):
-        pass
+        _hypothesis(search, config, config.examples)
+        if first:
+            _shrink(spec, config, ctx, known, result, first)
     finally:
-        result.seconds = time.perf_counter() - start
+        result.seconds = time.perf_counter() - result.started
         ctx.close()
-    if failing:
+    if first:
         result.failed = True
-        result.problems = list(failing["problems"])
-        result.counterexample = failing["scenario"]
-        result.cut_fraction = failing["cut"] if spec.name == "truncation" else None
+        result.problems = list(first["problems"])
+        result.counterexample = first["scenario"]
+        result.cut_fraction = first["cut"] if spec.name == "truncation" else None
     if spec.name == "docs-stricter":
         result.counts = {
             code: {"fired": ctx.docs_fired[code], "gate_accepted": ctx.docs_stricter[code]}
             for code in sorted(ctx.docs_fired)
         }
     return result
+
+
+def _checked(
+    spec: PropertySpec,
+    example: tuple[Scenario, float],
+    ctx: FuzzContext,
+    known: list[re.Pattern[str]],
+    result: PropertyResult,
+) -> list[str]:
+    """The property's problems on one example, the known ones left out (and counted)."""
+    scenario, cut = example
+    _targets(scenario)
+    ctx.cut_fraction = cut
+    t0 = time.perf_counter()
+    problems = spec.check(scenario, ctx)
+    result.model_seconds += time.perf_counter() - t0
+    if known and problems:
+        problems = _unknown(problems, known, result.known)
+    return problems
+
+
+def _shrink(
+    spec: PropertySpec,
+    config: CampaignConfig,
+    ctx: FuzzContext,
+    known: list[re.Pattern[str]],
+    result: PropertyResult,
+    first: dict[str, Any],
+) -> None:
+    """The search again with the same settings (Hypothesis's schedule depends on the example
+    count asked), failing at the first counterexample so that Hypothesis shrinks it: ``first``
+    becomes the shrunk one. Known problems are not counted twice. Should the search not meet
+    the failure where the first pass did, ``first`` stays as it was found, unshrunk."""
+    failing: dict[str, float] = {}
+    seen: dict[str, int] = {}
+    calls = 0
+
+    def again(example: tuple[Scenario, float]) -> None:
+        nonlocal calls
+        if failing:
+            if time.perf_counter() - failing["at"] > config.shrink_s:
+                raise _Stop
+            result.shrinks += 1
+        else:
+            calls += 1
+            if calls > (result.found_after or 0):
+                raise _Stop
+        saved, result.known = result.known, seen
+        try:
+            problems = _checked(spec, example, ctx, known, result)
+        finally:
+            result.known = saved
+        if problems:
+            failing.setdefault("at", time.perf_counter())
+            first.update(scenario=example[0], cut=example[1], problems=problems)
+            raise AssertionError("\n".join(problems))
+
+    _hypothesis(again, config, config.examples)
+
+
+def _hypothesis(
+    check: Callable[[tuple[Scenario, float]], None], config: CampaignConfig, examples: int | None
+) -> None:
+    """Run ``check`` on the campaign's examples under its seed (at most ``examples``)."""
+    streams = (
+        scenarios(config.px4, config.vehicle, config.transport)
+        if config.base is None
+        else mutations(config.base)
+    )
+    test = given(st.tuples(streams, st.floats(0.0, 1.0)))(check)
+    test = settings(
+        settings.get_profile(PROFILE_CI),
+        max_examples=examples if examples is not None else 10**9,
+        phases=(Phase.generate, Phase.target, Phase.shrink),
+    )(test)
+    test = seed(config.seed)(test)
+    with contextlib.suppress(_Stop, AssertionError, Found):
+        test()
 
 
 @dataclass(slots=True)

@@ -133,6 +133,8 @@ class Hazard:
     message: str
     spec: str
     end: float
+    nav_state: int | None = None
+    """The mode the vehicle is in after it (a failsafe's action), where the model says."""
 
     def describe(self) -> str:
         return f"{self.kind} at {self.t:.3f} s ({self.message}; gate spec {self.spec})"
@@ -172,5 +174,5 @@ def hazards(transitions: Sequence[GateTransition], t_end: float) -> list[Hazard]
             message = tr.message
             if _undone_earlier(tr, transitions):
                 message += " [undone by a transition before it: timeline out of order]"
-            out.append(Hazard(tr.t, what, message, tr.spec, tr.t))
+            out.append(Hazard(tr.t, what, message, tr.spec, tr.t, tr.nav_state))
     return out

@@ -161,6 +161,15 @@ class Margin:
     perturbation: Perturbation | None
     """The smallest perturbation that changes the outcome (None: none up to ``MAX_SIZE``)."""
     new_hazards: Outcome = ()
+    changes: tuple[str, ...] = ()
+    """What PX4 does differently after that perturbation (``fuzz.outcomes.changes``)."""
+
+    def describe(self) -> str:
+        p = self.perturbation
+        if p is None:
+            return "none up to the largest size tried"
+        what = "; ".join(self.changes) or "changes the gate's outcome"
+        return f"{p.describe()}: {what}"
 
     def to_json(self) -> dict[str, object]:
         p = self.perturbation
@@ -172,6 +181,7 @@ class Margin:
             "at_s": None if p is None else round(p.at, 6),
             "max_tried": MAX_SIZE[self.family],
             "outcome_after": [{"hazard": k, "time_s": t / 10} for k, t in self.new_hazards],
+            "changes": list(self.changes),
         }
 
 
@@ -223,8 +233,18 @@ def margins(scenario: Scenario, positions: int = 24, steps: int = 12) -> list[Ma
                     lo = mid
             if best is None or hi < best.size:
                 best, best_outcome = Perturbation(family, at, hi), hi_outcome
-        result.append(Margin(family, best, best_outcome))
+        result.append(Margin(family, best, best_outcome, _changes(scenario, best)))
     return result
+
+
+def _changes(scenario: Scenario, p: Perturbation | None) -> tuple[str, ...]:
+    if p is None:
+        return ()
+    from fuzzoff.fuzz.outcomes import changes, hazards_of
+
+    moved = p.size if p.family in ("stall", "jitter") else 0.0
+    before, after = hazards_of(scenario), hazards_of(apply(scenario, p))
+    return tuple(changes(scenario.px4, before, after, moved))
 
 
 def mutations(scenario: Scenario) -> st.SearchStrategy[Scenario]:

@@ -13,6 +13,7 @@ from typing import Any
 
 from fuzzoff import __version__
 from fuzzoff.fuzz.campaign import CampaignResult, PropertyResult
+from fuzzoff.fuzz.known import KNOWN
 from fuzzoff.report.sanitize import printable
 from fuzzoff.report.sarif import BASE_ID, artifact_uri
 
@@ -65,7 +66,8 @@ def to_junit(result: CampaignResult, saved: dict[str, Path]) -> str:
             suite, "testcase", classname="fuzzoff.fuzz", name=r.name, time=f"{r.seconds:.3f}"
         )
         if r.failed:
-            text = "\n".join(r.problems)
+            text = f"{r.failed_examples} of {r.examples} examples failed; the first:\n"
+            text += "\n".join(r.problems)
             if r.counterexample is not None:
                 text += f"\ncounterexample: {r.counterexample.describe()}"
             if r.name in saved:
@@ -76,6 +78,9 @@ def to_junit(result: CampaignResult, saved: dict[str, Path]) -> str:
             ET.SubElement(case, "skipped", message="no example ran within the time budget")
         out = ET.SubElement(case, "system-out")
         out.text = f"{r.claim}: {r.examples} examples in {r.seconds:.2f} s"
+        for pattern, count in r.known.items():
+            out.text += f"\nleft out, a known problem of fuzzoff in {count} examples: "
+            out.text += KNOWN.get(pattern, pattern)
     root = ET.Element("testsuites")
     root.append(suite)
     ET.indent(root)
@@ -146,23 +151,31 @@ def to_terminal(result: CampaignResult, saved: dict[str, Path], margins: list[An
         lines.append(f"  --from incomplete, the part before this was fuzzed: {printable(problem)}")
     for r in result.results:
         lines.append(_line(r))
+        if r.failed:
+            shrunk = f", shrunk in {r.shrinks} steps" if r.shrinks else ""
+            lines.append(
+                f"      {r.failed_examples} of {r.examples} examples failed; the first "
+                f"(example {r.found_after}){shrunk}:"
+            )
         for p in r.problems:
             lines.append(f"      {printable(p, 300)}")
         if r.counterexample is not None:
             lines.append(f"      counterexample: {r.counterexample.describe()}")
         if r.name in saved:
             lines.append(f"      reproducer: {saved[r.name]}  (fuzzoff replay {saved[r.name]})")
+        for pattern, count in r.known.items():
+            what = KNOWN.get(pattern, pattern)
+            lines.append(
+                f"      left out: a known problem of fuzzoff in {count} examples "
+                f"(--include-known to fail on it): {printable(what, 200)}"
+            )
         for code, c in r.counts.items():
             lines.append(
                 f"      {code}: fired {c['fired']}, gate accepted {c['gate_accepted']} "
                 "(docs stricter than code)"
             )
     for m in margins:
-        p = m.perturbation
-        if p is None:
-            lines.append(f"  margin {m.family:<7} none up to the largest size tried")
-        else:
-            lines.append(f"  margin {m.family:<7} {p.describe()} changes the gate's outcome")
+        lines.append(f"  margin {m.family:<7} {m.describe()}")
     lines.append(f"{result.examples} examples in {result.seconds:.1f} s; {_verdict(result)}")
     return "\n".join(lines) + "\n"
 

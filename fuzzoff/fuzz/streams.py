@@ -23,7 +23,7 @@ from hypothesis import strategies as st
 
 from fuzzoff import events as ev
 from fuzzoff.fuzz import strategies as fs
-from fuzzoff.fuzz.scenario import TRANSPORTS, Scenario, TransportName
+from fuzzoff.fuzz.scenario import AUTOPILOT, COMPANION, TRANSPORTS, Scenario, TransportName
 from fuzzoff.gate import GateModel
 from fuzzoff.gate.params import default_params, loss_timeout
 from fuzzoff.modes import mavros_mode_to_nav_state, nav_state_to_mavros_mode
@@ -35,11 +35,10 @@ MIN_STEP = 0.0001
 """Distinct receive times: events never share a timestamp (the readers' order for equal
 timestamps is the file's, which a writer need not keep)."""
 
-COMPANION = (1, 191)
 MODE_POSCTL = (1.0, 3.0)
+"""DO_SET_MODE params for POSCTL (custom main mode 3)."""
 STATUS_STEP = 0.05
 """How often the MAVROS state echo looks at the model between messages."""
-"""DO_SET_MODE params for POSCTL (custom main mode 3)."""
 
 
 def _cmd(t: float, command: int, params: Sequence[float], transport: TransportName) -> ev.Command:
@@ -51,6 +50,8 @@ def _cmd(t: float, command: int, params: Sequence[float], transport: TransportNa
             command=command,
             params=full,
             sender_time_us=round(t * 1e6),
+            target_system=AUTOPILOT[0],
+            target_component=AUTOPILOT[1],
             source_system=0,
             source_component=0,
             from_external=True,
@@ -61,6 +62,8 @@ def _cmd(t: float, command: int, params: Sequence[float], transport: TransportNa
         vehicle="1",
         command=command,
         params=full,
+        target_system=AUTOPILOT[0],
+        target_component=AUTOPILOT[1],
         source_system=COMPANION[0],
         source_component=COMPANION[1],
         from_external=True,
@@ -226,6 +229,24 @@ def _published(kind: str, px4: str) -> bool:
     return px4_msgs.definition(release_for(px4) or "main", _MESSAGE[kind]) is not None
 
 
+_WIRE_NAME = {"normalized_steering_angle": "normalized_steering_setpoint"}
+"""Event fields whose message field was renamed in a release (1.17's RoverSteeringSetpoint)."""
+
+
+def _carried(kind: str, px4: str, values: dict[str, Any]) -> dict[str, Any]:
+    """``values`` with NaN for the fields the release's message does not have (1.17 dropped
+    RoverSteeringSetpoint's ``normalized_speed_diff``): a recording of that release cannot
+    hold them, and its reader gives NaN, as PX4 would never see them."""
+    if kind not in _MESSAGE:
+        return values
+    name = _MESSAGE[kind]
+    text = px4_msgs.definition(release_for(px4) or "main", name)
+    if text is None:
+        return values
+    wire = px4_msgs.field_names(px4_msgs.type_name(name), text)
+    return {k: v if k in wire or _WIRE_NAME.get(k) in wire else fs.NAN for k, v in values.items()}
+
+
 def _ros2_setpoint_kinds(vehicle: str, px4: str) -> list[str]:
     kinds = ["trajectory", "trajectory", "attitude", "rates", "none"]
     if is_rover(vehicle) and at_least(px4, "1.16"):
@@ -269,12 +290,14 @@ def ros2_sent(draw: st.DrawFn, px4: str, vehicle: str, times: list[float]) -> li
     if not times:
         return out
     for offset, kind in enumerate(k for k in kinds if k != "none"):
-        out += draw(_setpoint_series(kind, times, 0.001 * (offset + 1)))
+        out += draw(_setpoint_series(kind, times, 0.001 * (offset + 1), px4))
     return out
 
 
 @st.composite
-def _setpoint_series(draw: st.DrawFn, kind: str, times: list[float], lag: float) -> list[ev.Event]:
+def _setpoint_series(
+    draw: st.DrawFn, kind: str, times: list[float], lag: float, px4: str
+) -> list[ev.Event]:
     """One setpoint topic following the keep-alive by ``lag``, maybe starting late or stopping
     early (stale setpoints under a live keep-alive: OFB104), frozen or moving."""
     if kind == "trajectory":
@@ -285,6 +308,7 @@ def _setpoint_series(draw: st.DrawFn, kind: str, times: list[float], lag: float)
         values = draw(fs.rates_setpoints())
     else:
         _, values = draw(fs.rover_setpoints(kind))
+        values = _carried(kind, px4, values)
     nth = fs.frozen_or_moving(values) if draw(st.booleans()) else (lambda i: values)
     whole = draw(st.sampled_from(["whole", "whole", "late", "early"]))
     start = draw(st.integers(0, len(times) - 1)) if whole == "late" else 0
@@ -318,13 +342,13 @@ def mavlink_sent(draw: st.DrawFn, times: list[float], transport: TransportName) 
     build = _MAV_BUILD[kind]
     out: list[ev.Event] = []
     for i, t in enumerate(times):
-        extra: dict[str, Any]
+        extra: dict[str, Any] = {"target_system": AUTOPILOT[0], "target_component": AUTOPILOT[1]}
         if transport == "mavlink":
-            extra = {"source_system": COMPANION[0], "source_component": COMPANION[1]}
+            extra |= {"source_system": COMPANION[0], "source_component": COMPANION[1]}
             extra["sender_time_us"] = stamps[i] % (2**32 * 1000)
             extra["vehicle"] = "1"
         else:  # MAVROS addresses its target (tgt_system 1, tgt_component 1); ROS namespace ""
-            extra = {"target_system": 1, "target_component": 1, "vehicle": ""}
+            extra["vehicle"] = ""
         out.append(build(t=t, transport=transport, **extra, **nth(i)))
     return out
 
