@@ -11,6 +11,7 @@ state (mode, arming, pre-arm health, acks, parameters) and feeds PX4's clock (``
 from __future__ import annotations
 
 import os
+import socket
 import struct
 import threading
 import time
@@ -62,6 +63,23 @@ switch twice, the receiver's ACCEPTED first and Commander's result 4-9 ms later 
 FLOAT_PARAMS = frozenset({"COM_OF_LOSS_T", "COM_OBC_LOSS_T", "COM_RC_LOSS_T", "COM_DL_LOSS_T"})
 
 
+class UdpClient(mavutil.mavudp):  # type: ignore[misc]
+    """pymavlink's UDP link sending to one resolved address of either family (mavudp itself
+    is IPv4 only), with send errors raised instead of dropped."""
+
+    def __init__(self, family: int, address: tuple[Any, ...], sysid: int, compid: int) -> None:
+        super().__init__("127.0.0.1:0", input=False, source_system=sysid, source_component=compid)
+        old: socket.socket = getattr(self, "port")  # noqa: B009 (mavudp's own socket)
+        old.close()
+        self.port: socket.socket = socket.socket(family, socket.SOCK_DGRAM)
+        self.port.setblocking(False)
+        self.fd = self.port.fileno()
+        self.destination_addr = address
+
+    def write(self, buf: bytes) -> None:
+        self.port.sendto(buf, self.destination_addr)
+
+
 def open_tlog(path: Any) -> Any:
     """pymavlink's reader of a .tlog, decoding with the ``development`` dialect."""
     log = mavutil.mavlink_connection(str(path), notimestamps=False, robust_parsing=True)
@@ -98,6 +116,8 @@ class VehicleView:
     acks: list[Ack] = field(default_factory=list)
     params: dict[str, tuple[float, int]] = field(default_factory=dict)
     statustexts: list[tuple[float, str]] = field(default_factory=list)
+    release: str | None = None
+    """From AUTOPILOT_VERSION ``flight_sw_version`` (major, minor, patch, type bytes)."""
 
 
 def param_encode(name: str, value: float, param_type: int | None) -> tuple[float, int]:
@@ -121,11 +141,12 @@ def param_decode(value: float, param_type: int) -> float:
 
 
 class Link:
-    """One MAVLink connection to PX4 (``udpin:HOST:PORT`` or ``udpout:HOST:PORT``)."""
+    """One MAVLink connection to PX4: ``udpin:HOST:PORT`` (listen where PX4 sends, as in a
+    SITL the client starts), or ``(family, address)`` to send to PX4's listening port."""
 
     def __init__(
         self,
-        address: str,
+        address: str | tuple[int, tuple[Any, ...]],
         *,
         sysid: int = COMPANION_SYSID,
         compid: int = MAV_COMP_ID_ONBOARD_COMPUTER,
@@ -134,9 +155,12 @@ class Link:
     ) -> None:
         if sysid == 1:
             raise LinkError("system id 1 is the autopilot's own: the client needs another")
-        self.conn: Any = mavutil.mavlink_connection(
-            address, source_system=sysid, source_component=compid
-        )
+        if isinstance(address, str):
+            self.conn: Any = mavutil.mavlink_connection(
+                address, source_system=sysid, source_component=compid
+            )
+        else:
+            self.conn = UdpClient(address[0], address[1], sysid, compid)
         # The dialect is set on this connection only: mavutil's ``dialect=`` would change the
         # module-wide default that other readers in the process rely on.
         self.mav: Any = mavlink.MAVLink(self.conn, srcSystem=sysid, srcComponent=compid)
@@ -212,6 +236,9 @@ class Link:
         elif kind == "PARAM_VALUE":
             name = msg.param_id.rstrip("\x00")
             view.params[name] = (param_decode(msg.param_value, msg.param_type), msg.param_type)
+        elif kind == "AUTOPILOT_VERSION":
+            sw = int(msg.flight_sw_version)
+            view.release = f"{(sw >> 24) & 0xFF}.{(sw >> 16) & 0xFF}.{(sw >> 8) & 0xFF}"
         elif kind == "STATUSTEXT":
             view.statustexts.append((host, str(msg.text)))
 

@@ -118,8 +118,7 @@ def attitude(d: Driver) -> None:
     d.stream(d.attitude(0.3), 0.5)
     d.require(d.arm(), "arm in OFFBOARD")
     d.stream(d.attitude(0.3), 4.0)
-    d.disarm()
-    d.wait(1.0)
+    d.land_and_wait()
 
 
 def enu_frame(d: Driver) -> None:
@@ -222,7 +221,7 @@ SCENARIOS: dict[str, Scenario] = {
         ),
         Scenario(
             "attitude",
-            "SET_ATTITUDE_TARGET level at 0.3 thrust: switch, arm, disarm on the ground",
+            "SET_ATTITUDE_TARGET level at 0.3 thrust: switch, arm, 4 s, land",
             attitude,
             "clean",
         ),

@@ -33,6 +33,9 @@ LOOP_S = 0.012
 LOSS_TOLERANCE_S = 0.11
 """The model's loss instant may differ from PX4's flag by up to one check period and a loop
 (gate spec 2.1.3: at least 110 ms)."""
+DECISION_S = 0.05
+"""The model decides a request at the time the tlog recorded it; PX4 logs it when its receiver
+took it: a few milliseconds apart on the shifted clocks."""
 MATCH_S = 0.6
 """A PX4 event and a model event this close are the same event."""
 MODE_SETTLE_S = 0.5
@@ -116,11 +119,16 @@ def _accepted(result: int | None) -> str:
 
 
 def _model_decision(rows: list[dict[str, Any]], t: float) -> dict[str, Any] | None:
-    kinds = {"request_accepted", "request_rejected", "arm_accepted", "arm_rejected", "mode"}
-    near = [r for r in rows if r["what"] in kinds and abs(r["time_s"] - t) <= 0.05]
-    kinds_disarm = {"disarmed"}
-    near += [r for r in rows if r["what"] in kinds_disarm and 0 <= r["time_s"] - t <= 0.05]
-    return near[0] if near else None
+    kinds = {
+        "request_accepted",
+        "request_rejected",
+        "arm_accepted",
+        "arm_rejected",
+        "mode",
+        "disarmed",
+    }
+    near = [r for r in rows if r["what"] in kinds and abs(r["time_s"] - t) <= DECISION_S]
+    return min(near, key=lambda r: abs(r["time_s"] - t)) if near else None
 
 
 def _model_accepts(row: dict[str, Any]) -> bool:
@@ -153,7 +161,23 @@ def compare(
         truth.keepalives = [k + offset for k in truth.keepalives]
     _requests(verdict, truth, rows)
     _losses(verdict, truth, rows, params.get("COM_OF_LOSS_T", 1.0), ulog is not None)
+    _gate_disagreements(verdict, rows)
+    verdict.items.sort(key=lambda i: i.t)
     return verdict
+
+
+def _gate_disagreements(verdict: Verdict, rows: list[dict[str, Any]]) -> None:
+    """``fuzzoff gate``'s own disagreements (recorded mode or ack vs the model) not already
+    judged above."""
+    judged = [i.t for i in verdict.items if i.agree is False]
+    for row in rows:
+        if row["what"] != "disagreement":
+            continue
+        if any(abs(row["px4_t"] - t) <= 0.2 for t in judged):
+            continue
+        verdict.items.append(
+            Item("recorded vs model", row["px4_t"], "as recorded", row["message"], False)
+        )
 
 
 def _requests(verdict: Verdict, truth: Truth, rows: list[dict[str, Any]]) -> None:
