@@ -123,8 +123,13 @@ def compare(expected: list[dict[str, Any]], actual: list[dict[str, Any]]) -> lis
 def run(args: argparse.Namespace) -> int:
     if not MIN_SPEED <= args.speed <= MAX_SPEED:  # NaN too
         raise ConfigError(f"--speed {args.speed:g}: expected {MIN_SPEED:g} to {MAX_SPEED:g}")
+    path = Path(args.path)
+    if args.to and path.suffix.lower() == ".tlog" and path.is_file():
+        beside = path.parent / f"{path.stem}.expected.json"
+        if not beside.exists():  # any tlog can be replayed into PX4, reproducer or not
+            return _stream(path, args)
     try:
-        reproducer = load(Path(args.path))
+        reproducer = load(path)
     except ReproducerError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
