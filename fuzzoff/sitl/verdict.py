@@ -236,7 +236,8 @@ def _losses(
     px4 = _px4_losses(truth, flagged)
     used: set[int] = set()
     for t in px4:
-        match = [r for r in model if abs(r["px4_t"] - t) <= MATCH_S and id(r) not in used]
+        window = MATCH_S if flagged else HEARTBEAT_SETTLE_S
+        match = [r for r in model if abs(r["px4_t"] - t) <= window and id(r) not in used]
         keepalive = truth.last_keepalive_before(t)
         if not match:
             verdict.items.append(Item("offboard loss", t, "lost", "no loss predicted", False))
