@@ -43,6 +43,17 @@ def _name(path: Path) -> str:
     return path.name.removesuffix(".expected.json")
 
 
+def _short(spec: dict[str, Any], path: Path) -> str:
+    """'issue 17: OFB107 warning, ...' from the expected file's known_false (which says why)."""
+    by_issue: dict[str, list[str]] = {}
+    for entry in spec.get("known_false", []):
+        finding, _, why = entry.partition(": ")
+        issue = why.split(":")[0] if why.startswith("issue") else "to review"
+        by_issue.setdefault(issue, []).append(finding)
+    parts = [f"{issue}: {', '.join(found)}" for issue, found in sorted(by_issue.items())]
+    return "; ".join(parts) + f" (why: known_false in {path.name})"
+
+
 def _clean_cases() -> list[Any]:
     cases = []
     for path in SPECS:
@@ -51,8 +62,7 @@ def _clean_cases() -> list[Any]:
             continue
         marks = []
         if spec["exit_status"] != 0:
-            reason = "; ".join(spec.get("known_false", [])) or "to review"
-            marks.append(pytest.mark.xfail(strict=True, reason=reason))
+            marks.append(pytest.mark.xfail(strict=True, reason=_short(spec, path)))
         cases.append(pytest.param(path, marks=marks, id=_name(path)))
     return cases
 

@@ -27,10 +27,6 @@ from tests.helpers import CORPORA, run_cli
 SITL = CORPORA / "sitl"
 RUNS = json.loads((SITL / "runs.json").read_text())
 PAIRS = sorted(s for s in RUNS if (SITL / f"{s}.tlog").exists() and (SITL / f"{s}.ulg").exists())
-NO_MANUAL_CONTROL = (
-    "issue 17: on 1.17+ the model assumes manual control in a tlog without MANUAL_CONTROL and"
-    " predicts POSCTL; PX4 without manual control goes to Return (NAV_RCL_ACT)"
-)
 DISARM_DENIED = (
     "issue 18: PX4 refuses a disarm in flight ('Disarming denied: not landed'); the model"
     " accepts it"
@@ -143,18 +139,12 @@ def test_sitl_list_shows_the_scenarios() -> None:
     assert "clean_offboard" in out.stdout and "hazard" in out.stdout
 
 
-def _release(stem: str) -> tuple[int, ...]:
-    return tuple(int(n) for n in RUNS[stem]["release"].split("-")[0].split("."))
-
-
 def _verdict_cases() -> list[object]:
     cases = []
     for stem in PAIRS:
         marks = []
         if stem.startswith("disarm_in_flight"):
             marks.append(pytest.mark.xfail(strict=True, reason=DISARM_DENIED))
-        elif stem.split("-")[0] in ("loss_no_manual", "stall_1_5s") and _release(stem) >= (1, 17):
-            marks.append(pytest.mark.xfail(strict=True, reason=NO_MANUAL_CONTROL))
         cases.append(pytest.param(stem, marks=marks, id=stem))
     return cases
 

@@ -70,11 +70,6 @@ def test_replay_to_a_running_px4_prints_its_outcome_beside_the_models(tmp_path: 
     assert record.stat().st_size > 0
 
 
-def _minor(release: str) -> tuple[int, int]:
-    major, minor = release.split(".")[:2]
-    return int(major), int(minor)
-
-
 def _matrix() -> list[object]:
     cases = []
     for release in RELEASES:
@@ -85,14 +80,6 @@ def _matrix() -> list[object]:
                     pytest.mark.xfail(
                         strict=True,
                         reason="issue 18: PX4 refuses a disarm in flight; the model accepts it",
-                    )
-                )
-            elif name in ("loss_no_manual", "stall_1_5s") and _minor(release) >= (1, 17):
-                marks.append(
-                    pytest.mark.xfail(
-                        strict=True,
-                        reason="issue 17: the model assumes manual control in a tlog"
-                        " without it; PX4 goes to Return",
                     )
                 )
             cases.append(pytest.param(release, name, marks=marks, id=f"{name}-{release}"))

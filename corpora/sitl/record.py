@@ -1,9 +1,9 @@
 """Record the real-PX4 corpus: scenario programs flown on the bundled PX4 SITL releases.
 
 Run ``.venv/bin/python corpora/sitl/record.py --release 1.16.2 --instance 0 [SCENARIO...]``
-(when none is named: all on 1.16.2, the release-dependent ones elsewhere). Each run boots a
-fresh PX4 (``fuzzoff.sitl.session``), flies the program through pymavlink, and leaves beside
-this file:
+(when none is named: all on 1.16.2 and 1.18.0-alpha1, the release-dependent ones elsewhere).
+Each run boots a fresh PX4 (``fuzzoff.sitl.session``), flies the program through pymavlink, and
+leaves beside this file:
 
 - ``NAME-RELEASE.tlog``: both directions of the offboard link as the client saw them, stamped
   on PX4's clock (``fuzzoff.sitl.recorder``);
@@ -28,10 +28,11 @@ from fuzzoff.sitl.trim import trim
 
 HERE = Path(__file__).resolve().parent
 RUNS = HERE / "runs.json"
-EVERY_SCENARIO_ON = "1.16.2"
-"""The release every scenario runs on; the others run the ones whose outcome depends on the
-release (the loss action and manual control, the acks, the disarmed switch, the estimate an
-acceleration needs, the minimum stream), so that the corpus stays small."""
+EVERY_SCENARIO_ON = ("1.16.2", "1.18.0-alpha1")
+"""The releases every scenario runs on (a long-supported one and the newest); the others run
+the ones whose outcome depends on the release (the loss action and manual control, the acks,
+the disarmed switch, the estimate an acceleration needs, the minimum stream), so that the
+corpus stays small."""
 RELEASE_DEPENDENT = (
     "clean_offboard",
     "loss_no_manual",
@@ -80,7 +81,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("scenarios", nargs="*")
     args = parser.parse_args(argv)
     runs = json.loads(RUNS.read_text()) if RUNS.exists() else {}
-    default = SCENARIOS if args.release == EVERY_SCENARIO_ON else RELEASE_DEPENDENT
+    default = SCENARIOS if args.release in EVERY_SCENARIO_ON else RELEASE_DEPENDENT
     for name in args.scenarios or list(default):
         try:
             entry = record(args.release, args.instance, name)
