@@ -101,7 +101,17 @@ def test_replay_to_a_damaged_tlog_is_refused_before_anything_is_sent(tmp_path: P
     damaged.write_bytes(source[:4000] + b"\xfd\x09" + source[4100:])
     out = run_cli(["replay", str(damaged), "--to", "udp:127.0.0.1:9"])
     assert out.returncode == 2
-    assert "damaged at byte" in out.stderr and "a replay would not be the recording" in out.stderr
+    assert "damaged or cut short at byte" in out.stderr
+    assert "a replay would not be the recording" in out.stderr
+
+
+def test_replay_to_a_tlog_cut_short_is_refused(tmp_path: Path) -> None:
+    source = (CORPORA / "tlog" / "stream_lost_in_offboard.tlog").read_bytes()
+    cut = tmp_path / "cut.tlog"
+    cut.write_bytes(source[: len(source) // 2 + 7])
+    out = run_cli(["replay", str(cut), "--to", "udp:127.0.0.1:9"])
+    assert out.returncode == 2
+    assert "cut short at byte" in out.stderr
 
 
 def test_replay_to_where_no_px4_answers_heartbeats_as_a_companion_and_says_so() -> None:

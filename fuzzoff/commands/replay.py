@@ -224,9 +224,16 @@ def _stream(recording: Path, args: argparse.Namespace) -> int:
     try:
         from fuzzoff.fuzz.reproducers import load
 
-        scenario = load(Path(args.path)).scenario
+        loaded = load(Path(args.path))
+        scenario, cut = loaded.scenario, loaded.cut_fraction
     except ReproducerError:
-        scenario = None
+        scenario, cut = None, None
+    if cut is not None:
+        print(
+            f"fuzzoff: {printable(str(recording))} is the first {cut:.0%} of a recording (a"
+            " truncation reproducer): PX4 gets that part only",
+            file=sys.stderr,
+        )
     if scenario is not None:
         params = {**dict(scenario.params), **params}
     record = (

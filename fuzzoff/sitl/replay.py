@@ -63,12 +63,16 @@ def plan_from_tlog(path: Path) -> Plan:
         log = open_tlog(path)
     except OSError as exc:
         raise SourceError(str(path), f"cannot open: {exc.strerror or exc}") from None
+    end = 0
     try:
         while True:
             offset = log.f.tell()
             msg = log.recv_msg()
             if msg is None:
+                if end < path.stat().st_size and plan.damaged_at is None:
+                    plan.damaged_at = end  # the file ends inside a record: cut short
                 break
+            end = log.f.tell()
             kind = msg.get_type()
             if kind == "BAD_DATA":
                 if plan.damaged_at is None:

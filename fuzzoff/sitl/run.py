@@ -100,8 +100,8 @@ def load_plan(recording: Path) -> replay.Plan:
     plan = replay.plan_from_tlog(recording)
     if plan.damaged_at is not None:
         raise LinkError(
-            f"{recording}: damaged at byte {plan.damaged_at} (a packet pymavlink cannot read):"
-            " a replay would not be the recording"
+            f"{recording}: damaged or cut short at byte {plan.damaged_at} (a packet pymavlink"
+            " cannot read): a replay would not be the recording"
         )
     if not plan.messages:
         raise LinkError(f"{recording}: no message from a companion or ground station to send")

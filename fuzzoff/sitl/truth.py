@@ -156,12 +156,13 @@ def read_tlog(path: Path) -> TlogView:
     from fuzzoff.sitl.link import open_tlog
 
     truth = Truth()
-    offsets: list[float] = []
-    commands: list[tuple[float, int, float, float, float]] = []
-    acks: list[tuple[float, int, int]] = []
+    stamped: list[tuple[float, int, float]] = []
+    commands: list[tuple[float, int, int, float, float, float]] = []
+    acks: list[tuple[float, int, int, int]] = []
+    heartbeats: list[tuple[float, int, int, bool]] = []
+    setpoints: list[tuple[float, int]] = []
     first: float | None = None
     autopilot: int | None = None
-    last_mode: tuple[int, bool] | None = None
     log = open_tlog(path)
     try:
         while True:
@@ -178,29 +179,43 @@ def read_tlog(path: Path) -> TlogView:
             if kind == "HEARTBEAT" and msg.autopilot == 12 and msg.get_srcComponent() == 1:
                 autopilot = src if autopilot is None else autopilot
                 nav = custom_mode_to_nav_state(msg.custom_mode)
-                key = (nav if nav is not None else -1, bool(msg.base_mode & 128))
-                if src == autopilot and key != last_mode:
-                    truth.modes.append(Mode(t, key[0], key[1], None))
-                    last_mode = key
-            elif kind == "TIMESYNC" and msg.tc1 == 0 and msg.ts1 > 0 and src == autopilot:
-                offsets.append(msg.ts1 / 1e9 - t)
-            elif kind == "SYSTEM_TIME" and msg.time_boot_ms > 0 and src == autopilot:
-                offsets.append(msg.time_boot_ms / 1e3 - t)
-            elif kind == "COMMAND_LONG" and src != autopilot:
-                commands.append(
-                    (t, int(msg.command), float(msg.param1), float(msg.param2), float(msg.param3))
+                heartbeats.append(
+                    (t, src, nav if nav is not None else -1, bool(msg.base_mode & 128))
                 )
-            elif kind == "COMMAND_ACK" and src == autopilot:
-                acks.append((t, int(msg.command), int(msg.result)))
-            elif kind in ("SET_POSITION_TARGET_LOCAL_NED", "SET_ATTITUDE_TARGET") and (
-                src != autopilot
-            ):
-                truth.keepalives.append(t)
+            elif kind == "TIMESYNC" and msg.tc1 == 0 and msg.ts1 > 0:
+                stamped.append((t, src, msg.ts1 / 1e9))
+            elif kind == "SYSTEM_TIME" and msg.time_boot_ms > 0:
+                stamped.append((t, src, msg.time_boot_ms / 1e3))
+            elif kind == "COMMAND_LONG":
+                commands.append(
+                    (
+                        t,
+                        src,
+                        int(msg.command),
+                        float(msg.param1),
+                        float(msg.param2),
+                        float(msg.param3),
+                    )
+                )
+            elif kind == "COMMAND_ACK":
+                acks.append((t, src, int(msg.command), int(msg.result)))
+            elif kind in ("SET_POSITION_TARGET_LOCAL_NED", "SET_ATTITUDE_TARGET"):
+                setpoints.append((t, src))
     except (OSError, ValueError, struct_error) as exc:
         raise SourceError(str(path), f"not a readable tlog: {exc}") from None
     finally:
         log.close()
-    for t, command, p1, p2, p3 in commands:
+    # The autopilot is known from its first HEARTBEAT, which may come after its first answers.
+    last_mode: tuple[int, bool] | None = None
+    for t, src, nav, armed in heartbeats:
+        if src == autopilot and (nav, armed) != last_mode:
+            truth.modes.append(Mode(t, nav, armed, None))
+            last_mode = (nav, armed)
+    offsets = [px4 - t for t, src, px4 in stamped if src == autopilot]
+    truth.keepalives = [t for t, src in setpoints if src != autopilot]
+    own_acks = [(t, c, r) for t, src, c, r in acks if src == autopilot]
+    commands_sent = [(t, c, p1, p2, p3) for t, src, c, p1, p2, p3 in commands if src != autopilot]
+    for t, command, p1, p2, p3 in commands_sent:
         # a retry of the same command (no ack in between) is the same request
         if (
             truth.requests
@@ -208,6 +223,6 @@ def read_tlog(path: Path) -> TlogView:
             and (truth.requests[-1].result is None)
         ):
             truth.requests.pop()
-        truth.requests.append(Request(t, command, p1, p2, p3, _result(acks, t, command)))
+        truth.requests.append(Request(t, command, p1, p2, p3, _result(own_acks, t, command)))
     offset = median(offsets) if offsets else None
     return TlogView(truth, offset)
