@@ -240,6 +240,11 @@ def _losses(
         match = [r for r in model if abs(r["px4_t"] - t) <= window and id(r) not in used]
         keepalive = truth.last_keepalive_before(t)
         if not match:
+            preempted = _preempted_loss(rows, t, window)
+            if preempted is not None:
+                _loss_time(verdict, t, preempted, keepalive, timeout, flagged)
+                _px4_only(verdict, truth, t, flagged)
+                continue
             verdict.items.append(Item("offboard loss", t, "lost", "no loss predicted", False))
             continue
         row = match[0]
@@ -251,6 +256,45 @@ def _losses(
             verdict.items.append(
                 Item("offboard loss", row["px4_t"], "no loss", f"lost: {row['message']}", False)
             )
+
+
+PREEMPTED = (
+    "not judged: PX4's mode change reached the model before its own 10 Hz check, and the model"
+    " followed it as an unseen mode change instead of predicting the action"
+)
+
+
+def _px4_only(verdict: Verdict, truth: Truth, t: float, flagged: bool) -> None:
+    """The action and return PX4 took after a loss the model did not act on (preempted)."""
+    settle = MODE_SETTLE_S if flagged else HEARTBEAT_SETTLE_S
+    after = [m for m in truth.modes if t - 0.001 <= m.t <= t + settle and m.nav_state != 14]
+    nav = after[0].nav_state if after else None
+    verdict.items.append(Item("failsafe action", t, nav_state_name(nav), "-", None, PREEMPTED))
+    later = [m for m in truth.modes if m.t > (after[0].t if after else t) + 0.001]
+    back = bool(later) and later[0].nav_state == NAV_OFFBOARD and later[0].armed
+    px4 = "back to OFFBOARD" if back else "stays"
+    verdict.items.append(Item("automatic return", later[0].t if later else t, px4, "-", None))
+
+
+def _preempted_loss(rows: list[dict[str, Any]], t: float, window: float) -> dict[str, Any] | None:
+    """A model loss without a failsafe because the recording's mode change came first: a
+    ``mode`` row taken from the recording (no command for it) at most one check period and a
+    loop before the model's ``signal_lost``. The model then follows the recording instead of
+    predicting the action (gate spec 2.1.3: PX4's check has its own phase), so neither the
+    action nor the return can be judged."""
+    for i, row in enumerate(rows):
+        if row["what"] != "signal_lost" or abs(row["px4_t"] - t) > window:
+            continue
+        before = [
+            r
+            for r in rows[:i]
+            if r["what"] == "mode"
+            and "from the recording" in r["message"]
+            and 0 <= row["px4_t"] - r["px4_t"] <= CHECK_PERIOD_S + LOOP_S
+        ]
+        if before:
+            return row
+    return None
 
 
 def _loss_time(
