@@ -11,7 +11,6 @@ The verdict compares what PX4 did with the gate model's prediction for the relea
 
 from __future__ import annotations
 
-import shutil
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -60,15 +59,19 @@ def run_scenario(
     stem = f"{name}-{build.release}"
     tlog = out_dir / f"{stem}.tlog"
     session = Session(build, instance, env=env, log=log)
-    with session:
-        result = session.run(name, scenario.program, tlog, manual=scenario.manual, params=params)
-        session.finish(result)
-    outcome = Outcome(tlog, build.release, steps=result.steps)
-    if result.error:
-        outcome.notes.append(f"the scenario stopped: {result.error}")
-    if result.ulog is not None:
-        outcome.ulog = trim(result.ulog, out_dir / f"{stem}.ulg")
-    session.px4.cleanup()
+    try:
+        with session:
+            result = session.run(
+                name, scenario.program, tlog, manual=scenario.manual, params=params
+            )
+            session.finish(result)
+        outcome = Outcome(tlog, build.release, steps=result.steps)
+        if result.error:
+            outcome.notes.append(f"the scenario stopped: {result.error}")
+        if result.ulog is not None:
+            outcome.ulog = trim(result.ulog, out_dir / f"{stem}.ulg")
+    finally:
+        session.px4.cleanup()
     outcome.verdict = compare(
         tlog, _release_for_model(build.release), outcome.ulog, params, COMPANION_SYSID
     )
@@ -125,24 +128,24 @@ def replay_on_bundle(
     tlog = out_dir / f"{stem}.tlog"
     session = Session(build, instance, env=env, log=log)
     outcome = Outcome(tlog, build.release)
-    with session:
-        link = session._link()
-        session.starting_state()
-        _apply_params(link, params, log)
-        recorder = TlogRecorder(tlog, clock=link.clock.now)
-        link.recorder = recorder
-        try:
-            link.request_version()
-            _replay_on(link, plan, speed, params.get("COM_OF_LOSS_T", 1.0), log)
-        finally:
-            link.recorder = None
-            recorder.close()
+    try:
+        with session:
+            link = session._link()
+            session.starting_state()
+            _apply_params(link, params, log)
+            recorder = TlogRecorder(tlog, clock=link.clock.now)
+            link.recorder = recorder
+            try:
+                link.request_version()
+                _replay_on(link, plan, speed, params.get("COM_OF_LOSS_T", 1.0), log)
+            finally:
+                link.recorder = None
+                recorder.close()
         logs = session.px4.ulogs()
-        session.close()
-    logs = session.px4.ulogs()
-    if logs:
-        outcome.ulog = trim(logs[-1], out_dir / f"{stem}.ulg")
-    session.px4.cleanup()
+        if logs:
+            outcome.ulog = trim(logs[-1], out_dir / f"{stem}.ulg")
+    finally:
+        session.px4.cleanup()
     outcome.verdict = compare(
         tlog, _release_for_model(build.release), outcome.ulog, params, COMPANION_SYSID
     )
@@ -197,10 +200,3 @@ def replay_live(
     outcome = Outcome(tlog, release)
     outcome.verdict = compare(tlog, _release_for_model(release), None, params, COMPANION_SYSID)
     return outcome
-
-
-def keep(path: Path, directory: Path) -> Path:
-    directory.mkdir(parents=True, exist_ok=True)
-    target = directory / path.name
-    shutil.copy(path, target)
-    return target
