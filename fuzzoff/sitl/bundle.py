@@ -180,7 +180,8 @@ class Px4Process:
         return self.ulog
 
     def cleanup(self) -> None:
-        shutil.rmtree(self.workdir, ignore_errors=True)
+        """Remove the private folder (PX4's working folder and its console log)."""
+        shutil.rmtree(self.workdir.parent, ignore_errors=True)
 
 
 def start(
