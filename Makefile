@@ -55,8 +55,9 @@ test-lowest:
 	$(LOWEST)/venv/bin/pip list --format freeze
 	$(LOWEST)/venv/bin/python -m pytest -q -n 2 -p no:cacheprovider $(LOWEST_TESTS)
 
-# Every scenario on every PX4 SITL bundle in ../shared/px4-sitl, each compared with the gate model
-# (two PX4 at a time, instances 2 and 3; about a minute a run, 1.15 adds 40 s of boot).
+# The scenario matrix on the PX4 SITL bundles in ../shared/px4-sitl (fuzzoff.sitl.scenarios.
+# scenarios_for), each run compared with the gate model (two PX4 at a time, instances 2 and 3;
+# about a minute a run, 1.15 adds 40 s of boot).
 # `make test` runs only the short live check.
 test-sitl: $(STAMP)
 	FUZZOFF_SITL_MATRIX=1 $(BIN)/python -m pytest -q -n 2 tests/test_sitl_live.py tests/test_sitl.py

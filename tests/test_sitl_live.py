@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 from fuzzoff.sitl import bundle
-from fuzzoff.sitl.scenarios import SCENARIOS
+from fuzzoff.sitl.scenarios import scenarios_for
 from tests.helpers import CORPORA, run_cli_process
 
 RELEASES = bundle.releases()
@@ -73,7 +73,7 @@ def test_replay_to_a_running_px4_prints_its_outcome_beside_the_models(tmp_path: 
 def _matrix() -> list[object]:
     cases = []
     for release in RELEASES:
-        for name in SCENARIOS:
+        for name in scenarios_for(release):
             marks = []
             if name == "disarm_in_flight":
                 marks.append(

@@ -22,30 +22,12 @@ from pathlib import Path
 
 from fuzzoff.sitl import bundle
 from fuzzoff.sitl.link import LinkError
-from fuzzoff.sitl.scenarios import SCENARIOS
+from fuzzoff.sitl.scenarios import SCENARIOS, scenarios_for
 from fuzzoff.sitl.session import Session
 from fuzzoff.sitl.trim import trim
 
 HERE = Path(__file__).resolve().parent
 RUNS = HERE / "runs.json"
-EVERY_SCENARIO_ON = ("1.16.2", "1.18.0-alpha1")
-"""The releases every scenario runs on (a long-supported one and the newest); the others run
-the ones whose outcome depends on the release (the loss action and manual control, the acks,
-the disarmed switch, the estimate an acceleration needs, the minimum stream), so that the
-corpus stays small."""
-RELEASE_DEPENDENT = (
-    "clean_offboard",
-    "loss_no_manual",
-    "loss_manual",
-    "stall_1_5s",
-    "disarmed_switch_no_stream",
-    "switch_no_stream_flying",
-    "disarm_in_flight",
-    "acceleration_only",
-    "one_setpoint_then_switch",
-)
-
-
 def record(release: str, instance: int, name: str) -> dict[str, object]:
     scenario = SCENARIOS[name]
     build = bundle.find_build(release, None)
@@ -81,8 +63,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("scenarios", nargs="*")
     args = parser.parse_args(argv)
     runs = json.loads(RUNS.read_text()) if RUNS.exists() else {}
-    default = SCENARIOS if args.release in EVERY_SCENARIO_ON else RELEASE_DEPENDENT
-    for name in args.scenarios or list(default):
+    for name in args.scenarios or scenarios_for(args.release):
         try:
             entry = record(args.release, args.instance, name)
         except (LinkError, bundle.BundleError) as exc:

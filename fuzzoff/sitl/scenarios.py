@@ -273,3 +273,26 @@ SCENARIOS: dict[str, Scenario] = {
         ),
     )
 }
+
+
+EVERY_SCENARIO_ON = ("1.16.2", "1.18.0-alpha1")
+"""The releases every scenario runs on (a long-supported one and the newest) in the corpus and
+in ``make test-sitl``; the other releases run the scenarios whose outcome depends on the
+release (the loss action and manual control, the acks, the disarmed switch, the estimate an
+acceleration needs, the minimum stream)."""
+RELEASE_DEPENDENT = (
+    "clean_offboard",
+    "loss_no_manual",
+    "loss_manual",
+    "stall_1_5s",
+    "disarmed_switch_no_stream",
+    "switch_no_stream_flying",
+    "disarm_in_flight",
+    "acceleration_only",
+    "one_setpoint_then_switch",
+)
+
+
+def scenarios_for(release: str) -> list[str]:
+    """The scenarios the matrix runs on ``release``."""
+    return list(SCENARIOS) if release in EVERY_SCENARIO_ON else list(RELEASE_DEPENDENT)
