@@ -179,3 +179,48 @@ def test_the_gate_model_agrees_with_the_recorded_px4_run(stem: str) -> None:
         if i.agree is False
     ]
     assert not differ, differ
+
+
+def test_the_proxy_forwards_both_ways_unchanged_and_records_them(tmp_path: Path) -> None:
+    """Between a client and a PX4 (here two sockets speaking pymavlink): every datagram goes
+    through as it was sent, and the tlog holds both directions once PX4's clock is known."""
+    from pymavlink.dialects.v20 import development
+
+    from fuzzoff.sitl.proxy import RecordingProxy
+
+    px4 = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    px4.bind(("127.0.0.1", 0))
+    client = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    client.bind(("127.0.0.1", 0))
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as free:
+        free.bind(("127.0.0.1", 0))
+        px4_send_port = free.getsockname()[1]  # where PX4 sends: the proxy listens there
+    for sock in (px4, client):
+        sock.settimeout(5.0)
+    autopilot = development.MAVLink(None, srcSystem=1, srcComponent=1)
+    companion = development.MAVLink(None, srcSystem=COMPANION_SYSID, srcComponent=191)
+    tlog = tmp_path / "proxy.tlog"
+    with RecordingProxy(px4.getsockname()[1], px4_send_port, client.getsockname()[1], tlog):
+        for i in range(3):
+            down = autopilot.timesync_encode(0, int((10.0 + 0.1 * i) * 1e9)).pack(autopilot)
+            px4.sendto(down, ("127.0.0.1", px4_send_port))
+            got, proxy_addr = client.recvfrom(4096)
+            assert got == down
+            up = companion.heartbeat_encode(18, 8, 0, 0, 4).pack(companion)
+            client.sendto(up, proxy_addr)
+            got, from_addr = px4.recvfrom(4096)
+            assert got == up
+            assert from_addr[1] == px4_send_port  # PX4 sees one peer: the port it sends to
+    px4.close()
+    client.close()
+    kinds = [(m.get_srcSystem(), m.get_type()) for _, m in _messages(tlog)]
+    assert (1, "TIMESYNC") in kinds and (COMPANION_SYSID, "HEARTBEAT") in kinds
+
+
+def test_a_px4_int_parameter_travels_as_its_bytes_in_the_float() -> None:
+    from fuzzoff.sitl.link import param_decode, param_encode
+
+    value, param_type = param_encode("NAV_RCL_ACT", 3, 6)
+    assert value != 3.0 and param_decode(value, param_type) == 3.0
+    value, param_type = param_encode("COM_OF_LOSS_T", 1.5, 9)
+    assert (value, param_type) == (1.5, 9)
