@@ -133,7 +133,9 @@ Written by `record.py` (pymavlink scenario programs, `fuzzoff/sitl/scenarios.py`
 `mavsdk_offboard.py`, the sequence of MAVSDK's `cpp/examples/offboard`, through
 `fuzzoff/sitl/proxy.py`); the expected files by `expected.py`, the model-vs-PX4 table in
 `docs/sitl.md` by `agreement.py`. *clean*: a correct use of offboard, fuzzoff should find nothing
-at warning or above. *hazard*: fuzzoff should give the error named.
+at warning or above. *hazard*: fuzzoff should give the error named. The pymavlink programs
+stream at 10 Hz and pause while they wait for an ack (up to about 0.25 s around a switch or an
+arm); MAVSDK streams at 20 Hz throughout and sends each new setpoint at once.
 
 | recording | program | PX4 | what it is | lint today |
 | --- | --- | --- | --- | --- |
