@@ -9,6 +9,8 @@ several can run beside each other: PX4 then listens on ``14580 + N`` and sends t
 
 from __future__ import annotations
 
+import contextlib
+import ctypes
 import os
 import re
 import shutil
@@ -184,6 +186,16 @@ class Px4Process:
         shutil.rmtree(self.workdir.parent, ignore_errors=True)
 
 
+PR_SET_PDEATHSIG = 1
+
+
+def _stop_with_parent() -> None:  # pragma: no cover (runs in the child before exec)
+    """Linux: PX4 gets SIGINT when the process that started it dies, so that a run killed
+    from outside (a CI timeout, an interrupted test worker) leaves no PX4 holding its instance."""
+    with contextlib.suppress(OSError, AttributeError):
+        ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGINT)
+
+
 def start(
     build: Build,
     instance: int,
@@ -212,6 +224,11 @@ def start(
     proc_env = {**os.environ, "PX4_INSTANCE": str(instance)}
     with console.open("wb") as out:
         process = subprocess.Popen(
-            argv, stdout=out, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, env=proc_env
+            argv,
+            stdout=out,
+            stderr=subprocess.STDOUT,
+            stdin=subprocess.DEVNULL,
+            env=proc_env,
+            preexec_fn=_stop_with_parent if os.name == "posix" else None,
         )
     return Px4Process(build, instance, workdir, process, console)
