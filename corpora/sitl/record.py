@@ -28,6 +28,8 @@ from fuzzoff.sitl.trim import trim
 
 HERE = Path(__file__).resolve().parent
 RUNS = HERE / "runs.json"
+
+
 def record(release: str, instance: int, name: str) -> dict[str, object]:
     scenario = SCENARIOS[name]
     build = bundle.find_build(release, None)
