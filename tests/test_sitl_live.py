@@ -12,7 +12,6 @@ Each pytest worker uses its own PX4 instance (2 or 3) so that two runs never sha
 from __future__ import annotations
 
 import os
-import tempfile
 from pathlib import Path
 
 import pytest
@@ -89,8 +88,10 @@ def _matrix() -> list[object]:
 @needs_bundles
 @pytest.mark.skipif(not MATRIX, reason="the whole matrix runs with make test-sitl")
 @pytest.mark.parametrize(("release", "scenario"), _matrix())
-def test_px4_and_the_gate_model_agree_on_a_scenario(release: str, scenario: str) -> None:
-    save = Path(tempfile.mkdtemp(prefix="fuzzoff-sitl-test-"))
+def test_px4_and_the_gate_model_agree_on_a_scenario(
+    release: str, scenario: str, tmp_path: Path
+) -> None:
+    save = tmp_path / "run"
     out = run_cli_process(
         [
             "sitl",
