@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 MULTITOOL := build/node/node_modules/.bin/sarif-multitool
 
-.PHONY: install demo test test-tools test-lowest check bench fuzz clean
+.PHONY: install demo test test-tools test-lowest test-sitl check bench fuzz clean
 
 $(STAMP): pyproject.toml
 	$(PY) -m venv $(VENV)
@@ -54,6 +54,13 @@ test-lowest:
 		"$$(ls $(LOWEST)/dist/fuzzoff-*.whl)[fuzz]" pytest pytest-xdist junitparser
 	$(LOWEST)/venv/bin/pip list --format freeze
 	$(LOWEST)/venv/bin/python -m pytest -q -n 2 -p no:cacheprovider $(LOWEST_TESTS)
+
+# The scenario matrix on the PX4 SITL bundles in ../shared/px4-sitl (fuzzoff.sitl.scenarios.
+# scenarios_for), each run compared with the gate model (two PX4 at a time, instances 2 and 3;
+# about a minute a run, 1.15 adds 40 s of boot).
+# `make test` runs only the short live check.
+test-sitl: $(STAMP)
+	FUZZOFF_SITL_MATRIX=1 $(BIN)/python -m pytest -q -n 2 tests/test_sitl_live.py tests/test_sitl.py
 
 check: $(STAMP)
 	$(BIN)/ruff check fuzzoff tests bench corpora

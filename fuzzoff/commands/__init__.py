@@ -15,8 +15,9 @@ SUMMARIES: dict[str, str] = {
     "gate": "the gate model's timeline for a recording, beside the recorded mode",
     "lint": "lint recordings (tlog, ULog, MCAP, ROS 2 and ROS 1 bags)",
     "profiles": "list the modelled PX4 versions and vehicle types",
-    "replay": "re-check a fuzz reproducer, or stream it to a live PX4 (--to udp:...)",
+    "replay": "re-check a fuzz reproducer, or replay it to a live PX4 (--to udp:HOST:14580)",
     "rule": "show a rule's documentation, or list all rules",
+    "sitl": "run a scenario or replay a recording on a real PX4 SITL, beside the gate model",
 }
 
 

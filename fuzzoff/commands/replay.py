@@ -7,8 +7,13 @@ fails" or "fixed". Exit 0 when the findings match and the property holds now (th
 1 when the findings differ or the property still fails, 2 when the reproducer cannot be used
 (unreadable, or its recording missing, truncated or changed since it was saved).
 
-With ``--to udp:HOST:PORT``: send the recording's MAVLink stream (a tlog) to that endpoint at
-its recorded timing (``--speed`` to scale), e.g. to a PX4 SITL's offboard port.
+With ``--to udp:HOST:PORT``: replay the recording's MAVLink stream (a tlog) into a running PX4
+as a real client (``fuzzoff.sitl``): PX4 SITL listens on UDP 14580 (+ instance), so
+``--to udp:127.0.0.1:14580``. The client waits for PX4 and its pre-arm checks, brings the vehicle
+to the recording's starting state, sets the reproducer's parameters (read back, put back after),
+sends on PX4's clock (``--speed`` to scale), records both directions (``--record``) and prints
+what PX4 did beside the gate model's prediction: exit 0 when they agree, 1 when they differ,
+2 when the replay could not be done.
 """
 
 from __future__ import annotations
@@ -43,7 +48,37 @@ def add_parser(sub: Any) -> None:
     parser.add_argument(
         "--to",
         metavar="udp:HOST:PORT",
-        help="stream the MAVLink packets there (an IPv6 address in brackets: udp:[::1]:14540)",
+        help="replay into a running PX4 there: udp:127.0.0.1:14580 for a SITL (PX4 listens on"
+        " 14580 + instance; an IPv6 address in brackets: udp:[::1]:14580)",
+    )
+    parser.add_argument(
+        "--record",
+        metavar="FILE",
+        help="with --to: the tlog of the exchange (default: a temp file)",
+    )
+    parser.add_argument(
+        "--px4", metavar="VERSION", help="with --to: the release for the model if PX4 does not say"
+    )
+    parser.add_argument(
+        "--param",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="with --to: a PX4 parameter for the replay (PARAM_SET, read back, put back after)",
+    )
+    parser.add_argument(
+        "--connect-timeout",
+        type=float,
+        default=10.0,
+        metavar="S",
+        help="with --to: seconds to wait for PX4's first HEARTBEAT",
+    )
+    parser.add_argument(
+        "--ready-timeout",
+        type=float,
+        default=90.0,
+        metavar="S",
+        help="with --to: seconds to wait for PX4's pre-arm checks (1.15 needs about 40 s)",
     )
     parser.add_argument(
         "--speed",
@@ -88,8 +123,13 @@ def compare(expected: list[dict[str, Any]], actual: list[dict[str, Any]]) -> lis
 def run(args: argparse.Namespace) -> int:
     if not MIN_SPEED <= args.speed <= MAX_SPEED:  # NaN too
         raise ConfigError(f"--speed {args.speed:g}: expected {MIN_SPEED:g} to {MAX_SPEED:g}")
+    path = Path(args.path)
+    if args.to and path.suffix.lower() == ".tlog" and path.is_file():
+        beside = path.parent / f"{path.stem}.expected.json"
+        if not beside.exists():  # any tlog can be replayed into PX4, reproducer or not
+            return _stream(path, args)
     try:
-        reproducer = load(Path(args.path))
+        reproducer = load(path)
     except ReproducerError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
@@ -160,23 +200,67 @@ def _terminal(
 
 
 def _stream(recording: Path, args: argparse.Namespace) -> int:
-    from fuzzoff.fuzz.udp import TargetError, sent_packets, stream, target_for
+    import tempfile
+
+    from fuzzoff.commands._common import parse_params
+    from fuzzoff.commands.sitl import report
+    from fuzzoff.sitl.link import LinkError
+    from fuzzoff.sitl.run import replay_live
+    from fuzzoff.sitl.target import TargetError, target_for
+    from fuzzoff.sources.base import SourceError
 
     try:
         target = target_for(args.to)
     except TargetError as exc:
         raise ConfigError(str(exc)) from None
-    if recording.suffix != ".tlog":
+    if recording.suffix.lower() != ".tlog":
         raise ConfigError(f"{recording}: --to streams MAVLink: only a .tlog reproducer")
+    for name in ("connect_timeout", "ready_timeout"):
+        value = getattr(args, name)
+        if not 0 < value <= 3600:  # NaN too
+            option = "--" + name.replace("_", "-")
+            raise ConfigError(f"{option} {value:g}: expected more than 0 and at most 3600 s")
+    params = parse_params(args.param)
     try:
-        packets = sent_packets(recording)
-    except (OSError, ValueError) as exc:
-        print(f"error: {recording}: not a readable tlog: {exc}", file=sys.stderr)
+        from fuzzoff.fuzz.reproducers import load
+
+        loaded = load(Path(args.path))
+        scenario, cut = loaded.scenario, loaded.cut_fraction
+    except ReproducerError:
+        scenario, cut = None, None
+    if cut is not None:
+        print(
+            f"fuzzoff: {printable(str(recording))} is the first {cut:.0%} of a recording (a"
+            " truncation reproducer): PX4 gets that part only",
+            file=sys.stderr,
+        )
+    if scenario is not None:
+        params = {**dict(scenario.params), **params}
+    record = (
+        Path(args.record)
+        if args.record
+        else Path(tempfile.mkstemp(prefix="fuzzoff-replay-", suffix=".tlog")[1])
+    )
+
+    def log(line: str) -> None:
+        print(f"fuzzoff: {printable(line)}", file=sys.stderr)
+
+    try:
+        outcome = replay_live(
+            recording,
+            (target.family, target.address),
+            record,
+            release=args.px4,
+            params=params,
+            speed=args.speed,
+            connect_timeout=args.connect_timeout,
+            ready_timeout=args.ready_timeout,
+            log=log,
+        )
+    except (LinkError, SourceError) as exc:
+        print(f"error: --to {target}: {printable(str(exc))}", file=sys.stderr)
         return 2
-    try:
-        count = stream(packets, target, speed=args.speed)
     except OSError as exc:
         print(f"error: --to {args.to!r}: cannot send: {exc.strerror or exc}", file=sys.stderr)
         return 2
-    print(f"sent {count} packets to {target} over {packets[-1].t if packets else 0:.2f} s")
-    return 0
+    return report(outcome, args.format, args.output)

@@ -1,0 +1,206 @@
+"""Write ``NAME.expected.json`` for every recording in ``runs.json``: what ``fuzzoff lint`` says
+about it now, with what the recording is.
+
+    .venv/bin/python -m corpora.sitl.expected
+
+The findings are today's output, so that ``tests/test_corpora.py`` notices any change. Findings
+that are not true of a recording are not blessed silently: each expected file lists them under
+``known_false`` with the issue that fixes them, and ``tests/test_real_world_precision.py``
+holds the acceptance (clean recordings exit 0, hazards give their error) as strict xfails until
+the fix lands. Rerun this script after a rule or reader change and review the difference.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+from fuzzoff.commands.replay import compare
+from fuzzoff.sitl.scenarios import SCENARIOS
+from tests.helpers import run_cli
+
+HERE = Path(__file__).resolve().parent
+
+KNOWN_FALSE: dict[str, str] = {
+    "OFB001": "issue 17: a PX4 tlog holds MAVLink 'development' ids (8, 380, 410, 411, 436)"
+    " that the 'common' dialect lacks: ordinary traffic, not unreadable input",
+    "OFB107": "issue 17: OFB107 warns on every hold (a held position is what a stopped"
+    " controller should leave)",
+    "OFB404": "issue 17: OFB404 on PX4's own trajectory_setpoint before the switch, or on a"
+    " first descent after a takeoff",
+    "OFB702": "issue 17: OFB702 warns on every flight without RC although no loss happened",
+    "OFB102": "issue 17: OFB102 on the documented set-then-start pattern (MAVSDK) or one"
+    " setpoint before the switch, which PX4 accepts",
+    "OFB101": "issue 17: OFB101 after the switch away from offboard (the accepted ack ends"
+    " the window)",
+    "OFB103": "issue 18: the ULog's first offboard_control_mode samples are missing (logger),"
+    " so the model sees no keep-alive PX4 had",
+    "OFB202": "issue 18: the same missing ULog samples make the model disagree with PX4",
+    "OFB201": "issue 17: the ULog's missing first samples make the switch look unstreamed",
+    "OFB401": "issue 17: a ULog's trajectory_setpoint also holds PX4's own setpoints (its"
+    " flight tasks in its own modes), not the client's",
+    "OFB105": "issue 17: OFB105 judges a keep-alive's jitter PX4 does not act on",
+}
+"""Rule -> why its finding on a *clean* recording is false (the rule helper's and the readers
+helper's fixes, issue 17/18). Hazard recordings keep all their findings as true."""
+
+
+DISARM_DENIED = (
+    "issue 18: the model accepts a disarm in flight that PX4 refuses ('Disarming denied: not"
+    " landed'), and OFB202 then calls it an arm"
+)
+
+
+MISSED_SAMPLES = (
+    "issue 18: the logger missed the ULog's first offboard_control_mode samples (the switch"
+    " came 10-50 ms after the first setpoint), so the model sees no keep-alive PX4 had; PX4's"
+    " failsafe_flags.offboard_control_signal_lost says it had one"
+)
+
+
+def why_false(finding: dict[str, Any], findings: list[dict[str, Any]]) -> str:
+    if finding["code"] == "OFB202" and "arm acked TEMPORARILY_REJECTED" in finding["message"]:
+        return DISARM_DENIED
+    unseen = any(
+        f["code"] == "OFB103" and "no keep-alive while in OFFBOARD" in f["message"]
+        for f in findings
+    )
+    if unseen and finding["code"] in ("OFB102", "OFB103", "OFB202", "OFB702"):
+        return MISSED_SAMPLES
+    return KNOWN_FALSE.get(finding["code"], "to review")
+
+
+def classify(stem: str) -> tuple[str, list[str], str]:
+    """(kind, the hazard's error codes, what program wrote it)."""
+    scenario_name = stem.split("-")[0]
+    if scenario_name.startswith("mavsdk"):
+        version = scenario_name[len("mavsdk") : scenario_name.index("_")]
+        return "clean", [], f"MAVSDK {version}.x (PyPI mavsdk), cpp/examples/offboard sequence"
+    scenario = SCENARIOS[scenario_name]
+    return (
+        scenario.kind,
+        list(scenario.codes),
+        f"fuzzoff.sitl.scenarios.{scenario.program.__name__} (pymavlink)",
+    )
+
+
+def expected_for(recording: Path, release: str) -> dict[str, Any]:
+    stem = recording.name.rsplit(".", 1)[0]
+    kind, codes, program = classify(stem)
+    out = run_cli(["lint", str(recording), "--format", "json"])
+    data = json.loads(out.stdout)
+    (report,) = data["files"]
+    findings = [
+        {"code": f["code"], "severity": f["severity"], "time_s": f["time_s"]}
+        | ({"vehicle": f["vehicle"]} if f.get("vehicle") else {})
+        for f in report["findings"]
+    ]
+    spec: dict[str, Any] = {
+        "recording": recording.name,
+        "args": [],
+        "exit_status": out.returncode,
+        "complete": report["complete"],
+        "kind": kind,
+        "hazard": codes,
+        "program": program,
+        "px4_release": release,
+        "findings": findings,
+    }
+    if kind == "clean":
+        spec["known_false"] = sorted(
+            {
+                f"{f['code']} {f['severity']}: {why_false(f, report['findings'])}"
+                for f in report["findings"]
+                if f["severity"] in ("warning", "error")
+            }
+        )
+    elif recording.suffix == ".tlog":
+        spec["known_false"] = sorted(
+            {
+                f"{f['code']} {f['severity']}: {KNOWN_FALSE[f['code']]}"
+                for f in report["findings"]
+                if f["code"] == "OFB001"
+            }
+        )
+    assert not compare(findings, report["findings"])
+    return spec
+
+
+README_HEAD = """# Real PX4 SITL runs
+
+Recordings written by real PX4 (its own ULog) and by real clients on its offboard link (the
+tlog of both directions), on the PX4 SITL bundles of `../shared/px4-sitl/` (SIH quadrotor,
+default parameters, no RC). Each run boots a fresh PX4.
+
+- `NAME-RELEASE.tlog`: the exchange as the client saw it, on PX4's clock (`docs/sitl.md`);
+- `NAME-RELEASE.ulg`: PX4's log from boot to exit, cut with pyulog to the topics fuzzoff reads
+  (`fuzzoff/sitl/trim.py`, as `corpora/real/cut.py` does);
+- `NAME-RELEASE.{tlog,ulg}.expected.json`: today's findings (`tests/test_corpora.py`), what the
+  recording is (`kind`, `hazard`, `program`, `px4_release`), and `known_false`: findings that are
+  not true of a clean recording, with the issue that fixes them (never blessed silently);
+- `runs.json`: each run's steps with PX4's time and PX4's answer.
+
+Written by `record.py` (pymavlink scenario programs, `fuzzoff/sitl/scenarios.py`) and
+`record_mavsdk.py` (real MAVSDK from PyPI, 3.x with its `mavsdk_server` and 4.x native, flying
+`mavsdk_offboard.py`, the sequence of MAVSDK's `cpp/examples/offboard`, through
+`fuzzoff/sitl/proxy.py`); the expected files by `expected.py`, the model-vs-PX4 table in
+`docs/sitl.md` by `agreement.py`. *clean*: a correct use of offboard, fuzzoff should find nothing
+at warning or above. *hazard*: fuzzoff should give the error named. The pymavlink programs
+stream at 10 Hz and pause while they wait for an ack (up to about 0.25 s around a switch or an
+arm); MAVSDK streams at 20 Hz throughout and sends each new setpoint at once.
+
+| recording | program | PX4 | what it is | lint today |
+| --- | --- | --- | --- | --- |
+"""
+
+
+def readme_rows(runs: dict[str, Any]) -> list[str]:
+    rows = []
+    for stem, run in sorted(runs.items()):
+        kind, codes, program = classify(stem)
+        scenario = SCENARIOS.get(stem.split("-")[0])
+        what = (
+            scenario.summary if scenario else "MAVSDK offboard example: attitude, then velocity NED"
+        )
+        label = (
+            "clean"
+            if kind == "clean"
+            else f"hazard {'/'.join(codes)}: {scenario.hazard if scenario else ''}"
+        )
+        for suffix in (".tlog", ".ulg"):
+            spec_path = HERE / f"{stem}{suffix}.expected.json"
+            if not spec_path.exists():
+                continue
+            spec = json.loads(spec_path.read_text())
+            loud = sorted(
+                {
+                    f"{f['code']} {f['severity']}"
+                    for f in spec["findings"]
+                    if f["severity"] != "info"
+                }
+            )
+            today = f"exit {spec['exit_status']}" + (f": {', '.join(loud)}" if loud else "")
+            rows.append(
+                f"| `{stem}{suffix}` | {program.split(' (')[0]} | {run['release']} | {what};"
+                f" **{label}** | {today} |"
+            )
+    return rows
+
+
+def main() -> None:
+    runs = json.loads((HERE / "runs.json").read_text())
+    for stem, run in sorted(runs.items()):
+        for suffix in (".tlog", ".ulg"):
+            recording = HERE / f"{stem}{suffix}"
+            if not recording.exists():
+                continue
+            spec = expected_for(recording, run["release"])
+            target = HERE / f"{stem}{suffix}.expected.json"
+            target.write_text(json.dumps(spec, indent=2) + "\n")
+            print(f"{target.name}: exit {spec['exit_status']}, {len(spec['findings'])} findings")
+    (HERE / "README.md").write_text(README_HEAD + "\n".join(readme_rows(runs)) + "\n")
+
+
+if __name__ == "__main__":
+    main()

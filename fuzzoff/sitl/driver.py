@@ -1,0 +1,115 @@
+"""What a scenario program does to PX4, step by step, on PX4's clock.
+
+A ``Driver`` wraps a ``Link``: it streams setpoints at a rate for a time measured on PX4's
+clock (``stream``), sends the odd joystick sample beside them when the scenario has manual
+control, switches modes and arms, and notes every step with PX4's time (``steps``), so that a
+run can say what it did and when.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+from fuzzoff.sitl.link import Ack, Link, LinkError
+
+POSITION = 0x0DF8
+"""type_mask: position only (velocity, acceleration, yaw and yaw rate ignored)."""
+VELOCITY = 0x0DC7
+"""type_mask: velocity only."""
+ACCELERATION = 0x0C3F
+"""type_mask: acceleration only (FORCE bit clear)."""
+MAV_FRAME_LOCAL_NED = 1
+MAV_FRAME_LOCAL_ENU = 4
+NAV_POSCTL, NAV_LOITER, NAV_RTL, NAV_OFFBOARD, NAV_TAKEOFF, NAV_LAND = 2, 4, 5, 14, 17, 18
+MANUAL_EVERY_S = 0.1
+"""A MAVLink joystick at 10 Hz: PX4 declares manual control lost after COM_RC_LOSS_T (0.5 s)."""
+
+Setpoint = Callable[["Driver"], None]
+
+
+@dataclass(slots=True)
+class Step:
+    px4_t: float
+    what: str
+    result: int | None = None
+
+
+@dataclass(slots=True)
+class Driver:
+    link: Link
+    manual: bool = False
+    steps: list[Step] = field(default_factory=list)
+    _next_manual: float = 0.0
+
+    def now(self) -> float:
+        return self.link.clock.now()
+
+    def note(self, what: str, ack: Ack | None = None) -> Ack | None:
+        self.steps.append(Step(self.now(), what, None if ack is None else ack.result))
+        return ack
+
+    def _tick(self) -> None:
+        if self.manual and self.now() >= self._next_manual:
+            self.link.manual_control()
+            self._next_manual = self.now() + MANUAL_EVERY_S
+
+    def wait(self, seconds: float) -> None:
+        """Send nothing but the joystick (if any) for ``seconds`` of PX4's time."""
+        self.link.sleep_until(self.now() + seconds, self._tick)
+
+    def stream(self, setpoint: Setpoint, seconds: float, hz: float = 10.0) -> None:
+        """Send ``setpoint`` at ``hz`` for ``seconds`` of PX4's time."""
+        start = self.now()
+        n = max(1, round(seconds * hz))
+        for i in range(n):
+            setpoint(self)
+            self._tick()
+            self.link.sleep_until(start + (i + 1) / hz, self._tick)
+
+    def position(self, x: float, y: float, z: float, frame: int = MAV_FRAME_LOCAL_NED) -> Setpoint:
+        def send(d: Driver) -> None:
+            d.link.position_target(frame=frame, type_mask=POSITION, pos=(x, y, z))
+
+        return send
+
+    def velocity(self, vx: float, vy: float, vz: float) -> Setpoint:
+        def send(d: Driver) -> None:
+            d.link.position_target(type_mask=VELOCITY, vel=(vx, vy, vz))
+
+        return send
+
+    def acceleration(self, ax: float, ay: float, az: float) -> Setpoint:
+        def send(d: Driver) -> None:
+            d.link.position_target(type_mask=ACCELERATION, acc=(ax, ay, az))
+
+        return send
+
+    def attitude(self, thrust: float) -> Setpoint:
+        def send(d: Driver) -> None:
+            d.link.attitude_target((1.0, 0.0, 0.0, 0.0), thrust)
+
+        return send
+
+    def set_mode(self, nav_state: int, label: str) -> Ack | None:
+        return self.note(f"switch to {label}", self.link.set_mode(nav_state))
+
+    def arm(self) -> Ack | None:
+        return self.note("arm", self.link.arm(True))
+
+    def disarm(self) -> Ack | None:
+        return self.note("disarm", self.link.arm(False))
+
+    def land_and_wait(self, timeout: float = 40.0) -> None:
+        """AUTO_LAND, then wait (joystick going) until PX4 disarms by itself after landing."""
+        self.set_mode(NAV_LAND, "AUTO_LAND")
+        deadline = self.now() + timeout
+        while self.link.view.armed and self.now() < deadline:
+            self.wait(0.5)
+        self.note("disarmed" if not self.link.view.armed else "still armed after landing")
+
+    def require(self, ack: Ack | None, what: str) -> None:
+        """Stop the scenario when a step it depends on failed."""
+        if ack is None or ack.result != 0:
+            got = "no ack" if ack is None else f"ack {ack.result}"
+            raise LinkError(f"{what}: PX4 refused ({got}); cannot bring the vehicle there")

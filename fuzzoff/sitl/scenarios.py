@@ -1,0 +1,298 @@
+"""Scenario programs: what a companion computer does to PX4, one short flight each.
+
+Each starts on a landed, disarmed vehicle that passed its pre-arm checks, in the mode PX4 chose
+at boot, and ends landed and disarmed where it can. ``kind`` says whether the program is a
+*clean* use of offboard (fuzzoff should find nothing at warning or above in its recordings) or
+holds a *hazard* (``hazard`` names the error code fuzzoff should give, and why).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Literal
+
+from fuzzoff.sitl.driver import (
+    MAV_FRAME_LOCAL_ENU,
+    NAV_LOITER,
+    NAV_OFFBOARD,
+    NAV_TAKEOFF,
+    Driver,
+)
+
+ALT = -2.5
+"""Cruise height, NED (2.5 m up)."""
+
+
+@dataclass(frozen=True, slots=True)
+class Scenario:
+    name: str
+    summary: str
+    program: Callable[[Driver], None]
+    kind: Literal["clean", "hazard"]
+    hazard: str | None = None
+    """What the hazard is, for the user."""
+    codes: tuple[str, ...] = ()
+    """The error codes that name the hazard (any one of them at error: a tlog and a ULog hold
+    different parts of it, e.g. the dropped ENU messages only reach the tlog)."""
+    manual: bool = False
+    """Send a centred MAVLink joystick at 10 Hz throughout (manual control present)."""
+    params: dict[str, float] = field(default_factory=dict)
+
+
+def _offboard_takeoff(d: Driver, z: float = ALT, climb_s: float = 6.0) -> None:
+    """Stream a hover setpoint, switch to OFFBOARD, arm, climb: the documented sequence."""
+    d.stream(d.position(0, 0, z), 1.5)
+    d.require(d.set_mode(NAV_OFFBOARD, "OFFBOARD"), "switch to OFFBOARD")
+    d.stream(d.position(0, 0, z), 0.5)
+    d.require(d.arm(), "arm in OFFBOARD")
+    d.stream(d.position(0, 0, z), climb_s)
+
+
+def _auto_takeoff(d: Driver) -> None:
+    d.require(d.set_mode(NAV_TAKEOFF, "AUTO_TAKEOFF"), "switch to AUTO_TAKEOFF")
+    d.require(d.arm(), "arm in AUTO_TAKEOFF")
+    d.wait(9.0)
+
+
+def clean_offboard(d: Driver) -> None:
+    _offboard_takeoff(d)
+    d.stream(d.position(3, 0, ALT), 5.0)
+    d.stream(d.position(0, 0, ALT), 4.0)
+    d.land_and_wait()
+
+
+def stream_loss(d: Driver) -> None:
+    _offboard_takeoff(d)
+    d.note("stream stops")
+    d.wait(3.0)
+    d.note("stream resumes")
+    d.stream(d.position(0, 0, ALT), 5.0)
+    d.land_and_wait()
+
+
+def stall_1_5s(d: Driver) -> None:
+    _offboard_takeoff(d)
+    d.note("loop stalls")
+    d.wait(1.5)
+    d.note("loop back")
+    d.stream(d.position(0, 0, ALT), 4.0)
+    d.land_and_wait()
+
+
+def disarmed_switch_no_stream(d: Driver) -> None:
+    d.wait(1.0)
+    d.set_mode(NAV_OFFBOARD, "OFFBOARD")
+    d.wait(1.0)
+    d.arm()
+    d.wait(2.0)
+    d.set_mode(NAV_LOITER, "AUTO_LOITER")
+    d.wait(1.0)
+
+
+def switch_no_stream_flying(d: Driver) -> None:
+    _auto_takeoff(d)
+    d.set_mode(NAV_OFFBOARD, "OFFBOARD")
+    d.wait(2.0)
+    d.land_and_wait()
+
+
+def disarm_in_flight(d: Driver) -> None:
+    _offboard_takeoff(d)
+    d.disarm()
+    d.stream(d.position(0, 0, ALT), 3.0)
+    d.land_and_wait()
+
+
+def acceleration_only(d: Driver) -> None:
+    d.stream(d.acceleration(0, 0, 0), 1.5)
+    d.require(d.set_mode(NAV_OFFBOARD, "OFFBOARD"), "switch to OFFBOARD")
+    d.stream(d.acceleration(0, 0, 0), 0.5)
+    d.require(d.arm(), "arm in OFFBOARD")
+    d.stream(d.acceleration(0, 0, -1.0), 1.5)
+    d.stream(d.acceleration(0, 0, 1.0), 1.5)
+    d.stream(d.acceleration(0, 0, 0), 2.0)
+    d.land_and_wait()
+
+
+def attitude(d: Driver) -> None:
+    d.stream(d.attitude(0.3), 1.5)
+    d.require(d.set_mode(NAV_OFFBOARD, "OFFBOARD"), "switch to OFFBOARD")
+    d.stream(d.attitude(0.3), 0.5)
+    d.require(d.arm(), "arm in OFFBOARD")
+    d.stream(d.attitude(0.3), 4.0)
+    d.land_and_wait()
+
+
+def enu_frame(d: Driver) -> None:
+    _auto_takeoff(d)
+    d.stream(d.position(0, 0, -ALT, frame=MAV_FRAME_LOCAL_ENU), 2.0)
+    d.set_mode(NAV_OFFBOARD, "OFFBOARD")
+    d.stream(d.position(0, 0, -ALT, frame=MAV_FRAME_LOCAL_ENU), 2.0)
+    d.land_and_wait()
+
+
+def enu_z_from_ground(d: Driver) -> None:
+    """A program that thinks in ENU sends z = +2.5 (up) in LOCAL_NED: 2.5 m below ground."""
+    d.stream(d.position(0, 0, -ALT), 1.5)
+    d.set_mode(NAV_OFFBOARD, "OFFBOARD")
+    d.stream(d.position(0, 0, -ALT), 0.5)
+    d.arm()
+    d.stream(d.position(0, 0, -ALT), 5.0)
+    d.land_and_wait()
+
+
+def enu_z_airborne(d: Driver) -> None:
+    _offboard_takeoff(d)
+    d.note("setpoint z flips to +2.5 (ENU thinking)")
+    d.stream(d.position(0, 0, -ALT), 5.0)
+    d.land_and_wait()
+
+
+def one_setpoint_then_switch(d: Driver) -> None:
+    d.stream(d.position(0, 0, ALT), 0.1)
+    d.require(d.set_mode(NAV_OFFBOARD, "OFFBOARD"), "switch to OFFBOARD")
+    d.require(d.arm(), "arm in OFFBOARD")
+    d.stream(d.position(0, 0, ALT), 6.0)
+    d.land_and_wait()
+
+
+def frozen_velocity(d: Driver) -> None:
+    _offboard_takeoff(d)
+    d.note("velocity 2 m/s frozen")
+    d.stream(d.velocity(2.0, 0, 0), 20.0)
+    d.stream(d.velocity(0, 0, 0), 2.0)
+    d.land_and_wait()
+
+
+SCENARIOS: dict[str, Scenario] = {
+    s.name: s
+    for s in (
+        Scenario(
+            "clean_offboard",
+            "stream, switch, arm, climb to 2.5 m, fly 3 m and back, land",
+            clean_offboard,
+            "clean",
+        ),
+        Scenario(
+            "loss_no_manual",
+            "offboard flight, the stream stops for 3 s and resumes; no manual control",
+            stream_loss,
+            "hazard",
+            "stream lost in OFFBOARD (failsafe, then back to OFFBOARD)",
+            ("OFB103",),
+        ),
+        Scenario(
+            "loss_manual",
+            "as loss_no_manual with a MAVLink joystick at 10 Hz (manual control present)",
+            stream_loss,
+            "hazard",
+            "stream lost in OFFBOARD (failsafe, then back to OFFBOARD)",
+            ("OFB103",),
+            manual=True,
+        ),
+        Scenario(
+            "stall_1_5s",
+            "offboard flight, the setpoint loop stalls 1.5 s mid-air",
+            stall_1_5s,
+            "hazard",
+            "stream lost in OFFBOARD for 0.5 s",
+            ("OFB103",),
+        ),
+        Scenario(
+            "disarmed_switch_no_stream",
+            "no stream: switch to OFFBOARD while disarmed (accepted), arm (refused)",
+            disarmed_switch_no_stream,
+            "hazard",
+            "arm in OFFBOARD without a stream, refused",
+            ("OFB201",),
+        ),
+        Scenario(
+            "switch_no_stream_flying",
+            "auto takeoff, then a switch to OFFBOARD with no stream while flying (refused)",
+            switch_no_stream_flying,
+            "hazard",
+            "switch to OFFBOARD without a stream while armed, refused",
+            ("OFB201",),
+        ),
+        Scenario(
+            "disarm_in_flight",
+            "offboard flight, a disarm command mid-air (PX4: 'not landed'), land",
+            disarm_in_flight,
+            "clean",
+        ),
+        Scenario(
+            "acceleration_only",
+            "acceleration-only setpoints: switch, arm, up, brake, hover, land",
+            acceleration_only,
+            "clean",
+        ),
+        Scenario(
+            "attitude",
+            "SET_ATTITUDE_TARGET level at 0.3 thrust: switch, arm, 4 s, land",
+            attitude,
+            "clean",
+        ),
+        Scenario(
+            "enu_frame",
+            "auto takeoff, then LOCAL_ENU (frame 4) setpoints and a switch (refused)",
+            enu_frame,
+            "hazard",
+            "coordinate_frame 4 is dropped by PX4 (no keep-alive), switch refused",
+            ("OFB601", "OFB201"),
+        ),
+        Scenario(
+            "enu_z_from_ground",
+            "z = +2.5 (ENU 'up') sent in LOCAL_NED from the ground: 2.5 m below ground",
+            enu_z_from_ground,
+            "hazard",
+            "a climb written in ENU, from the ground",
+            ("OFB404",),
+        ),
+        Scenario(
+            "enu_z_airborne",
+            "offboard at 2.5 m, then z = +2.5 (ENU 'up') in LOCAL_NED: dives into the ground",
+            enu_z_airborne,
+            "hazard",
+            "z flips sign mid-air (ENU thinking), airborne",
+            ("OFB404",),
+        ),
+        Scenario(
+            "one_setpoint_then_switch",
+            "one setpoint, then switch and arm at once (accepted: no minimum stream)",
+            one_setpoint_then_switch,
+            "clean",
+        ),
+        Scenario(
+            "frozen_velocity",
+            "offboard at 2.5 m, then velocity 2 m/s frozen for 20 s while the stream keeps coming",
+            frozen_velocity,
+            "hazard",
+            "a motion command frozen for 20 s",
+            ("OFB107",),
+        ),
+    )
+}
+
+
+EVERY_SCENARIO_ON = ("1.16.2", "1.18.0-alpha1")
+"""The releases every scenario runs on (a long-supported one and the newest) in the corpus and
+in ``make test-sitl``; the other releases run the scenarios whose outcome depends on the
+release (the loss action and manual control, the acks, the disarmed switch, the estimate an
+acceleration needs, the minimum stream)."""
+RELEASE_DEPENDENT = (
+    "clean_offboard",
+    "loss_no_manual",
+    "loss_manual",
+    "stall_1_5s",
+    "disarmed_switch_no_stream",
+    "switch_no_stream_flying",
+    "disarm_in_flight",
+    "acceleration_only",
+    "one_setpoint_then_switch",
+)
+
+
+def scenarios_for(release: str) -> list[str]:
+    """The scenarios the matrix runs on ``release``."""
+    return list(SCENARIOS) if release in EVERY_SCENARIO_ON else list(RELEASE_DEPENDENT)

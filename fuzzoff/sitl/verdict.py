@@ -1,0 +1,414 @@
+"""What PX4 did beside what the gate model predicts for that release.
+
+The model runs on the client's tlog (what was sent, on PX4's clock: ``fuzzoff gate`` with the
+release given), and its prediction is shifted onto PX4's boot time with the tlog's own
+TIMESYNC/SYSTEM_TIME stamps. PX4's side comes from its ULog where there is one
+(``truth.read_truth``), else from the same tlog (HEARTBEAT modes and COMMAND_ACKs).
+
+Judged, item by item:
+
+- every mode switch and arm or disarm the client sent: accepted or rejected (PX4's last ack);
+- every offboard loss while armed in OFFBOARD: the time. PX4 checks the keep-alive at 10 Hz,
+  so a loss falls in a *window* one check period long after ``newest keep-alive +
+  COM_OF_LOSS_T``; the model's instant is judged against that window, and against PX4's own
+  ``offboard_control_signal_lost`` flag where the ULog has it (the tlog has no flag: there the
+  loss time is not judged, HEARTBEAT comes once a second);
+- the failsafe action (the mode PX4 went to) and the automatic return to OFFBOARD.
+"""
+
+from __future__ import annotations
+
+import argparse
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from fuzzoff.modes import custom_mode_to_nav_state, nav_state_name
+from fuzzoff.sitl.truth import Mode, Truth, read_tlog, read_truth
+
+CHECK_PERIOD_S = 0.1
+"""Commander's health-check pass (gate spec 2.1.3)."""
+LOOP_S = 0.012
+"""One Commander iteration (10 ms) and a logging tick: slack on each side of the window."""
+LOSS_TOLERANCE_S = 0.11
+"""The model's loss instant may differ from PX4's flag by up to one check period and a loop
+(gate spec 2.1.3: at least 110 ms)."""
+DECISION_S = 0.05
+"""The model decides a request at the time the tlog recorded it; PX4 logs it when its receiver
+took it: a few milliseconds apart on the shifted clocks."""
+MATCH_S = 0.6
+"""A PX4 event and a model event this close are the same event."""
+MODE_SETTLE_S = 0.5
+"""PX4's mode after a loss is read this long after its flag (vehicle_status follows in 12 ms)."""
+HEARTBEAT_SETTLE_S = 1.6
+"""The same over a 1 Hz HEARTBEAT."""
+NAV_OFFBOARD = 14
+REQUESTS = {176: "switch", 400: "arm"}
+
+
+@dataclass(frozen=True, slots=True)
+class Item:
+    what: str
+    t: float
+    """PX4's boot time in seconds."""
+    px4: str
+    model: str
+    agree: bool | None
+    """None: not judged (said why in ``note``)."""
+    note: str = ""
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "what": self.what,
+            "px4_time_s": round(self.t, 3),
+            "px4": self.px4,
+            "model": self.model,
+            "agree": self.agree,
+            "note": self.note,
+        }
+
+
+@dataclass(slots=True)
+class Verdict:
+    release: str
+    source: str
+    """Where PX4's side was read: ``ulog`` or ``tlog``."""
+    items: list[Item] = field(default_factory=list)
+    problems: list[str] = field(default_factory=list)
+
+    @property
+    def agree(self) -> bool:
+        return all(i.agree is not False for i in self.items)
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "release": self.release,
+            "px4_side": self.source,
+            "agree": self.agree,
+            "items": [i.to_json() for i in self.items],
+            "problems": self.problems,
+        }
+
+
+def model_rows(
+    tlog: Path, release: str, params: dict[str, float]
+) -> tuple[list[dict[str, Any]], list[str]]:
+    """The gate model's timeline for the autopilot in ``tlog`` (``fuzzoff gate``'s rows)."""
+    from fuzzoff.commands.gate import gate_report
+
+    args = argparse.Namespace(
+        px4=release, vehicle="mc", param=[f"{k}={v}" for k, v in params.items()]
+    )
+    report, rows = gate_report(str(tlog), args, controllers=False)
+    vehicles = [v for v in rows if v != ""] or list(rows)
+    mine = rows[vehicles[0]] if vehicles else []
+    return [r for r in mine if r["source"] == "model"], list(report.problems)
+
+
+def _request_label(command: int, param1: float, param2: float, param3: float) -> str:
+    if command == 400:
+        return "arm" if param1 >= 0.5 else "disarm"
+    nav = custom_mode_to_nav_state((int(param2) & 0xFF) << 16 | (int(param3) & 0xFF) << 24)
+    return f"switch to {nav_state_name(nav)}"
+
+
+def _accepted(result: int | None) -> str:
+    if result is None:
+        return "no ack"
+    return "accepted" if result == 0 else f"rejected ({result})"
+
+
+def _model_decision(rows: list[dict[str, Any]], t: float) -> dict[str, Any] | None:
+    kinds = {
+        "request_accepted",
+        "request_rejected",
+        "arm_accepted",
+        "arm_rejected",
+        "mode",
+        "disarmed",
+    }
+    near = [r for r in rows if r["what"] in kinds and abs(r["time_s"] - t) <= DECISION_S]
+    return min(near, key=lambda r: abs(r["time_s"] - t)) if near else None
+
+
+def _model_accepts(row: dict[str, Any]) -> bool:
+    return row["what"] in ("request_accepted", "arm_accepted", "mode", "disarmed")
+
+
+def compare(
+    tlog: Path,
+    release: str,
+    ulog: Path | None = None,
+    params: dict[str, float] | None = None,
+    client_sysid: int | None = None,
+) -> Verdict:
+    params = params or {}
+    view = read_tlog(tlog)
+    verdict = Verdict(release, "ulog" if ulog is not None else "tlog")
+    if view.offset is None:
+        verdict.problems.append(f"{tlog}: no TIMESYNC or SYSTEM_TIME from PX4: times unknown")
+        return verdict
+    offset = view.offset
+    rows, problems = model_rows(tlog, release, params)
+    verdict.problems += problems
+    for r in rows:
+        r["px4_t"] = r["time_s"] + offset
+    truth: Truth = read_truth(ulog, client_sysid) if ulog is not None else view.truth
+    if ulog is None:
+        for request in truth.requests:
+            object.__setattr__(request, "t", request.t + offset)
+        truth.modes = [Mode(m.t + offset, m.nav_state, m.armed, None) for m in truth.modes]
+        truth.keepalives = [k + offset for k in truth.keepalives]
+    _requests(verdict, truth, rows)
+    _losses(verdict, truth, rows, params.get("COM_OF_LOSS_T", 1.0), ulog is not None)
+    _gate_disagreements(verdict, rows)
+    verdict.items.sort(key=lambda i: i.t)
+    return verdict
+
+
+def _gate_disagreements(verdict: Verdict, rows: list[dict[str, Any]]) -> None:
+    """``fuzzoff gate``'s own disagreements (recorded mode or ack vs the model) not already
+    judged above."""
+    judged = [i.t for i in verdict.items if i.agree is False]
+    for row in rows:
+        if row["what"] != "disagreement":
+            continue
+        if any(abs(row["px4_t"] - t) <= 0.2 for t in judged):
+            continue
+        verdict.items.append(
+            Item("recorded vs model", row["px4_t"], "as recorded", row["message"], False)
+        )
+
+
+def _requests(verdict: Verdict, truth: Truth, rows: list[dict[str, Any]]) -> None:
+    for request in truth.requests:
+        if request.command not in REQUESTS:
+            continue
+        label = _request_label(request.command, request.param1, request.param2, request.param3)
+        row = _model_decision([{**r, "time_s": r["px4_t"]} for r in rows], request.t)
+        px4 = _accepted(request.result)
+        if row is None:
+            verdict.items.append(
+                Item(label, request.t, px4, "no decision", None, "the model does not judge it")
+            )
+            continue
+        model_ok = _model_accepts(row)
+        model = ("accepted" if model_ok else "rejected") + f": {row['message']}"
+        agree = None if request.result is None else (request.result == 0) == model_ok
+        verdict.items.append(Item(label, request.t, px4, model, agree))
+
+
+def _px4_losses(truth: Truth, flagged: bool) -> list[float]:
+    """Times PX4 lost the signal while armed in OFFBOARD: its flag, or the mode leaving
+    OFFBOARD with no request (a tlog: HEARTBEAT)."""
+    out = []
+    if flagged:
+        for t, lost in truth.loss_flag:
+            mode = truth.mode_at(t)
+            if lost and mode is not None and mode.armed and mode.nav_state == NAV_OFFBOARD:
+                out.append(t)
+        return out
+    requested = [r.t for r in truth.requests]
+    prev: Mode | None = None
+    for mode in truth.modes:
+        if (
+            prev is not None
+            and prev.nav_state == NAV_OFFBOARD
+            and prev.armed
+            and mode.armed
+            and mode.nav_state != NAV_OFFBOARD
+            and not any(0 <= mode.t - r <= HEARTBEAT_SETTLE_S for r in requested)
+        ):
+            out.append(mode.t)
+        prev = mode
+    return out
+
+
+def _losses(
+    verdict: Verdict, truth: Truth, rows: list[dict[str, Any]], timeout: float, flagged: bool
+) -> None:
+    model = [
+        r
+        for i, r in enumerate(rows)
+        if r["what"] == "signal_lost"
+        and any(f["what"] == "failsafe" and 0 <= f["px4_t"] - r["px4_t"] <= 0.05 for f in rows[i:])
+    ]
+    px4 = _px4_losses(truth, flagged)
+    used: set[int] = set()
+    for t in px4:
+        window = MATCH_S if flagged else HEARTBEAT_SETTLE_S
+        match = [r for r in model if abs(r["px4_t"] - t) <= window and id(r) not in used]
+        keepalive = truth.last_keepalive_before(t)
+        if not match:
+            preempted = _preempted_loss(rows, t, window)
+            if preempted is not None:
+                _loss_time(verdict, t, preempted, keepalive, timeout, flagged)
+                _px4_only(verdict, truth, t, flagged)
+                continue
+            verdict.items.append(Item("offboard loss", t, "lost", "no loss predicted", False))
+            continue
+        row = match[0]
+        used.add(id(row))
+        _loss_time(verdict, t, row, keepalive, timeout, flagged)
+        _failsafe(verdict, truth, rows, t, row, flagged)
+    for row in model:
+        if id(row) not in used:
+            verdict.items.append(
+                Item("offboard loss", row["px4_t"], "no loss", f"lost: {row['message']}", False)
+            )
+
+
+PREEMPTED = (
+    "not judged: PX4's mode change reached the model before its own 10 Hz check, and the model"
+    " followed it as an unseen mode change instead of predicting the action"
+)
+
+
+def _px4_only(verdict: Verdict, truth: Truth, t: float, flagged: bool) -> None:
+    """The action and return PX4 took after a loss the model did not act on (preempted)."""
+    settle = MODE_SETTLE_S if flagged else HEARTBEAT_SETTLE_S
+    after = [m for m in truth.modes if t - 0.001 <= m.t <= t + settle and m.nav_state != 14]
+    nav = after[0].nav_state if after else None
+    verdict.items.append(Item("failsafe action", t, nav_state_name(nav), "-", None, PREEMPTED))
+    later = [m for m in truth.modes if m.t > (after[0].t if after else t) + 0.001]
+    back = bool(later) and later[0].nav_state == NAV_OFFBOARD and later[0].armed
+    px4 = "back to OFFBOARD" if back else "stays"
+    verdict.items.append(Item("automatic return", later[0].t if later else t, px4, "-", None))
+
+
+def _preempted_loss(rows: list[dict[str, Any]], t: float, window: float) -> dict[str, Any] | None:
+    """A model loss without a failsafe because the recording's mode change came first: a
+    ``mode`` row taken from the recording (no command for it) at most one check period and a
+    loop before the model's ``signal_lost``. The model then follows the recording instead of
+    predicting the action (gate spec 2.1.3: PX4's check has its own phase), so neither the
+    action nor the return can be judged."""
+    for i, row in enumerate(rows):
+        if row["what"] != "signal_lost" or abs(row["px4_t"] - t) > window:
+            continue
+        before = [
+            r
+            for r in rows[:i]
+            if r["what"] == "mode"
+            and "from the recording" in r["message"]
+            and 0 <= row["px4_t"] - r["px4_t"] <= CHECK_PERIOD_S + LOOP_S
+        ]
+        if before:
+            return row
+    return None
+
+
+def _loss_time(
+    verdict: Verdict,
+    t: float,
+    row: dict[str, Any],
+    keepalive: float | None,
+    timeout: float,
+    flagged: bool,
+) -> None:
+    model_t = row["px4_t"]
+    if not flagged:
+        verdict.items.append(
+            Item(
+                "loss time",
+                t,
+                "seen over HEARTBEAT (1 Hz)",
+                f"{model_t:.3f} s",
+                None,
+                "not judged: the tlog has no loss flag, HEARTBEAT comes once a second",
+            )
+        )
+        return
+    if keepalive is None:
+        verdict.items.append(
+            Item(
+                "loss time",
+                t,
+                f"{t:.3f} s",
+                f"{model_t:.3f} s",
+                None,
+                "no keep-alive logged before it",
+            )
+        )
+        return
+    start, end = keepalive + timeout, keepalive + timeout + CHECK_PERIOD_S
+    inside = start - LOOP_S <= t <= end + LOOP_S and abs(model_t - t) <= LOSS_TOLERANCE_S
+    verdict.items.append(
+        Item(
+            "loss time",
+            t,
+            f"{t - keepalive:.3f} s after the newest keep-alive (PX4's flag)",
+            f"{model_t - keepalive:.3f} s; window {timeout:.2f}-{timeout + CHECK_PERIOD_S:.2f} s"
+            " (one 10 Hz check period)",
+            inside,
+            f"model {1000 * (model_t - t):+.0f} ms from PX4's flag",
+        )
+    )
+
+
+def _failsafe(
+    verdict: Verdict,
+    truth: Truth,
+    rows: list[dict[str, Any]],
+    t: float,
+    row: dict[str, Any],
+    flagged: bool,
+) -> None:
+    failsafe = next(
+        (f for f in rows if f["what"] == "failsafe" and 0 <= f["px4_t"] - row["px4_t"] <= 0.05),
+        None,
+    )
+    settle = MODE_SETTLE_S if flagged else HEARTBEAT_SETTLE_S
+    after = [m for m in truth.modes if t - 0.001 <= m.t <= t + settle and m.nav_state != 14]
+    px4_nav = after[0].nav_state if after else None
+    model_nav = failsafe["nav_state"] if failsafe else None
+    verdict.items.append(
+        Item(
+            "failsafe action",
+            t,
+            nav_state_name(px4_nav),
+            f"{nav_state_name(model_nav)}: {failsafe['message'] if failsafe else ''}",
+            px4_nav == model_nav,
+        )
+    )
+    back_model = next(
+        (
+            r
+            for r in rows
+            if r["px4_t"] > row["px4_t"]
+            and r["what"] in ("offboard_resumed", "mode", "request_accepted")
+        ),
+        None,
+    )
+    model_returns = back_model is not None and back_model["what"] == "offboard_resumed"
+    failsafe_t = after[0].t if after else t
+    later = [m for m in truth.modes if m.t > failsafe_t + 0.001]
+    px4_returns = bool(later) and later[0].nav_state == NAV_OFFBOARD and later[0].armed
+    verdict.items.append(
+        Item(
+            "automatic return",
+            later[0].t if later else t,
+            "back to OFFBOARD"
+            if px4_returns
+            else f"stays ({nav_state_name(later[0].nav_state) if later else 'end'})",
+            "back to OFFBOARD" if model_returns else "no return",
+            px4_returns == model_returns,
+        )
+    )
+
+
+def render(verdict: Verdict) -> str:
+    lines = [f"PX4 {verdict.release} (read from its {verdict.source}) beside the gate model:"]
+    for item in verdict.items:
+        mark = {True: "agree ", False: "DIFFER", None: "  -   "}[item.agree]
+        line = f"  {mark} {item.t:8.3f} s  {item.what:<18} PX4: {item.px4:<28} model: {item.model}"
+        if item.note:
+            line += f"  ({item.note})"
+        lines.append(line)
+    if not verdict.items:
+        lines.append("  nothing to compare (no request, no loss)")
+    for p in verdict.problems:
+        lines.append(f"  note: {p}")
+    lines.append(
+        "verdict: PX4 and the model agree" if verdict.agree else "verdict: PX4 and the model DIFFER"
+    )
+    return "\n".join(lines) + "\n"
