@@ -63,7 +63,7 @@ test-sitl: $(STAMP)
 	FUZZOFF_SITL_MATRIX=1 $(BIN)/python -m pytest -q -n 2 tests/test_sitl_live.py tests/test_sitl.py
 
 check: $(STAMP)
-	$(BIN)/ruff check fuzzoff tests bench corpora
+	$(BIN)/ruff check fuzzoff tests bench corpora docs
 	$(BIN)/mypy
 
 # A pip install compiles the package to bytecode; an editable one only when Python may write it
