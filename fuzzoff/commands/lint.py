@@ -44,6 +44,12 @@ def add_parser(sub: Any) -> None:
         "--quiet", "-q", action="store_true", help="only findings at the fail level"
     )
     parser.add_argument("--statistics", action="store_true", help="counts per rule")
+    parser.add_argument(
+        "--verbose",
+        "-v",
+        action="store_true",
+        help="each finding in full: what the docs require, what PX4 does, the exact place",
+    )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.set_defaults(run=run)
 
@@ -63,7 +69,12 @@ def _lint_on_terminal(args: argparse.Namespace, paths: list[str], settings: Sett
 
     def draw(console: Console) -> None:
         print_report(
-            console, report, settings.fail_on, quiet=args.quiet, statistics=args.statistics
+            console,
+            report,
+            settings.fail_on,
+            quiet=args.quiet,
+            statistics=args.statistics,
+            verbose=args.verbose,
         )
 
     render_rich(draw, args.output)
