@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 from rich.console import Console
 
+from fuzzoff.events import Where
 from fuzzoff.findings import FileReport, Finding, Report, Severity, shorten
 from fuzzoff.profiles import Profile
 from fuzzoff.report.terminal import print_report
@@ -176,6 +177,7 @@ def test_on_a_terminal_a_long_line_wraps_at_a_word_under_its_own_column() -> Non
                         "long",
                         time_s=1.0,
                         summary=words,
+                        where=Where("/fmu/in/offboard_control_mode", index=81),
                     )
                 ],
             )
@@ -189,6 +191,9 @@ def test_on_a_terminal_a_long_line_wraps_at_a_word_under_its_own_column() -> Non
     for row in rows[1:]:
         assert row.startswith(" " * 26) and re.match(r"^ +word\d\d( |$)", row)
     assert " ".join(" ".join(rows).split()).endswith(words.split()[-1])
+    # the place is never broken across rows: it gets a row of its own when it does not fit
+    place = next(ln for ln in text.splitlines() if "offboard_control_mode" in ln)
+    assert place.strip() == "/fmu/in/offboard_control_mode #81"
 
 
 def test_summaries_keep_the_key_fact_and_json_keeps_both(no_colour_env: None) -> None:

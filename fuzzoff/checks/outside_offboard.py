@@ -198,7 +198,7 @@ class SetpointsOutsideOffboard(Check):
                 f"{docs}; PX4 flies no setpoint while disarmed, so nothing fights them (the "
                 "stream before a switch must run anyway)"
             )
-            effect = "disarmed: nothing flies them"
+            effect = "nothing flies them (disarmed)"
         elif entered:
             severity = Severity.INFO
             why = (

@@ -47,9 +47,9 @@ def _location(finding: Finding, full: bool) -> str:
     return where.topic if where.index is None else f"{where.topic} #{where.index}"
 
 
-def finding_parts(finding: Finding, *, vehicle: bool = True) -> tuple[Text, Text]:
-    """The columns of a finding's line: time, code and severity; then the key fact (the
-    vehicle first where the file has several) and where in the file it sits."""
+def finding_parts(finding: Finding, *, vehicle: bool = True) -> tuple[Text, Text, Text]:
+    """The parts of a finding's line: time, code and severity; the key fact (the vehicle
+    first where the file has several); where in the file it sits (empty if nowhere)."""
     when = "whole file" if finding.time_s is None else f"{finding.time_s:.3f}s"
     head = Text()
     head.append(f"{when:>10}", style="dim")
@@ -61,16 +61,17 @@ def finding_parts(finding: Finding, *, vehicle: bool = True) -> tuple[Text, Text
     if vehicle and finding.vehicle:
         body.append(f"[{printable(finding.vehicle, 40)}] ", style="magenta")
     body.append(printable(finding.short, 300))
-    location = _location(finding, full=False)
-    if location:
-        body.append(f"  {printable(location, 120)}", style="dim")
-    return head, body
+    where = Text(printable(_location(finding, full=False), 120), style="dim")
+    return head, body, where
 
 
 def finding_line(finding: Finding, *, vehicle: bool = True) -> Text:
     """One finding on one line: time, code, severity, the key fact, where."""
-    head, body = finding_parts(finding, vehicle=vehicle)
-    return Text.assemble(head, " ", body)
+    head, body, where = finding_parts(finding, vehicle=vehicle)
+    line = Text.assemble(head, " ", body)
+    if where:
+        line.append("  ").append_text(where)
+    return line
 
 
 def finding_detail(finding: Finding) -> Text:
@@ -106,24 +107,40 @@ def _print_findings(
     grid = Table.grid(padding=(0, 1))
     grid.add_column(no_wrap=True, width=HEAD_WIDTH - 1)
     grid.add_column(overflow="fold")
+    room = console.width - HEAD_WIDTH
     for finding in findings:
-        head, body = finding_parts(finding, vehicle=vehicle)
-        grid.add_row(head, body)
+        head, body, where = finding_parts(finding, vehicle=vehicle)
+        if where and body.cell_len + 2 + where.cell_len <= room:
+            grid.add_row(head, Text.assemble(body, "  ", where))
+        else:  # the place on a row of its own rather than broken across two
+            grid.add_row(head, body)
+            if where:
+                grid.add_row(Text(), where)
         if verbose:
             grid.add_row(Text(), finding_detail(finding))
     console.print(grid)
 
 
-def file_header(file: FileReport) -> Text:
-    header = Text()
-    header.append(printable(file.path), style="bold underline")
-    header.append(f"  {file.format}, {printable(file.profile.describe(), 200)}", style="dim")
+def file_header_parts(file: FileReport) -> tuple[Text, Text]:
+    """The recording's name, and what it is: format, profile, its one vehicle, incomplete."""
+    name = Text(printable(file.path), style="bold underline")
+    about = Text(f"{file.format}, {printable(file.profile.describe(), 200)}", style="dim")
     vehicles = {f.vehicle for f in file.findings if f.vehicle}
     if len(vehicles) == 1:
-        header.append(f", vehicle {printable(vehicles.pop(), 40)}", style="dim")
+        about.append(f", vehicle {printable(vehicles.pop(), 40)}", style="dim")
     if not file.complete:
-        header.append("  (incomplete)", style="bold red")
-    return header
+        about.append("  (incomplete)", style="bold red")
+    return name, about
+
+
+def _print_header(console: Console, file: FileReport) -> None:
+    """One line; on a terminal too narrow for it, the name and then what it is, each whole."""
+    name, about = file_header_parts(file)
+    if not console.is_terminal or name.cell_len + 2 + about.cell_len <= console.width:
+        console.print(Text.assemble(name, "  ", about), soft_wrap=True)
+        return
+    console.print(name, soft_wrap=True)
+    console.print(Text("  ").append_text(about))
 
 
 def print_file(
@@ -132,7 +149,7 @@ def print_file(
     shown = [f for f in file.findings if not quiet or f.severity >= fail_on]
     if quiet and not shown:
         return
-    console.print(file_header(file), soft_wrap=True)
+    _print_header(console, file)
     # one vehicle is named in the heading; several are named on each line
     several = len({f.vehicle for f in file.findings if f.vehicle}) > 1
     _print_findings(console, shown, several, verbose)
