@@ -79,6 +79,7 @@ def test_every_rule_is_described_with_its_whole_page() -> None:
     rules = run["tool"]["driver"]["rules"]
     catalog = load_catalog()
     assert [r["id"] for r in rules] == list(catalog)
+    assert run["tool"]["driver"]["informationUri"] == "https://pypi.org/project/fuzzoff/"
     for descriptor in rules:
         rule = catalog[descriptor["id"]]
         # no made-up address: SARIF wants an absolute helpUri and the project has no site

@@ -2,8 +2,9 @@
 
 Every catalog rule is in ``tool.driver.rules`` with its whole page as help text (plain and
 Markdown), which GitHub code scanning shows beside each result. There is no ``helpUri``: SARIF
-requires an absolute URI there, and the project publishes no site; the page's references link to
-PX4's docs and source instead. A recording is binary, so a result points at the file without a
+requires an absolute URI there, and the project publishes no site of rule pages; the page's
+references link to PX4's docs and source instead. The tool's ``informationUri`` is its package
+page. A recording is binary, so a result points at the file without a
 text region; the time, vehicle and topic go into the message and the result's properties, and
 ``partialFingerprints`` is computed here from rule, vehicle, topic and time window (GitHub cannot
 fingerprint a binary file itself). Paths under the working folder are written relative to the
@@ -26,6 +27,8 @@ from fuzzoff.findings import Finding, Report, Severity
 from fuzzoff.report.sanitize import CI_TEXT_LIMIT, printable
 
 SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
+INFORMATION_URI = "https://pypi.org/project/fuzzoff/"
+"""Where the tool is described: its package page (the README), where ``pip install`` gets it."""
 FINGERPRINT_KEY = "fuzzoffFinding/v1"
 LEVEL = {Severity.ERROR: "error", Severity.WARNING: "warning", Severity.INFO: "note"}
 BASE_ID = "SRCROOT"
@@ -159,6 +162,7 @@ def sarif_log(report: Report, settings: Settings, root: Path | None = None) -> d
                 "name": "fuzzoff",
                 "version": __version__,
                 "semanticVersion": __version__,
+                "informationUri": INFORMATION_URI,
                 "rules": [rule_descriptor(rule) for rule in catalog.values()],
             }
         },
