@@ -15,11 +15,10 @@ $(STAMP): pyproject.toml
 
 install: $(STAMP)
 
-# Lint the bundled corpus (it holds deliberately damaged files, so exit 2 is expected) and write
-# the HTML report.
+# Lint the bundled corpus (it holds deliberately damaged files, so exit 2 is expected): the HTML
+# report and the errors on the terminal, from one lint.
 demo: $(STAMP)
-	$(BIN)/fuzzoff lint corpora --fail-on error --format html --output build/demo-report.html || [ $$? -le 2 ]
-	$(BIN)/fuzzoff lint corpora --fail-on error --quiet || [ $$? -le 2 ]
+	$(BIN)/fuzzoff lint corpora --fail-on error --quiet --format html --output build/demo-report.html --format terminal || [ $$? -le 2 ]
 	@echo "HTML report written to $$(pwd)/build/demo-report.html"
 
 # The SARIF validator (Microsoft's SARIF Multitool, from npm) and Chromium for the browser tests.
@@ -63,7 +62,7 @@ test-sitl: $(STAMP)
 	FUZZOFF_SITL_MATRIX=1 $(BIN)/python -m pytest -q -n 2 tests/test_sitl_live.py tests/test_sitl.py
 
 check: $(STAMP)
-	$(BIN)/ruff check fuzzoff tests bench corpora
+	$(BIN)/ruff check fuzzoff tests bench corpora docs
 	$(BIN)/mypy
 
 # A pip install compiles the package to bytecode; an editable one only when Python may write it

@@ -1,9 +1,14 @@
 """The rule catalog: one TOML file per rule in ``rules/``, documented the way ruff documents rules.
 
-A rule file holds ``code``, ``name``, ``severity``, ``profiles``, ``source`` (seed document and
-section), ``summary`` (what it does), ``why`` (why it is bad), ``docs_vs_code`` (where PX4's code
-behaves differently), ``options`` (thresholds with defaults) and ``example.bad`` /
-``example.good`` as tiny event streams that the tests replay through the rule.
+A rule file holds ``code``, ``name``, ``severity``, ``profiles``, ``summary`` (what it does),
+``why`` (why it is bad), ``docs_vs_code`` (where PX4's code behaves differently), ``options``
+(thresholds with defaults), ``example`` (the client code that breaks the rule and its fix, in the
+client that fits: rclpy or rclcpp with px4_msgs, MAVSDK, MAVROS, pymavlink), ``test_stream.bad`` /
+``test_stream.good`` (tiny event streams the tests replay through the rule) and ``references``
+(PX4's docs by page and section, PX4's source by file and release tag).
+
+Each page is also a Markdown file in the repository, ``docs/rules/CODE.md``, written from the
+catalog by ``docs/rules/build.py`` (a test keeps the two equal): that is where a rule links to.
 """
 
 from __future__ import annotations
@@ -24,16 +29,20 @@ from fuzzoff._version import __version__
 from fuzzoff.findings import Severity
 from fuzzoff.profiles import PX4_PROFILES, VEHICLE_TYPES
 
-SOURCE_DOCS = {
-    "000": "000_f9f2ad20eb5ad951.txt (PX4 User Guide, Offboard Mode, main / v1.16+)",
-    "002": "002_6cfbef319bb21c3e.txt (PX4 User Guide, Offboard mode, v1.13-v1.14, Chinese)",
-    "003": "003_87de8cdeab70eae1.txt (uORB-era offboard internals blog, legacy)",
-    "code": "px4-offboard-gate.md (what PX4's code does)",
-    "tool": "fuzzoff itself (input handling)",
-}
+RULE_PAGE = "docs/rules/{code}.md"
+"""Where a rule's page sits in the repository, relative to its root. The project publishes no web
+site, so reports link here (the HTML report carries the pages themselves)."""
 
-RULE_URL = "https://fuzzoff.dev/rules/{code}"
-"""Where a rule's page is published; every machine-readable output links to it."""
+REFERENCE_PREFIXES = (
+    "https://docs.px4.io/",
+    "https://github.com/PX4/PX4-Autopilot/",
+    "https://mavlink.io/en/",
+    "docs/",
+)
+"""What a reference may point at: PX4's docs, PX4's source at a release tag, the MAVLink message
+definitions, or this repository's own docs (for the rules about reading a recording)."""
+
+EXAMPLE_LANGUAGES = ("python", "cpp", "sh", "toml")
 
 
 class CatalogError(ValueError):
@@ -48,6 +57,35 @@ class RuleOption:
 
 
 @dataclass(frozen=True, slots=True)
+class Reference:
+    """A page and section of PX4's docs, a file of PX4's source at a release tag, or a page of
+    this repository's docs (a path relative to its root)."""
+
+    title: str
+    url: str
+
+    @property
+    def external(self) -> bool:
+        return self.url.startswith("https://")
+
+    def markdown(self) -> str:
+        return f"[{self.title}]({self.url})" if self.external else f"{self.title}: `{self.url}`"
+
+
+@dataclass(frozen=True, slots=True)
+class ClientExample:
+    """The code a user writes that breaks the rule (``bad``) and its fix (``good``)."""
+
+    client: str
+    """The client library, and the PX4 release the code is written for."""
+    language: str
+    bad: str
+    good: str
+    px4: str = "1.15"
+    """The px4_msgs release whose fields the code uses (ROS 2 clients)."""
+
+
+@dataclass(frozen=True, slots=True)
 class Rule:
     code: str
     name: str
@@ -56,20 +94,23 @@ class Rule:
     why: str
     px4: tuple[str, ...]
     vehicles: tuple[str, ...]
-    source_doc: str
-    source_section: str
+    references: tuple[Reference, ...]
     docs_vs_code: str = ""
     heuristic: bool = False
     options: tuple[RuleOption, ...] = ()
-    example_bad: tuple[dict[str, Any], ...] = ()
-    example_good: tuple[dict[str, Any], ...] = ()
-    example_profile: dict[str, str] = field(default_factory=dict)
+    example: ClientExample | None = None
+    stream_bad: tuple[dict[str, Any], ...] = ()
+    """The test stream: events the tests replay through the rule (it must report them)."""
+    stream_good: tuple[dict[str, Any], ...] = ()
+    """The test stream the rule must stay silent on."""
+    stream_profile: dict[str, str] = field(default_factory=dict)
     formats: tuple[str, ...] = ()
     """Recording formats whose data can show this rule (empty = all)."""
 
     @property
-    def url(self) -> str:
-        return RULE_URL.format(code=self.code)
+    def page(self) -> str:
+        """The rule's page in the repository, relative to its root."""
+        return RULE_PAGE.format(code=self.code)
 
     def applies_to(self, px4: str, vehicle: str) -> bool:
         return px4 in self.px4 and vehicle in self.vehicles
@@ -170,12 +211,13 @@ def _write(cache: Path, data: dict[str, Any]) -> None:
 def _load_rule(path: Path, data: dict[str, Any]) -> Rule:
     try:
         profiles = data.get("profiles", {})
-        source = data["source"]
         options = tuple(
             RuleOption(name=name, default=opt["default"], doc=opt["doc"])
             for name, opt in data.get("options", {}).items()
         )
-        example = data.get("example", {})
+        references = tuple(Reference(r["title"], r["url"]) for r in data["references"])
+        example = data.get("example")
+        stream = data.get("test_stream", {})
         rule = Rule(
             code=data["code"],
             name=data["name"],
@@ -184,23 +226,38 @@ def _load_rule(path: Path, data: dict[str, Any]) -> Rule:
             why=data["why"].strip(),
             px4=_expand(profiles.get("px4", ["all"]), PX4_PROFILES, "PX4 profile", path),
             vehicles=_expand(profiles.get("vehicles", ["all"]), VEHICLE_TYPES, "vehicle", path),
-            source_doc=source["doc"],
-            source_section=source["section"],
+            references=references,
             docs_vs_code=data.get("docs_vs_code", "").strip(),
             heuristic=bool(data.get("heuristic", False)),
             options=options,
-            example_bad=tuple(example.get("bad", ())),
-            example_good=tuple(example.get("good", ())),
-            example_profile=dict(example.get("profile", {})),
+            example=None if example is None else _client_example(example),
+            stream_bad=tuple(stream.get("bad", ())),
+            stream_good=tuple(stream.get("good", ())),
+            stream_profile=dict(stream.get("profile", {})),
             formats=tuple(data.get("formats", ())),
         )
     except KeyError as exc:
         raise CatalogError(f"{path.name}: missing key {exc}") from None
     if rule.code != path.stem:
         raise CatalogError(f"{path.name}: code {rule.code} does not match the file name")
-    if rule.source_doc not in SOURCE_DOCS:
-        raise CatalogError(f"{path.name}: unknown source document {rule.source_doc!r}")
+    if not rule.references:
+        raise CatalogError(f"{path.name}: no references")
+    for ref in rule.references:
+        if not ref.url.startswith(REFERENCE_PREFIXES):
+            raise CatalogError(f"{path.name}: reference {ref.url!r} is not PX4's docs or source")
+    if rule.example is not None and rule.example.language not in EXAMPLE_LANGUAGES:
+        raise CatalogError(f"{path.name}: example language {rule.example.language!r}")
     return rule
+
+
+def _client_example(data: dict[str, Any]) -> ClientExample:
+    return ClientExample(
+        client=data["client"],
+        language=data["language"],
+        bad=data["bad"].strip("\n"),
+        good=data["good"].strip("\n"),
+        px4=data.get("px4", "1.15"),
+    )
 
 
 @functools.cache
@@ -247,8 +304,9 @@ def expand_selectors(selectors: Iterable[str]) -> set[str]:
     return chosen
 
 
-def render_page(rule: Rule) -> str:
-    """The rule's page in Markdown, with ruff's headings plus Profiles and Docs vs code."""
+def render_page(rule: Rule, *, test_stream: bool = False) -> str:
+    """The rule's page in Markdown, with ruff's headings plus Profiles and Docs vs code;
+    ``test_stream`` adds the event streams the tests replay (``fuzzoff rule CODE --verbose``)."""
     lines = [f"# {rule.name} ({rule.code})", ""]
     lines += [f"Default severity: {rule.severity.label}. Profiles: {rule.profiles_text()}."]
     if rule.heuristic:
@@ -256,21 +314,34 @@ def render_page(rule: Rule) -> str:
     lines += ["", "## What it does", "", rule.summary, "", "## Why is this bad?", "", rule.why]
     if rule.docs_vs_code:
         lines += ["", "## Docs vs code", "", rule.docs_vs_code]
-    if rule.example_bad:
-        lines += ["", "## Example", "", "```toml", *_example_lines(rule.example_bad), "```"]
-    if rule.example_good:
-        lines += ["", "## Use instead", "", "```toml", *_example_lines(rule.example_good), "```"]
+    if rule.example is not None:
+        ex = rule.example
+        lines += ["", "## Example", "", f"{ex.client}:", "", f"```{ex.language}", ex.bad, "```"]
+        lines += ["", "## Use instead", "", f"```{ex.language}", ex.good, "```"]
     if rule.options:
         lines += ["", "## Options", ""]
         for opt in rule.options:
             lines.append(f"- `{rule.code}.{opt.name}` (default `{opt.default}`): {opt.doc}")
     lines += ["", "## Profiles", "", rule.profiles_text()]
-    lines += [
-        "",
-        "## References",
-        "",
-        f"- {SOURCE_DOCS[rule.source_doc]}, section \u201c{rule.source_section}\u201d",
-    ]
+    lines += ["", "## References", ""]
+    lines += [f"- {ref.markdown()}" for ref in rule.references]
+    if test_stream and rule.stream_bad:
+        profile = ", ".join(f"{k} {v}" for k, v in rule.stream_profile.items())
+        lines += ["", "## Test stream", ""]
+        lines += [
+            "The events the tests replay through the rule"
+            + (f" (profile: {profile})" if profile else "")
+            + ": it reports the first stream and stays silent on the second.",
+            "",
+            "```toml",
+            "bad = [",
+            *_example_lines(rule.stream_bad),
+            "]",
+            "good = [",
+            *_example_lines(rule.stream_good),
+            "]",
+            "```",
+        ]
     return "\n".join(lines) + "\n"
 
 
@@ -278,7 +349,7 @@ def _example_lines(stream: tuple[dict[str, Any], ...]) -> list[str]:
     out = []
     for event in stream:
         items = ", ".join(f"{k} = {_toml_value(v)}" for k, v in event.items())
-        out.append(f"{{ {items} }},")
+        out.append(f"  {{ {items} }},")
     return out
 
 

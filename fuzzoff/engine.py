@@ -26,7 +26,7 @@ from fuzzoff.events import (
     VehicleStatus,
     is_keepalive,
 )
-from fuzzoff.findings import FileReport, Finding, Report, Severity
+from fuzzoff.findings import FileReport, Finding, Report, Severity, clip, first_clause
 from fuzzoff.gate import GateModel, GateTransition
 from fuzzoff.profiles import (
     DEFAULT_PX4,
@@ -367,6 +367,7 @@ def _run_events(
                     name=get_rule("OFB002").name,
                     severity=settings.severity_of("OFB002", Severity.INFO),
                     message=f"{code} ({rule.name}) cannot be checked on this recording: {needs}",
+                    summary=clip(f"{code} not checkable: {first_clause(needs)}"),
                 )
             )
     stats = {
@@ -397,6 +398,8 @@ def _stream_not_recorded(vehicles: list[str], settings: Settings) -> Finding:
             "PX4's own failsafe is recorded. If this is the companion's own log, it sent no "
             "setpoint at all"
         ),
+        summary="no companion stream in the recording (a ground station's log?): stream rules "
+        "not checked",
         vehicle=vehicles[0] if len(vehicles) == 1 else "",
     )
 
@@ -439,7 +442,11 @@ def lint_file(
         report = FileReport(name, "unknown", resolve_profile(RecordingInfo(name, "?"), settings))
         report.complete = False
         report.problems.append(exc.line())
-        report.findings.append(Finding("OFB001", unreadable.name, Severity.ERROR, exc.line()))
+        report.findings.append(
+            Finding(
+                "OFB001", unreadable.name, Severity.ERROR, exc.line(), summary=_unreadable(exc)
+            )
+        )
         return report
     try:
         try:
@@ -471,7 +478,14 @@ def lint_file(
         line = problem.line(name)
         report.problems.append(line)
         findings.append(
-            Finding("OFB001", unreadable.name, Severity.ERROR, line, time_s=problem.time_s)
+            Finding(
+                "OFB001",
+                unreadable.name,
+                Severity.ERROR,
+                line,
+                time_s=problem.time_s,
+                summary=_unreadable(problem),
+            )
         )
     report.complete = not source.problems
     vehicle_assumed = info.vehicle_assumed if settings.vehicle is None else None
@@ -501,6 +515,12 @@ def _until_unreadable(events: Iterable[Event], problems: list[SourceProblem]) ->
         problems.append(_problem(exc))
 
 
+def _unreadable(problem: SourceError | SourceProblem) -> str:
+    """The problem without the file's name (the report's heading names the file)."""
+    at = f" at {problem.where}" if problem.where else ""
+    return clip(f"{problem.what}{at}")
+
+
 def _problem(exc: SourceError) -> SourceProblem:
     return SourceProblem(exc.what, exc.where)
 
@@ -513,12 +533,20 @@ def _assumed(profile: Profile, vehicle_assumed: str | None = None) -> Finding:
         missing.append(f"vehicle type (assumed {profile.vehicle}; set --vehicle)")
     elif vehicle_assumed:
         missing.append(f"vehicle type fully: it says {vehicle_assumed}")
+    guessed, options = [], []
+    if not profile.px4_detected:
+        guessed.append(f"PX4 {profile.px4}")
+        options.append("--px4")
+    if not profile.vehicle_detected or vehicle_assumed:
+        guessed.append(profile.vehicle)
+        options.append("--vehicle")
     rule = get_rule("OFB003")
     return Finding(
         "OFB003",
         rule.name,
         Severity.INFO,
         "the recording does not say its " + " or its ".join(missing),
+        summary=f"profile assumed: {', '.join(guessed)} (set {' and '.join(options)})",
     )
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from enum import IntEnum
 from typing import Any
@@ -29,9 +30,69 @@ class Severity(IntEnum):
             raise ValueError(f"unknown severity {text!r}: one of error, warning, info") from None
 
 
+SHORT_LIMIT = 90
+"""Longest summary a terminal line shows (characters): with the time, code, severity and
+location it keeps a finding on one line of a 120-column terminal."""
+
+
+def _top_level(text: str, separators: tuple[str, ...]) -> int:
+    """Where the first separator stands outside brackets, or -1."""
+    depth = 0
+    for i, ch in enumerate(text):
+        if ch in "([{":
+            depth += 1
+        elif ch in ")]}":
+            depth = max(0, depth - 1)
+        elif depth == 0 and any(text.startswith(sep, i) for sep in separators):
+            return i
+    return -1
+
+
+def _without_brackets(text: str) -> str:
+    out: list[str] = []
+    depth = 0
+    for ch in text:
+        if ch == "(":
+            depth += 1
+        elif ch == ")" and depth:
+            depth -= 1
+        elif depth == 0:
+            out.append(ch)
+    return re.sub(r"\s+([,;:.])", r"\1", re.sub(r"\s{2,}", " ", "".join(out))).strip()
+
+
+def shorten(message: str, limit: int = SHORT_LIMIT) -> str:
+    """A message's first statement, for a terminal line: up to its first ``; `` or ``: ``
+    outside brackets (the messages put the fact first and the explanation after), without its
+    bracketed asides if still too long, and cut at a word with an ellipsis as a last resort."""
+    end = _top_level(message, ("; ", ": "))
+    return clip(message if end < 0 else message[:end], limit)
+
+
+def first_clause(text: str) -> str:
+    """``text`` up to its first ``, ``, `` to `` or ``; `` outside brackets."""
+    end = _top_level(text, (", ", " to ", "; "))
+    return text if end < 0 else text[:end]
+
+
+def clip(text: str, limit: int = SHORT_LIMIT) -> str:
+    """``text`` within ``limit`` characters: without its bracketed asides if too long, and cut
+    at a word with an ellipsis as a last resort."""
+    if len(text) > limit:
+        text = _without_brackets(text)
+    if len(text) > limit:
+        cut = text.rfind(" ", 0, limit - 1)
+        text = text[: cut if cut > 0 else limit - 1].rstrip(",;: ") + "\u2026"
+    return text
+
+
 @dataclass(frozen=True, slots=True)
 class Finding:
-    """One thing a rule found, at one time (or for the whole file when ``time_s`` is None)."""
+    """One thing a rule found, at one time (or for the whole file when ``time_s`` is None).
+
+    ``message`` is the whole statement (what the docs require, what the profile's PX4 does,
+    what the recording shows); ``summary`` the key fact in a few words, for one terminal line.
+    A finding without a summary of its own gets its message's first statement."""
 
     code: str
     name: str
@@ -42,6 +103,12 @@ class Finding:
     vehicle: str = ""
     end_s: float | None = None
     """End of the time window the finding covers, where it covers one."""
+    summary: str = ""
+
+    @property
+    def short(self) -> str:
+        """The summary, or the message's first statement."""
+        return self.summary or shorten(self.message)
 
     def to_json(self) -> dict[str, Any]:
         location: dict[str, Any] | None = None
@@ -56,6 +123,7 @@ class Finding:
             "name": self.name,
             "severity": self.severity.label,
             "message": self.message,
+            "summary": self.short,
             "time_s": None if self.time_s is None else round(self.time_s, 6),
             "end_s": None if self.end_s is None else round(self.end_s, 6),
             "location": location,

@@ -1,8 +1,9 @@
-"""Every rule page's example replays through the engine: ``bad`` gives that rule, ``good`` not.
+"""Every rule page's test stream replays through the engine: ``bad`` gives that rule, ``good`` not.
 
-This also enforces that every rule in ``rules/`` has both examples (the page's "Example" and
-"Use instead" sections). OFB001-OFB003 are about the input and the profile, not about a stream:
-they are exempt, and listed here so that the exemption is visible.
+The test stream is the rule's behaviour as tiny event lists (``[test_stream]`` in its TOML page,
+shown by ``fuzzoff rule CODE --verbose``); the page's Example and Use instead sections show client
+code instead. OFB001-OFB003 are about the input and the profile, not about a stream: they are
+exempt, and listed here so that the exemption is visible.
 """
 
 from __future__ import annotations
@@ -30,8 +31,8 @@ def _replay(rule: Rule, stream: tuple[dict[str, Any], ...]) -> list[Finding]:
     fmt = rule.formats[0] if rule.formats else "mcap"
     info = RecordingInfo("example", fmt, kinds={e.kind for e in events})
     profile = Profile(
-        px4=rule.example_profile.get("px4", DEFAULT_PX4),
-        vehicle=rule.example_profile.get("vehicle", DEFAULT_VEHICLE),
+        px4=rule.stream_profile.get("px4", DEFAULT_PX4),
+        vehicle=rule.stream_profile.get("vehicle", DEFAULT_VEHICLE),
         px4_detected=True,
         vehicle_detected=True,
     )
@@ -40,21 +41,21 @@ def _replay(rule: Rule, stream: tuple[dict[str, Any], ...]) -> list[Finding]:
 
 
 @pytest.mark.parametrize("rule", RULES, ids=[r.code for r in RULES])
-def test_bad_example_gives_the_rule(rule: Rule) -> None:
-    assert rule.example_bad, f"rules/{rule.code}.toml has no example.bad"
-    found = [f for f in _replay(rule, rule.example_bad) if f.code == rule.code]
-    assert found, f"{rule.code}: example.bad gives no {rule.code} finding"
+def test_bad_test_stream_gives_the_rule(rule: Rule) -> None:
+    assert rule.stream_bad, f"rules/{rule.code}.toml has no test_stream.bad"
+    found = [f for f in _replay(rule, rule.stream_bad) if f.code == rule.code]
+    assert found, f"{rule.code}: test_stream.bad gives no {rule.code} finding"
 
 
 @pytest.mark.parametrize("rule", RULES, ids=[r.code for r in RULES])
-def test_good_example_stays_clean(rule: Rule) -> None:
-    assert rule.example_good, f"rules/{rule.code}.toml has no example.good"
-    found = [f for f in _replay(rule, rule.example_good) if f.code == rule.code]
-    assert not found, f"{rule.code}: example.good gives {[f.message for f in found]}"
+def test_good_test_stream_stays_clean(rule: Rule) -> None:
+    assert rule.stream_good, f"rules/{rule.code}.toml has no test_stream.good"
+    found = [f for f in _replay(rule, rule.stream_good) if f.code == rule.code]
+    assert not found, f"{rule.code}: test_stream.good gives {[f.message for f in found]}"
 
 
 @pytest.mark.parametrize("rule", RULES, ids=[r.code for r in RULES])
-def test_example_profile_is_one_the_rule_applies_to(rule: Rule) -> None:
-    px4 = rule.example_profile.get("px4", DEFAULT_PX4)
-    vehicle = rule.example_profile.get("vehicle", DEFAULT_VEHICLE)
-    assert rule.applies_to(px4, vehicle), f"{rule.code}: example profile {px4}/{vehicle}"
+def test_stream_profile_is_one_the_rule_applies_to(rule: Rule) -> None:
+    px4 = rule.stream_profile.get("px4", DEFAULT_PX4)
+    vehicle = rule.stream_profile.get("vehicle", DEFAULT_VEHICLE)
+    assert rule.applies_to(px4, vehicle), f"{rule.code}: test stream profile {px4}/{vehicle}"

@@ -106,3 +106,38 @@ def test_a_closed_standard_output_is_one_line() -> None:
 def test_tables_off_a_terminal_are_ascii(command: list[str]) -> None:
     text = run_cli(command).stdout
     assert text.isascii() and "|" in text
+
+
+def test_one_lint_writes_several_reports(tmp_path: Path) -> None:
+    """``--format``/``--output`` pairs: SARIF for code scanning, HTML as an artifact and the
+    findings on standard output, from one lint, each the report a run of its own gives."""
+    sarif, html, data = tmp_path / "out" / "f.sarif", tmp_path / "f.html", tmp_path / "f.json"
+    both = run_cli(
+        ["lint", str(LOST), "--format", "sarif", "-o", str(sarif), "--format", "html",
+         "-o", str(html), "--format", "json", "-o", str(data), "--format", "terminal"]
+    )
+    alone = run_cli(["lint", str(LOST), "--format", "json"])
+    assert both.returncode == alone.returncode == 1
+    assert json.loads(data.read_text(encoding="utf-8")) == json.loads(alone.stdout)
+    findings = json.loads(alone.stdout)["files"][0]["findings"]
+    results = json.loads(sarif.read_text(encoding="utf-8"))["runs"][0]["results"]
+    assert [r["ruleId"] for r in results] == [f["code"] for f in findings]
+    page = html.read_text(encoding="utf-8")
+    assert all(f'id="rule-{f["code"]}"' in page for f in findings)
+    assert "fuzzoff summary" in both.stdout and "OFB101" in both.stdout
+
+
+@pytest.mark.parametrize(
+    ("args", "says"),
+    [
+        (["--format", "sarif", "--format", "html"], "only one report can go to standard output"),
+        (["-o", "a.json", "-o", "b.json"], "2 --output for 1 --format"),
+        (["--format", "json", "-o", "r", "--format", "sarif", "-o", "r"], "named twice"),
+    ],
+)
+def test_reports_that_cannot_be_told_apart_are_a_usage_error(
+    tmp_path: Path, args: list[str], says: str
+) -> None:
+    result = run_cli(["lint", str(LOST), *args], cwd=tmp_path)
+    assert result.returncode == 2 and says in result.stderr
+    assert result.stderr.count("\n") == 1 and not list(tmp_path.iterdir())

@@ -11,7 +11,7 @@ from typing import Any
 
 import pytest
 
-from fuzzoff.catalog import load_catalog
+from fuzzoff.catalog import load_catalog, render_page
 from fuzzoff.config import Settings
 from fuzzoff.events import Where
 from fuzzoff.findings import FileReport, Finding, Report, Severity
@@ -74,14 +74,18 @@ def test_multitool_finds_nothing_to_complain_about(tmp_path: Path) -> None:
     assert {p["ruleId"] for p in problems} == {"JSON1008"}
 
 
-def test_every_rule_is_described_with_its_page_and_url() -> None:
+def test_every_rule_is_described_with_its_whole_page() -> None:
     run = sarif_log(Report(), Settings())["runs"][0]
     rules = run["tool"]["driver"]["rules"]
     catalog = load_catalog()
     assert [r["id"] for r in rules] == list(catalog)
+    assert run["tool"]["driver"]["informationUri"] == "https://pypi.org/project/fuzzoff/"
     for descriptor in rules:
         rule = catalog[descriptor["id"]]
-        assert descriptor["helpUri"] == rule.url
+        # no made-up address: SARIF wants an absolute helpUri and the project has no site
+        assert "helpUri" not in descriptor
+        assert descriptor["help"]["markdown"] == render_page(rule)
+        assert descriptor["properties"]["page"] == f"docs/rules/{rule.code}.md"
         assert descriptor["shortDescription"]["text"]
         assert descriptor["fullDescription"]["text"]
         assert "Why is this bad?" in descriptor["help"]["markdown"]
@@ -167,7 +171,7 @@ def test_a_recordings_text_cannot_forge_lines_in_ci_views(render: str) -> None:
         failure = ET.fromstring(junit_render(report, Settings())).find(".//failure")
         assert failure is not None and failure.text is not None
         finding_line, rule_line = failure.text.splitlines()  # one line a finding, then the rule
-        assert rule_line.startswith("rule: ")
+        assert rule_line.startswith("rule OFB101 ")
         text = finding_line
     assert "\n" not in text and "\u202e" not in text and len(text) <= 2000
     assert "\\x0aFAKE LINE" in text

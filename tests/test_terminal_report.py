@@ -10,9 +10,11 @@ from pathlib import Path
 import pytest
 from rich.console import Console
 
-from fuzzoff.findings import Severity
+from fuzzoff.events import Where
+from fuzzoff.findings import FileReport, Finding, Report, Severity, shorten
+from fuzzoff.profiles import Profile
 from fuzzoff.report.terminal import print_report
-from tests.helpers import run_cli
+from tests.helpers import CORPORA, run_cli
 from tests.report_fixtures import gap_recording, hostile_report
 
 COLOUR = re.compile(r"\x1b\[[0-9;]*(?:3[0-9]|9[0-7])[0-9;]*m")
@@ -56,9 +58,12 @@ def test_findings_grouped_per_file_then_summary(
         assert str(finding["severity"]) in line
         if finding["time_s"] is not None:
             assert f"{finding['time_s']:.3f}s" in line
+        assert str(finding["summary"]) in line  # the key fact, not the whole explanation
+        assert str(finding["message"]) not in line
         location = finding["location"]
         if isinstance(location, dict):
-            assert f"at {location['topic']}" in line
+            assert f"  {location['topic']} #{location['index']}" in line
+            assert f"@{location['offset']}" not in line  # the byte offset is --verbose's
     assert "result: incomplete input" in out
 
 
@@ -79,6 +84,7 @@ def test_hostile_strings_in_findings_are_neutralised() -> None:
     buffer = io.StringIO()
     console = Console(file=buffer, force_terminal=True, width=200)
     print_report(console, hostile_report(), Severity.WARNING)
+    print_report(console, hostile_report(), Severity.WARNING, verbose=True)
     out = buffer.getvalue()
     assert COLOUR.search(out)
     assert "\x1b[2J" not in out and "\\x1b[2J" in out
@@ -121,3 +127,95 @@ def test_statistics_counts_per_rule(recordings: tuple[Path, Path], no_colour_env
     assert counts == expected
     assert [int(r[0]) for r in rows] == sorted((int(r[0]) for r in rows), reverse=True)
     assert "fuzzoff summary" not in result.stdout and str(gap) not in result.stdout
+
+
+def test_a_finding_is_one_short_line_with_its_details_behind_verbose(
+    recordings: tuple[Path, Path], no_colour_env: None
+) -> None:
+    gap, _ = recordings
+    findings = json_findings([str(gap)])
+    plain = run_cli(["lint", str(gap)]).stdout
+    verbose = run_cli(["lint", str(gap), "--verbose"]).stdout
+    finding_lines = [ln for ln in plain.splitlines() if re.search(r" OFB\d{3} ", ln)]
+    assert len(finding_lines) == len(findings)
+    assert all(len(ln) <= 140 for ln in finding_lines), finding_lines
+    assert "--verbose shows each finding in full" in plain
+    for finding in findings:
+        assert str(finding["message"]) not in plain
+        assert str(finding["message"]) in verbose
+        location = finding["location"]
+        if isinstance(location, dict) and "offset" in location:
+            assert f"@{location['offset']}" in verbose
+    # one vehicle: named once in the heading, not on every line
+    assert ", vehicle 1" in plain.splitlines()[0] and "[1]" not in plain
+    assert "--verbose shows" not in verbose
+
+
+def test_several_vehicles_are_named_on_each_line(no_colour_env: None) -> None:
+    bag = CORPORA / "rules_mavlink" / "ofb607_second_vehicle_target.tlog"
+    out = run_cli(["lint", str(bag)]).stdout
+    lines = [ln for ln in out.splitlines() if re.search(r" OFB\d{3} ", ln)]
+    vehicles = {f["vehicle"] for f in json_findings([str(bag)]) if f["vehicle"]}
+    assert len(vehicles) > 1
+    for vehicle in vehicles:
+        assert any(f"[{vehicle}] " in ln for ln in lines), vehicle
+
+
+def test_on_a_terminal_a_long_line_wraps_at_a_word_under_its_own_column() -> None:
+    words = " ".join(f"word{i:02d}" for i in range(30))
+    report = Report(
+        files=[
+            FileReport(
+                path="flight.tlog",
+                format="tlog",
+                profile=Profile(),
+                findings=[
+                    Finding(
+                        "OFB101",
+                        "keepalive-below-2hz",
+                        Severity.ERROR,
+                        "long",
+                        time_s=1.0,
+                        summary=words,
+                        where=Where("/fmu/in/offboard_control_mode", index=81),
+                    )
+                ],
+            )
+        ]
+    )
+    buffer = io.StringIO()
+    print_report(Console(file=buffer, force_terminal=True, width=80), report, Severity.WARNING)
+    text = re.sub(r"\x1b\[[0-9;]*m", "", buffer.getvalue())
+    rows = [ln for ln in text.splitlines() if "word" in ln]
+    assert len(rows) > 1 and all(len(ln) <= 80 for ln in rows)
+    for row in rows[1:]:
+        assert row.startswith(" " * 26) and re.match(r"^ +word\d\d( |$)", row)
+    assert " ".join(" ".join(rows).split()).endswith(words.split()[-1])
+    # the place is never broken across rows: it gets a row of its own when it does not fit
+    place = next(ln for ln in text.splitlines() if "offboard_control_mode" in ln)
+    assert place.strip() == "/fmu/in/offboard_control_mode #81"
+
+
+def test_summaries_keep_the_key_fact_and_json_keeps_both(no_colour_env: None) -> None:
+    recording = CORPORA / "tlog" / "stream_lost_in_offboard.tlog"
+    findings = {str(f["code"]): f for f in json_findings([str(recording)])}
+    assert findings["OFB101"]["summary"] == (
+        "keep-alive gap 2.00 s in OFFBOARD; PX4 1.15 loses the signal at 1.00 s"
+    )
+    assert str(findings["OFB101"]["message"]).startswith("keep-alive gap of 2.00 s in OFFBOARD")
+    assert "docs: keep-alive at > 2 Hz" in str(findings["OFB101"]["message"])
+    assert findings["OFB103"]["summary"] == (
+        "keep-alive stopped at 8.00 s: POSCTL at 9.01 s; recorded: POSCTL at 10.00 s"
+    )
+    assert findings["OFB701"]["summary"] == (
+        "on a 1 s stream loss: POSCTL, back to OFFBOARD when it resumes"
+    )
+
+
+def test_shorten_takes_the_first_statement_and_never_cuts_a_word() -> None:
+    assert shorten("gap of 2 s (until it left); docs: 2 Hz") == "gap of 2 s (until it left)"
+    assert shorten("VehicleControlMode: payload of 27 bytes") == "VehicleControlMode"
+    long = "a setpoint (with a long aside that says a great deal) " + "word " * 30
+    short = shorten(long, 60)
+    assert len(short) <= 60 and short.endswith("\u2026") and "aside" not in short
+    assert all(w == "a" or w == "setpoint" or w.startswith("word") for w in short[:-1].split())

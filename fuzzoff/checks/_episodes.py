@@ -27,6 +27,8 @@ class Offence:
 
     message: str
     severity: Severity | None = None
+    short: str = ""
+    """The key fact for a terminal line (else the message's first statement)."""
 
 
 @dataclass(slots=True)
@@ -103,4 +105,5 @@ class Episodes:
             stretch.where,
             severity=stretch.offence.severity,
             end=stretch.last_t if stretch.count > 1 else None,
+            short=stretch.offence.short,
         )

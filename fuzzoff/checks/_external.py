@@ -67,6 +67,7 @@ class Episode:
     last: float
     count: int = 1
     severity: Severity | None = None
+    short: str = ""
 
 
 class Episodes:
@@ -84,10 +85,11 @@ class Episodes:
         where: Where,
         message: str,
         severity: Severity | None = None,
+        short: str = "",
     ) -> None:
         episode = self.open.get(key)
         if episode is None:
-            self.open[key] = Episode(t, where, message, t, severity=severity)
+            self.open[key] = Episode(t, where, message, t, severity=severity, short=short)
         else:
             episode.last = t
             episode.count += 1
@@ -122,4 +124,5 @@ class Episodes:
             episode.where,
             severity=episode.severity,
             end=episode.last if episode.count > 1 else None,
+            short=episode.short,
         )

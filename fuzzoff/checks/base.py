@@ -107,9 +107,11 @@ class CheckContext:
         *,
         severity: Severity | None = None,
         end: float | None = None,
+        short: str = "",
     ) -> None:
         """Record a finding. ``severity`` lowers or raises the catalog default for this case
-        (e.g. a docs rule the profile's PX4 tolerates); the user's override wins over both."""
+        (e.g. a docs rule the profile's PX4 tolerates); the user's override wins over both.
+        ``short`` is the key fact for a terminal line (else the message's first statement)."""
         if not self.enabled(code):
             return
         rule = get_rule(code)
@@ -124,6 +126,7 @@ class CheckContext:
                 where=where,
                 vehicle=self.vehicle,
                 end_s=end,
+                summary=short,
             )
         )
 

@@ -26,6 +26,7 @@ from fuzzoff.events import (
     TrajectorySetpoint,
     VehicleStatus,
 )
+from fuzzoff.findings import clip
 from fuzzoff.tables.control_mode import SETPOINT_NAMES
 
 TRAJECTORY_CONTROLS = ("position", "velocity", "acceleration")
@@ -143,6 +144,7 @@ class TrajectoryContent(Check):
                 event.where,
                 f"TrajectorySetpoint with position, velocity and acceleration all NaN while "
                 f"OffboardControlMode declares '{flag}': it sets no target",
+                short=f"TrajectorySetpoint all NaN under '{flag}': no target",
             )
             return
         self.all_nan.good("nan")
@@ -153,6 +155,7 @@ class TrajectoryContent(Check):
                 event.where,
                 f"OffboardControlMode declares '{flag}' but the TrajectorySetpoint content "
                 f"selects the {selected} controller; PX4 follows the content",
+                short=f"'{flag}' declared, but the setpoint's content flies {selected} control",
             )
         else:
             self.mismatch.close_all()
@@ -164,6 +167,7 @@ class TrajectoryContent(Check):
                 event.where,
                 f"TrajectorySetpoint PX4's position controller rejects: {'; '.join(problems)}; "
                 f"{_invalid_effect(self.ctx)}",
+                short=clip(f"TrajectorySetpoint rejected by PX4: {problems[0]}"),
             )
         else:
             self.axis.good("axis")

@@ -111,6 +111,7 @@ class SetpointNotDeclared(Check):
             f"{SETPOINT_NAMES[event.kind]} published in offboard while OffboardControlMode's "
             f"first true field is '{flag}', which does not select it: PX4's own controller "
             f"still writes this topic{mode_note(self.ctx)}",
+            short=f"{SETPOINT_NAMES[event.kind]} sent under '{flag}', which does not select it",
         )
 
     def on_batch(self, batch: StreamBatch) -> None:
@@ -282,6 +283,8 @@ class DeclaredSetpointMissing(Check):
             f"setpoint for the controllers it enabled{mode_note(self.ctx)}",
             deadline,
             self.ctx.state.control_mode.where if self.ctx.state.control_mode else None,
+            short=f"'{self.flag}' declared since {self.since:.3f} s, but no "
+            f"{describe_required(row)} published",
         )
 
     def _served(self, row: FlagRow, by: float) -> bool:
@@ -324,6 +327,7 @@ class DeclaredSetpointMissing(Check):
             f"next one arrives{mode_note(self.ctx)}",
             deadline,
             sent.where,
+            short=f"in OFFBOARD since {since:.3f} s without a MAVLink setpoint: the vehicle holds",
         )
 
     def finish(self, t_end: float) -> None:
@@ -358,6 +362,7 @@ class ControlModeChanged(Check):
                 f"{mode_note(self.ctx)}",
                 event.t,
                 event.where,
+                short=f"declaration changed from '{self.flag}' to '{flag}' in offboard",
             )
         self.flag = flag
 
@@ -413,6 +418,7 @@ class RequiredEstimateMissing(Check):
             f"recording shows it invalid {at}",
             event.t,
             _where(event),
+            short=f"'{flag}' declared without a valid {estimate} estimate",
         )
 
     def _missing(self) -> tuple[str | None, str] | None:

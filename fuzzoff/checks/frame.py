@@ -245,6 +245,7 @@ class FrameConventionSuspect(Check):
             f"(thresholds z_m = {self.z_m:g}, vz_mps = {self.vz_mps:g})",
             event.t,
             event.where,
+            short=f"first climb from the ground is {what}, down in NED: ENU?",
         )
 
     def _in_the_air(self, event: Event) -> None:
@@ -260,6 +261,7 @@ class FrameConventionSuspect(Check):
             "mode that takes off) since the vehicle was last on the ground: looks like a "
             "height written in ENU (up positive); PX4 expects NED and flies the vehicle down "
             f"towards it, into the ground (threshold z_m = {self.z_m:g})",
+            short=f"position target z = {z:g} m in the air, below the origin in NED: ENU?",
         )
 
     def _thrust(self, event: AttitudeSetpoint | RatesSetpoint) -> None:

@@ -410,6 +410,8 @@ class SetpointFrozen(Check):
             run.start,
             run.where,
             end=run.last,
+            short=f"the same {motion.what}{bounded} held for {duration:.1f} s while the stream "
+            "goes on",
         )
 
     def finish(self, t_end: float) -> None:

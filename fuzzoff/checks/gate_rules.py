@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from fuzzoff.checks.base import Check, CheckContext
 from fuzzoff.events import Event, FailsafeFlags, Parameter, VehicleStatus
-from fuzzoff.findings import Severity
+from fuzzoff.findings import Severity, clip
 from fuzzoff.gate import GateTransition
 from fuzzoff.gate.failsafe import LossAction
 from fuzzoff.gate.params import RC_PRESENT
@@ -34,6 +34,7 @@ class GateDisagrees(Check):
                 f"evaluation slack {self.ctx.gate.compare.slack:.2f} s)",
                 event.t,
                 event.cause.where if event.cause is not None else None,
+                short=clip(event.message),
             )
 
     def finish(self, t_end: float) -> None:
@@ -98,6 +99,24 @@ def loss_summary(ctx: CheckContext) -> str:
     return f"{head}; {_rc_text(ctx)}: the vehicle will {what}; {back}"
 
 
+def loss_short(ctx: CheckContext) -> str:
+    """OFB701 in a few words: after how long, what the vehicle does, whether it comes back."""
+    gate = ctx.gate
+    action = gate.current_loss_action()
+    loss_t = float(gate.params.get("COM_OF_LOSS_T", 0.0))
+    after = (
+        f"0.5 s + {loss_t:g} s" if ctx.profile.px4 == "legacy" else f"{loss_t:g} s"
+    )
+    if action.disarm:
+        what = "disarm"
+    elif action.none:
+        what = "no failsafe"
+    else:
+        what = action.action
+    back = ", back to OFFBOARD when it resumes" if action.nav_state not in (None, 13) else ""
+    return f"on a {after} stream loss: {what}{back}"
+
+
 def _action_text(action: LossAction) -> str:
     """What the vehicle does, with the parameters that chose it (``note``): a disarm may come
     from COM_OBL_RC_ACT 7 or, on 1.17+ without RC, from NAV_RCL_ACT 6."""
@@ -123,7 +142,7 @@ class LossActionSummary(Check):
             return
         if self.ctx.gate.in_offboard or self.ctx.state.in_offboard:
             self.done = True
-            self.ctx.report("OFB701", loss_summary(self.ctx), event.t)
+            self.ctx.report("OFB701", loss_summary(self.ctx), event.t, short=loss_short(self.ctx))
 
 
 _Key = tuple[str, str | None, bool, str | None]
@@ -135,7 +154,7 @@ class LossActionUnavailable(Check):
 
     def __init__(self, ctx: CheckContext) -> None:
         super().__init__(ctx)
-        self.noted: dict[_Key, tuple[float, str]] = {}
+        self.noted: dict[_Key, tuple[float, str, str]] = {}
         """Configuration notes waiting for the end: a loss that runs the fallback later makes
         its error the one finding."""
         self.ran: set[_Key] = set()
@@ -173,18 +192,23 @@ class LossActionUnavailable(Check):
             self.noted.pop(key, None)
             message = f"the offboard signal was lost at {event.t:.2f} s and the fallback ran: "
             self.ctx.report(
-                "OFB702", message + self._message(action), event.t, severity=Severity.ERROR
+                "OFB702",
+                message + self._message(action),
+                event.t,
+                severity=Severity.ERROR,
+                short=f"offboard loss: {self._short(action)}",
             )
         elif key not in self.noted:
-            self.noted[key] = (event.t, self._message(action))
+            self.noted[key] = (event.t, self._message(action), self._short(action))
 
     def finish(self, t_end: float) -> None:
-        for t, message in self.noted.values():
+        for t, message, short in self.noted.values():
             self.ctx.report(
                 "OFB702",
                 f"configuration note, no offboard loss in this recording: {message}",
                 t,
                 severity=Severity.INFO,
+                short=f"on a loss: {short}",
             )
         self.noted.clear()
 
@@ -192,6 +216,13 @@ class LossActionUnavailable(Check):
         if self.ctx.gate.est.rc_recorded:
             return "the recording's manual_control_signal_lost"
         return f"{RC_PRESENT} = 0"
+
+    def _short(self, action: LossAction) -> str:
+        if action.degraded_from:
+            return f"{action.degraded_from} cannot run, PX4 falls back to {action.action}"
+        if action.replaced_from:
+            return f"{action.replaced_from} without manual control, PX4 runs {action.action}"
+        return f"{action.action}, a pilot mode, with no manual control"
 
     def _message(self, action: LossAction) -> str:
         px4 = self.ctx.profile.px4

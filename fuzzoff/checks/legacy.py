@@ -58,6 +58,7 @@ class LegacyAccelerationNotIgnored(Check):
             event.where,
             f"{what} with {disabled} not ignored: enabling acceleration/force disables "
             f"{disabled} control",
+            short=f"acceleration used with {disabled}: it switches {disabled} control off",
         )
 
     def finish(self, t_end: float) -> None:

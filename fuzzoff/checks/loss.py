@@ -39,6 +39,7 @@ class _Pending:
     message: str
     where: Where
     last_keepalive: float | None
+    short: str = ""
 
 
 class OffboardLoss(Check):
@@ -124,8 +125,11 @@ class OffboardLoss(Check):
         )
         if tr.reason:
             message += f" ({tr.reason})"
+        counted = not stopped.startswith("the keep-alive kept arriving")
+        brief = stopped.removeprefix("the ") if counted else "keep-alive no longer counted"
+        short = f"{brief}: {action} at {tr.t:.2f} s"
         self.reported_until = self.last if self.last is not None else tr.t
-        self.pending = _Pending(tr.t, message, self.last_where, self.last)
+        self.pending = _Pending(tr.t, message, self.last_where, self.last, short)
         if not self.ctx.state.mode_recorded:
             self._flush(None)
 
@@ -143,20 +147,28 @@ class OffboardLoss(Check):
             f"recording shows OFFBOARD; {px4_label(self.ctx)} loses the offboard signal after "
             f"{timeout:.2f} s and runs the COM_OBL_RC_ACT = {act:g} failsafe"
         )
-        self.ctx.report("OFB103", message, self.last + timeout, self.last_where, end=now)
+        short = (
+            f"keep-alive stopped for {now - self.last:.2f} s in OFFBOARD; "
+            f"{px4_label(self.ctx)} runs its loss failsafe after {timeout:.2f} s"
+        )
+        self.ctx.report(
+            "OFB103", message, self.last + timeout, self.last_where, end=now, short=short
+        )
 
     def _flush(self, answer: VehicleStatus | None) -> None:
         pending, self.pending = self.pending, None
         if pending is None:
             return
-        message = pending.message
+        message, short = pending.message, pending.short
         if answer is not None:
             message += f"; recorded: {nav_state_name(answer.nav_state)} at {answer.t:.2f} s"
+            short += f"; recorded: {nav_state_name(answer.nav_state)} at {answer.t:.2f} s"
         elif self.ctx.state.mode_recorded:
             message += f"; recorded: still {nav_state_name(self.ctx.state.nav_state)}"
+            short += f"; recorded: still {nav_state_name(self.ctx.state.nav_state)}"
         else:
             message += " (the recording has no mode to compare)"
-        self.ctx.report("OFB103", message, pending.t, pending.where)
+        self.ctx.report("OFB103", message, pending.t, pending.where, short=short)
 
     def finish(self, t_end: float) -> None:
         self._flush(None)

@@ -28,7 +28,7 @@ from fuzzoff.events import (
     SetPositionTargetGlobal,
     SetPositionTargetLocal,
 )
-from fuzzoff.findings import Severity
+from fuzzoff.findings import Severity, clip
 from fuzzoff.gate.estimates import Estimates
 from fuzzoff.gate.receiver import DROPPED, FLOAT_FIELDS, ReceiverContext, receive
 from fuzzoff.profiles import at_least
@@ -211,13 +211,15 @@ class PositionTargetFields(Check):
         receiver = tm.RECEIVER_FRAMES[event.kind]
         px4 = self.ctx.profile.px4
         what = f"{name} with coordinate_frame {tm.frame_name(frame)} ({frame})"
+        brief = f"coordinate_frame {tm.frame_name(frame)} ({frame})"
         if frame in docs:
             if frame in receiver:
                 return {}
             return {
                 f"frame:{frame}": Offence(
                     f"{what}: listed by the PX4 {px4} docs, but PX4's receiver accepts only "
-                    f"{frames_text(receiver)} and drops the message (no setpoint, no keep-alive)"
+                    f"{frames_text(receiver)} and drops the message (no setpoint, no keep-alive)",
+                    short=f"{brief}: in the docs, but PX4 drops it",
                 )
             }
         for_what = f"a {tm.describe_combo(usable)} setpoint" if usable in rules.combos else name
@@ -233,6 +235,7 @@ class PositionTargetFields(Check):
                     f"{what}: {docs_text}; PX4's receiver accepts it nevertheless (every "
                     "release from v1.12)",
                     Severity.INFO,
+                    f"{brief}: not in the docs, but PX4 takes it",
                 )
             }
         consequence = "PX4 drops the message (no setpoint, no keep-alive)"
@@ -244,7 +247,9 @@ class PositionTargetFields(Check):
                     "PX4 ignores the position in this frame and, with nothing else left, "
                     "drops the message (no setpoint, no keep-alive)"
                 )
-        return {f"frame:{frame}": Offence(f"{what}: {docs_text}; {consequence}")}
+        dropped = "drops" in consequence
+        short = f"{brief}: {'dropped, no keep-alive' if dropped else 'position ignored'}"
+        return {f"frame:{frame}": Offence(f"{what}: {docs_text}; {consequence}", short=short)}
 
     # -- OFB602 -------------------------------------------------------------------------
 
@@ -258,7 +263,8 @@ class PositionTargetFields(Check):
             return {
                 "empty": Offence(
                     f"{head} selects no position, velocity or acceleration: PX4 drops it "
-                    "(no setpoint, no keep-alive)"
+                    "(no setpoint, no keep-alive)",
+                    short=f"type_mask {mask} selects nothing: dropped, no keep-alive",
                 )
             }
         if mask & tm.FORCE_BIT and "acceleration" in selected:
@@ -283,7 +289,7 @@ class PositionTargetFields(Check):
         else:
             px4_does = (
                 "PX4's receiver passes it on; what the rover or fixed-wing controllers make of "
-                "the mix is unverified (gate spec 15)"
+                "the mix is unverified"
             )
             severity = Severity.WARNING
         return {
@@ -292,6 +298,8 @@ class PositionTargetFields(Check):
                 f"{self.ctx.profile.px4} docs support on a {self.vehicle_label} (supported: "
                 f"{supported}); {px4_does}",
                 severity,
+                short=f"type_mask {event.type_mask} selects {tm.describe_combo(usable)}: not in "
+                f"the docs' list for a {self.vehicle_label}",
             )
         }
 
@@ -324,7 +332,9 @@ class PositionTargetFields(Check):
                 f"({frame}): the PX4 {self.ctx.profile.px4} docs list this frame for "
                 f"{tm.describe_combo(usable)} setpoints on a {self.vehicle_label}, but in it "
                 f"PX4's receiver {why}, so nothing is left and PX4 drops the message (no "
-                "setpoint, no keep-alive)"
+                "setpoint, no keep-alive)",
+                short=f"type_mask {event.type_mask}: {tm.describe_combo(selected)} in "
+                f"{tm.frame_name(frame)} leaves nothing: dropped, no keep-alive",
             )
         }
 
@@ -354,7 +364,8 @@ class PositionTargetFields(Check):
                 f"PX4's receiver makes of it, {'; '.join(problems)} (a used field that is NaN "
                 "counts as missing); PX4's multicopter position controller rejects such a "
                 f"setpoint and {fallback} (no mode change, no failsafe flag); the docs' "
-                "combinations use all three components of a group"
+                "combinations use all three components of a group",
+                short=clip(f"type_mask {event.type_mask}: {problems[0]}: PX4 holds instead"),
             )
         }
 
@@ -372,13 +383,14 @@ class PositionTargetFields(Check):
             f"setpoint-type value ({listed}): the docs say the vehicle then flies a "
             "flower-like pattern"
         )
+        short = f"fixed-wing position with type_mask {event.type_mask}: no setpoint type"
         if at_least(self.ctx.profile.px4, "1.13"):
             message += (
                 f"; PX4 {self.ctx.profile.px4}'s receiver does not read these bits at all "
                 "(v1.12+), so the value changes nothing there"
             )
-            return {"type": Offence(message, Severity.INFO)}
-        return {"type": Offence(message)}
+            return {"type": Offence(message, Severity.INFO, short + " (PX4 ignores it)")}
+        return {"type": Offence(message, short=short)}
 
     # -- OFB604 -------------------------------------------------------------------------
 
@@ -526,7 +538,7 @@ class LegacySetpointDropped(Check):
         return {
             "global": Offence(
                 f"{name} on PX4 1.11 goes to a legacy-style handler whose details are "
-                "unverified (gate spec 6.3): fuzzoff's gate model takes it as a keep-alive "
+                "unverified: fuzzoff's gate model takes it as a keep-alive "
                 "without a position setpoint; SET_POSITION_TARGET_LOCAL_NED is the safe choice",
                 Severity.WARNING,
             )

@@ -245,6 +245,8 @@ class SetpointTarget(Check):
                     seen.t,
                     seen.where,
                     end=seen.last_t if seen.count > 1 else None,
+                    short=f"setpoints for system {system} component {component}, which is not "
+                    "in the recording: dropped",
                 )
             return
         self.ctx.cannot_check(

@@ -198,18 +198,21 @@ class SetpointsOutsideOffboard(Check):
                 f"{docs}; PX4 flies no setpoint while disarmed, so nothing fights them (the "
                 "stream before a switch must run anyway)"
             )
+            effect = "nothing flies them (disarmed)"
         elif entered:
             severity = Severity.INFO
             why = (
                 f"{docs}; they ran up to the offboard request or PX4's return to OFFBOARD at "
                 f"{t:.3f} s, so PX4's own controllers wrote the same topics only until then"
             )
+            effect = "the run-up to offboard"
         else:
             severity = Severity.ERROR
             why = (
                 f"{docs}; no offboard request followed while they ran, so they collide with "
                 "PX4's own controllers, which write the same topics in this mode"
             )
+            effect = "they fight PX4's own controllers"
         state = "" if run.armed else ", disarmed"
         self.ctx.report(
             "OFB203",
@@ -219,6 +222,7 @@ class SetpointsOutsideOffboard(Check):
             run.where,
             severity=severity,
             end=run.last if run.last > run.start else None,
+            short=f"{what} sent while {run.mode}: {effect}",
         )
 
     def finish(self, t_end: float) -> None:

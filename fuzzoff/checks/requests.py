@@ -124,10 +124,12 @@ class RequestRejected(Check):
         self.ctx.report(
             "OFB201",
             f"{request.what} at {request.command.t:.2f} s: {px4_label(self.ctx)} would reject it "
-            f"({verdict.reason or verdict.message}, gate spec {verdict.spec}); the recording "
-            "has no command acks to show the vehicle's answer",
+            f"({verdict.reason or verdict.message}); the recording has no command acks to show "
+            "the vehicle's answer",
             request.command.t,
             request.command.where,
+            short=f"{request.what}: {px4_label(self.ctx)} would reject it "
+            f"({verdict.reason or verdict.message})",
         )
 
     def _settle(self, now: float) -> None:
@@ -143,7 +145,7 @@ class RequestRejected(Check):
             return
         verdict = request.verdict
         if verdict is not None and verdict.what.endswith("rejected"):
-            why = f"gate model: {verdict.reason or verdict.message} (gate spec {verdict.spec})"
+            why = f"gate model: {verdict.reason or verdict.message}"
         elif verdict is not None:
             why = (
                 f"the gate model expected {px4_label(self.ctx)} to accept it, so the cause is "
@@ -157,6 +159,7 @@ class RequestRejected(Check):
             f"{ack.result_name}; {why}",
             ack.t,
             ack.where,
+            short=f"{request.what} at {request.command.t:.2f} s rejected: {ack.result_name}",
         )
 
     def finish(self, t_end: float) -> None:

@@ -154,7 +154,8 @@ class RoverCombination(Check):
         return {
             f"invalid:{sorted(with_value)}": Offence(
                 f"rover setpoints published with values: {tr.names(with_value)}; not one of the "
-                f"valid combinations ({valid})"
+                f"valid combinations ({valid})",
+                short=f"{tr.names(with_value)}: not a valid rover setpoint combination",
             )
         }
 
@@ -164,7 +165,8 @@ class RoverCombination(Check):
         return {
             f"flags:{row.name}:{mode.flags()}": Offence(
                 f"rover setpoints form {row.name}, which needs OffboardControlMode "
-                f"{row.flag} alone; the flags set are: {flags_text(mode)}"
+                f"{row.flag} alone; the flags set are: {flags_text(mode)}",
+                short=f"{row.name} needs '{row.flag}' alone; set: {flags_text(mode)}",
             )
         }
 
@@ -190,7 +192,8 @@ class RoverCombination(Check):
             f"nan:{row.name}:{sorted(carry)}:{sorted(missing)}": Offence(
                 f"{row.name} needs {tr.names(row.nan)} published as NaN, but "
                 f"{' and '.join(parts)}: the rover module's hierarchy overrides the intended "
-                "setpoint"
+                "setpoint",
+                short=f"{row.name}: {' and '.join(parts)} (needs NaN)",
             )
         }
 

@@ -195,6 +195,7 @@ class StaleSetpoints(Check):
             since + self.stale,
             where,
             end=t,
+            short=f"{what} not sent for {t - since:.2f} s while the keep-alive goes on",
         )
 
     def finish(self, t_end: float) -> None:

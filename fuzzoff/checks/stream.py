@@ -43,6 +43,7 @@ keeps the signal, but only just."""
 IN_OFFBOARD = "in OFFBOARD"
 ACROSS_SWITCH = "across the switch to OFFBOARD"
 BEFORE_REQUEST = "in the second before an offboard request"
+SHORT_CONTEXT = {ACROSS_SWITCH: "across the switch", BEFORE_REQUEST: "before a request"}
 
 
 def gap_severity(gap: float, timeout: float) -> Severity:
@@ -218,20 +219,30 @@ class KeepaliveRate(Check):
                 f"{head} refuses the request: its newest keep-alive was {flown:.2f} s old "
                 f"(loss timeout {timeout:.2f} s)"
             )
+            verdict = "refuses the request"
         elif severity is Severity.ERROR:
             message = f"{head} loses the offboard signal after {timeout:.2f} s"
+            verdict = f"loses the signal at {timeout:.2f} s"
         elif gap.counts is not None and flown < self.max_gap:
             message = (
                 f"{head} judges only the newest keep-alive's age at the request (loss timeout "
                 f"{timeout:.2f} s): OFB102 and OFB201 say what it does with the request"
             )
+            verdict = "judges only the keep-alive's age at the request"
         else:
             margin = " (only just)" if severity is Severity.WARNING else ""
             message = (
                 f"{head} would: keep the offboard signal{margin}, it is lost only after a gap "
                 f"of COM_OF_LOSS_T = {timeout:.2f} s"
             )
-        ctx.report("OFB101", message, gap.start, gap.where, severity=severity, end=gap.end)
+            just = ", only just" if margin else ""
+            verdict = f"keeps the signal{just} (lost at {timeout:.2f} s)"
+        place = context.partition(" (")[0]  # "in OFFBOARD (until it left)": the place only
+        place = SHORT_CONTEXT.get(place, place)
+        short = f"keep-alive gap {gap.proven:.2f} s {place}; {px4_label(ctx)} {verdict}"
+        ctx.report(
+            "OFB101", message, gap.start, gap.where, severity=severity, end=gap.end, short=short
+        )
 
     def finish(self, t_end: float) -> None:
         left, self.left_at = self.left_at, None
@@ -324,20 +335,33 @@ class StreamBeforeRequest(Check):
                 if isinstance(event, VehicleStatus)
                 else "see the gate timeline"
             )
+            brief = ""
         elif verdict.what.endswith("accepted"):
             would = "accept it"
+            brief = "accepts it"
             if not fresh:
                 # accepted only because the vehicle is disarmed (1.14+, D8): 1.13 and legacy
                 # reject the same switch, and arming then needs a fresh keep-alive
                 would += " (disarmed: accepted without a fresh keep-alive, checked at arming)"
+                brief += " (disarmed)"
         else:
             would = f"reject it ({verdict.reason or verdict.message})"
+            brief = "rejects it"
             severity = Severity.ERROR
         message = (
             f"{what} with {had}; docs: stream for at least {self.min_stream:.0f} s first; "
             f"{px4_label(self.ctx)} would: {would}"
         )
-        self.ctx.report("OFB102", message, t, event.where, severity=severity)
+        if self.last is None:
+            stream = "with no keep-alive"
+        elif not fresh:
+            stream = f"{t - self.last:.2f} s after the last keep-alive"
+        else:
+            stream = f"after {t - (self.run_start or t):.2f} s of keep-alive"
+        short = f"{what} {stream} (docs: {self.min_stream:g} s of it)"
+        if brief:
+            short += f"; {px4_label(self.ctx)} {brief}"
+        self.ctx.report("OFB102", message, t, event.where, severity=severity, short=short)
 
 
 @cache

@@ -50,6 +50,50 @@ def add_output_options(parser: argparse.ArgumentParser, formats: tuple[str, ...]
     parser.add_argument("--output", "-o", metavar="FILE", help="write the report here")
 
 
+def add_report_options(parser: argparse.ArgumentParser) -> None:
+    """``--format`` and ``--output`` that may repeat, in pairs: one lint, several reports."""
+    parser.add_argument(
+        "--format",
+        action="append",
+        choices=FORMATS,
+        help="report format (default terminal); repeat it with an --output each for several",
+    )
+    parser.add_argument(
+        "--output",
+        "-o",
+        action="append",
+        metavar="FILE",
+        help="where the --format of the same position goes (default and '-': standard output)",
+    )
+
+
+def report_targets(
+    formats: list[str] | None, outputs: list[str] | None
+) -> list[tuple[str, str | None]]:
+    """``--format``/``--output`` pairs in the order given: ``[("sarif", "a.sarif"), ("html",
+    "r.html"), ("terminal", None)]``. A format without an output of its own goes to standard
+    output, which only one report can; an output needs a format."""
+    formats = formats or ["terminal"]
+    outputs = outputs or []
+    if len(outputs) > len(formats):
+        raise ConfigError(
+            f"{len(outputs)} --output for {len(formats)} --format: give a --format for each"
+        )
+    pairs = [(fmt, outputs[i] if i < len(outputs) else None) for i, fmt in enumerate(formats)]
+    pairs = [(fmt, None if out == "-" else out) for fmt, out in pairs]
+    to_stdout = [fmt for fmt, out in pairs if out is None]
+    if len(to_stdout) > 1:
+        raise ConfigError(
+            f"only one report can go to standard output ({' and '.join(to_stdout)} would): "
+            "give an --output for each --format but one"
+        )
+    files = [out for _, out in pairs if out is not None]
+    twice = sorted({out for out in files if files.count(out) > 1})
+    if twice:
+        raise ConfigError(f"--output {twice[0]} is named twice: one report a file")
+    return pairs
+
+
 def parse_params(values: list[str]) -> dict[str, float]:
     params: dict[str, float] = {}
     for item in values:

@@ -9,12 +9,13 @@ from typing import Any
 
 from fuzzoff.commands import add_command
 from fuzzoff.commands._common import (
-    add_output_options,
     add_profile_options,
+    add_report_options,
     add_rule_options,
     check_output,
     existing_paths,
     render_rich,
+    report_targets,
     settings_from_args,
     settings_per_recording,
     write_output,
@@ -38,36 +39,59 @@ def add_parser(sub: Any) -> None:
     )
     add_profile_options(parser)
     add_rule_options(parser)
-    add_output_options(parser)
+    add_report_options(parser)
     parser.add_argument("--jobs", "-j", type=int, default=1, help="lint files in N processes")
     parser.add_argument(
         "--quiet", "-q", action="store_true", help="only findings at the fail level"
     )
     parser.add_argument("--statistics", action="store_true", help="counts per rule")
+    parser.add_argument(
+        "--verbose",
+        "-v",
+        action="store_true",
+        help="each finding in full: what the docs require, what PX4 does, the exact place",
+    )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.set_defaults(run=run)
 
 
-def _lint_on_terminal(args: argparse.Namespace, paths: list[str], settings: Settings) -> Report:
-    """Lint with a progress bar where one helps, then print the findings with rich (imported
-    here: the machine-readable formats need not pay for it at start-up)."""
+def _lint(
+    args: argparse.Namespace, paths: list[str], settings: Settings, formats: set[str]
+) -> Report:
+    """One lint for every report asked for: with the timelines the HTML report plots, with a
+    progress bar where a terminal report goes to a terminal (rich is imported only then: the
+    machine-readable formats need not pay for it at start-up)."""
+    if "html" in formats:
+        return lint_with_timelines(paths, settings, jobs=args.jobs)
+    if formats == {"terminal"} and not args.no_progress and args.jobs == 1:
+        from rich.console import Console
+
+        from fuzzoff.report.terminal import lint_with_progress
+
+        screen = Console(highlight=False)
+        if screen.is_terminal:
+            return lint_with_progress(paths, settings, screen)
+    return lint_paths(paths, settings, jobs=args.jobs)
+
+
+def _terminal(
+    args: argparse.Namespace, report: Report, settings: Settings, output: str | None
+) -> None:
     from rich.console import Console
 
-    from fuzzoff.report.terminal import lint_with_progress, print_report
-
-    screen = Console(highlight=False)
-    if screen.is_terminal and not args.no_progress and args.jobs == 1:
-        report = lint_with_progress(paths, settings, screen)
-    else:
-        report = lint_paths(paths, settings, jobs=args.jobs)
+    from fuzzoff.report.terminal import print_report
 
     def draw(console: Console) -> None:
         print_report(
-            console, report, settings.fail_on, quiet=args.quiet, statistics=args.statistics
+            console,
+            report,
+            settings.fail_on,
+            quiet=args.quiet,
+            statistics=args.statistics,
+            verbose=args.verbose,
         )
 
-    render_rich(draw, args.output)
-    return report
+    render_rich(draw, output)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -86,15 +110,16 @@ def run(args: argparse.Namespace) -> int:
         suffixes = ", ".join(RECORDING_SUFFIXES)
         raise ConfigError(f"no recordings in {empty[0]} (searched for {suffixes} and bag folders)")
     paths = [str(f) for _, recordings in found for f in recordings]
-    check_output(args.output, paths)
+    targets = report_targets(args.format, args.output)
+    for _, output in targets:
+        check_output(output, paths)
     settings_per_recording(settings, paths)
-    if args.format == "terminal":
-        report = _lint_on_terminal(args, paths, settings)
-    else:
-        # the HTML report plots each vehicle's timeline
-        lint = lint_with_timelines if args.format == "html" else lint_paths
-        report = lint(paths, settings, jobs=args.jobs)
-        write_output(renderer(args.format)(report, settings), args.output)
+    report = _lint(args, paths, settings, {fmt for fmt, _ in targets})
+    for fmt, output in targets:
+        if fmt == "terminal":
+            _terminal(args, report, settings, output)
+        else:
+            write_output(renderer(fmt)(report, settings), output)
     for f in report.files:
         for line in f.problems:
             print(f"fuzzoff: {printable(line)}", file=sys.stderr)

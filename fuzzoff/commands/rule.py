@@ -20,6 +20,12 @@ def add_parser(sub: Any) -> None:
     parser = add_command(sub, "rule")
     parser.add_argument("code", nargs="?", help="a rule code such as OFB101")
     parser.add_argument("--format", choices=("terminal", "json", "markdown"), default="terminal")
+    parser.add_argument(
+        "--verbose",
+        "-v",
+        action="store_true",
+        help="also show the test stream: the events the tests replay through the rule",
+    )
     parser.set_defaults(run=run)
 
 
@@ -29,13 +35,21 @@ def rule_json(rule: Rule) -> dict[str, Any]:
         "name": rule.name,
         "severity": rule.severity.label,
         "profiles": {"px4": list(rule.px4), "vehicles": list(rule.vehicles)},
-        "source": {"doc": rule.source_doc, "section": rule.source_section},
         "summary": rule.summary,
         "why": rule.why,
         "docs_vs_code": rule.docs_vs_code or None,
         "heuristic": rule.heuristic,
         "options": {o.name: {"default": o.default, "doc": o.doc} for o in rule.options},
-        "url": rule.url,
+        "example": None
+        if rule.example is None
+        else {
+            "client": rule.example.client,
+            "language": rule.example.language,
+            "bad": rule.example.bad,
+            "good": rule.example.good,
+        },
+        "references": [{"title": r.title, "url": r.url} for r in rule.references],
+        "page": rule.page,
     }
 
 
@@ -48,27 +62,28 @@ def run(args: argparse.Namespace) -> int:
         if args.format == "json":
             write_output(json.dumps(rule_json(rule), indent=2, ensure_ascii=False) + "\n", None)
         elif args.format == "markdown":
-            write_output(render_page(rule), None)
+            write_output(render_page(rule, test_stream=args.verbose), None)
         else:
-            render_rich(lambda console: _draw_page(console, rule))
+            render_rich(lambda console: _draw_page(console, rule, args.verbose))
         return 0
     rules = list(load_catalog().values())
     if args.format == "json":
         text = json.dumps([rule_json(r) for r in rules], indent=2, ensure_ascii=False)
         write_output(text + "\n", None)
     elif args.format == "markdown":
-        write_output("\n".join(render_page(r) for r in rules), None)
+        write_output("\n".join(render_page(r, test_stream=args.verbose) for r in rules), None)
     else:
         render_rich(lambda console: _draw_list(console, rules))
     return 0
 
 
-def _draw_page(console: Console, rule: Rule) -> None:
+def _draw_page(console: Console, rule: Rule, verbose: bool) -> None:
     """Rendered Markdown on a terminal; the Markdown itself in a file or a pipe."""
+    page = render_page(rule, test_stream=verbose)
     if console.is_terminal:
-        console.print(Markdown(render_page(rule)))
+        console.print(Markdown(page))
     else:
-        console.out(render_page(rule), end="", highlight=False)
+        console.out(page, end="", highlight=False)
 
 
 def _draw_list(console: Console, rules: list[Rule]) -> None:

@@ -159,14 +159,11 @@ def _findings_table(markers: list[Marker], timed: set[str]) -> str:
     rows = []
     for m in markers:
         f = m.finding
-        rule = _rule(f.code)
         sev = f.severity.label
         when = e(_time(f))
         if m.ident in timed:
             when = f'<a href="#mark-{e(m.ident)}">{when}</a>'
         code = f'<a href="#rule-{e(f.code)}">{e(f.code)}</a>'
-        if rule is not None:
-            code += f' <a class="ext" href="{e(rule.url)}" title="rule page online">↗</a>'
         where = e(str(f.where)) if f.where is not None and f.where.topic else ""
         rows.append(
             f'<tr id="finding-{e(m.ident)}" class="{sev}"><td>{when}</td><td>{code}</td>'
@@ -203,7 +200,8 @@ def rule_article(rule: Rule) -> str:
     body = body.replace("<h1>", "<h3>").replace("</h1>", "</h3>")
     return (
         f'<article class="rule" id="rule-{e(rule.code)}">{body}'
-        f'<p>Online: <a href="{e(rule.url)}">{e(rule.url)}</a></p></article>'
+        f"<p>In a terminal: <code>fuzzoff rule {e(rule.code)}</code>; in fuzzoff's repository: "
+        f"<code>{e(rule.page)}</code>.</p></article>"
     )
 
 

@@ -18,7 +18,6 @@ dl.summary dt { color: #555; } dl.summary dd { margin: 0; overflow-wrap: anywher
 ul.problems li { color: var(--error); overflow-wrap: anywhere; }
 .none { color: #777; font-style: italic; }
 .js .needs-js { display: none; }
-a.ext { text-decoration: none; }
 tr:target { background: #fff3b0; }
 details.help { margin: 10px 0; color: #444; } details.help summary { cursor: pointer; }
 

@@ -36,6 +36,11 @@ def finding_line(finding: Finding) -> str:
     return xml_text(printable(" | ".join(parts), CI_TEXT_LIMIT))
 
 
+def rule_line(rule: Rule) -> str:
+    """Where the rule is explained: its page in the terminal and in fuzzoff's repository."""
+    return f"rule {rule.code} {rule.name}: fuzzoff rule {rule.code}, or {rule.page}"
+
+
 def not_checkable(file: FileReport) -> dict[str, str]:
     """Code -> the OFB002 message saying why it cannot be checked on this recording."""
     out = {}
@@ -77,7 +82,7 @@ def testcase(
             message=f"{len(failing)} finding(s) at or above {settings.fail_on.label}",
             type=rule.code,
         )
-        failure.text = "\n".join(finding_line(f) for f in failing) + f"\nrule: {rule.url}"
+        failure.text = "\n".join(finding_line(f) for f in failing) + f"\n{rule_line(rule)}"
     elif reason is not None and not mine:
         ET.SubElement(case, "skipped", message=xml_text(reason))
     below = [f for f in mine if f.severity < settings.fail_on]

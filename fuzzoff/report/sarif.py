@@ -1,8 +1,11 @@
 """``--format sarif``: SARIF 2.1.0 for code-scanning services (GitHub, Azure DevOps, ...).
 
-Every catalog rule is in ``tool.driver.rules`` with its page as help text and ``Rule.url`` as
-``helpUri``. A recording is binary, so a result points at the file without a text region; the
-time, vehicle and topic go into the message and the result's properties, and
+Every catalog rule is in ``tool.driver.rules`` with its whole page as help text (plain and
+Markdown), which GitHub code scanning shows beside each result. There is no ``helpUri``: SARIF
+requires an absolute URI there, and the project publishes no site of rule pages; the page's
+references link to PX4's docs and source instead. The tool's ``informationUri`` is its package
+page. A recording is binary, so a result points at the file without a
+text region; the time, vehicle and topic go into the message and the result's properties, and
 ``partialFingerprints`` is computed here from rule, vehicle, topic and time window (GitHub cannot
 fingerprint a binary file itself). Paths under the working folder are written relative to the
 ``SRCROOT`` base, which is what code scanning matches against the repository.
@@ -24,7 +27,8 @@ from fuzzoff.findings import Finding, Report, Severity
 from fuzzoff.report.sanitize import CI_TEXT_LIMIT, printable
 
 SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
-INFORMATION_URI = "https://fuzzoff.dev"
+INFORMATION_URI = "https://pypi.org/project/fuzzoff/"
+"""Where the tool is described: its package page (the README), where ``pip install`` gets it."""
 FINGERPRINT_KEY = "fuzzoffFinding/v1"
 LEVEL = {Severity.ERROR: "error", Severity.WARNING: "warning", Severity.INFO: "note"}
 BASE_ID = "SRCROOT"
@@ -44,12 +48,12 @@ def rule_descriptor(rule: Rule) -> dict[str, Any]:
         "shortDescription": {"text": _first_sentence(rule.summary)},
         "fullDescription": {"text": " ".join(rule.summary.split())},
         "help": {"text": page, "markdown": page},
-        "helpUri": rule.url,
         "defaultConfiguration": {"level": LEVEL[rule.severity]},
         "properties": {
             "tags": ["px4", "offboard", *(["heuristic"] if rule.heuristic else [])],
             "precision": "medium" if rule.heuristic else "high",
             "profiles": rule.profiles_text(),
+            "page": rule.page,
         },
     }
 

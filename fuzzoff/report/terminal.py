@@ -1,5 +1,10 @@
 """Terminal output with rich: findings grouped per file, then a summary (ruff-like).
 
+A finding is one line: its time, code and severity, the key fact (``Finding.short``) and where
+in the file it sits; ``--verbose`` adds its whole message (what the docs require and what the
+profile's PX4 does), its time window and byte offset, and ``fuzzoff rule CODE`` explains the
+rule. On a terminal a line too long for the window wraps at a word, under its own column.
+
 Colour only on a terminal and without ``NO_COLOR`` (rich decides; ``FORCE_COLOR`` forces it);
 tables fall back to ASCII when the output is not a terminal. Every string that comes from a
 recording goes through ``printable`` and into ``Text`` objects, never into markup, so escape
@@ -32,47 +37,130 @@ def table_box(console: Console) -> box.Box:
     return box.SIMPLE_HEAVY if console.is_terminal else box.ASCII
 
 
-def finding_line(finding: Finding) -> Text:
-    when = "   whole file" if finding.time_s is None else f"{finding.time_s:11.3f}s"
-    line = Text()
-    line.append(when, style="dim")
-    line.append("  ")
-    line.append(finding.code, style="bold")
-    line.append(" ")
-    line.append(f"{finding.severity.label:<7}", style=STYLE[finding.severity])
-    line.append(" ")
-    if finding.vehicle:
-        line.append(f"[{printable(finding.vehicle, 40)}] ", style="magenta")
-    line.append(printable(finding.message))
-    if finding.end_s is not None and finding.time_s is not None:
-        line.append(f"  (until {finding.end_s:.3f}s)", style="dim")
-    if finding.where is not None and finding.where.topic:
-        line.append(f"  at {printable(str(finding.where), 120)}", style="dim")
+def _location(finding: Finding, full: bool) -> str:
+    """Topic or message type and index (``#140``); ``full`` adds the byte offset (``@10714``)."""
+    where = finding.where
+    if where is None or not where.topic:
+        return ""
+    if full:
+        return str(where)
+    return where.topic if where.index is None else f"{where.topic} #{where.index}"
+
+
+def finding_parts(finding: Finding, *, vehicle: bool = True) -> tuple[Text, Text, Text]:
+    """The parts of a finding's line: time, code and severity; the key fact (the vehicle
+    first where the file has several); where in the file it sits (empty if nowhere)."""
+    when = "whole file" if finding.time_s is None else f"{finding.time_s:.3f}s"
+    head = Text()
+    head.append(f"{when:>10}", style="dim")
+    head.append(" ")
+    head.append(finding.code, style="bold")
+    head.append(" ")
+    head.append(f"{finding.severity.label:<7}", style=STYLE[finding.severity])
+    body = Text()
+    if vehicle and finding.vehicle:
+        body.append(f"[{printable(finding.vehicle, 40)}] ", style="magenta")
+    body.append(printable(finding.short, 300))
+    where = Text(printable(_location(finding, full=False), 120), style="dim")
+    return head, body, where
+
+
+def finding_line(finding: Finding, *, vehicle: bool = True) -> Text:
+    """One finding on one line: time, code, severity, the key fact, where."""
+    head, body, where = finding_parts(finding, vehicle=vehicle)
+    line = Text.assemble(head, " ", body)
+    if where:
+        line.append("  ").append_text(where)
     return line
 
 
-def file_header(file: FileReport) -> Text:
-    header = Text()
-    header.append(printable(file.path), style="bold underline")
-    header.append(f"  {file.format}, {printable(file.profile.describe(), 200)}", style="dim")
+def finding_detail(finding: Finding) -> Text:
+    """``--verbose``: the whole message, then the time window and the exact place."""
+    text = Text(printable(finding.message))
+    extra = []
+    if finding.end_s is not None and finding.time_s is not None:
+        extra.append(f"until {finding.end_s:.3f}s")
+    location = _location(finding, full=True)
+    if location:
+        extra.append(f"at {printable(location, 120)}")
+    if extra:
+        text.append("\n" + ", ".join(extra), style="dim")
+    return text
+
+
+HEAD_WIDTH = 26
+"""Columns before a finding's text: time (10), code (6), severity (7) and their spaces."""
+
+
+def _print_findings(
+    console: Console, findings: list[Finding], vehicle: bool, verbose: bool
+) -> None:
+    """On a terminal, a grid that wraps long text at word boundaries under its own column; in
+    a file or a pipe, one line per finding (grep-able, however long)."""
+    if not console.is_terminal:
+        for finding in findings:
+            console.print(finding_line(finding, vehicle=vehicle), soft_wrap=True)
+            if verbose:
+                for line in finding_detail(finding).split("\n"):
+                    console.print(Text(" " * HEAD_WIDTH).append_text(line), soft_wrap=True)
+        return
+    grid = Table.grid(padding=(0, 1))
+    grid.add_column(no_wrap=True, width=HEAD_WIDTH - 1)
+    grid.add_column(overflow="fold")
+    room = console.width - HEAD_WIDTH
+    for finding in findings:
+        head, body, where = finding_parts(finding, vehicle=vehicle)
+        if where and body.cell_len + 2 + where.cell_len <= room:
+            grid.add_row(head, Text.assemble(body, "  ", where))
+        else:  # the place on a row of its own rather than broken across two
+            grid.add_row(head, body)
+            if where:
+                grid.add_row(Text(), where)
+        if verbose:
+            grid.add_row(Text(), finding_detail(finding))
+    console.print(grid)
+
+
+def file_header_parts(file: FileReport) -> tuple[Text, Text]:
+    """The recording's name, and what it is: format, profile, its one vehicle, incomplete."""
+    name = Text(printable(file.path), style="bold underline")
+    about = Text(f"{file.format}, {printable(file.profile.describe(), 200)}", style="dim")
+    vehicles = {f.vehicle for f in file.findings if f.vehicle}
+    if len(vehicles) == 1:
+        about.append(f", vehicle {printable(vehicles.pop(), 40)}", style="dim")
     if not file.complete:
-        header.append("  (incomplete)", style="bold red")
-    return header
+        about.append("  (incomplete)", style="bold red")
+    return name, about
 
 
-def print_file(console: Console, file: FileReport, fail_on: Severity, quiet: bool) -> None:
+def _print_header(console: Console, file: FileReport) -> None:
+    """One line; on a terminal too narrow for it, the name and then what it is, each whole."""
+    name, about = file_header_parts(file)
+    if not console.is_terminal or name.cell_len + 2 + about.cell_len <= console.width:
+        console.print(Text.assemble(name, "  ", about), soft_wrap=True)
+        return
+    console.print(name, soft_wrap=True)
+    console.print(Text("  ").append_text(about))
+
+
+def print_file(
+    console: Console, file: FileReport, fail_on: Severity, quiet: bool, verbose: bool = False
+) -> None:
     shown = [f for f in file.findings if not quiet or f.severity >= fail_on]
     if quiet and not shown:
         return
-    console.print(file_header(file), soft_wrap=True)
-    for finding in shown:
-        console.print(finding_line(finding), soft_wrap=True)
+    _print_header(console, file)
+    # one vehicle is named in the heading; several are named on each line
+    several = len({f.vehicle for f in file.findings if f.vehicle}) > 1
+    _print_findings(console, shown, several, verbose)
     if not shown:
         console.print(Text("  no findings", style="green"))
     console.print()
 
 
-def print_summary(console: Console, report: Report, fail_on: Severity) -> None:
+def print_summary(
+    console: Console, report: Report, fail_on: Severity, verbose: bool = False
+) -> None:
     counts = Counter(f.severity for f in report.findings)
     table = Table(title="fuzzoff summary", box=table_box(console), show_edge=False)
     table.add_column("files", justify="right")
@@ -94,6 +182,9 @@ def print_summary(console: Console, report: Report, fail_on: Severity) -> None:
         verdict += f" (findings at or above {fail_on.label})"
     style = "bold green" if status == 0 else "bold red"
     console.print(Text(f"result: {verdict}", style=style))
+    if report.findings and not verbose:
+        hint = "--verbose shows each finding in full; fuzzoff rule CODE explains a rule, with a fix"
+        console.print(Text(hint, style="dim"), soft_wrap=True)
 
 
 def print_statistics(console: Console, report: Report) -> None:
@@ -123,15 +214,17 @@ def print_report(
     *,
     quiet: bool = False,
     statistics: bool = False,
+    verbose: bool = False,
 ) -> None:
-    """The whole terminal report; ``quiet`` keeps only findings at the fail level, no summary."""
+    """The whole terminal report; ``quiet`` keeps only findings at the fail level, no summary;
+    ``verbose`` adds each finding's whole message, time window and byte offset."""
     if statistics:
         print_statistics(console, report)
         return
     for file in report.files:
-        print_file(console, file, fail_on, quiet)
+        print_file(console, file, fail_on, quiet, verbose)
     if not quiet:
-        print_summary(console, report, fail_on)
+        print_summary(console, report, fail_on, verbose)
 
 
 def lint_with_progress(paths: list[str], settings: Settings, console: Console) -> Report:

@@ -1,0 +1,249 @@
+"""The README is the package page: every command block it shows is run here, as a user would.
+
+``console`` blocks: each ``$ fuzzoff ...`` line runs from the repository root in a 120-column,
+colourless environment, and the lines shown under it must appear in its output, in order
+(``...`` stands for lines left out); ``$ echo $?`` shows the previous command's exit status. A
+block without a language is a line from an output shown above it. The ``toml`` configuration is
+used for a lint, the ``python`` API example runs against corpus recordings, the GitHub Actions
+workflow's lint step runs in a folder of recordings and writes the two reports its upload steps
+name, and the pre-commit configuration is the repository's own hook. A block marked
+``<!-- readme-test: not run (why) -->`` is left out, and says why.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+from ruamel.yaml import YAML
+
+from tests.helpers import CORPORA, ROOT, run_cli
+
+README = (ROOT / "README.md").read_text(encoding="utf-8")
+FENCE = re.compile(r"^(?P<fence>`{3,})(?P<lang>[\w-]*)\n(?P<body>.*?)^(?P=fence)$", re.M | re.S)
+NOT_RUN = re.compile(r"<!-- readme-test: not run \((?P<why>[^)]+)\) -->\s*$")
+DURATION = re.compile(r"\d+\.\d+ s( +\d+/s)?")
+
+
+@dataclass(frozen=True)
+class Block:
+    lang: str
+    body: str
+    line: int
+    skipped: str | None
+
+    @property
+    def name(self) -> str:
+        return f"{self.lang or 'plain'}@{self.line}"
+
+
+def _blocks() -> list[Block]:
+    out = []
+    for match in FENCE.finditer(README):
+        before = README[: match.start()].rstrip("\n").rsplit("\n", 1)[-1]
+        skipped = NOT_RUN.search(before)
+        out.append(
+            Block(
+                match.group("lang"),
+                match.group("body"),
+                README.count("\n", 0, match.start()) + 1,
+                skipped.group("why") if skipped else None,
+            )
+        )
+    return out
+
+
+BLOCKS = _blocks()
+
+
+def _of(lang: str) -> list[Block]:
+    return [b for b in BLOCKS if b.lang == lang and b.skipped is None]
+
+
+def test_every_block_is_run_here_or_says_why_not() -> None:
+    handled = {"console", "", "toml", "python", "yaml"}
+    for block in BLOCKS:
+        assert block.skipped is not None or block.lang in handled, block.name
+    assert [b.lang for b in BLOCKS if b.skipped] == ["sh"]  # the install commands
+    assert len(_of("console")) >= 3 and _of("yaml") and _of("toml") and _of("python")
+
+
+@dataclass
+class Command:
+    argv: list[str]
+    shown: list[str]
+
+
+def _commands(body: str) -> list[Command]:
+    commands: list[Command] = []
+    for line in body.splitlines():
+        if line.startswith("$ "):
+            commands.append(Command(line[2:].split(), []))
+        else:
+            commands[-1].shown.append(line.rstrip())
+    return commands
+
+
+def _in_order(shown: list[str], actual: list[str]) -> None:
+    """Each run of shown lines between ``...`` appears in ``actual``, consecutively and in
+    order; a block that does not start (end) with ``...`` starts (ends) the output."""
+    groups: list[list[str]] = [[]]
+    for line in shown:
+        if line == "...":
+            groups.append([])
+        else:
+            groups[-1].append(line)
+    at = 0
+    for i, group in enumerate(groups):
+        if not group:
+            continue
+        n = len(group)
+        starts = [j for j in range(at, len(actual) - n + 1) if actual[j : j + n] == group]
+        assert starts, f"not in the output (from line {at}):\n" + "\n".join(group)
+        if i == 0 and shown[0] != "...":
+            assert starts[0] == 0, f"the output does not start with {group[0]!r}"
+        at = starts[0] + n
+    if shown and shown[-1] != "...":
+        assert at == len(actual), f"the output goes on after {shown[-1]!r}"
+
+
+@pytest.fixture
+def terminal_of_120_columns(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("COLUMNS", "120")
+    monkeypatch.setenv("NO_COLOR", "1")
+    monkeypatch.delenv("FORCE_COLOR", raising=False)
+
+
+CONSOLE = _of("console")
+
+
+@pytest.mark.parametrize("block", CONSOLE, ids=[b.name for b in CONSOLE])
+def test_console_block_prints_what_the_readme_shows(
+    block: Block, terminal_of_120_columns: None
+) -> None:
+    status = None
+    for command in _commands(block.body):
+        if command.argv == ["echo", "$?"]:
+            assert command.shown == [str(status)]
+            continue
+        assert command.argv[0] == "fuzzoff", command.argv
+        result = run_cli(command.argv[1:], cwd=ROOT)
+        status = result.returncode
+        assert status in (0, 1), result.stderr
+        actual = [ln.rstrip() for ln in result.stdout.splitlines()]
+        shown = command.shown
+        if command.argv[1] == "fuzz":  # a campaign's durations and rates vary from run to run
+            actual = [DURATION.sub("S", ln) for ln in actual]
+            shown = [DURATION.sub("S", ln) for ln in shown]
+        _in_order(shown, actual)
+
+
+def _outputs() -> list[str]:
+    lines = []
+    for block in CONSOLE:
+        for command in _commands(block.body):
+            lines += command.shown
+    return lines
+
+
+@pytest.mark.parametrize("block", _of(""), ids=[b.name for b in _of("")])
+def test_a_plain_block_is_a_line_the_readme_shows_in_an_output(block: Block) -> None:
+    outputs = _outputs()
+    for line in block.body.splitlines():
+        assert line.rstrip() in outputs, line
+
+
+def test_the_configuration_example_configures_a_lint(tmp_path: Path) -> None:
+    (block,) = _of("toml")
+    config = tomllib.loads(block.body)["tool"]["fuzzoff"]
+    (tmp_path / "pyproject.toml").write_text(block.body, encoding="utf-8")
+    shutil.copy(CORPORA / "tlog" / "stream_lost_in_offboard.tlog", tmp_path / "flight.tlog")
+    result = run_cli(["lint", "flight.tlog", "--format", "json"], cwd=tmp_path)
+    assert result.returncode in (0, 1), result.stderr
+    findings = json.loads(result.stdout)["files"][0]["findings"]
+    assert findings and all(f["code"][:4] in ("OFB1", "OFB2") for f in findings)
+    assert not any(f["code"] in config["ignore"] for f in findings)
+    assert json.loads(result.stdout)["files"][0]["profile"]["px4"] == config["px4"]
+
+
+def test_the_python_example_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    (block,) = _of("python")
+    shutil.copy(CORPORA / "tlog" / "stream_lost_in_offboard.tlog", tmp_path / "flight.tlog")
+    (tmp_path / "logs").mkdir()
+    shutil.copy(CORPORA / "tlog" / "good_offboard.tlog", tmp_path / "logs" / "good.tlog")
+    monkeypatch.chdir(tmp_path)
+    scope: dict[str, object] = {}
+    exec(compile(block.body, "README.md", "exec"), scope)
+    findings = scope["findings"]
+    assert isinstance(findings, list) and any(f.code == "OFB303" for f in findings)
+
+
+def _yaml(block: Block) -> object:
+    return YAML(typ="safe").load(block.body)
+
+
+def _workflow() -> dict[str, object]:
+    for block in _of("yaml"):
+        data = _yaml(block)
+        if isinstance(data, dict) and "jobs" in data:
+            return data
+    raise AssertionError("no GitHub Actions workflow in the README")
+
+
+def test_the_github_workflow_writes_the_reports_it_uploads_from_one_lint(tmp_path: Path) -> None:
+    workflow = _workflow()
+    assert workflow["permissions"] == {"contents": "read", "security-events": "write"}
+    jobs = workflow["jobs"]
+    assert isinstance(jobs, dict)
+    steps = next(iter(jobs.values()))["steps"]
+    lint = next(s for s in steps if "fuzzoff lint" in s.get("run", ""))
+    assert lint["run"].count("fuzzoff lint") == 1  # one lint, both reports
+    upload = next(s for s in steps if s.get("uses", "").startswith("github/codeql-action/upload"))
+    artifact = next(s for s in steps if s.get("uses", "").startswith("actions/upload-artifact"))
+    logs = tmp_path / "logs"
+    logs.mkdir()
+    for name in ("stream_lost_in_offboard.tlog", "good_offboard.tlog"):
+        shutil.copy(CORPORA / "tlog" / name, logs / name)
+    output = tmp_path / "github_output"
+    env = {
+        **os.environ,
+        "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}",
+        "GITHUB_OUTPUT": str(output),
+        "NO_COLOR": "1",
+    }
+    proc = subprocess.run(
+        ["bash", "-e", "-c", lint["run"]],
+        cwd=tmp_path,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert proc.returncode == 0, proc.stderr  # the step itself passes: the status is kept
+    assert output.read_text().strip() == "status=1"  # and the last step fails the job with it
+    sarif = json.loads((tmp_path / upload["with"]["sarif_file"]).read_text(encoding="utf-8"))
+    assert sarif["version"] == "2.1.0" and sarif["runs"][0]["results"]
+    html = (tmp_path / artifact["with"]["path"]).read_text(encoding="utf-8")
+    assert "stream_lost_in_offboard.tlog" in html and "<!DOCTYPE html>" in html[:200]
+    assert "OFB101" in proc.stdout  # the findings in the job's log too
+    last = steps[-1]
+    assert last["if"] == f"steps.{lint['id']}.outputs.status != '0'"
+
+
+def test_the_pre_commit_example_is_the_repositorys_hook() -> None:
+    (hook,) = YAML(typ="safe").load((ROOT / ".pre-commit-hooks.yaml").read_text())
+    configs = [_yaml(b) for b in _of("yaml")]
+    config = next(c for c in configs if isinstance(c, dict) and "repos" in c)
+    (local,) = config["repos"][0]["hooks"]
+    assert config["repos"][0]["repo"] == "local"
+    for key in ("id", "entry", "language", "files", "require_serial"):
+        assert local[key] == hook[key], key
+    assert local["additional_dependencies"] == ["fuzzoff"]
