@@ -1,0 +1,232 @@
+"""Recordings as Dask tasks: one task per recording, results as they finish, no recording able
+to end the run.
+
+A worker process that dies while linting (a crash in a reader's C code, the kernel's OOM
+killer) is restarted by its nanny and the scheduler tries the recording again elsewhere; when
+it has killed ``allowed-failures`` + 1 workers the scheduler gives up on it (``KilledWorker``)
+and it becomes that recording's OFB001. A recording that runs past ``--timeout`` is stopped
+the only way a thread can be: its task is cancelled and its worker restarted. The clock runs
+from the moment the task starts on its worker (each task announces itself with
+``Worker.log_event``), not from its submission, so a long queue does not time anything out.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import threading
+import time
+import uuid
+from collections.abc import Callable, Collection, Iterator, Sequence
+from contextlib import contextmanager
+from dataclasses import dataclass
+from typing import Any
+
+from fuzzoff.config import ConfigError, Settings
+from fuzzoff.engine import lint_file
+from fuzzoff.fleet import require
+from fuzzoff.fleet.task import CRASHED, FAILED, TIMED_OUT, Lint, Outcome, failed_report, lint_target
+
+LOCAL = "local"
+DEFAULT_TIMEOUT_S = 600.0
+"""Per recording. A 1M-message recording lints in about 10 s on one core; ten minutes is a
+recording fuzzoff cannot finish, not a slow one."""
+LOCAL_ALLOWED_FAILURES = 1
+"""For ``--scheduler local``: a recording that killed two worker processes in turn is the
+cause, not the machine (Dask's default, 3, restarts four workers before it says so). A remote
+scheduler keeps its own ``distributed.scheduler.allowed-failures``."""
+POLL_S = 0.02
+
+
+@contextmanager
+def connect(address: str, workers: int | None = None) -> Iterator[Any]:
+    """A ``distributed.Client`` for ``address``: a scheduler's address (``tcp://host:8786``,
+    or a scheduler file's path), or ``local`` for a LocalCluster on this machine with
+    ``workers`` single-threaded worker processes (default: one per core)."""
+    require("scheduler", "--scheduler")
+    import dask
+    from distributed import Client, LocalCluster
+
+    # Dask logs a worker it restarts as a warning with a traceback; the run says it in one line
+    logging.getLogger("distributed").setLevel(logging.ERROR)
+    if address == LOCAL:
+        with dask.config.set({"distributed.scheduler.allowed-failures": LOCAL_ALLOWED_FAILURES}):
+            cluster = LocalCluster(
+                n_workers=workers or os.cpu_count() or 1,
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=None,
+                silence_logs=logging.ERROR,
+            )
+        with cluster, Client(cluster) as client:
+            yield client
+        return
+    try:
+        client = Client(address, timeout="20s")
+    except (OSError, TimeoutError, ValueError) as exc:
+        reason = f"cannot reach the Dask scheduler ({exc})"
+        raise ConfigError(f"--scheduler {address}: {reason}") from None
+    with client:
+        yield client
+
+
+def _run(
+    index: int,
+    target: str,
+    settings: Settings,
+    topic: str,
+    lint: Lint,
+    known: Collection[str],
+    record: bool,
+) -> Outcome:
+    """The task: say it started (the timeout's clock), then lint."""
+    from distributed import get_worker
+
+    worker = get_worker()
+    worker.log_event(topic, {"index": index, "worker": worker.address})
+    return lint_target(target, settings, lint=lint, known=known, record=record)
+
+
+@dataclass(slots=True)
+class _Start:
+    at: float
+    worker: str
+
+
+class _Run:
+    """One fleet run's futures, the start of each task, and the outcomes so far."""
+
+    def __init__(self, client: Any, targets: Sequence[str], settings: Settings) -> None:
+        self.client = client
+        self.targets = targets
+        self.settings = settings
+        self.id = uuid.uuid4().hex[:12]
+        self.topic = f"fuzzoff-started-{self.id}"
+        self.lock = threading.Lock()
+        self.started: dict[int, _Start] = {}
+        self.outcomes: list[Outcome | None] = [None] * len(targets)
+
+    def on_start(self, event: tuple[float, dict[str, Any]]) -> None:
+        msg = event[1]
+        with self.lock:
+            self.started[int(msg["index"])] = _Start(time.monotonic(), str(msg["worker"]))
+
+    def elapsed(self, index: int) -> float | None:
+        with self.lock:
+            start = self.started.get(index)
+        return None if start is None else time.monotonic() - start.at
+
+    def overdue(self, timeout_s: float) -> list[tuple[int, str]]:
+        now = time.monotonic()
+        with self.lock:
+            return [
+                (i, s.worker)
+                for i, s in self.started.items()
+                if self.outcomes[i] is None and now - s.at > timeout_s
+            ]
+
+    def forget_worker(self, worker: str) -> None:
+        """Tasks that were on a restarted worker start again elsewhere: their clocks too."""
+        with self.lock:
+            for i in [i for i, s in self.started.items() if s.worker == worker]:
+                del self.started[i]
+
+    def collect(self, index: int, future: Any) -> Outcome:
+        from distributed import KilledWorker
+
+        target = self.targets[index]
+        if future.status == "finished":
+            outcome: Outcome = future.result()
+            return outcome
+        exc = future.exception() if future.status == "error" else None
+        after = self.elapsed(index)
+        took = "" if after is None else f" after {after:.1f} s"
+        if isinstance(exc, KilledWorker):
+            what = (
+                f"the lint did not finish: the Dask worker process linting it died{took} "
+                "(killed, out of memory, or a crash in a reader), and so did the next one "
+                "it was given to; the scheduler gave up on it"
+            )
+            return self._failed(target, what, CRASHED, after)
+        what = f"the lint did not finish: fuzzoff failed{took} ({type(exc).__name__}: {exc})"
+        return self._failed(target, what, FAILED, after)
+
+    def _failed(self, target: str, what: str, status: str, after: float | None) -> Outcome:
+        report = failed_report(target, what, self.settings)
+        return Outcome(target, report, status, seconds=after or 0.0)
+
+    def timed_out(self, index: int, worker: str, timeout_s: float) -> Outcome:
+        what = (
+            f"the lint did not finish within {timeout_s:g} s (--timeout): stopped, and its "
+            f"Dask worker {worker} restarted"
+        )
+        return self._failed(self.targets[index], what, TIMED_OUT, timeout_s)
+
+
+def run_on_cluster(
+    client: Any,
+    targets: Sequence[str],
+    settings: Settings,
+    *,
+    timeout_s: float = DEFAULT_TIMEOUT_S,
+    lint: Lint = lint_file,
+    known: Collection[str] = (),
+    record: bool = False,
+    on_outcome: Callable[[Outcome], None] | None = None,
+) -> list[Outcome]:
+    """Lint every target as its own task on ``client``'s cluster; the outcomes in the order of
+    ``targets``, each handed to ``on_outcome`` as it arrives."""
+    from distributed import as_completed
+
+    run = _Run(client, targets, settings)
+    client.subscribe_topic(run.topic, run.on_start)
+    known_arg: Any = frozenset(known)
+    if known:  # once to every worker, not once per task
+        known_arg = client.scatter(frozenset(known), broadcast=True, hash=False)
+    futures: dict[str, tuple[int, Any]] = {}
+    for i, target in enumerate(targets):
+        key = f"fuzzoff-lint-{run.id}-{i}"
+        future = client.submit(
+            _run, i, target, settings, run.topic, lint, known_arg, record, key=key, pure=False
+        )
+        futures[key] = (i, future)
+    remaining = len(targets)
+    pending = as_completed([f for _, f in futures.values()])
+
+    def done(i: int, outcome: Outcome) -> None:
+        nonlocal remaining
+        run.outcomes[i] = outcome
+        remaining -= 1
+        if on_outcome is not None:
+            on_outcome(outcome)
+
+    try:
+        while remaining:
+            batch = pending.next_batch(block=False) if pending.has_ready() else []
+            for future in batch:
+                entry = futures.pop(future.key, None)
+                if entry is not None and run.outcomes[entry[0]] is None:
+                    done(entry[0], run.collect(entry[0], future))
+                future.release()
+            for i, worker in run.overdue(timeout_s):
+                if not _still_on(client, f"fuzzoff-lint-{run.id}-{i}", worker):
+                    run.forget_worker(worker)  # it died and the task is queued again
+                    continue
+                _, future = futures.pop(f"fuzzoff-lint-{run.id}-{i}")
+                future.cancel()
+                done(i, run.timed_out(i, worker, timeout_s))
+                client.restart_workers([worker], raise_for_error=False)
+                run.forget_worker(worker)
+            if not batch:
+                time.sleep(POLL_S)
+    finally:
+        client.unsubscribe_topic(run.topic)
+        for _, future in futures.values():
+            future.cancel()
+    return [o for o in run.outcomes if o is not None]
+
+
+def _still_on(client: Any, key: str, worker: str) -> bool:
+    processing: dict[str, Any] = client.processing(workers=[worker])
+    return key in processing.get(worker, ())
+
