@@ -142,22 +142,21 @@ def known_hashes(root: Path) -> frozenset[str]:
     return frozenset(h for h in table.column("sha256").to_pylist() if h)
 
 
-def latest(recordings: pa.Table) -> pa.Table:
-    """One row per recording: its newest (the newest ``run_id`` per hash; rows without a hash
-    stay as they are)."""
+def latest(recordings: pa.Table, key: str = "sha256") -> pa.Table:
+    """One row per recording: its newest (the newest ``run_id`` per ``key``; rows with a null
+    key stay as they are)."""
     if recordings.num_rows == 0:
         return recordings
-    rows = recordings.sort_by([("run_id", "descending")]).to_pylist()
+    ordered = recordings.sort_by([("run_id", "descending")])
     seen: set[str] = set()
     keep = []
-    for row in rows:
-        sha = row["sha256"]
-        if sha is not None:
-            if sha in seen:
+    for i, value in enumerate(ordered.column(key).to_pylist()):
+        if value is not None:
+            if value in seen:
                 continue
-            seen.add(sha)
-        keep.append(row)
-    return pa.Table.from_pylist(keep, schema=recordings.schema)
+            seen.add(value)
+        keep.append(i)
+    return ordered.take(keep)
 
 
 class Writer:
