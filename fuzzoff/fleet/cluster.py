@@ -36,6 +36,9 @@ LOCAL_ALLOWED_FAILURES = 1
 cause, not the machine (Dask's default, 3, restarts four workers before it says so). A remote
 scheduler keeps its own ``distributed.scheduler.allowed-failures``."""
 POLL_S = 0.02
+BYSTANDER_TRIES = 3
+"""Submissions of a recording whose task died with workers that another task killed (it was
+queued there, or its start was not heard before the worker died): the first, and two more."""
 
 
 @contextmanager
@@ -44,21 +47,12 @@ def connect(address: str, workers: int | None = None) -> Iterator[Any]:
     or a scheduler file's path), or ``local`` for a LocalCluster on this machine with
     ``workers`` single-threaded worker processes (default: one per core)."""
     require("scheduler", "--scheduler")
-    import dask
-    from distributed import Client, LocalCluster
+    from distributed import Client
 
     # Dask logs a worker it restarts as a warning with a traceback; the run says it in one line
     logging.getLogger("distributed").setLevel(logging.ERROR)
     if address == LOCAL:
-        with dask.config.set({"distributed.scheduler.allowed-failures": LOCAL_ALLOWED_FAILURES}):
-            cluster = LocalCluster(
-                n_workers=workers or os.cpu_count() or 1,
-                threads_per_worker=1,
-                processes=True,
-                dashboard_address=None,
-                silence_logs=logging.ERROR,
-            )
-        with cluster, Client(cluster) as client:
+        with local_cluster(workers or os.cpu_count() or 1) as cluster, Client(cluster) as client:
             yield client
         return
     try:
@@ -68,6 +62,26 @@ def connect(address: str, workers: int | None = None) -> Iterator[Any]:
         raise ConfigError(f"--scheduler {address}: {reason}") from None
     with client:
         yield client
+
+
+def local_cluster(workers: int) -> Any:
+    """A LocalCluster of ``workers`` single-threaded worker processes, each with a nanny."""
+    import dask
+    from distributed import LocalCluster
+
+    local = {
+        "distributed.scheduler.allowed-failures": LOCAL_ALLOWED_FAILURES,
+        # one task on a worker at a time: a worker that dies takes no queued recording along
+        "distributed.scheduler.worker-saturation": 1.0,
+    }
+    with dask.config.set(local):
+        return LocalCluster(
+            n_workers=workers,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=None,
+            silence_logs=logging.ERROR,
+        )
 
 
 def _run(
@@ -131,6 +145,18 @@ class _Run:
             for i in [i for i, s in self.started.items() if s.worker == worker]:
                 del self.started[i]
 
+    def bystander(self, index: int, future: Any) -> bool:
+        """Did the task die with workers that were killed by another task? A worker that
+        dies takes the tasks queued on it along; the one that killed it had started there."""
+        from distributed import KilledWorker
+
+        exc = future.exception() if future.status == "error" else None
+        if not isinstance(exc, KilledWorker):
+            return False
+        with self.lock:
+            start = self.started.get(index)
+        return start is None or start.worker != exc.last_worker.address
+
     def collect(self, index: int, future: Any) -> Outcome:
         from distributed import KilledWorker
 
@@ -182,16 +208,22 @@ def run_on_cluster(
     client.subscribe_topic(run.topic, run.on_start)
     known_arg: Any = frozenset(known)
     if known:  # once to every worker, not once per task
-        known_arg = client.scatter(frozenset(known), broadcast=True, hash=False)
+        # in a list: scatter sends a collection's items one by one
+        [known_arg] = client.scatter([frozenset(known)], broadcast=True, hash=False)
     futures: dict[str, tuple[int, Any]] = {}
-    for i, target in enumerate(targets):
-        key = f"fuzzoff-lint-{run.id}-{i}"
+    tries: dict[int, int] = {}
+
+    def submit(i: int) -> Any:
+        tries[i] = tries.get(i, 0) + 1
+        key = f"fuzzoff-lint-{run.id}-{i}-{tries[i]}"
         future = client.submit(
-            _run, i, target, settings, run.topic, lint, known_arg, record, key=key, pure=False
+            _run, i, targets[i], settings, run.topic, lint, known_arg, record, key=key, pure=False
         )
         futures[key] = (i, future)
+        return future
+
+    pending = as_completed([submit(i) for i in range(len(targets))])
     remaining = len(targets)
-    pending = as_completed([f for _, f in futures.values()])
 
     def done(i: int, outcome: Outcome) -> None:
         nonlocal remaining
@@ -206,13 +238,18 @@ def run_on_cluster(
             for future in batch:
                 entry = futures.pop(future.key, None)
                 if entry is not None and run.outcomes[entry[0]] is None:
-                    done(entry[0], run.collect(entry[0], future))
+                    i = entry[0]
+                    if run.bystander(i, future) and tries[i] < BYSTANDER_TRIES:
+                        pending.add(submit(i))
+                    else:
+                        done(i, run.collect(i, future))
                 future.release()
             for i, worker in run.overdue(timeout_s):
-                if not _still_on(client, f"fuzzoff-lint-{run.id}-{i}", worker):
+                key = f"fuzzoff-lint-{run.id}-{i}-{tries[i]}"
+                if not _still_on(client, key, worker):
                     run.forget_worker(worker)  # it died and the task is queued again
                     continue
-                _, future = futures.pop(f"fuzzoff-lint-{run.id}-{i}")
+                _, future = futures.pop(key)
                 future.cancel()
                 done(i, run.timed_out(i, worker, timeout_s))
                 client.restart_workers([worker], raise_for_error=False)
