@@ -13,7 +13,6 @@ from the moment the task starts on its worker (each task announces itself with
 from __future__ import annotations
 
 import logging
-import os
 import threading
 import time
 import uuid
@@ -42,17 +41,17 @@ queued there, or its start was not heard before the worker died): the first, and
 
 
 @contextmanager
-def connect(address: str, workers: int | None = None) -> Iterator[Any]:
-    """A ``distributed.Client`` for ``address``: a scheduler's address (``tcp://host:8786``,
-    or a scheduler file's path), or ``local`` for a LocalCluster on this machine with
-    ``workers`` single-threaded worker processes (default: one per core)."""
+def connect(address: str, workers: int = 1) -> Iterator[Any]:
+    """A ``distributed.Client`` for ``address``: a scheduler's address (``tcp://host:8786``),
+    or ``local`` for a LocalCluster on this machine with ``workers`` single-threaded worker
+    processes (``--jobs``, as for the local processes without Dask)."""
     require("scheduler", "--scheduler")
     from distributed import Client
 
     # Dask logs a worker it restarts as a warning with a traceback; the run says it in one line
     logging.getLogger("distributed").setLevel(logging.ERROR)
     if address == LOCAL:
-        with local_cluster(workers or os.cpu_count() or 1) as cluster, Client(cluster) as client:
+        with local_cluster(workers) as cluster, Client(cluster) as client:
             yield client
         return
     try:

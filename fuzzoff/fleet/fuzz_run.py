@@ -14,6 +14,7 @@ import argparse
 import dataclasses
 import hashlib
 import json
+import os
 import re
 import threading
 from collections import Counter
@@ -58,9 +59,11 @@ def run_seeds(
     seeds: Sequence[int],
     scheduler: str | None,
     on_seed: Callable[[int], None] | None = None,
+    workers: int = 0,
 ) -> tuple[CampaignResult, list[str]]:
     """Every seed's campaign, merged; and one line per seed whose campaign did not finish (a
-    worker that died, fuzzoff raising): the merged result is then of the others."""
+    worker that died, fuzzoff raising): the merged result is then of the others. ``workers``:
+    for ``--scheduler local`` (default one per core: fuzz has no ``--jobs``)."""
     results: dict[int, CampaignResult] = {}
     unfinished: list[str] = []
     if scheduler is None:
@@ -73,7 +76,7 @@ def run_seeds(
 
         from fuzzoff.fleet.cluster import connect
 
-        with connect(scheduler) as client:
+        with connect(scheduler, workers or os.cpu_count() or 1) as client:
             futures = {
                 client.submit(one_seed, config, seed, key=f"fuzzoff-fuzz-{seed}", pure=False): seed
                 for seed in seeds

@@ -147,12 +147,12 @@ def lint_all(
     on_outcome: Callable[[Outcome], None] | None = None,
 ) -> list[Outcome]:
     """Every target's outcome, in the order given: on the Dask cluster at ``scheduler``
-    (``local`` starts one with ``jobs`` workers, or one per core when ``jobs`` is 1), else in
-    ``jobs`` processes here."""
+    (``local`` starts one with ``jobs`` worker processes, as many as ``--jobs`` would use),
+    else in ``jobs`` processes here."""
     if scheduler is not None:
         from fuzzoff.fleet.cluster import DEFAULT_TIMEOUT_S, connect, run_on_cluster
 
-        with connect(scheduler, jobs if jobs > 1 else None) as client:
+        with connect(scheduler, jobs) as client:
             return run_on_cluster(
                 client,
                 targets,
