@@ -34,7 +34,8 @@ LOCAL_ALLOWED_FAILURES = 1
 """For ``--scheduler local``: a recording that killed two worker processes in turn is the
 cause, not the machine (Dask's default, 3, restarts four workers before it says so). A remote
 scheduler keeps its own ``distributed.scheduler.allowed-failures``."""
-POLL_S = 0.02
+WATCH_S = 0.5
+"""How often the watchdog looks for tasks past the timeout."""
 BYSTANDER_TRIES = 3
 """Submissions of a recording whose task died with workers that another task killed (it was
 queued there, or its start was not heard before the worker died): the first, and two more."""
@@ -144,26 +145,23 @@ class _Run:
             for i in [i for i, s in self.started.items() if s.worker == worker]:
                 del self.started[i]
 
-    def bystander(self, index: int, future: Any) -> bool:
+    def bystander(self, index: int, exc: BaseException) -> bool:
         """Did the task die with workers that were killed by another task? A worker that
         dies takes the tasks queued on it along; the one that killed it had started there."""
         from distributed import KilledWorker
 
-        exc = future.exception() if future.status == "error" else None
         if not isinstance(exc, KilledWorker):
             return False
         with self.lock:
             start = self.started.get(index)
         return start is None or start.worker != exc.last_worker.address
 
-    def collect(self, index: int, future: Any) -> Outcome:
+    def failed(self, index: int, exc: BaseException) -> Outcome:
+        """The outcome of a task that raised: its worker died (``KilledWorker``) or fuzzoff
+        raised (a bug: the report names the exception)."""
         from distributed import KilledWorker
 
         target = self.targets[index]
-        if future.status == "finished":
-            outcome: Outcome = future.result()
-            return outcome
-        exc = future.exception() if future.status == "error" else None
         after = self.elapsed(index)
         took = "" if after is None else f" after {after:.1f} s"
         if isinstance(exc, KilledWorker):
@@ -200,7 +198,8 @@ def run_on_cluster(
     on_outcome: Callable[[Outcome], None] | None = None,
 ) -> list[Outcome]:
     """Lint every target as its own task on ``client``'s cluster; the outcomes in the order of
-    ``targets``, each handed to ``on_outcome`` as it arrives."""
+    ``targets``, each handed to ``on_outcome`` as it arrives. Results are gathered in batches
+    as they finish; a watchdog thread stops the tasks that run past ``timeout_s``."""
     from distributed import as_completed
 
     run = _Run(client, targets, settings)
@@ -209,57 +208,90 @@ def run_on_cluster(
     if known:  # once to every worker, not once per task
         # in a list: scatter sends a collection's items one by one
         [known_arg] = client.scatter([frozenset(known)], broadcast=True, hash=False)
-    futures: dict[str, tuple[int, Any]] = {}
+    futures: dict[str, Any] = {}
     tries: dict[int, int] = {}
 
     def submit(i: int) -> Any:
         tries[i] = tries.get(i, 0) + 1
-        key = f"fuzzoff-lint-{run.id}-{i}-{tries[i]}"
+        key = _key(run, i, tries[i])
         future = client.submit(
             _run, i, targets[i], settings, run.topic, lint, known_arg, record, key=key, pure=False
         )
-        futures[key] = (i, future)
+        futures[key] = future
         return future
 
-    pending = as_completed([submit(i) for i in range(len(targets))])
-    remaining = len(targets)
-
     def done(i: int, outcome: Outcome) -> None:
-        nonlocal remaining
-        run.outcomes[i] = outcome
-        remaining -= 1
-        if on_outcome is not None:
-            on_outcome(outcome)
+        with run.lock:
+            if run.outcomes[i] is not None:
+                return
+            run.outcomes[i] = outcome
+            if on_outcome is not None:
+                on_outcome(outcome)
 
+    results = as_completed(
+        [submit(i) for i in range(len(targets))], with_results=True, raise_errors=False
+    )
+    stop = threading.Event()
+    watchdog = threading.Thread(
+        target=_watch, args=(run, futures, tries, timeout_s, done, stop), daemon=True
+    )
+    watchdog.start()
     try:
-        while remaining:
-            batch = pending.next_batch(block=False) if pending.has_ready() else []
-            for future in batch:
-                entry = futures.pop(future.key, None)
-                if entry is not None and run.outcomes[entry[0]] is None:
-                    i = entry[0]
-                    if run.bystander(i, future) and tries[i] < BYSTANDER_TRIES:
-                        pending.add(submit(i))
-                    else:
-                        done(i, run.collect(i, future))
+        for batch in results.batches():
+            for future, result in batch:
+                i = int(future.key.rsplit("-", 2)[1])
+                futures.pop(future.key, None)
                 future.release()
-            for i, worker in run.overdue(timeout_s):
-                key = f"fuzzoff-lint-{run.id}-{i}-{tries[i]}"
-                if not _still_on(client, key, worker):
-                    run.forget_worker(worker)  # it died and the task is queued again
+                if isinstance(result, Outcome):
+                    done(i, result)
                     continue
-                _, future = futures.pop(key)
-                future.cancel()
-                done(i, run.timed_out(i, worker, timeout_s))
-                client.restart_workers([worker], raise_for_error=False)
-                run.forget_worker(worker)
-            if not batch:
-                time.sleep(POLL_S)
+                exc = _raised(result)
+                if run.bystander(i, exc) and tries[i] < BYSTANDER_TRIES:
+                    results.add(submit(i))
+                else:
+                    done(i, run.failed(i, exc))
     finally:
+        stop.set()
+        watchdog.join()
         client.unsubscribe_topic(run.topic)
-        for _, future in futures.values():
+        for future in list(futures.values()):
             future.cancel()
     return [o for o in run.outcomes if o is not None]
+
+
+def _key(run: _Run, index: int, attempt: int) -> str:
+    return f"fuzzoff-lint-{run.id}-{index}-{attempt}"
+
+
+def _raised(result: Any) -> BaseException:
+    """What a failed task raised (``as_completed`` gives it as ``(type, value, traceback)``)."""
+    if isinstance(result, tuple) and len(result) == 3 and isinstance(result[1], BaseException):
+        return result[1]
+    return RuntimeError(f"unexpected task result {type(result).__name__}")
+
+
+def _watch(
+    run: _Run,
+    futures: dict[str, Any],
+    tries: dict[int, int],
+    timeout_s: float,
+    done: Callable[[int, Outcome], None],
+    stop: threading.Event,
+) -> None:
+    """Every ``WATCH_S``: a task past the timeout is cancelled (its outcome: OFB001) and its
+    worker restarted, the only way to stop the thread that runs it."""
+    while not stop.wait(WATCH_S):
+        for i, worker in run.overdue(timeout_s):
+            key = _key(run, i, tries[i])
+            if not _still_on(run.client, key, worker):
+                run.forget_worker(worker)  # it died and the task is queued again
+                continue
+            future = futures.pop(key, None)
+            if future is not None:
+                future.cancel()
+            done(i, run.timed_out(i, worker, timeout_s))
+            run.client.restart_workers([worker], raise_for_error=False)
+            run.forget_worker(worker)
 
 
 def _still_on(client: Any, key: str, worker: str) -> bool:
