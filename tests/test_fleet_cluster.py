@@ -95,11 +95,12 @@ def test_a_recording_that_hangs_is_stopped_after_the_timeout(client: Any, tmp_pa
     assert [o.status for o in outcomes] == [LINTED, LINTED, LINTED, TIMED_OUT]
     hung = outcomes[-1].report
     assert hung is not None
-    assert hung.problems == [
-        f"{targets[-1]}: the lint did not finish within 2 s (--timeout): stopped, and its Dask "
-        f"worker {hung.problems[0].rsplit('Dask worker ', 1)[1]}"
-    ]
-    assert hung.problems[0].endswith(" restarted")
+    [problem] = hung.problems
+    assert problem.startswith(
+        f"{targets[-1]}: the lint did not finish within 2 s (--timeout): stopped by ending its "
+        "Dask worker tcp://127.0.0.1:"
+    )
+    assert problem.endswith(" (its nanny starts a new one)")
     client.wait_for_workers(2, timeout=30)
     # the restarted worker lints again
     again = run_on_cluster(client, targets[:3], Settings())
@@ -134,6 +135,11 @@ class _Quiet(SimpleHTTPRequestHandler):
         pass
 
 
+class _Server(ThreadingHTTPServer):
+    def handle_error(self, request: Any, client_address: Any) -> None:
+        """A client that closes early (fsspec reads what it needs) is not news here."""
+
+
 @pytest.fixture
 def http_root(tmp_path: Path) -> Iterator[tuple[str, Path]]:
     """A local HTTP server (Python's http.server in a thread) over a folder of recordings."""
@@ -141,7 +147,7 @@ def http_root(tmp_path: Path) -> Iterator[tuple[str, Path]]:
     shutil.copytree(TLOGS, root / "tlog", ignore=shutil.ignore_patterns("*.json", "*.py"))
     shutil.copytree(CORPORA / "rosbag2" / "good_flight_sqlite3", root / "bags" / "flight")
     handler = functools.partial(_Quiet, directory=str(root))
-    server = ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    server = _Server(("127.0.0.1", 0), handler)
     thread = threading.Thread(target=server.serve_forever, daemon=True)
     thread.start()
     try:

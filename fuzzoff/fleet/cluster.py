@@ -5,14 +5,17 @@ A worker process that dies while linting (a crash in a reader's C code, the kern
 killer) is restarted by its nanny and the scheduler tries the recording again elsewhere; when
 it has killed ``allowed-failures`` + 1 workers the scheduler gives up on it (``KilledWorker``)
 and it becomes that recording's OFB001. A recording that runs past ``--timeout`` is stopped
-the only way a thread can be: its task is cancelled and its worker restarted. The clock runs
+the only way a thread can be: its task is cancelled and its worker process ended, and the
+worker's nanny starts a new one. The clock runs
 from the moment the task starts on its worker (each task announces itself with
 ``Worker.log_event``), not from its submission, so a long queue does not time anything out.
 """
 
 from __future__ import annotations
 
+import contextlib
 import logging
+import os
 import threading
 import time
 import uuid
@@ -34,6 +37,8 @@ LOCAL_ALLOWED_FAILURES = 1
 """For ``--scheduler local``: a recording that killed two worker processes in turn is the
 cause, not the machine (Dask's default, 3, restarts four workers before it says so). A remote
 scheduler keeps its own ``distributed.scheduler.allowed-failures``."""
+EXIT_STOPPED = 75
+"""Exit status of a worker process ended because a recording ran past the timeout."""
 WATCH_S = 0.5
 """How often the watchdog looks for tasks past the timeout."""
 BYSTANDER_TRIES = 3
@@ -79,7 +84,7 @@ def local_cluster(workers: int) -> Any:
             n_workers=workers,
             threads_per_worker=1,
             processes=True,
-            dashboard_address=None,
+            dashboard_address=":0",  # any free port: no warning when 8787 is taken
             silence_logs=logging.ERROR,
         )
 
@@ -180,8 +185,8 @@ class _Run:
 
     def timed_out(self, index: int, worker: str, timeout_s: float) -> Outcome:
         what = (
-            f"the lint did not finish within {timeout_s:g} s (--timeout): stopped, and its "
-            f"Dask worker {worker} restarted"
+            f"the lint did not finish within {timeout_s:g} s (--timeout): stopped by ending "
+            f"its Dask worker {worker} (its nanny starts a new one)"
         )
         return self._failed(self.targets[index], what, TIMED_OUT, timeout_s)
 
@@ -279,19 +284,34 @@ def _watch(
     stop: threading.Event,
 ) -> None:
     """Every ``WATCH_S``: a task past the timeout is cancelled (its outcome: OFB001) and its
-    worker restarted, the only way to stop the thread that runs it."""
+    worker process ended, the only way to stop the thread that runs it."""
     while not stop.wait(WATCH_S):
         for i, worker in run.overdue(timeout_s):
             key = _key(run, i, tries[i])
             if not _still_on(run.client, key, worker):
                 run.forget_worker(worker)  # it died and the task is queued again
                 continue
+            # the outcome first: the cancelled task may come back as cancelled, not as this
+            done(i, run.timed_out(i, worker, timeout_s))
             future = futures.pop(key, None)
             if future is not None:
                 future.cancel()
-            done(i, run.timed_out(i, worker, timeout_s))
-            run.client.restart_workers([worker], raise_for_error=False)
+            _end_worker(run.client, worker)
             run.forget_worker(worker)
+
+
+def _end_worker(client: Any, worker: str) -> None:
+    """End the worker's process at once; its nanny starts a new one. A graceful restart
+    (``Client.restart_workers``) waits for the worker to close, and a worker whose thread
+    never returns cannot: Python joins its executor's threads at exit."""
+    with contextlib.suppress(Exception):  # the worker is gone before it can answer
+        client.run(_exit, workers=[worker], wait=False)
+
+
+async def _exit() -> None:
+    """Run on the worker's event loop (``Client.run`` sends only a coroutine without waiting
+    for its answer), not in its busy thread pool."""
+    os._exit(EXIT_STOPPED)
 
 
 def _still_on(client: Any, key: str, worker: str) -> bool:
