@@ -118,10 +118,11 @@ _frozen = False
 
 
 def _freeze_once() -> None:
-    """Keep what the worker process holds before its first lint (distributed, tornado, the
-    readers' libraries) out of the cyclic collector's full collections: a Dask worker's heap
-    is larger than a ``--jobs`` process's, and walking it again and again cost a ROS 1 bag
-    lint about a third more CPU time there (``gc.freeze`` is for such long-lived heaps)."""
+    """Keep what the worker process holds before its first lint (distributed, tornado) out of
+    the cyclic collector's full collections: a Dask worker's heap is larger than a ``--jobs``
+    process's, and every full collection during a lint walks all of it (``gc.freeze`` is for
+    such long-lived heaps). The ROS 1 bags, which make the most garbage, measured up to 1.4x
+    the CPU time of ``--jobs`` without it, on a machine too loaded to be sure."""
     global _frozen
     if not _frozen:
         _frozen = True
