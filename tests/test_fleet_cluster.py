@@ -180,10 +180,19 @@ def test_fuzz_seeds_on_the_cluster_report_as_the_same_campaign_run_here(client: 
     there = run_cli([*args, "--scheduler", client.scheduler.address])
     assert there.returncode == 1
     on_cluster = json.loads(there.stdout)
-    for report in (here, on_cluster):
-        report.pop("seconds")
-        for prop in report["properties"]:
-            for timing in ("seconds", "examples_per_s", "model_seconds", "found_after_seconds"):
-                prop.pop(timing)
-    assert on_cluster == here
+    assert on_cluster["campaign"] == here["campaign"]
     assert on_cluster["campaign"]["seeds"] == [0, 1]
+
+    def stable(report: dict[str, Any]) -> list[tuple[Any, ...]]:
+        """What does not depend on time (shrinking stops after a time limit on a busy
+        machine, so the shrunk scenario can differ)."""
+        return [
+            (p["property"], p["failed"], p["examples"], _found_by_seed_0(p["problems"]))
+            for p in report["properties"]
+        ]
+
+    assert stable(on_cluster) == stable(here) == [("explained", True, 400, True)]
+
+
+def _found_by_seed_0(problems: list[str]) -> bool:
+    return any(p.startswith("found by seed 0 (fuzzoff fuzz --seed 0)") for p in problems)

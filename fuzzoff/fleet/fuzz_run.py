@@ -133,6 +133,8 @@ def _merge_property(runs: list[tuple[int, PropertyResult]]) -> PropertyResult:
         out.examples += r.examples
         out.seconds += r.seconds
         out.model_seconds += r.model_seconds
+        out.failed_examples += r.failed_examples
+        out.shrinks += r.shrinks
         known.update(r.known)
         for code, c in r.counts.items():
             counts.setdefault(code, Counter()).update(c)
@@ -140,7 +142,7 @@ def _merge_property(runs: list[tuple[int, PropertyResult]]) -> PropertyResult:
             key = f"seed {seed}" if r.counterexample is None else content_key(r.counterexample)
             copies[key] += 1
             distinct.setdefault(key, (seed, r))
-    out.counts = {code: dict(c) for code, c in counts.items()}
+    out.counts = {code: dict(c) for code, c in sorted(counts.items())}
     out.known = dict(known)
     if distinct:
         (seed, r), *others = distinct.values()
