@@ -106,7 +106,7 @@ def run(args: argparse.Namespace) -> int:
     if fleet_wanted(args):
         from fuzzoff.fleet.lint_run import run_fleet
 
-        return run_fleet(args, settings)
+        return run_fleet(args, settings, _terminal)
     existing_paths(args.paths)
     # A folder with nothing to lint is a mistake (a wrong path, a recording step that failed):
     # passing it would turn a CI job green without looking at a single flight.

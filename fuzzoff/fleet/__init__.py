@@ -41,7 +41,7 @@ def fleet_wanted(args: argparse.Namespace) -> bool:
     """Does this lint need the fleet path (a cluster, URLs, the dataset or its options)?"""
     return bool(
         args.scheduler is not None
-        or args.format == "parquet"
+        or "parquet" in (args.format or ())
         or args.timeout is not None
         or args.force
         or any(is_url(p) for p in args.paths)

@@ -15,12 +15,12 @@ from concurrent.futures import ProcessPoolExecutor
 from contextlib import contextmanager
 from functools import partial
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from fuzzoff.commands._common import (
     check_output,
     existing_paths,
-    render_rich,
+    report_targets,
+    settings_per_recording,
     write_output,
     write_stdout,
 )
@@ -33,9 +33,6 @@ from fuzzoff.fleet.task import LINTED, SKIPPED, Lint, Outcome, lint_target
 from fuzzoff.report import renderer
 from fuzzoff.report.sanitize import printable
 from fuzzoff.sources import RECORDING_SUFFIXES, find_recordings
-
-if TYPE_CHECKING:
-    from rich.console import Console
 
 PARQUET = "parquet"
 
@@ -58,43 +55,58 @@ def targets_of(paths: Sequence[str]) -> list[str]:
     return list(dict.fromkeys(found))
 
 
-def check_fleet_args(args: argparse.Namespace) -> None:
+def check_fleet_args(args: argparse.Namespace, reports: list[tuple[str, str | None]]) -> None:
     if args.timeout is not None and args.scheduler is None:
         raise ConfigError("--timeout needs --scheduler (local processes cannot stop one recording)")
     if args.timeout is not None and not args.timeout > 0:
         raise ConfigError(f"--timeout {args.timeout:g}: expected seconds above 0")
-    if args.force and args.format != PARQUET:
+    dataset = dataset_dir(reports)
+    if args.force and dataset is None:
         raise ConfigError("--force applies to --format parquet (it lints known recordings again)")
-    if args.format == PARQUET:
+    if any(fmt == PARQUET for fmt, _ in reports):
         require("parquet", "--format parquet")
-        if not args.output or args.output == "-":
+        if dataset is None:
             raise ConfigError("--format parquet needs --output DIR (the dataset's folder)")
-        if Path(args.output).exists() and not Path(args.output).is_dir():
-            raise ConfigError(f"--output {args.output} is a file: --format parquet writes a folder")
+        if Path(dataset).exists() and not Path(dataset).is_dir():
+            raise ConfigError(f"--output {dataset} is a file: --format parquet writes a folder")
 
 
-def run_fleet(args: argparse.Namespace, settings: Settings) -> int:
-    """The lint command when it runs on a cluster, reads URLs or writes the dataset."""
-    check_fleet_args(args)
+def dataset_dir(reports: list[tuple[str, str | None]]) -> str | None:
+    """The ``--output`` of ``--format parquet`` (None: not asked, or no folder given)."""
+    return next((out for fmt, out in reports if fmt == PARQUET), None)
+
+
+def run_fleet(
+    args: argparse.Namespace,
+    settings: Settings,
+    terminal: Callable[[argparse.Namespace, Report, Settings, str | None], None],
+) -> int:
+    """The lint command when it runs on a cluster, reads URLs or writes the dataset;
+    ``terminal`` draws the terminal report as the plain lint does."""
+    reports = report_targets(args.format, args.output)
+    check_fleet_args(args, reports)
     targets = targets_of(args.paths)
-    if args.format != PARQUET:
-        check_output(args.output, [t for t in targets if not is_url(t)])
+    local = [t for t in targets if not is_url(t)]
+    for fmt, output in reports:
+        if fmt != PARQUET:
+            check_output(output, local)
+    settings_per_recording(settings, local)
     lint: Lint = lint_file
-    if args.format == "html":
+    if any(fmt == "html" for fmt, _ in reports):
         from fuzzoff.report.timelines import lint_one
 
         lint = lint_one
-    record = args.format == PARQUET
+    dataset = dataset_dir(reports)
     known: frozenset[str] = frozenset()
     writer = None
-    if record:
+    if dataset is not None:
         from fuzzoff.fleet.dataset import DatasetError, RunInfo, Writer, known_hashes
 
         try:
-            known = frozenset() if args.force else known_hashes(Path(args.output))
+            known = frozenset() if args.force else known_hashes(Path(dataset))
         except DatasetError as exc:
             raise ConfigError(str(exc)) from None
-        writer = Writer(Path(args.output), RunInfo.now())
+        writer = Writer(Path(dataset), RunInfo.now())
     with _progress(len(targets), enabled=not args.no_progress) as advance:
 
         def on_outcome(outcome: Outcome) -> None:
@@ -110,24 +122,22 @@ def run_fleet(args: argparse.Namespace, settings: Settings) -> int:
             timeout_s=args.timeout,
             lint=lint,
             known=known,
-            record=record,
+            record=writer is not None,
             on_outcome=on_outcome,
         )
     report = Report([o.report for o in outcomes if o.report is not None])
-    if writer is not None:
-        writer.flush()
-        write_stdout(_dataset_summary(outcomes, writer.findings, args.output))
-    elif args.format == "terminal":
-        from fuzzoff.report.terminal import print_report
-
-        def draw(console: Console) -> None:
-            print_report(
-                console, report, settings.fail_on, quiet=args.quiet, statistics=args.statistics
-            )
-
-        render_rich(draw, args.output)
-    else:
-        write_output(renderer(args.format)(report, settings), args.output)
+    for fmt, output in reports:
+        if fmt == PARQUET and writer is not None:
+            writer.flush()
+            summary = _dataset_summary(outcomes, writer.findings, str(output))
+            if any(out is None for _, out in reports):  # another report has standard output
+                print(summary, end="", file=sys.stderr)
+            else:
+                write_stdout(summary)
+        elif fmt == "terminal":
+            terminal(args, report, settings, output)
+        else:
+            write_output(renderer(fmt)(report, settings), output)
     for f in report.files:
         for line in f.problems:
             print(f"fuzzoff: {printable(line)}", file=sys.stderr)

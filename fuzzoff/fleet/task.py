@@ -65,6 +65,9 @@ def lint_target(
     dataset's row; a recording whose hash is in ``known`` is skipped without linting."""
     t0 = time.perf_counter()
     if is_url(target):
+        # a fetched copy is judged with the command's configuration, not one found near the
+        # temporary folder it is fetched into
+        settings = dataclasses.replace(settings, discovery=None)
         try:
             with fetched(target) as local:
                 outcome = _lint_local(local, target, settings, lint, known, record)
