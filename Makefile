@@ -10,7 +10,7 @@ MULTITOOL := build/node/node_modules/.bin/sarif-multitool
 $(STAMP): pyproject.toml
 	$(PY) -m venv $(VENV)
 	$(BIN)/pip install -q --upgrade pip
-	$(BIN)/pip install -q -e '.[dev]'
+	$(BIN)/pip install -q -e '.[dev,fleet]'
 	touch $(STAMP)
 
 install: $(STAMP)

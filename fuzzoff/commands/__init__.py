@@ -11,6 +11,7 @@ import argparse
 from typing import Any
 
 SUMMARIES: dict[str, str] = {
+    "fleet": "a page over a fleet's Parquet dataset: rules per week, release, vehicle",
     "fuzz": "search setpoint streams for hazards the rules miss (seeded, shrunk)",
     "gate": "the gate model's timeline for a recording, beside the recorded mode",
     "lint": "lint recordings (tlog, ULog, MCAP, ROS 2 and ROS 1 bags)",

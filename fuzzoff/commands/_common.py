@@ -50,12 +50,14 @@ def add_output_options(parser: argparse.ArgumentParser, formats: tuple[str, ...]
     parser.add_argument("--output", "-o", metavar="FILE", help="write the report here")
 
 
-def add_report_options(parser: argparse.ArgumentParser) -> None:
+def add_report_options(
+    parser: argparse.ArgumentParser, formats: tuple[str, ...] = FORMATS
+) -> None:
     """``--format`` and ``--output`` that may repeat, in pairs: one lint, several reports."""
     parser.add_argument(
         "--format",
         action="append",
-        choices=FORMATS,
+        choices=formats,
         help="report format (default terminal); repeat it with an --output each for several",
     )
     parser.add_argument(
@@ -92,6 +94,32 @@ def report_targets(
     if twice:
         raise ConfigError(f"--output {twice[0]} is named twice: one report a file")
     return pairs
+
+
+def add_scheduler_option(parser: argparse.ArgumentParser, what: str) -> None:
+    parser.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help=f"run {what} as Dask tasks: a scheduler's address (tcp://host:8786), or 'local' "
+        "for a cluster on this machine (needs: pip install 'fuzzoff[fleet]'; docs/fleet.md)",
+    )
+
+
+def add_fleet_options(parser: argparse.ArgumentParser) -> None:
+    """``lint`` on a fleet (docs/fleet.md): Dask, and the Parquet dataset's incremental runs."""
+    add_scheduler_option(parser, "one task per recording")
+    parser.add_argument(
+        "--timeout",
+        type=float,
+        metavar="SECONDS",
+        help="with --scheduler: a recording still linting after this is stopped and reported "
+        "as OFB001 (default 600)",
+    )
+    parser.add_argument(
+        "--force",
+        action="store_true",
+        help="--format parquet: lint recordings the dataset holds already",
+    )
 
 
 def parse_params(values: list[str]) -> dict[str, float]:

@@ -17,7 +17,12 @@ from pathlib import Path
 from typing import Any
 
 from fuzzoff.commands import add_command
-from fuzzoff.commands._common import parse_params, settings_from_args, write_output
+from fuzzoff.commands._common import (
+    add_scheduler_option,
+    parse_params,
+    settings_from_args,
+    write_output,
+)
 from fuzzoff.config import ConfigError
 from fuzzoff.fuzz.campaign import CampaignConfig, CampaignResult, PropertyResult, run_campaign
 from fuzzoff.fuzz.known import KNOWN
@@ -77,6 +82,13 @@ def add_parser(sub: Any) -> None:
     )
     parser.add_argument("--no-save", action="store_true", help="do not save reproducers")
     parser.add_argument("--quiet", "-q", action="store_true", help="no progress display")
+    add_scheduler_option(parser, "one campaign per seed")
+    parser.add_argument(
+        "--seeds",
+        metavar="SEEDS",
+        help="one campaign per seed (0-199, or 3,7,11), merged into one report; each seed "
+        "runs what --seed N runs (docs/fleet.md)",
+    )
     parser.set_defaults(run=run)
 
 
@@ -202,8 +214,14 @@ def run(args: argparse.Namespace) -> int:
         label = f"{DEFAULT_DIR} (where reproducers go: --save-dir DIR or --no-save to change)"
     if not args.no_save:
         check_save_dir(Path(args.save_dir), label)
-    with _Progress(not args.quiet) as progress:
-        result = run_campaign(config, progress.example, progress.done)
+    unfinished: list[str] = []
+    if args.scheduler is not None or args.seeds is not None:
+        from fuzzoff.fleet.fuzz_run import run_seeds_of
+
+        result, unfinished = run_seeds_of(args, config)
+    else:
+        with _Progress(not args.quiet) as progress:
+            result = run_campaign(config, progress.example, progress.done)
     saved: dict[str, Path] = {}
     save_error = None
     if not args.no_save:
@@ -216,6 +234,10 @@ def run(args: argparse.Namespace) -> int:
     write_output(_render(args.format, result, saved, margins), args.output)
     if save_error is not None:
         print(f"error: {save_error}", file=sys.stderr)
+        return 2
+    for line in unfinished:
+        print(f"error: {line}", file=sys.stderr)
+    if unfinished:
         return 2
     if config.base_problems:
         # As lint: the campaign ran on the part that could be read; the status says the rest.

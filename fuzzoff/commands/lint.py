@@ -9,6 +9,7 @@ from typing import Any
 
 from fuzzoff.commands import add_command
 from fuzzoff.commands._common import (
+    add_fleet_options,
     add_profile_options,
     add_report_options,
     add_rule_options,
@@ -23,7 +24,8 @@ from fuzzoff.commands._common import (
 from fuzzoff.config import ConfigError, Settings
 from fuzzoff.engine import lint_paths
 from fuzzoff.findings import Report
-from fuzzoff.report import renderer
+from fuzzoff.fleet import fleet_wanted
+from fuzzoff.report import FORMATS, renderer
 from fuzzoff.report.sanitize import printable
 from fuzzoff.report.timelines import lint_with_timelines
 from fuzzoff.sources import RECORDING_SUFFIXES, find_recordings
@@ -39,7 +41,7 @@ def add_parser(sub: Any) -> None:
     )
     add_profile_options(parser)
     add_rule_options(parser)
-    add_report_options(parser)
+    add_report_options(parser, (*FORMATS, "parquet"))
     parser.add_argument("--jobs", "-j", type=int, default=1, help="lint files in N processes")
     parser.add_argument(
         "--quiet", "-q", action="store_true", help="only findings at the fail level"
@@ -52,6 +54,7 @@ def add_parser(sub: Any) -> None:
         help="each finding in full: what the docs require, what PX4 does, the exact place",
     )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_fleet_options(parser)
     parser.set_defaults(run=run)
 
 
@@ -100,6 +103,10 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError("--jobs must be at least 1")
     # As ruff: no path means the current folder.
     args.paths = args.paths or ["."]
+    if fleet_wanted(args):
+        from fuzzoff.fleet.lint_run import run_fleet
+
+        return run_fleet(args, settings, _terminal)
     existing_paths(args.paths)
     # A folder with nothing to lint is a mistake (a wrong path, a recording step that failed):
     # passing it would turn a CI job green without looking at a single flight.

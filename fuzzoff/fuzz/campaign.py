@@ -121,6 +121,9 @@ class CampaignConfig:
     base_problems: list[str] = field(default_factory=list)
     """The parts of the ``--from`` recording that could not be read (``base`` is the part
     before them), one line each as ``fuzzoff lint`` reports them."""
+    seeds: tuple[int, ...] = ()
+    """``--seeds``: the campaign was run once per seed (``fuzzoff.fleet.fuzz_run``) and its
+    result merged; ``seed`` is then the first of them."""
 
 
 def _targets(scenario: Scenario) -> None:

@@ -30,6 +30,7 @@ def to_json(result: CampaignResult, saved: dict[str, Path], margins: list[Any]) 
             "vehicle": cfg.vehicle,
             "transport": cfg.transport,
             "seed": cfg.seed,
+            "seeds": list(cfg.seeds) or [cfg.seed],
             "examples": cfg.examples,
             "budget_s": cfg.budget_s,
             "from": None if cfg.base is None else cfg.base.describe(),
@@ -54,7 +55,7 @@ def to_junit(result: CampaignResult, saved: dict[str, Path]) -> str:
     failures = sum(1 for r in result.results if r.failed)
     suite = ET.Element(
         "testsuite",
-        name=f"fuzzoff fuzz (seed {result.config.seed})",
+        name=f"fuzzoff fuzz ({_seeds(result)})",
         tests=str(len(result.results)),
         failures=str(failures),
         errors="0",
@@ -137,6 +138,20 @@ def to_sarif(result: CampaignResult, saved: dict[str, Path], root: Path | None =
     return json.dumps(doc, indent=2) + "\n"
 
 
+def _seeds(result: CampaignResult) -> str:
+    seeds = result.config.seeds
+    if len(seeds) > 1:
+        return f"seeds {seeds_text(seeds)} ({len(seeds)} campaigns)"
+    return f"seed {result.config.seed}"
+
+
+def seeds_text(seeds: tuple[int, ...]) -> str:
+    """``0-199`` for a range, else the seeds with commas."""
+    if seeds == tuple(range(seeds[0], seeds[0] + len(seeds))):
+        return f"{seeds[0]}-{seeds[-1]}"
+    return ",".join(str(s) for s in seeds)
+
+
 def _line(r: PropertyResult) -> str:
     rate = f"{r.examples / r.seconds:.0f}/s" if r.seconds else "-"
     verdict = "FAILED" if r.failed else ("counted" if r.name == "docs-stricter" else "held")
@@ -146,7 +161,7 @@ def _line(r: PropertyResult) -> str:
 
 
 def to_terminal(result: CampaignResult, saved: dict[str, Path], margins: list[Any]) -> str:
-    lines = [f"fuzzoff fuzz, seed {result.config.seed}"]
+    lines = [f"fuzzoff fuzz, {_seeds(result)}"]
     for problem in result.config.base_problems:
         lines.append(f"  --from incomplete, the part before this was fuzzed: {printable(problem)}")
     for r in result.results:
