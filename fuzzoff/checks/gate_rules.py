@@ -104,9 +104,7 @@ def loss_short(ctx: CheckContext) -> str:
     gate = ctx.gate
     action = gate.current_loss_action()
     loss_t = float(gate.params.get("COM_OF_LOSS_T", 0.0))
-    after = (
-        f"0.5 s + {loss_t:g} s" if ctx.profile.px4 == "legacy" else f"{loss_t:g} s"
-    )
+    after = f"0.5 s + {loss_t:g} s" if ctx.profile.px4 == "legacy" else f"{loss_t:g} s"
     if action.disarm:
         what = "disarm"
     elif action.none:
