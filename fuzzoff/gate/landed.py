@@ -70,6 +70,14 @@ class LandedState:
         """Why the vehicle is taken as airborne (no land detector recorded), or None."""
         self.armed_at: float | None = None
         self.climb_since: float | None = None
+        self.watching = False
+        """Do setpoints still matter (no land detector recorded, armed, no evidence yet)? An
+        attribute, not a property: the model asks it on every setpoint."""
+
+    def _watch(self) -> None:
+        self.watching = (
+            not self.recorded_ever and self.armed_at is not None and self.evidence is None
+        )
 
     def land_detected(self, event: LandDetected) -> None:
         if event.landed is None:
@@ -78,19 +86,23 @@ class LandedState:
             self.recorded_since = event.t
         self.recorded = event.landed
         self.recorded_ever = True
+        self.watching = False
 
     def armed(self, t: float) -> None:
         if self.armed_at is None:
             self.armed_at = t
+            self._watch()
 
     def disarmed(self) -> None:
         self.armed_at = None
         self.climb_since = None
         self.evidence = None
+        self._watch()
 
     def mode(self, t: float, nav: int | None) -> None:
         if nav in TAKEOFF_NAV_STATES and self.armed_at is not None and self.evidence is None:
             self.evidence = f"recorded in a take-off mode at {t:.2f} s"
+            self._watch()
 
     def setpoint(self, t: float, climbing: bool) -> None:
         """A setpoint flown armed in OFFBOARD (``climbing``: ``climbs`` said so)."""
@@ -100,11 +112,6 @@ class LandedState:
             self.climb_since = None
         elif self.climb_since is None:
             self.climb_since = t
-
-    @property
-    def watching(self) -> bool:
-        """Do setpoints still matter (no land detector recorded, armed, no evidence yet)?"""
-        return not self.recorded_ever and self.armed_at is not None and self.evidence is None
 
     def landed(self, t: float) -> tuple[bool, str]:
         """PX4's ``landed or maybe_landed`` at ``t`` and why the model says so."""
@@ -130,5 +137,6 @@ class LandedState:
                 f"that has not taken off within COM_DISARM_PRFLT {self.preflight_disarm_s:g} s"
             )
         if self.evidence is not None:
+            self.watching = False
             return False, f"assumed airborne ({self.evidence}; no land detector recorded)"
         return True, "assumed on the ground (no take-off seen, no land detector recorded)"

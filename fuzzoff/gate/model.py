@@ -82,7 +82,7 @@ NOT_OFFBOARD = "no OFFBOARD on either side: other modes' own rules are not model
 FAILSAFE_TEXT_WINDOW_S = 3.0
 """A failsafe STATUSTEXT this long before a recorded change out of OFFBOARD explains it (PX4
 sends the text at once; the 1 Hz HEARTBEAT shows the new mode up to a second later)."""
-NO_STREAM_SWITCH = "1.14+ takes a switch while disarmed without a stream, checked at arming"
+NO_STREAM_SWITCH = "1.14+: no stream needed while disarmed, checked at arming"
 RECORDED_FAILSAFE = "PX4's failsafe recorded then"
 FLAG_FRESH_S = 1.0
 """PX4 publishes ``failsafe_flags`` at each change and about every 0.5 s: a recording whose
@@ -881,8 +881,7 @@ class GateModel:
         self._emit(
             cmd.t,
             "undecided",
-            f"{self._request_name(cmd, target)}: {reason} (the recording does not show the "
-            "arming state)",
+            f"{self._request_name(cmd, target)}: {reason}; arming not recorded",
             if_armed.spec if not if_armed.accepted else if_disarmed.spec,
             reason=reason,
             unverified=if_disarmed.unverified or if_armed.unverified,
