@@ -2,8 +2,8 @@
 
 Seen on PX4 1.15.4 and 1.18.0-alpha1 SITL (corpora/gate/px4_*_disarm_refused.ulg): a disarm
 that is not forced is refused with ack 1, "Disarming denied: not landed", while the land
-detector says airborne; param2 21196 forces it; on the ground it is accepted; an arm request
-while armed is acked ACCEPTED and changes nothing.
+detector says airborne; param2 21196 forces it (acked 0 in flight on both, the vehicle falling);
+on the ground it is accepted; an arm request while armed is acked ACCEPTED and changes nothing.
 """
 
 from __future__ import annotations
