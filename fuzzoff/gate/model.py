@@ -84,6 +84,8 @@ FAILSAFE_TEXT_WINDOW_S = 3.0
 sends the text at once; the 1 Hz HEARTBEAT shows the new mode up to a second later)."""
 NO_STREAM_SWITCH = "1.14+: no stream needed while disarmed, checked at arming"
 RECORDED_FAILSAFE = "PX4's failsafe recorded then"
+NOT_FLAGGED = "the model's alone: PX4's failsafe_flags shows no loss"
+"""``seen_in`` of a loss the recording's flag of PX4 contradicts (a disagreement follows)."""
 FLAG_FRESH_S = 1.0
 """PX4 publishes ``failsafe_flags`` at each change and about every 0.5 s: a recording whose
 newest sample is older than this does not show PX4's verdict any more."""
@@ -374,15 +376,13 @@ class GateModel:
         recording holds PX4's flag and it has not flipped, the model's own verdict (a flag
         that still says available becomes a disagreement)."""
         window = self._window or (t, t)
-        self._lose(t, window, shown=not self._flag_shows)
+        self._lose(t, window, NOT_FLAGGED if self._flag_shows else None)
 
     def _lose(
         self,
         t: float,
         window: tuple[float, float] | None = None,
         seen_in: str | None = None,
-        *,
-        shown: bool = True,
     ) -> None:
         """The signal is lost at ``t``: ``window`` is PX4's check-pass window (1.14+),
         ``seen_in`` where the recording shows PX4's verdict when ``t`` comes from there."""
@@ -396,7 +396,7 @@ class GateModel:
         if why is None and self.tick_based and self.signal.stamps_lag:
             why = "the newest keep-alive's timestamp is older than COM_OF_LOSS_T (2.1.1)"
         reason = why or "keep-alive timeout"
-        when, earliest = self._loss_when(t, window, seen_in, shown)
+        when, earliest = self._loss_when(t, window, seen_in)
         age = ""
         if why is None and last is not None:
             start = t if earliest is None else earliest
@@ -426,22 +426,23 @@ class GateModel:
         else:
             self._refresh(t, cause=None)
 
+    @staticmethod
     def _loss_when(
-        self, t: float, window: tuple[float, float] | None, seen_in: str | None, shown: bool
+        t: float, window: tuple[float, float] | None, seen_in: str | None
     ) -> tuple[str, float | None]:
         """The time words of a loss and the window's start (None: ``t`` is the time)."""
         if window is None:
             return "", None
         start, end = window
+        if seen_in == NOT_FLAGGED:
+            return (
+                f" by {end:.3f} s (the model's window {start:.3f}-{end:.3f} s; PX4's "
+                f"failsafe_flags shows no loss by {t:.3f} s)",
+                None,
+            )
         if seen_in is not None:
             at = "by" if seen_in == RECORDED_FAILSAFE else "at"
             return f" {at} {t:.3f} s ({seen_in}; the model's window {start:.3f}-{end:.3f} s)", None
-        if not shown:
-            return (
-                f" by {end:.3f} s (the model's window {start:.3f}-{end:.3f} s; PX4's flag "
-                f"shows no loss by {t:.3f} s)",
-                None,
-            )
         return (
             f" between {start:.3f} and {end:.3f} s (PX4 checks at 10 Hz; the check's phase is "
             "not in the recording)",

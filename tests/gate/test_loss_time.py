@@ -138,3 +138,14 @@ def test_ofb103_says_between_for_a_heartbeat(tmp_path: Path) -> None:
     report = lint_file(path, Settings(px4="1.15", vehicle="mc"))
     (finding,) = [f for f in report.findings if f.code == "OFB103"]
     assert "recorded: POSCTL between 6.00 and 7.00 s (mode sampled at 1 Hz)" in finding.message
+
+
+@pytest.mark.parametrize("px4", TICK)
+def test_a_loss_pxs_flag_does_not_show_is_the_models_alone(px4: str) -> None:
+    """PX4's flag, published every 0.5 s, still says available past the window: the model's
+    loss says so, and the flag's next sample is a disagreement."""
+    flags = [_flag(round(0.5 * k, 3), False) for k in range(1, 7)]
+    trs = run(px4, [in_offboard(), *stream(0.0, 1.0), *flags], t_end=3.0)
+    (lost,) = of("signal_lost", trs)
+    assert lost.seen_in is not None and "failsafe_flags shows no loss" in lost.seen_in
+    assert of("disagreement", trs)
