@@ -86,6 +86,8 @@ NO_STREAM_SWITCH = "1.14+: no stream needed while disarmed, checked at arming"
 RECORDED_FAILSAFE = "PX4's failsafe recorded then"
 NOT_FLAGGED = "the model's alone: PX4's failsafe_flags shows no loss"
 """``seen_in`` of a loss the recording's flag of PX4 contradicts (a disagreement follows)."""
+SAME_ITERATION_S = 0.012
+"""A request and a flag logged this close were handled in one Commander iteration (10 ms)."""
 FLAG_FRESH_S = 1.0
 """PX4 publishes ``failsafe_flags`` at each change and about every 0.5 s: a recording whose
 newest sample is older than this does not show PX4's verdict any more."""
@@ -181,6 +183,10 @@ class GateModel:
         """That flag's previous recorded value."""
         self._flag_shows = False
         """The current loss window is one PX4's recorded flag will date."""
+        self._rejected_unseen: tuple[Command, int | None, tuple[int | None, bool | None]] | None
+        self._rejected_unseen = None
+        """The newest request the model rejected for want of a signal (PX4's flag turning
+        available in the same Commander iteration shows PX4 had one)."""
         self._dirty = False
         self._stamp_offset: float | None = None
         self.compare = Comparator(slack(self.px4) + LOOP_PERIOD)
@@ -649,7 +655,36 @@ class GateModel:
             return False
         mask = None if first else self.ocm_mask
         self._signal_available(t, mask, "PX4's failsafe_flags; the logged keep-alive follows")
+        self._rejudge(t)
         return True
+
+    def _rejudge(self, t: float) -> None:
+        """A switch or arm the model rejected for want of a signal, logged in the same
+        Commander iteration as PX4's flag turning available: Commander had the keep-alive the
+        logger missed (its forced check pass runs before it handles the command, 2.1.3; the
+        ULog dates the command on receipt and the flag on publication). Judged again."""
+        rejected, self._rejected_unseen = self._rejected_unseen, None
+        if rejected is None:
+            return
+        cmd, target, before = rejected
+        if t - cmd.t > SAME_ITERATION_S or self.armed is None:
+            return
+        decision = self._decide(cmd, target, self.armed)
+        if not decision.accepted:
+            return
+        self._emit(
+            t,
+            "mode",
+            f"{self._request_name(cmd, target)} at {cmd.t:.3f} s judged again: PX4's flag shows "
+            "the signal it had (the logger missed that keep-alive)",
+            "2.1.3",
+            cause=None,
+        )
+        if cmd.is_mode_switch:
+            self._apply_switch(t, target, decision)
+        else:
+            self._apply_arm(t, decision)
+        self.compare.decided(cmd, decision, before, target)
 
     def _flag_differs(self) -> None:
         pending, self._flag = self._flag, None
@@ -830,6 +865,8 @@ class GateModel:
         else:
             self._apply_disarm(t, decision)
         self.compare.decided(cmd, decision, before, target)
+        unseen = not decision.accepted and decision.reason == "no offboard signal"
+        self._rejected_unseen = (cmd, target, before) if unseen and not cmd.is_disarm else None
 
     def _decide(self, cmd: Command, target: int | None, armed: bool) -> Decision:
         """PX4's answer to ``cmd`` were the vehicle ``armed`` (4.1, 4.2, 13a)."""

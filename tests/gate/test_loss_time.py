@@ -16,12 +16,22 @@ import pytest
 
 from fuzzoff.config import Settings
 from fuzzoff.engine import lint_file, run_events
-from fuzzoff.events import ControlMode, Event, FailsafeFlags, SetPositionTargetLocal
+from fuzzoff.events import CommandAck, ControlMode, Event, FailsafeFlags, SetPositionTargetLocal
 from fuzzoff.findings import Finding
 from fuzzoff.profiles import Profile
 from fuzzoff.sources.base import RecordingInfo
 from fuzzoff.writers.tlog import write_tlog
-from tests.gate.streams import OFFBOARD, POSCTL, TICK, in_offboard, of, run, status, stream
+from tests.gate.streams import (
+    OFFBOARD,
+    POSCTL,
+    TICK,
+    in_offboard,
+    of,
+    run,
+    status,
+    stream,
+    switch_offboard,
+)
 
 
 def _flag(t: float, lost: bool) -> FailsafeFlags:
@@ -149,3 +159,22 @@ def test_a_loss_pxs_flag_does_not_show_is_the_models_alone(px4: str) -> None:
     (lost,) = of("signal_lost", trs)
     assert lost.seen_in is not None and "failsafe_flags shows no loss" in lost.seen_in
     assert of("disagreement", trs)
+
+
+@pytest.mark.parametrize("px4", TICK)
+def test_a_switch_logged_just_before_pxs_flag_is_judged_with_it(px4: str) -> None:
+    """MAVSDK's set-then-start on SITL: the ULog has the switch at 6.552 s, PX4's flag turning
+    available at 6.556 s and the ack ACCEPTED, but not the keep-alive (the logger missed it).
+    Commander's forced check pass ran before it handled the command: the switch had a signal."""
+    events: list[Event] = [
+        status(0.0, POSCTL, True, POSCTL),
+        _flag(0.5, True),
+        switch_offboard(1.000),
+        _flag(1.004, False),
+        CommandAck(t=1.004, command=176, result=0),
+        *_logged(stream(1.1, 2.0)),
+    ]
+    trs = run(px4, events, t_end=2.0)
+    assert of("disagreement", trs) == []
+    (accepted,) = of("request_accepted", trs)
+    assert accepted.t == pytest.approx(1.004)
