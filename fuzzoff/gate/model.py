@@ -187,6 +187,9 @@ class GateModel:
         self._rejected_unseen = None
         """The newest request the model rejected for want of a signal (PX4's flag turning
         available in the same Commander iteration shows PX4 had one)."""
+        self._flags_unlogged = False
+        """PX4's flag made the signal available before any logged keep-alive: its flags are
+        not known yet, and PX4's flag stands for them."""
         self._dirty = False
         self._stamp_offset: float | None = None
         self.compare = Comparator(slack(self.px4) + LOOP_PERIOD)
@@ -478,6 +481,7 @@ class GateModel:
             else:
                 self._dirty = stamp is not None and not self.signal.moved_later
             return
+        self._flags_unlogged = False
         changed = mask != self.ocm_mask
         if changed:
             self.ocm_mask = mask
@@ -654,6 +658,7 @@ class GateModel:
         if not self.signal.keepalive(t, True):
             return False
         mask = None if first else self.ocm_mask
+        self._flags_unlogged = first
         self._signal_available(t, mask, "PX4's failsafe_flags; the logged keep-alive follows")
         self._rejudge(t)
         return True
@@ -877,7 +882,8 @@ class GateModel:
             )
         if cmd.is_arm:
             why = estimate_failure(self.px4, self.ocm_mask, self.est) or "no offboard signal"
-            now_ok = self.signal.ok_now(cmd.t, self.ocm_mask != 0 and why == "no offboard signal")
+            flags_known = self.ocm_mask != 0 or self._flags_unlogged
+            now_ok = self.signal.ok_now(cmd.t, flags_known and why == "no offboard signal")
             return arm_decision(self.px4, cmd, self.user_intention, now_ok, why, attitude_ok, armed)
         landed, why = self.landed.landed(cmd.t)
         ground = self.vehicle_type.startswith("rover")

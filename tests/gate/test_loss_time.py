@@ -25,6 +25,7 @@ from tests.gate.streams import (
     OFFBOARD,
     POSCTL,
     TICK,
+    arm,
     in_offboard,
     of,
     run,
@@ -178,3 +179,21 @@ def test_a_switch_logged_just_before_pxs_flag_is_judged_with_it(px4: str) -> Non
     assert of("disagreement", trs) == []
     (accepted,) = of("request_accepted", trs)
     assert accepted.t == pytest.approx(1.004)
+
+
+@pytest.mark.parametrize("px4", TICK)
+def test_an_arm_while_only_pxs_flag_shows_the_signal_is_accepted(px4: str) -> None:
+    """One setpoint, the switch, the arm (SITL, 1.17.0 and 1.18.0-alpha1): PX4's flag says
+    available from 4.39 s while the first logged offboard_control_mode comes at 4.99 s; PX4
+    armed at 4.64 s. The flag stands for the keep-alive's flags the log does not hold yet."""
+    events: list[Event] = [
+        status(0.0, POSCTL, False, POSCTL),
+        _flag(0.5, True),
+        _flag(4.392, False),
+        switch_offboard(4.484),
+        arm(4.636),
+        CommandAck(t=4.644, command=400, result=0),
+        *_logged(stream(4.992, 6.0)),
+    ]
+    trs = run(px4, events, t_end=6.0)
+    assert of("arm_accepted", trs) and of("disagreement", trs) == []
