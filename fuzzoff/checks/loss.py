@@ -177,7 +177,10 @@ class OffboardLoss(Check):
             message += f" ({tr.reason})"
         counted = not stopped.startswith("the keep-alive kept arriving")
         brief = stopped.removeprefix("the ") if counted else "keep-alive no longer counted"
-        short = f"{brief}: {action} at {tr.t:.2f} s"
+        at = f"at {tr.t:.2f} s"
+        if tr.t_earliest is not None:  # PX4's check window, its phase not recorded
+            at = f"{tr.t_earliest:.2f}-{tr.t:.2f} s"
+        short = f"{brief}: {action} {at}"
         self.reported_until = self.last if self.last is not None else tr.t
         self.pending = _Pending(tr.t, message, self.last_where, self.last, short)
         left = self.left
