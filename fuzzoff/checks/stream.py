@@ -340,7 +340,6 @@ class StreamBeforeRequest(Check):
         elif verdict.what == "undecided":  # the arming state is not in the recording
             would = verdict.reason or verdict.message
             brief = "accepts it if disarmed, rejects it if armed"
-            severity = Severity.WARNING  # rejected in one of the two outcomes
         elif verdict.what.endswith("accepted"):
             would = "accept it"
             brief = "accepts it"
