@@ -446,6 +446,19 @@ class FailsafeFlags(Event):
     origin: Origin = "vehicle"
 
 
+@dataclass(frozen=True, slots=True, kw_only=True)
+class LandDetected(Event):
+    """The land detector's verdict, which PX4 reads when it judges a disarm request (gate spec
+    13a: refused in flight). ``landed`` is what Commander tests, ``landed or maybe_landed``
+    (ULog ``vehicle_land_detected``), or MAVLink ``EXTENDED_SYS_STATE.landed_state`` ON_GROUND
+    (IN_AIR, TAKEOFF and LANDING are not landed; UNDEFINED is ``None``)."""
+
+    kind: ClassVar[str] = "land_detected"
+
+    landed: bool | None = None
+    origin: Origin = "vehicle"
+
+
 # ---------------------------------------------------------------------------------------------
 # Commands, acks, parameters, vehicle identity
 
@@ -605,6 +618,7 @@ ALL_EVENT_TYPES: tuple[type[Event], ...] = (
     VehicleStatus,
     VehicleControlModeStatus,
     FailsafeFlags,
+    LandDetected,
     Command,
     CommandAck,
     Parameter,

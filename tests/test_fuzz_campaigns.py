@@ -195,9 +195,12 @@ def test_from_recording_reports_the_stall_margin(tmp_path: Path) -> None:
     margins = {m["family"]: m for m in json.loads(out.stdout)["margins"]}
     stall = margins["stall"]
     assert stall["found"]
-    # 20 Hz stream, COM_OF_LOSS_T 1 s checked at 10 Hz: a stall of about 0.95 s loses it.
-    assert 0.8 <= stall["size"] <= 1.05
-    assert any(o["hazard"] == "failsafe" for o in stall["outcome_after"])
+    # 20 Hz stream, COM_OF_LOSS_T 1 s checked at 10 Hz: a stall of about 0.95-1.05 s loses it
+    # (a gap over the timeout plus the check period whose phase the recording does not show);
+    # the loss shows as the failsafe, or as the switch that follows it rejected.
+    assert 0.8 <= stall["size"] <= 1.1
+    hazards = {o["hazard"] for o in stall["outcome_after"]}
+    assert hazards & {"failsafe", "request_rejected"}
 
 
 def test_from_a_real_recording_measures_new_hazards_not_the_recordings_own(
@@ -219,7 +222,8 @@ def test_from_a_real_recording_measures_new_hazards_not_the_recordings_own(
         "runs",
     ]
     stall = {m["family"]: m for m in report["margins"]}["stall"]
-    assert 0.8 <= stall["size"] <= 1.05
+    # a new gap over COM_OF_LOSS_T and the check period whose phase the tlog does not show
+    assert 0.8 <= stall["size"] <= 1.1
     assert stall["at_s"] < 8.0  # before the recording's own loss
 
 
@@ -315,8 +319,8 @@ def test_invariant_2_dates_a_late_ros2_keepalive_by_its_timestamp() -> None:
     scenario = Scenario("1.15", "mc", "ros2", (*events, disarm))
     timelines: dict[str, Timeline] = {}
     run(scenario, timelines=timelines)
-    lost = [tr.t for tl in timelines.values() for tr in tl.transitions if tr.what == "signal_lost"]
-    assert lost == [pytest.approx(3.0)]
+    lost = [tr for tl in timelines.values() for tr in tl.transitions if tr.what == "signal_lost"]
+    assert [tr.t_earliest for tr in lost] == [pytest.approx(3.0)]  # the window 3.0-3.1 s
     assert invariant_violations(scenario) == []
 
 

@@ -27,10 +27,6 @@ from tests.helpers import CORPORA, run_cli
 SITL = CORPORA / "sitl"
 RUNS = json.loads((SITL / "runs.json").read_text())
 PAIRS = sorted(s for s in RUNS if (SITL / f"{s}.tlog").exists() and (SITL / f"{s}.ulg").exists())
-DISARM_DENIED = (
-    "issue 18: PX4 refuses a disarm in flight ('Disarming denied: not landed'); the model"
-    " accepts it"
-)
 
 
 def test_px4_clock_follows_a_simulation_slower_than_real_time() -> None:
@@ -149,17 +145,7 @@ def test_sitl_list_shows_the_scenarios() -> None:
     assert "clean_offboard" in out.stdout and "hazard" in out.stdout
 
 
-def _verdict_cases() -> list[object]:
-    cases = []
-    for stem in PAIRS:
-        marks = []
-        if stem.startswith("disarm_in_flight"):
-            marks.append(pytest.mark.xfail(strict=True, reason=DISARM_DENIED))
-        cases.append(pytest.param(stem, marks=marks, id=stem))
-    return cases
-
-
-@pytest.mark.parametrize("stem", _verdict_cases())
+@pytest.mark.parametrize("stem", PAIRS)
 def test_the_gate_model_agrees_with_the_recorded_px4_run(stem: str) -> None:
     """Issue 18 item 3 on the recordings: the model run on the client's tlog against PX4's ULog
     (switches and arms, loss time within one check period, failsafe action, return)."""

@@ -7,9 +7,10 @@ stream rules the flights also touch):
 
 * ``loss_and_resume_agrees`` (1.15): offboard flight, the stream stops at 5.0 s and resumes at
   8.0 s; the log shows POSCTL with the failsafe flag from 6.1 s and OFFBOARD again at 8.05 s, as
-  the gate model predicts (loss at the 6.0 s check pass, action Position, automatic return).
-  OFB202 must stay clean; OFB701 states the loss behaviour at the request (1.5 s); OFB103 is the
-  loss (6.01 s) and OFB101 the 3 s gap.
+  the gate model predicts (loss due at 6.0 s, seen within one 10 Hz check period: the recorded
+  failsafe at 6.1 s dates it; action Position, automatic return). OFB202 must stay clean; OFB701
+  states the loss behaviour at the request (1.5 s); OFB103 is the loss (6.1 s) and OFB101 the
+  3 s gap.
 * ``recorded_stays_offboard`` (1.15): the same stream, but the log stays in OFFBOARD through the
   gap (as if COM_OF_LOSS_T were larger on the vehicle than in the log): OFB202 at the first status
   that contradicts the model (6.5 s).
@@ -151,8 +152,12 @@ def offboard_flight(
 # OFB203 and OFB302 (only PX4's own copies of the messages) cannot be judged on a ULog.
 NOT_CHECKABLE_115 = [("OFB002", "info", None)] * 5
 # The 3 s gap in OFFBOARD: OFB101 (docs: keep-alive gaps under 0.5 s) from the last keep-alive,
-# and OFB103 (PX4's loss after COM_OF_LOSS_T, at the 10 Hz check pass plus one iteration).
-GAP = [("OFB101", "error", STOP_T), ("OFB103", "error", 6.01)]
+# and OFB103 at PX4's failsafe: its loss is due at 6.0 s and seen by a 10 Hz check pass within
+# 0.1 s, then one iteration. The recorded failsafe (the status at 6.1 s) dates it; PX4's flag
+# (lost from 6.005 s) dates it where logged; with neither, the window's end (6.11 s).
+GAP = [("OFB101", "error", STOP_T), ("OFB103", "error", 6.1)]
+GAP_FLAG = [("OFB101", "error", STOP_T), ("OFB103", "error", 6.015)]
+GAP_UNDATED = [("OFB101", "error", STOP_T), ("OFB103", "error", 6.11)]
 
 
 def signal_flags(lost: tuple[float, float]) -> list[Event]:
@@ -204,7 +209,12 @@ def cases() -> list[Case]:
         Case(
             "recorded_stays_offboard",
             offboard_flight((OFFBOARD, False)),
-            [*NOT_CHECKABLE_115, ("OFB701", "info", SWITCH_T), *GAP, ("OFB202", "warning", 6.5)],
+            [
+                *NOT_CHECKABLE_115,
+                ("OFB701", "info", SWITCH_T),
+                *GAP_UNDATED,
+                ("OFB202", "warning", 6.5),
+            ],
             ["OFB702"],
         ),
         Case(
@@ -220,7 +230,7 @@ def cases() -> list[Case]:
                 *NOT_CHECKABLE_115,
                 ("OFB701", "info", SWITCH_T),
                 *GAP,
-                ("OFB702", "error", 6.01),  # the loss ran NAV_RCL_ACT instead of Position
+                ("OFB702", "error", 6.1),  # the loss ran NAV_RCL_ACT instead of Position
             ],
             ["OFB202"],
             px4_version="1.17.0",
@@ -239,13 +249,18 @@ def cases() -> list[Case]:
         Case(
             "signal_flag_agrees",
             with_flags(offboard_flight((POSCTL, True)), (6.0, RESUME_T)),
-            [*NOT_CHECKABLE_115, ("OFB701", "info", SWITCH_T), *GAP],
+            [*NOT_CHECKABLE_115, ("OFB701", "info", SWITCH_T), *GAP_FLAG],
             ["OFB202", "OFB702"],
         ),
         Case(
             "signal_flag_lost_early",
             with_flags(offboard_flight((POSCTL, True)), (5.6, RESUME_T)),
-            [*NOT_CHECKABLE_115, ("OFB701", "info", SWITCH_T), *GAP, ("OFB202", "warning", 5.605)],
+            [
+                *NOT_CHECKABLE_115,
+                ("OFB701", "info", SWITCH_T),
+                *GAP_FLAG,
+                ("OFB202", "warning", 5.605),
+            ],
             ["OFB702"],
         ),
         Case(

@@ -205,9 +205,9 @@ def mcap_cases() -> list[Case]:
 
     # OFB106: the companion's clock stops at 3.0 s; the first message lagging by more than
     # COM_OF_LOSS_T (1.0 s) is at 4.1 s. PX4 1.15 takes the stream for lost (warning): it judges
-    # the keep-alive's age by its rewritten timestamp (gate spec 2.1.1), so at the 10 Hz check
-    # after 4.0 s it fails over to POSCTL (OFB103 at 4.01 s), which the recorded status shows
-    # from 4.1 s with its failsafe flag.
+    # the keep-alive's age by its rewritten timestamp (gate spec 2.1.1), so at a 10 Hz check
+    # within 0.1 s after 4.0 s it fails over to POSCTL, which the recorded status shows from
+    # 4.1 s with its failsafe flag (OFB103 at 4.1 s, that status dating it).
     frozen_clock = [
         e
         for e in Flight(POSITION, climb, ocm_stamp=lambda t: stamp(min(t, 3.0))).events()
@@ -223,7 +223,7 @@ def mcap_cases() -> list[Case]:
             "ofb106_clock_stops",
             frozen_clock,
             # ...and the companion keeps publishing TrajectorySetpoint in POSCTL (OFB203).
-            [("OFB106", "warning", 4.1), ("OFB103", "error", 4.01), ("OFB203", "error", 4.15)],
+            [("OFB106", "warning", 4.1), ("OFB103", "error", 4.1), ("OFB203", "error", 4.15)],
             ["OFB202"],
         )
     )
@@ -551,7 +551,8 @@ def ulog_cases() -> list[Case]:
     # OFB305: the local position estimate turns invalid at 4.0 s in offboard. PX4 1.15 then
     # takes the offboard signal for lost (gate spec 2.1) and, without a position estimate, falls
     # back to ALTCTL instead of the configured POSCTL (OFB103, OFB702); the logged status
-    # shows ALTCTL with the failsafe flag from the next 10 Hz check pass.
+    # shows ALTCTL with the failsafe flag from the next 10 Hz check pass (4.2 s: the status
+    # logged every 0.1 s; it dates OFB103, as the log has no failsafe_flags sample of the loss).
     def failsafe(e: Event) -> Event:
         if isinstance(e, VehicleStatus) and e.t >= 4.1:
             return replace(e, nav_state=ALTCTL, failsafe=True, user_intention=OFFBOARD)
@@ -562,7 +563,7 @@ def ulog_cases() -> list[Case]:
             "ofb305_position_estimate_lost",
             [*(failsafe(e) for e in logged), valid, lost],
             # the loss ran the fallback ALTCTL instead of the configured POSCTL: OFB702 error
-            [("OFB305", "error", 4.0), ("OFB103", "error", 4.01), ("OFB702", "error", 4.01)],
+            [("OFB305", "error", 4.0), ("OFB103", "error", 4.2), ("OFB702", "error", 4.2)],
             [],
             fmt="ulg",
         )

@@ -370,7 +370,7 @@ def main() -> None:
         profile=p115,
     )
     write("logger_dropout", with_gap(dropout=True), context, exit_status=0, profile=p115)
-    loss = [finding("OFB101", "error", 8.0), finding("OFB103", "error", 9.0)]
+    loss = [finding("OFB101", "error", 8.0), finding("OFB103", "error", 9.08)]  # PX4's own time
     write("stream_lost_in_offboard", lost_stream(), [*context, *loss], exit_status=1, profile=p115)
     write(
         "switch_rejected",

@@ -104,9 +104,7 @@ def loss_short(ctx: CheckContext) -> str:
     gate = ctx.gate
     action = gate.current_loss_action()
     loss_t = float(gate.params.get("COM_OF_LOSS_T", 0.0))
-    after = (
-        f"0.5 s + {loss_t:g} s" if ctx.profile.px4 == "legacy" else f"{loss_t:g} s"
-    )
+    after = f"0.5 s + {loss_t:g} s" if ctx.profile.px4 == "legacy" else f"{loss_t:g} s"
     if action.disarm:
         what = "disarm"
     elif action.none:
@@ -190,7 +188,10 @@ class LossActionUnavailable(Check):
         if loss:
             self.ran.add(key)
             self.noted.pop(key, None)
-            message = f"the offboard signal was lost at {event.t:.2f} s and the fallback ran: "
+            when = f"at {event.t:.2f} s"
+            if isinstance(event, GateTransition) and event.t_earliest is not None:
+                when = f"between {event.t_earliest:.2f} and {event.t:.2f} s"  # a check window
+            message = f"the offboard signal was lost {when} and the fallback ran: "
             self.ctx.report(
                 "OFB702",
                 message + self._message(action),

@@ -4,6 +4,11 @@ Driven by the gate model's ``failsafe`` transitions (gate spec 5); where the gat
 vehicle in offboard but the recording does (a MAVROS bag has no mode commands to model), the same
 timeout is applied to the recorded mode so the loss is still reported. Where the recording shows
 what the vehicle did next, the finding compares it with the model's action.
+
+Times quoted: the model's loss as the gate dates it (PX4's own flag where the recording holds
+it, else the window of PX4's 10 Hz check pass, gate spec 2.1.3); the recorded change as the
+recording shows it: the first status with the new mode, or, where the mode is sampled over a
+link (1 Hz HEARTBEAT, ``/mavros/state``), between the last sample still in OFFBOARD and that one.
 """
 
 from __future__ import annotations
@@ -20,6 +25,7 @@ from fuzzoff.checks._keepalive import (
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import NAV_STATE_OFFBOARD, Event, VehicleStatus, Where
 from fuzzoff.gate import GateTransition
+from fuzzoff.gate.compare import over_a_link
 from fuzzoff.modes import nav_state_name
 
 RECORDED_ANSWER_WINDOW_S = 2.5
@@ -31,6 +37,35 @@ def _inner(message: str) -> str:
     """``offboard signal lost (why)`` -> ``why``."""
     _head, sep, rest = message.partition("(")
     return rest[:-1] if sep and rest.endswith(")") else message
+
+
+@dataclass(frozen=True, slots=True)
+class _Change:
+    """A recorded change out of OFFBOARD: first sample with the new mode, the sample before."""
+
+    t: float
+    before: float | None
+    nav: int | None
+    sampled: bool
+    """The mode reached the recording over a link at 1 Hz: the change lies between the two."""
+
+    def text(self) -> str:
+        mode = nav_state_name(self.nav)
+        if self.sampled and self.before is not None:
+            return f"{mode} between {self.before:.2f} and {self.t:.2f} s (mode sampled at 1 Hz)"
+        return f"{mode} at {self.t:.2f} s"
+
+
+def loss_when(lost: GateTransition) -> str:
+    """The time of the gate's ``signal_lost``: a window, or where the recording shows it."""
+    if lost.t_earliest is not None:
+        return (
+            f"between {lost.t_earliest:.2f} and {lost.t:.2f} s (its 10 Hz check pass, at a phase "
+            "the recording does not show)"
+        )
+    if lost.seen_in is not None:
+        return f"at {lost.t:.2f} s ({lost.seen_in})"
+    return f"at {lost.t:.2f} s"
 
 
 @dataclass(slots=True)
@@ -56,6 +91,10 @@ class OffboardLoss(Check):
         """The gate's latest ``signal_lost`` (its message says why: silence, an old stamp...)."""
         self.reported_until: float = -1.0
         """Keep-alive time up to which a loss has been reported (one finding per gap)."""
+        self.sample_t: float | None = None
+        """The previous recorded status's time."""
+        self.left: _Change | None = None
+        """The latest recorded change out of OFFBOARD (None while the recording shows it)."""
 
     def on_event(self, event: Event) -> None:
         if self.pending is not None and event.t - self.pending.t > RECORDED_ANSWER_WINDOW_S:
@@ -75,8 +114,9 @@ class OffboardLoss(Check):
             elif event.what == "failsafe":
                 self._from_gate(event)
         elif isinstance(event, VehicleStatus):
+            self._sample(event)
             if self.pending is not None and event.nav_state is not None and not event.in_offboard:
-                self._flush(event)
+                self._flush(self.left)
             if self.last_flying and not state.flying:
                 self._gap_from_recording(event.t)  # only the silence spent in OFFBOARD counts
                 self.last_flying = False
@@ -106,6 +146,15 @@ class OffboardLoss(Check):
         self.last, self.last_where = run.times[-1], run.events[-1].where
         self.last_flying = flying
 
+    def _sample(self, status: VehicleStatus) -> None:
+        """Keep where the recording shows the vehicle leaving OFFBOARD."""
+        if status.nav_state is not None:
+            if status.in_offboard:
+                self.left = None
+            elif self.left is None:
+                self.left = _Change(status.t, self.sample_t, status.nav_state, over_a_link(status))
+        self.sample_t = status.t
+
     def _from_gate(self, tr: GateTransition) -> None:
         self._flush(None)  # a loss still waiting for the recorded answer is reported first
         timeout = loss_timeout(self.ctx)
@@ -119,19 +168,26 @@ class OffboardLoss(Check):
         else:
             stopped = f"the keep-alive stopped at {self.last:.2f} s"
         action = tr.action or "its failsafe"
+        when = loss_when(self.lost) if self.lost is not None else f"by {tr.t:.2f} s"
         message = (
             f"{stopped} while in OFFBOARD; {px4_label(self.ctx)} declares the offboard signal lost "
-            f"at {tr.t:.2f} s (loss timeout {timeout:.2f} s) and runs {action}"
+            f"{when} and runs {action} (loss timeout {timeout:.2f} s)"
         )
         if tr.reason:
             message += f" ({tr.reason})"
         counted = not stopped.startswith("the keep-alive kept arriving")
         brief = stopped.removeprefix("the ") if counted else "keep-alive no longer counted"
-        short = f"{brief}: {action} at {tr.t:.2f} s"
+        at = f"at {tr.t:.2f} s"
+        if tr.t_earliest is not None:  # PX4's check window, its phase not recorded
+            at = f"{tr.t_earliest:.2f}-{tr.t:.2f} s"
+        short = f"{brief}: {action} {at}"
         self.reported_until = self.last if self.last is not None else tr.t
         self.pending = _Pending(tr.t, message, self.last_where, self.last, short)
+        left = self.left
         if not self.ctx.state.mode_recorded:
             self._flush(None)
+        elif left is not None and tr.t - left.t <= RECORDED_ANSWER_WINDOW_S:
+            self._flush(left)  # the recording showed the change first (PX4's own timing)
 
     def _gap_from_recording(self, now: float) -> None:
         """A loss the gate did not model, judged on the recorded mode with the same timeout."""
@@ -155,14 +211,14 @@ class OffboardLoss(Check):
             "OFB103", message, self.last + timeout, self.last_where, end=now, short=short
         )
 
-    def _flush(self, answer: VehicleStatus | None) -> None:
+    def _flush(self, answer: _Change | None) -> None:
         pending, self.pending = self.pending, None
         if pending is None:
             return
         message, short = pending.message, pending.short
         if answer is not None:
-            message += f"; recorded: {nav_state_name(answer.nav_state)} at {answer.t:.2f} s"
-            short += f"; recorded: {nav_state_name(answer.nav_state)} at {answer.t:.2f} s"
+            message += f"; recorded: {answer.text()}"
+            short += f"; recorded: {answer.text()}"
         elif self.ctx.state.mode_recorded:
             message += f"; recorded: still {nav_state_name(self.ctx.state.nav_state)}"
             short += f"; recorded: still {nav_state_name(self.ctx.state.nav_state)}"

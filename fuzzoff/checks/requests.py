@@ -22,6 +22,7 @@ from fuzzoff.events import (
     CommandAck,
     Event,
 )
+from fuzzoff.findings import Severity
 from fuzzoff.gate import GateTransition
 from fuzzoff.state import DOUBLE_ACK_WINDOW_S
 
@@ -118,6 +119,9 @@ class RequestRejected(Check):
         if self.ctx.has("command_ack"):
             return
         verdict = request.verdict
+        if verdict is not None and verdict.what == "undecided":
+            self._undecided(request, verdict)
+            return
         if verdict is None or not verdict.what.endswith("rejected"):
             self.unconfirmed = True
             return
@@ -130,6 +134,21 @@ class RequestRejected(Check):
             request.command.where,
             short=f"{request.what}: {px4_label(self.ctx)} would reject it "
             f"({verdict.reason or verdict.message})",
+        )
+
+    def _undecided(self, request: _Request, verdict: GateTransition) -> None:
+        """The rejection depends on the arming state, which the recording does not show: both
+        outcomes, as a warning (PX4 rejects it only in one of them)."""
+        self.ctx.report(
+            "OFB201",
+            f"{request.what} at {request.command.t:.2f} s, {px4_label(self.ctx)}: "
+            f"{verdict.reason}; the recording shows neither the arming state nor the vehicle's "
+            "answer",
+            request.command.t,
+            request.command.where,
+            severity=Severity.WARNING,
+            short=f"{request.what}: {px4_label(self.ctx)} rejects it only if armed (arming not "
+            "recorded)",
         )
 
     def _settle(self, now: float) -> None:
@@ -146,6 +165,11 @@ class RequestRejected(Check):
         verdict = request.verdict
         if verdict is not None and verdict.what.endswith("rejected"):
             why = f"gate model: {verdict.reason or verdict.message}"
+        elif verdict is not None and verdict.what == "undecided":
+            why = (
+                f"gate model: {verdict.reason}; the recording did not show the arming state, "
+                "this answer does"
+            )
         elif verdict is not None:
             why = (
                 f"the gate model expected {px4_label(self.ctx)} to accept it, so the cause is "

@@ -289,6 +289,7 @@ class StreamBeforeRequest(Check):
                 "request_rejected",
                 "arm_accepted",
                 "arm_rejected",
+                "undecided",
             ):
                 self.gate_verdict[id(event.cause)] = event
         elif isinstance(event, Command):
@@ -336,6 +337,9 @@ class StreamBeforeRequest(Check):
                 else "see the gate timeline"
             )
             brief = ""
+        elif verdict.what == "undecided":  # the arming state is not in the recording
+            would = verdict.reason or verdict.message
+            brief = "accepts it if disarmed, rejects it if armed"
         elif verdict.what.endswith("accepted"):
             would = "accept it"
             brief = "accepts it"

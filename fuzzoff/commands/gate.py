@@ -1,8 +1,11 @@
 """``fuzzoff gate PATH``: the gate model's timeline beside the recorded mode.
 
 Each row is a model transition (time, what, message, gate-spec section, ``U`` for behaviour the
-spec lists as unverified) or a recorded mode change (``recorded``). Rows where the recording and
-the model differ beyond the profile's evaluation slack are ``disagreement`` rows naming both.
+spec lists as unverified) or a recorded mode change (``recorded``). A loss whose time is PX4's
+10 Hz check window is dated at the window's end, ``earliest_s`` its start; ``seen_in`` names
+where the recording shows PX4's own timing when the model took it from there. Rows where the
+recording and the model differ beyond the profile's evaluation slack are ``disagreement`` rows
+naming both.
 Exit status: 0 the model and the recording agree (or the recording has no mode), 1 they
 disagree somewhere, 2 usage error or the recording could not be read completely.
 """
@@ -64,6 +67,8 @@ def _transition_row(tr: GateTransition) -> Row:
         "action": tr.action,
         "reason": tr.reason,
         "recorded_nav_state": tr.recorded_nav_state,
+        "earliest_s": None if tr.t_earliest is None else round(tr.t_earliest, 6),
+        "seen_in": tr.seen_in,
     }
 
 

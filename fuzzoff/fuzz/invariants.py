@@ -39,7 +39,8 @@ TERMINATION = 13
 
 
 def invariant_violations(scenario: Scenario) -> list[str]:
-    model = GateModel(scenario.profile, dict(scenario.params), _vehicle(scenario))
+    # The scenario's vehicle boots disarmed (its stream starts from there).
+    model = GateModel(scenario.profile, dict(scenario.params), _vehicle(scenario), armed=False)
     sent = [e for e in scenario.events if e.origin == "sent"]
     new_gate = at_least(scenario.px4, "1.14")
     problems: list[str] = []
@@ -143,7 +144,7 @@ def _disarmed_switch(
     scenario: Scenario,
     cmd: Command,
     out: list[GateTransition],
-    was_armed: bool,
+    was_armed: bool | None,
     nav: int | None,
 ) -> list[str]:
     if was_armed or nav == TERMINATION:

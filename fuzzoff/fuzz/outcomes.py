@@ -12,12 +12,16 @@ still unmatched are gone ("no longer: ...").
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 
 from fuzzoff.engine import Timeline
 from fuzzoff.fuzz.hazards import Hazard, hazards
 from fuzzoff.fuzz.scenario import Scenario, run
 from fuzzoff.modes import nav_state_name
+
+_TIMING = re.compile(r" (?:between [\d.]+ and [\d.]+ s|at [\d.]+ s \([^)]*\))")
+"""The time words of a gate failsafe message (its window, or where the recording dated it)."""
 
 
 def hazards_of(scenario: Scenario) -> list[Hazard]:
@@ -58,7 +62,8 @@ def changes(
 
 def describe(px4: str, h: Hazard) -> str:
     """One hazard as what PX4 does: "PX4 1.15 runs POSCTL at 7.2 s (offboard loss)"."""
-    cause = h.message.split(":", 1)[0]
+    # "offboard loss between 5.81 and 5.91 s: POSCTL": the cause, not the gate's timing words
+    cause = _TIMING.sub("", h.message.split(":", 1)[0])
     if h.kind == "failsafe":
         return f"PX4 {px4} runs {nav_state_name(h.nav_state)} at {h.t:.1f} s ({cause})"
     if h.kind == "disarmed":

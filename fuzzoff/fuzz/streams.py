@@ -119,7 +119,7 @@ def _retime(e: ev.Event, t: float) -> ev.Event:
 # ----------------------------------------------------------------------------- the vehicle
 
 ACCEPT = {"request_accepted", "arm_accepted", "disarmed", "mode"}
-REJECT = {"request_rejected", "arm_rejected"}
+REJECT = {"request_rejected", "arm_rejected", "disarm_rejected"}
 
 
 def echo(
@@ -137,9 +137,9 @@ def echo(
     each change."""
     profile = Profile(px4=px4, vehicle=vehicle, px4_detected=True, vehicle_detected=True)
     vid = "1" if transport == "mavlink" else ""
-    model = GateModel(profile, params, vid)
+    model = GateModel(profile, params, vid, armed=False)  # the simulated vehicle boots disarmed
     out: list[ev.Event] = []
-    last_state: tuple[int | None, bool] | None = None
+    last_state: tuple[int | None, bool | None] | None = None
     next_beat = 0.0
     clock = 0.0
 

@@ -2,15 +2,17 @@
 
 A recorded ``VehicleStatus`` agrees with the model when its nav_state equals the model's, or
 equals the model's previous nav_state and the model changed less than the slack ago (the
-recording lags), or the model reaches it within the slack (the recording leads: PX4's 10 Hz
-check pass has its own phase, gate spec 2.1.3). Otherwise the difference waits ``slack``; if it
-is still there it is confirmed once per episode (until the two agree again).
+recording lags), or the model reaches it within the slack (the recording leads: a loss whose
+time the recording does not show is dated at the end of its window, PX4's 10 Hz check pass of
+unknown phase, gate spec 2.1.3, and the slack covers the window). Otherwise the difference waits
+``slack``; if it is still there it is confirmed once per episode (until the two agree again).
 
 A mode that reached the recording over a link (HEARTBEAT, ``/mavros/state``) may also lag by
 ``LINK_LAG``.
 
 Acks: PX4 1.16/1.17 ack a mode switch twice (4.3), so an ack is judged ``ACK_WINDOW`` after the
-first one, by the last one.
+first one, by the last one. A request decided while the arming state was unknown carries the
+outcome if armed as ``alternative``: its ack is handed back whatever it says, to settle which.
 """
 
 from __future__ import annotations
@@ -48,8 +50,11 @@ class Decided:
     t: float
     decision: Decision
     cmd: Command
-    before: tuple[int | None, bool]
+    before: tuple[int | None, bool | None]
     target: int | None
+    alternative: Decision | None = None
+    """The decision were the vehicle armed, where the arming state was unknown and the two
+    differ (``decision`` is then the one if disarmed)."""
 
 
 @dataclass(slots=True)
@@ -58,7 +63,9 @@ class AckWait:
     ack: CommandAck
 
 
-def _over_a_link(status: VehicleStatus) -> bool:
+def over_a_link(status: VehicleStatus) -> bool:
+    """A mode sampled over a link (1 Hz HEARTBEAT, ``/mavros/state``), not published by PX4 on
+    each change."""
     topic = status.where.topic
     return topic == "HEARTBEAT" or topic.endswith("/state")
 
@@ -115,7 +122,7 @@ class Comparator:
             self.pending = None
             self.open_episode = False
             return
-        lag = self.slack + (LINK_LAG if _over_a_link(status) else 0.0)
+        lag = self.slack + (LINK_LAG if over_a_link(status) else 0.0)
         if status.t - self.changed_at <= lag and recorded == self.nav_before:
             return
         if self.open_episode:
@@ -142,10 +149,11 @@ class Comparator:
         self,
         cmd: Command,
         decision: Decision,
-        before: tuple[int | None, bool],
+        before: tuple[int | None, bool | None],
         target: int | None,
+        alternative: Decision | None = None,
     ) -> None:
-        self.decisions[cmd.command] = Decided(cmd.t, decision, cmd, before, target)
+        self.decisions[cmd.command] = Decided(cmd.t, decision, cmd, before, target, alternative)
         self.last_command_t = cmd.t
 
     def ack(self, ack: CommandAck) -> None:
@@ -159,7 +167,8 @@ class Comparator:
         self.ack_wait = AckWait(ack.t, ack)
 
     def take_ack(self) -> tuple[Decided, CommandAck] | None:
-        """The judged ack if it disagrees with the model's decision, else None."""
+        """The judged ack if it disagrees with the model's decision or settles an undecided
+        one, else None."""
         wait = self.ack_wait
         self.ack_wait = None
         if wait is None:
@@ -167,6 +176,6 @@ class Comparator:
         decided = self.decisions.pop(wait.ack.command, None)
         if decided is None:
             return None
-        if wait.ack.accepted == decided.decision.accepted:
+        if decided.alternative is None and wait.ack.accepted == decided.decision.accepted:
             return None
         return decided, wait.ack

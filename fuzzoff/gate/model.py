@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
+from dataclasses import dataclass
 from typing import Any
 
 from fuzzoff.events import (
@@ -33,6 +34,7 @@ from fuzzoff.events import (
     ControlMode,
     Event,
     FailsafeFlags,
+    LandDetected,
     LegacyControlMode,
     Parameter,
     PositionSetpointTriplet,
@@ -44,13 +46,21 @@ from fuzzoff.events import (
     VehicleStatus,
 )
 from fuzzoff.gate import controllers, ocm
-from fuzzoff.gate.compare import Comparator
+from fuzzoff.gate.compare import SAMPLED_SLACK, Comparator, Decided
 from fuzzoff.gate.estimates import Estimates
 from fuzzoff.gate.failsafe import LossAction, loss_action
+from fuzzoff.gate.landed import LandedState, climbs
 from fuzzoff.gate.params import default_params
 from fuzzoff.gate.receiver import DROPPED, SHAPES, ReceiverContext, Result, Shape, receive
-from fuzzoff.gate.requests import Decision, arm_decision, decode_mode, switch_decision
+from fuzzoff.gate.requests import (
+    Decision,
+    arm_decision,
+    decode_mode,
+    disarm_decision,
+    switch_decision,
+)
 from fuzzoff.gate.signal import (
+    CHECK_PERIOD,
     INF,
     LOOP_PERIOD,
     UnseenSignal,
@@ -72,6 +82,29 @@ NOT_OFFBOARD = "no OFFBOARD on either side: other modes' own rules are not model
 FAILSAFE_TEXT_WINDOW_S = 3.0
 """A failsafe STATUSTEXT this long before a recorded change out of OFFBOARD explains it (PX4
 sends the text at once; the 1 Hz HEARTBEAT shows the new mode up to a second later)."""
+NO_STREAM_SWITCH = "1.14+: no stream needed while disarmed, checked at arming"
+RECORDED_FAILSAFE = "PX4's failsafe recorded then"
+NOT_FLAGGED = "the model's alone: PX4's failsafe_flags shows no loss"
+"""``seen_in`` of a loss the recording's flag of PX4 contradicts (a disagreement follows)."""
+SAME_ITERATION_S = 0.012
+"""A request and a flag logged this close were handled in one Commander iteration (10 ms)."""
+FLAG_FRESH_S = 1.0
+"""PX4 publishes ``failsafe_flags`` at each change and about every 0.5 s: a recording whose
+newest sample is older than this does not show PX4's verdict any more."""
+
+
+@dataclass(slots=True)
+class Undecided:
+    """A request decided while the recording did not show the arming state, whose outcome
+    depends on it: the model follows ``if_disarmed`` until the recording decides."""
+
+    cmd: Command
+    target: int | None
+    if_disarmed: Decision
+    if_armed: Decision
+    before: tuple[int | None, bool | None]
+    """(user intention, armed) before the request."""
+    nav_before: int | None
 
 
 class GateModel:
@@ -82,6 +115,7 @@ class GateModel:
         vehicle: str = "",
         *,
         stream_recorded: bool = True,
+        armed: bool | None = None,
     ) -> None:
         self.profile = profile
         self.px4 = profile.px4
@@ -102,10 +136,18 @@ class GateModel:
         self.tick_based = at_least(self.px4, "1.14")
         self._flags_ignored = self.px4 in ("legacy", "1.11")
         """Before 1.13 any keep-alive counts, whatever its flags (2.2)."""
-        self.armed = False
+        self.armed: bool | None = armed
+        """None until the recording shows the arming state (or a request settles it):
+        decisions that depend on it give both outcomes (``undecided``). A generator that
+        simulates a vehicle from boot passes False."""
+        self._undecided: list[Undecided] = []
+        self.landed = LandedState(float(self.params.get("COM_DISARM_PRFLT", 0.0)))
         self.user_intention: int | None = None
         self._nav: int | None = None
         self._fallback: LossAction | None = None
+        self._fallback_when = ""
+        """When the model ran the current failsafe (a window where the recording does not
+        date it), for disagreement texts."""
         self._fallback_stage = 0
         self._terminated = False
         self.ocm_mask = 0
@@ -129,6 +171,25 @@ class GateModel:
         """A flag difference was reported and the two have not agreed since."""
         self._failsafe_due = INF
         """1.14+: the Commander iteration that will run the loss failsafe (2.1.3), inf if none."""
+        self._window: tuple[float, float] | None = None
+        """1.14+: the current loss window (its start, the latest check pass), while held."""
+        self._timing: tuple[float | None, str | None] = (None, None)
+        """(earliest time, where the recording shows it) for the next failsafe transition."""
+        self._verdict_recorded = False
+        """The recording holds PX4's ``offboard_control_signal_lost`` (1.14+)."""
+        self._flag_at = -INF
+        """When that flag was last recorded."""
+        self._flag_was: bool | None = None
+        """That flag's previous recorded value."""
+        self._flag_shows = False
+        """The current loss window is one PX4's recorded flag will date."""
+        self._rejected_unseen: tuple[Command, int | None, tuple[int | None, bool | None]] | None
+        self._rejected_unseen = None
+        """The newest request the model rejected for want of a signal (PX4's flag turning
+        available in the same Commander iteration shows PX4 had one)."""
+        self._flags_unlogged = False
+        """PX4's flag made the signal available before any logged keep-alive: its flags are
+        not known yet, and PX4's flag stands for them."""
         self._dirty = False
         self._stamp_offset: float | None = None
         self.compare = Comparator(slack(self.px4) + LOOP_PERIOD)
@@ -160,6 +221,7 @@ class GateModel:
             CommandAck: self._on_ack,
             Parameter: self._on_parameter,
             StatusText: self._on_status_text,
+            LandDetected: self._on_land,
         }
 
     # ------------------------------------------------------------------ public state
@@ -259,6 +321,7 @@ class GateModel:
             self.compare.due(),
             self._failsafe_due,
             self._flag_due,
+            self.signal.held_until,
         )
 
     @property
@@ -271,7 +334,8 @@ class GateModel:
             timeout = self.signal.timeout_at()
             failsafe = self._failsafe_due
             flag = self._flag_due
-            due = min(lost, timeout, self.ctl.reuse_due, self.compare.due(), failsafe, flag)
+            held = self.signal.held_until
+            due = min(lost, timeout, self.ctl.reuse_due, self.compare.due(), failsafe, flag, held)
             if due > t:
                 return
             # Due before an event already applied (a deadline that moved earlier): PX4 acts at
@@ -279,9 +343,12 @@ class GateModel:
             at = max(due, self._clock)
             if flag == due:
                 self._flag_differs()
+            elif held == due:
+                self._not_shown(at)
             elif failsafe == due:
                 self._failsafe_due = INF
                 self._refresh(at, cause=None)
+                self._timing = (None, None)  # no failsafe ran (disarmed): nothing to date
             elif lost == due:
                 self._signal_lost(at)
             elif timeout == due:
@@ -296,23 +363,64 @@ class GateModel:
     # ------------------------------------------------------------------ proof of life
 
     def _signal_lost(self, t: float) -> None:
+        """The loss is due at ``t``. On 1.14+ PX4's 10 Hz check pass sees it within one check
+        period (2.1.3), at a phase only the recording can show: the model waits to the end of
+        that window (``hold``). PX4's flag or its failsafe recorded meanwhile dates the loss;
+        a good keep-alive meanwhile ends it with no loss (PX4 flags one only if its pass fell
+        before it); otherwise the loss is the window, dated at its end."""
+        if not self.tick_based:
+            self._lose(t)
+            return
+        self._window = (t, t + CHECK_PERIOD)
+        wait = CHECK_PERIOD
+        self._flag_shows = self._verdict_recorded and t - self._flag_at <= FLAG_FRESH_S
+        if self._flag_shows:
+            # PX4's flag will say: allow one iteration, and one logging interval where the
+            # keep-alive is a logged subsample that may hide the stream's last messages.
+            wait += LOOP_PERIOD + (SAMPLED_SLACK if self._sampled else 0.0)
+        self.signal.hold(t + wait)
+
+    def _not_shown(self, t: float) -> None:
+        """The window passed with no keep-alive: the loss is the window, or, where the
+        recording holds PX4's flag and it has not flipped, the model's own verdict (a flag
+        that still says available becomes a disagreement)."""
+        window = self._window or (t, t)
+        self._lose(t, window, NOT_FLAGGED if self._flag_shows else None)
+
+    def _lose(
+        self,
+        t: float,
+        window: tuple[float, float] | None = None,
+        seen_in: str | None = None,
+    ) -> None:
+        """The signal is lost at ``t``: ``window`` is PX4's check-pass window (1.14+),
+        ``seen_in`` where the recording shows PX4's verdict when ``t`` comes from there."""
+        self._window = None
         self.signal.mark_lost()
         self._signal_changed(t)
         last = self.signal.last
-        age = f"{t - last:.2f} s after the newest keep-alive" if last is not None else ""
         why = estimate_failure(self.px4, self.ocm_mask, self.est) if self.tick_based else None
         if why is None and self.ocm_mask == 0 and last is not None and not self._flags_ignored:
             why = "no flag set in the newest keep-alive"
         if why is None and self.tick_based and self.signal.stamps_lag:
             why = "the newest keep-alive's timestamp is older than COM_OF_LOSS_T (2.1.1)"
         reason = why or "keep-alive timeout"
+        when, earliest = self._loss_when(t, window, seen_in)
+        age = ""
+        if why is None and last is not None:
+            start = t if earliest is None else earliest
+            span = f"{t - last:.2f}" if start == t else f"{start - last:.2f}-{t - last:.2f}"
+            age = f", {span} s after the newest keep-alive"
+        note = self._unknown_arming_note()
         self._emit(
             t,
             "signal_lost",
-            f"offboard signal lost ({reason}) {age if why is None else ''}".strip(),
+            f"offboard signal lost ({reason}){when}{age}{note}",
             self.signal.spec,
             cause=None,
             reason=reason,
+            t_earliest=earliest,
+            seen_in=seen_in,
         )
         if self.signal.timeout_at() <= t:  # legacy: COM_OF_LOSS_T 0 = both stages at once
             self.signal.timed_out = True  # type: ignore[attr-defined]
@@ -323,8 +431,42 @@ class GateModel:
             # arrives in between cancels it (the forced check pass clears the flag). Emitting
             # it only when that iteration is reached keeps the timeline in time order.
             self._failsafe_due = t + LOOP_PERIOD
+            self._timing = (None if earliest is None else earliest + LOOP_PERIOD, seen_in)
         else:
             self._refresh(t, cause=None)
+
+    @staticmethod
+    def _loss_when(
+        t: float, window: tuple[float, float] | None, seen_in: str | None
+    ) -> tuple[str, float | None]:
+        """The time words of a loss and the window's start (None: ``t`` is the time)."""
+        if window is None:
+            return "", None
+        start, end = window
+        if seen_in == NOT_FLAGGED:
+            return (
+                f" by {end:.3f} s (the model's window {start:.3f}-{end:.3f} s; PX4's "
+                f"failsafe_flags shows no loss by {t:.3f} s)",
+                None,
+            )
+        if seen_in is not None:
+            at = "by" if seen_in == RECORDED_FAILSAFE else "at"
+            return f" {at} {t:.3f} s ({seen_in}; the model's window {start:.3f}-{end:.3f} s)", None
+        return (
+            f" between {start:.3f} and {end:.3f} s (PX4 checks at 10 Hz; the check's phase is "
+            "not in the recording)",
+            start,
+        )
+
+    def _unknown_arming_note(self) -> str:
+        """A loss in OFFBOARD while the arming state is unknown: the failsafe runs only if
+        armed (1.14+: none while disarmed, 4.1)."""
+        if not (self.tick_based and self.armed is None):
+            return ""
+        if self.user_intention != NAV_STATE_OFFBOARD:
+            return ""
+        action = self.current_loss_action()
+        return f"; arming not recorded: if armed, PX4 runs {action.action}, if disarmed nothing"
 
     def _keepalive(self, t: float, mask: int, event: Event, stamp: float | None = None) -> None:
         if mask == self.ocm_mask and self._good and (self._sampled or event.origin != "vehicle"):
@@ -339,6 +481,7 @@ class GateModel:
             else:
                 self._dirty = stamp is not None and not self.signal.moved_later
             return
+        self._flags_unlogged = False
         changed = mask != self.ocm_mask
         if changed:
             self.ocm_mask = mask
@@ -353,14 +496,20 @@ class GateModel:
         if changed:
             self._update_controller(t)
 
-    def _signal_available(self, t: float, mask: int) -> None:
+    def _signal_available(self, t: float, mask: int | None, seen_in: str | None = None) -> None:
+        """``mask`` None: the keep-alive's flags are not in the recording yet."""
         self._failsafe_due = INF
+        self._window = None
+        self._timing = (None, None)
         self._signal_changed(t)
+        what = [] if mask is None else [ocm.names(mask)]
+        what += [seen_in] if seen_in else []
         self._emit(
             t,
             "signal_available",
-            f"offboard signal available ({ocm.names(mask)})",
+            f"offboard signal available ({'; '.join(what)})",
             self.signal.spec,
+            seen_in=seen_in,
         )
         self._refresh(t)
 
@@ -434,6 +583,8 @@ class GateModel:
             self._drop_reason = None
         t = event.t
         self._keepalive(t, mask, event)
+        if self.landed.watching and self._nav == NAV_STATE_OFFBOARD:
+            self.landed.setpoint(t, isinstance(event, SetPositionTargetLocal) and climbs(event))
         if not axes:
             return
         if self._nav == NAV_STATE_OFFBOARD:
@@ -445,6 +596,8 @@ class GateModel:
 
     def _on_trajectory(self, event: TrajectorySetpoint) -> None:
         t = event.t
+        if self.landed.watching and self._nav == NAV_STATE_OFFBOARD:
+            self.landed.setpoint(t, climbs(event))
         self._dirty = self.ctl.trajectory(
             t, controllers.axes_of(event), self._nav == NAV_STATE_OFFBOARD
         )
@@ -472,6 +625,15 @@ class GateModel:
         recorded = event.offboard_control_signal_lost
         if recorded is None:
             return
+        flipped = self._flag_was is True and not recorded
+        self._flag_was = recorded
+        self._flag_at = event.t
+        if self.tick_based:
+            self._verdict_recorded = True
+            if recorded and self.signal.held_until != INF:
+                self._lose(event.t, self._window, "PX4's failsafe_flags")
+            elif flipped and self._flag_back(event.t):
+                return
         if recorded == (not self.signal.available):
             self._flag = None
             self._flag_episode = False
@@ -485,6 +647,49 @@ class GateModel:
         if event.t - self._sig_changed_at <= self.compare.slack:
             return  # the log lags the model's own change
         self._flag = (event.t, recorded, event)
+
+    def _flag_back(self, t: float) -> bool:
+        """PX4's flag has just turned to available before the logger's subsampled copy of the
+        keep-alive arrives (13a: its first samples can be missing): the signal is available at
+        the flag's time. Not where the model lost it because the keep-alive stopped counting."""
+        if self.signal.available or (self.signal.last is not None and not self._good):
+            return False  # a keep-alive that stopped counting (flags, estimates) is not lag
+        first = self.signal.last is None
+        if not self.signal.keepalive(t, True):
+            return False
+        mask = None if first else self.ocm_mask
+        self._flags_unlogged = first
+        self._signal_available(t, mask, "PX4's failsafe_flags; the logged keep-alive follows")
+        self._rejudge(t)
+        return True
+
+    def _rejudge(self, t: float) -> None:
+        """A switch or arm the model rejected for want of a signal, logged in the same
+        Commander iteration as PX4's flag turning available: Commander had the keep-alive the
+        logger missed (its forced check pass runs before it handles the command, 2.1.3; the
+        ULog dates the command on receipt and the flag on publication). Judged again."""
+        rejected, self._rejected_unseen = self._rejected_unseen, None
+        if rejected is None:
+            return
+        cmd, target, before = rejected
+        if t - cmd.t > SAME_ITERATION_S or self.armed is None:
+            return
+        decision = self._decide(cmd, target, self.armed)
+        if not decision.accepted:
+            return
+        self._emit(
+            t,
+            "mode",
+            f"{self._request_name(cmd, target)} at {cmd.t:.3f} s judged again: PX4's flag shows "
+            "the signal it had (the logger missed that keep-alive)",
+            "2.1.3",
+            cause=None,
+        )
+        if cmd.is_mode_switch:
+            self._apply_switch(t, target, decision)
+        else:
+            self._apply_arm(t, decision)
+        self.compare.decided(cmd, decision, before, target)
 
     def _flag_differs(self) -> None:
         pending, self._flag = self._flag, None
@@ -503,6 +708,10 @@ class GateModel:
             self.signal.spec,
             cause=event,
         )
+
+    def _on_land(self, event: LandDetected) -> None:
+        self._dirty = False
+        self.landed.land_detected(event)
 
     def _on_failsafe_flags(self, event: FailsafeFlags) -> None:
         self._recorded_flag(event)
@@ -529,6 +738,8 @@ class GateModel:
                 self.signal.timeout = max(0.0, event.value)
         elif name == "MAV_FWDEXTSP":
             self._rx.fwdextsp = bool(event.value)
+        elif name == "COM_DISARM_PRFLT":
+            self.landed.preflight_disarm_s = event.value
         elif name == "MAV_COMP_ID":
             self._rx.own_component = int(event.value)
 
@@ -540,7 +751,7 @@ class GateModel:
         if self._failsafe_due != INF:
             return False  # lost at the last check pass; the failsafe iteration is still ahead
         if self.tick_based:
-            return self.armed
+            return self.armed is True  # unknown: the signal_lost row says both
         return True  # 1.13 and older: recomputed even when disarmed (4.1)
 
     def _refresh(self, t: float, cause: Event | bool | None = True) -> None:
@@ -564,7 +775,7 @@ class GateModel:
                 self._fallback = None
                 self._fallback_stage = 0
                 if self.user_intention == NAV_STATE_OFFBOARD and (
-                    self.armed or not self.tick_based
+                    self.armed is True or not self.tick_based
                 ):
                     self._emit(
                         t,
@@ -579,19 +790,30 @@ class GateModel:
 
     def _failsafe(self, t: float, action: LossAction, kwargs: dict[str, Any]) -> None:
         note = f" ({action.note})" if action.note else ""
-        disarmed = "" if self.armed else " while disarmed"
+        disarmed = " while disarmed" if self.armed is False else ""
+        earliest, seen_in = self._timing
+        self._timing = (None, None)
+        when = ""
+        if earliest is not None:
+            when = f" between {earliest:.3f} and {t:.3f} s"
+        elif seen_in is not None:
+            when = f" at {t:.3f} s ({seen_in})"
+        self._fallback_when = when or f" at {t:.3f} s"
         self._emit(
             t,
             "failsafe",
-            f"offboard loss{disarmed}: {action.action}{note}",
+            f"offboard loss{disarmed}{when}: {action.action}{note}",
             action.spec,
             action=action.action,
             nav_state=action.nav_state if action.nav_state is not None else self._nav,
             unverified=action.unverified,
+            t_earliest=earliest,
+            seen_in=seen_in,
             **kwargs,
         )
-        if action.disarm and self.armed:
+        if action.disarm and self.armed is not False:
             self.armed = False
+            self.landed.disarmed()
             self._emit(t, "disarmed", "disarmed by the offboard-loss action", action.spec, **kwargs)
 
     def _set_nav(self, t: float, new: int | None) -> None:
@@ -625,39 +847,141 @@ class GateModel:
         t = cmd.t
         if cmd.is_mode_switch:
             target = decode_mode(cmd)
-            decision = switch_decision(
-                self.px4,
-                cmd,
-                target,
-                self.armed,
-                self.signal.available,
-                self._nav,
-                self.est.attitude and self.est.angular_velocity,
-            )
-            before = (self.user_intention, self.armed)
-            self._apply_switch(t, target, decision)
-            self.compare.decided(cmd, decision, before, target)
         elif cmd.command == MAV_CMD_COMPONENT_ARM_DISARM:
-            before = (self.user_intention, self.armed)
-            if cmd.is_arm:
-                why = estimate_failure(self.px4, self.ocm_mask, self.est) or "no offboard signal"
-                now_ok = self.signal.ok_now(t, self.ocm_mask != 0 and why == "no offboard signal")
-                decision = arm_decision(
-                    self.px4,
-                    cmd,
-                    self.user_intention,
-                    now_ok,
-                    why,
-                    self.est.attitude and self.est.angular_velocity,
-                )
-                self._apply_arm(t, decision)
-            else:
-                decision = Decision(True, "4.2")
-                if self.armed:
-                    self.armed = False
-                    self._emit(t, "disarmed", "disarm requested", "4.2")
-                    self._refresh(t)
-            self.compare.decided(cmd, decision, before, None)
+            target = None
+        else:
+            return
+        before = (self.user_intention, self.armed)
+        if self.armed is None:
+            if_disarmed, if_armed = (
+                self._decide(cmd, target, False),
+                self._decide(cmd, target, True),
+            )
+            if if_disarmed.accepted != if_armed.accepted:
+                self._undecided_request(cmd, target, if_disarmed, if_armed, before)
+                return
+            decision = if_disarmed
+        else:
+            decision = self._decide(cmd, target, self.armed)
+        if cmd.is_mode_switch:
+            self._apply_switch(t, target, decision)
+        elif cmd.is_arm:
+            self._apply_arm(t, decision)
+        else:
+            self._apply_disarm(t, decision)
+        self.compare.decided(cmd, decision, before, target)
+        unseen = not decision.accepted and decision.reason == "no offboard signal"
+        self._rejected_unseen = (cmd, target, before) if unseen and not cmd.is_disarm else None
+
+    def _decide(self, cmd: Command, target: int | None, armed: bool) -> Decision:
+        """PX4's answer to ``cmd`` were the vehicle ``armed`` (4.1, 4.2, 13a)."""
+        attitude_ok = self.est.attitude and self.est.angular_velocity
+        if cmd.is_mode_switch:
+            return switch_decision(
+                self.px4, cmd, target, armed, self.signal.available, self._nav, attitude_ok
+            )
+        if cmd.is_arm:
+            why = estimate_failure(self.px4, self.ocm_mask, self.est) or "no offboard signal"
+            flags_known = self.ocm_mask != 0 or self._flags_unlogged
+            now_ok = self.signal.ok_now(cmd.t, flags_known and why == "no offboard signal")
+            return arm_decision(self.px4, cmd, self.user_intention, now_ok, why, attitude_ok, armed)
+        landed, why = self.landed.landed(cmd.t)
+        ground = self.vehicle_type.startswith("rover")
+        return disarm_decision(self.px4, cmd, armed, landed, why, ground)
+
+    # -- requests while the arming state is unknown
+
+    @staticmethod
+    def _outcome(decision: Decision, switch: bool) -> str:
+        if not decision.accepted:
+            return f"rejected ({decision.reason or 'no reason modelled'})"
+        if not decision.changes:
+            return f"acked ACCEPTED, no change ({decision.reason})"
+        if switch and decision.reason is None:
+            return f"accepted ({NO_STREAM_SWITCH})"
+        return "accepted" + (f" ({decision.reason})" if decision.reason else "")
+
+    @staticmethod
+    def _request_name(cmd: Command, target: int | None) -> str:
+        if cmd.is_mode_switch:
+            return f"switch to {nav_state_name(target) if target is not None else 'a mode'}"
+        return "arm" if cmd.is_arm else "disarm"
+
+    def _undecided_request(
+        self,
+        cmd: Command,
+        target: int | None,
+        if_disarmed: Decision,
+        if_armed: Decision,
+        before: tuple[int | None, bool | None],
+    ) -> None:
+        """Both outcomes on the timeline; the model goes on with the disarmed one, arming still
+        unknown, until the recording decides (an ack of this request, a recorded arming)."""
+        switch = cmd.is_mode_switch
+        reason = (
+            f"if disarmed: {self._outcome(if_disarmed, switch)}; "
+            f"if armed: {self._outcome(if_armed, switch)}"
+        )
+        self._emit(
+            cmd.t,
+            "undecided",
+            f"{self._request_name(cmd, target)}: {reason}; arming not recorded",
+            if_armed.spec if not if_armed.accepted else if_disarmed.spec,
+            reason=reason,
+            unverified=if_disarmed.unverified or if_armed.unverified,
+        )
+        self._undecided.append(Undecided(cmd, target, if_disarmed, if_armed, before, self._nav))
+        self.compare.decided(cmd, if_disarmed, before, target, alternative=if_armed)
+        if switch and if_disarmed.accepted and if_disarmed.changes and target is not None:
+            self._take_intention(cmd.t, target)
+
+    def _resolve(self, t: float, was_armed: bool, because: str) -> None:
+        """The recording shows the arming state the undecided requests depended on."""
+        undecided, self._undecided = self._undecided, []
+        if not undecided:
+            if self.armed is None:
+                self.armed = was_armed
+            return
+        names = ", ".join(
+            f"{self._request_name(u.cmd, u.target)} at {u.cmd.t:.2f} s" for u in undecided
+        )
+        if not was_armed:
+            if self.armed is None:
+                self.armed = False
+            self._emit(
+                t,
+                "mode",
+                f"{because}: the vehicle was disarmed, so the outcomes if disarmed stand ({names})",
+                "12",
+            )
+            return
+        intention = undecided[0].before[0]
+        for u in undecided:
+            if u.cmd.is_mode_switch and u.if_armed.accepted and u.if_armed.changes:
+                intention = u.target
+        self.armed = True
+        self.landed.armed(undecided[0].cmd.t)
+        self.user_intention = intention
+        self._fallback = None
+        if intention is None:
+            self._set_nav(t, undecided[0].nav_before)
+        self._emit(
+            t,
+            "mode",
+            f"{because}: the vehicle was armed, so the outcomes if armed hold ({names}); the "
+            "model follows them",
+            "12",
+        )
+        self._refresh(t)
+
+    # -- applying a decision
+
+    def _take_intention(self, t: float, target: int) -> None:
+        self.user_intention = target
+        self._terminated = self._terminated and target == TERMINATION
+        self._fallback = None
+        self._fallback_stage = 0
+        self._refresh(t, cause=None)
 
     def _apply_switch(self, t: float, target: int | None, decision: Decision) -> None:
         offboard = target == NAV_STATE_OFFBOARD
@@ -677,7 +1001,7 @@ class GateModel:
             return
         if offboard:
             note = ""
-            if not self.armed and self.tick_based:
+            if self.armed is False and self.tick_based:
                 note = " (disarmed: accepted without a stream, checked at arming)"
             self._emit(
                 t,
@@ -691,11 +1015,7 @@ class GateModel:
             self._emit(
                 t, "mode", f"switch to {name} (assumed accepted)", decision.spec, nav_state=target
             )
-        self.user_intention = target
-        self._terminated = self._terminated and target == TERMINATION
-        self._fallback = None
-        self._fallback_stage = 0
-        self._refresh(t, cause=None)
+        self._take_intention(t, target)
 
     def _apply_arm(self, t: float, decision: Decision) -> None:
         if not decision.accepted:
@@ -707,13 +1027,34 @@ class GateModel:
                 reason=decision.reason,
             )
             return
-        if not self.armed:
+        if self.armed is not True:
             self.armed = True
+            self.landed.armed(t)
             note = f" ({decision.reason})" if decision.reason else ""
             self._emit(
                 t, "arm_accepted", f"armed{note}", decision.spec, unverified=decision.unverified
             )
             self._refresh(t, cause=None)
+        elif not decision.changes:
+            self._emit(t, "mode", f"arm request: {decision.reason}", decision.spec)
+
+    def _apply_disarm(self, t: float, decision: Decision) -> None:
+        if not decision.accepted:
+            self._emit(
+                t,
+                "disarm_rejected",
+                f"disarm rejected: {decision.reason}",
+                decision.spec,
+                reason=decision.reason,
+                unverified=decision.unverified,
+            )
+            return
+        if self.armed is not False:
+            self.armed = False
+            self.landed.disarmed()
+            note = f" ({decision.reason})" if decision.reason else ""
+            self._emit(t, "disarmed", f"disarm requested{note}", decision.spec)
+            self._refresh(t)
 
     # ------------------------------------------------------------------ the recording
 
@@ -766,12 +1107,18 @@ class GateModel:
             self._refresh(t)
 
     def _on_status(self, status: VehicleStatus) -> None:
+        self.landed.mode(status.t, status.nav_state)
         if not self._started:
             self._start(status)
             return
         self.compare.remember(status)
         if not self.stream_recorded:
             self._recorded_loss(status)
+        if status.armed is not None and self.armed is None:
+            state = "armed" if status.armed else "disarmed"
+            self._resolve(status.t, status.armed, f"recorded: {state} at {status.t:.2f} s")
+        if self.signal.held_until != INF and self._shows_failsafe(status):
+            self._lose(status.t, self._window, RECORDED_FAILSAFE)
         if (
             self._failsafe_due != INF
             and status.nav_state is not None
@@ -788,6 +1135,18 @@ class GateModel:
         if not self.stream_recorded:
             self._recorded_back(status)
         self.compare.observe(status, self._nav)
+
+    def _shows_failsafe(self, status: VehicleStatus) -> bool:
+        """Does this status, inside the loss window, show PX4 out of OFFBOARD by the loss
+        failsafe: no command that explains it, and the intention still OFFBOARD or the mode the
+        loss action selects (a recording may carry the mode as the intention)?"""
+        if status.nav_state is None or status.nav_state == NAV_STATE_OFFBOARD:
+            return False
+        if self.user_intention != NAV_STATE_OFFBOARD or self.compare.recent_command(status.t):
+            return False
+        if status.user_intention in (None, NAV_STATE_OFFBOARD):
+            return True
+        return status.nav_state == self.current_loss_action().nav_state
 
     def _unseen_inputs(self, status: VehicleStatus) -> tuple[bool, int | None]:
         """Changes the recording shows with no recorded command near them (an RC switch, an
@@ -827,7 +1186,12 @@ class GateModel:
         self._started = True
         t = status.t
         if status.armed is not None:
+            state = "armed" if status.armed else "disarmed"
+            if self._undecided:
+                self._resolve(t, status.armed, f"recorded: {state} at {t:.2f} s")
             self.armed = status.armed
+            if status.armed:
+                self.landed.armed(t)
         intention = status.user_intention
         if intention is None:
             intention = status.nav_state
@@ -861,6 +1225,10 @@ class GateModel:
         changed = []
         if status.armed is not None and status.armed != self.armed:
             self.armed = status.armed
+            if status.armed:
+                self.landed.armed(t)
+            else:
+                self.landed.disarmed()
             changed.append("armed" if status.armed else "disarmed")
         if intention is not None and intention != self.user_intention:
             self.user_intention = intention
@@ -889,7 +1257,7 @@ class GateModel:
         status = pending.status
         model = nav_state_name(self._nav)
         if self._fallback is not None:
-            model += f" (failsafe {self._fallback.action})"
+            model += f" (failsafe {self._fallback.action}{self._fallback_when})"
         text = f"recorded: {nav_state_name(status.nav_state)} at {pending.t:.2f} s; model: {model}"
         if self._involves_offboard(status.nav_state, status.user_intention) or (
             self._involves_offboard(pending.latest.nav_state, pending.latest.user_intention)
@@ -924,10 +1292,11 @@ class GateModel:
         if judged is None:
             return
         decided, ack = judged
+        if decided.alternative is not None:
+            self._ack_decides(decided, ack)
+            return
         cmd, target = decided.cmd, decided.target
-        what = "arm" if cmd.command == MAV_CMD_COMPONENT_ARM_DISARM else "mode switch"
-        if target is not None:
-            what = f"switch to {nav_state_name(target)}"
+        what = self._request_name(cmd, target)
         decision = decided.decision
         model = "accepted" if decision.accepted else f"rejected ({decision.reason})"
         text = f"recorded: {what} acked {ack.result_name} at {ack.t:.2f} s; model: {model}"
@@ -935,11 +1304,32 @@ class GateModel:
             self._emit(ack.t, "disagreement", text, "4.3", cause=ack)
         else:
             self._emit(ack.t, "mode", f"{text} ({NOT_OFFBOARD})", "4.3", cause=ack)
+        self._follow_ack(decided, ack)
+
+    def _follow_ack(self, decided: Decided, ack: CommandAck) -> None:
+        cmd, target = decided.cmd, decided.target
         if ack.accepted and cmd.command == MAV_CMD_COMPONENT_ARM_DISARM:
-            self.armed = cmd.is_arm
+            if decided.decision.changes or self.armed is None:
+                self.armed = cmd.is_arm
+                if cmd.is_arm:
+                    self.landed.armed(ack.t)
+                else:
+                    self.landed.disarmed()
         elif ack.accepted and target is not None:
             self.user_intention = target
             self._fallback = None
         elif not ack.accepted:
             self.user_intention, self.armed = decided.before
         self._refresh(ack.t, cause=ack)
+
+    def _ack_decides(self, decided: Decided, ack: CommandAck) -> None:
+        """An ack of a request decided while the arming state was unknown: its result says
+        which it was (never a disagreement while one outcome matches)."""
+        alternative = decided.alternative
+        assert alternative is not None
+        what = self._request_name(decided.cmd, decided.target)
+        said = f"recorded: {what} acked {ack.result_name} at {ack.t:.2f} s"
+        if ack.accepted == decided.decision.accepted:
+            self._resolve(ack.t, False, said)
+        elif ack.accepted == alternative.accepted:
+            self._resolve(ack.t, True, said)

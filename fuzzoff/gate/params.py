@@ -25,6 +25,7 @@ GATE_PARAMS: tuple[str, ...] = (
     "MAV_SYS_ID",
     "MAV_COMP_ID",
     "MPC_LAND_SPEED",
+    "COM_DISARM_PRFLT",
     RC_PRESENT,
 )
 
@@ -42,6 +43,9 @@ def default_params(px4: str) -> dict[str, float]:
         "NAV_RCL_ACT": 2.0,
         "COM_RCL_EXCEPT": 0.0,
         "COM_POSCTL_NAVL": 0.0,
+        # Auto-disarm of a vehicle that does not take off; fuzzoff reads it as take-off
+        # evidence (gate/landed.py). Not read for legacy (0: no such inference).
+        "COM_DISARM_PRFLT": 0.0 if legacy else 10.0,
         RC_PRESENT: 1.0,
     }
     if not at_least(px4, "1.14"):

@@ -1,7 +1,8 @@
-"""Mode-switch and arming requests: accepted or rejected, and why (gate spec section 4).
+"""Mode-switch, arming and disarming requests: accepted or rejected, and why (gate spec 4, 13a).
 
-``decode_mode`` turns a command into the nav_state it asks for; ``switch_decision`` and
-``arm_decision`` return ``Decision`` (accepted, reason, spec, ack result).
+``decode_mode`` turns a command into the nav_state it asks for; ``switch_decision``,
+``arm_decision`` and ``disarm_decision`` return ``Decision`` (accepted, reason, spec, ack
+result).
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ TERMINATION = 13
 FORCE_ARM_MAGIC = 21196
 ACCEPTED = 0
 TEMPORARILY_REJECTED = 1
+DENIED = 2
 UNSUPPORTED = 3
 NO_ATTITUDE = "no attitude or angular-velocity estimate (OFFBOARD mode requirement, D11)"
 
@@ -98,9 +100,20 @@ def arm_decision(
     signal_now: bool,
     why: str | None,
     attitude_ok: bool = True,
+    armed: bool = False,
 ) -> Decision:
     """Arming (4.2). ``signal_now`` is the condition evaluated at the request (1.14+ re-runs the
-    checks); ``why`` the reason it fails."""
+    checks); ``why`` the reason it fails. Arming an armed vehicle changes nothing and is acked
+    ACCEPTED (Commander's ``arm()`` returns "not changed"; seen on 1.15.4 and 1.18.0-alpha1 SITL
+    after a refused disarm in flight)."""
+    if armed:
+        return Decision(
+            True,
+            "4.2",
+            "already armed: acked ACCEPTED, no change",
+            changes=False,
+            unverified=px4 in ("legacy", "1.11"),
+        )
     if intention != NAV_STATE_OFFBOARD:
         return Decision(True, "4.2", None)
     if not at_least(px4, "1.14"):
@@ -113,3 +126,29 @@ def arm_decision(
     if signal_now:
         return Decision(True, "4.2", None)
     return Decision(False, "4.2", why or "no offboard signal", TEMPORARILY_REJECTED)
+
+
+def disarm_decision(
+    px4: str, cmd: Command, armed: bool, landed: bool, why: str, ground_vehicle: bool
+) -> Decision:
+    """Disarming (13a): refused unless forced (param2 21196, from any source), landed
+    (``landed``/``maybe_landed``) or a ground vehicle. Seen on 1.15.4 and 1.18.0-alpha1 SITL:
+    ack 1, "Disarming denied: not landed". 1.12+ ack it TEMPORARILY_REJECTED; older releases
+    DENIED (from the code of those years, unverified per release). ``why`` says where the landed
+    state comes from."""
+    if not armed:
+        return Decision(True, "13a", "already disarmed: acked ACCEPTED, no change", changes=False)
+    if nearest(cmd.params[1]) == FORCE_ARM_MAGIC:
+        return Decision(True, "13a", "forced disarm (param2 21196): the land check is skipped")
+    if ground_vehicle:
+        return Decision(True, "13a", "a ground vehicle disarms anywhere")
+    if landed:
+        return Decision(True, "13a", why)
+    old = px4 in ("legacy", "1.11")
+    return Decision(
+        False,
+        "13a",
+        f"Disarming denied: not landed ({why})",
+        DENIED if old else TEMPORARILY_REJECTED,
+        unverified=old,
+    )

@@ -4,8 +4,10 @@ Each model keeps only the newest keep-alive and computes the time of its loss ar
 (no per-tick loop):
 
 * ``TickSignal`` (1.14+, 2.1): lost at the first 10 Hz check pass at or after
-  ``newest + COM_OF_LOSS_T`` (or after the newest keep-alive turned bad); available again at the
-  keep-alive that arrives while lost (2.1.3: the forced check pass).
+  ``newest + COM_OF_LOSS_T`` (or after the newest keep-alive turned bad), i.e. within one check
+  period after it; available again at the keep-alive that arrives while lost (2.1.3: the forced
+  check pass). ``lost_at`` is the window's start; the model dates the loss there with the
+  window, or waits (``hold``) for PX4's own verdict where the recording holds it.
 * ``HysteresisSignal`` (1.13, 2.2): Commander iterations every 10 ms; lost once no good keep-alive
   was seen for ``COM_OF_LOSS_T`` counted from the first iteration without one.
 * ``AgeSignal`` (1.11, 2.2): lost at the first iteration where the keep-alive's age is
@@ -13,8 +15,8 @@ Each model keeps only the newest keep-alive and computes the time of its loss ar
 * ``LegacySignal`` (legacy, 2.3): lost 500 ms after the newest accepted message; a second stage,
   the loss timeout, ``COM_OF_LOSS_T`` later.
 
-Check passes and iterations are placed on a grid anchored at the recording's time zero: PX4's
-own phase is unknown, hence the evaluation slack of ``slack()``.
+Commander iterations (1.11-1.13) are placed on a 10 ms grid anchored at the recording's time
+zero: PX4's own phase is unknown, hence the evaluation slack of ``slack()``.
 """
 
 from __future__ import annotations
@@ -94,6 +96,9 @@ class Signal:
         self.moved_later = False
         """The newest stamped keep-alive (2.1.1) was good and moved the loss no earlier than
         the one before it (set by ``TickSignal``; False elsewhere)."""
+        self.held_until = INF
+        """``TickSignal.hold``: until when the model waits for PX4's recorded verdict on a loss
+        (inf: not waiting; always inf elsewhere)."""
 
     @property
     def stamps_lag(self) -> bool:
@@ -116,6 +121,12 @@ class Signal:
 
     def mark_lost(self) -> None:
         self.available = False
+        self.held_until = INF
+
+    def hold(self, until: float) -> None:
+        """Wait for the recording to show PX4's verdict until ``until`` (``lost_at`` is inf
+        meanwhile, where the subclass honours it); a good keep-alive ends the wait."""
+        self.held_until = until
 
     def ok_now(self, t: float, good: bool) -> bool:
         """The condition evaluated right now (the arming path re-runs the checks, 4.2)."""
@@ -159,6 +170,7 @@ class TickSignal(Signal):
                 self.bad_since = t
             return False
         self.bad_since = None
+        self.held_until = INF  # a good keep-alive before PX4's check pass: no loss
         if not self.available:
             self.available = True
             return True
@@ -169,13 +181,14 @@ class TickSignal(Signal):
             self.bad_since = t
 
     def lost_at(self) -> float:
-        if not self.available or self.last is None:
+        """The start of the loss window: from here the next check pass, within
+        ``CHECK_PERIOD``, drops the signal (inf while held or not available)."""
+        if not self.available or self.last is None or self.held_until != INF:
             return INF
         # Once the newest sample is bad (flags, estimates, an old stamp) the next check pass
         # after that moment drops the signal; otherwise the pass after its age reaches the
         # timeout.
-        due = self.bad_since if self.bad_since is not None else self.last + self.timeout
-        return grid_ceil(due, CHECK_PERIOD)
+        return self.bad_since if self.bad_since is not None else self.last + self.timeout
 
     def ok_now(self, t: float, good: bool) -> bool:
         return self.last is not None and good and t < self.last + self.timeout

@@ -14,6 +14,7 @@ TransitionKind = Literal[
     "request_rejected",
     "arm_accepted",
     "arm_rejected",
+    "disarm_rejected",
     "failsafe",
     "offboard_resumed",
     "mode",
@@ -21,10 +22,13 @@ TransitionKind = Literal[
     "setpoint_dropped",
     "disarmed",
     "disagreement",
+    "undecided",
 ]
 """``mode``: a mode change that is not an offboard request (another mode requested, or the
 model re-synchronised to the recording); ``disagreement``: the recording shows something the
-model did not predict (recorded mode or ack vs the model's), see ``recorded_nav_state``."""
+model did not predict (recorded mode or ack vs the model's), see ``recorded_nav_state``;
+``undecided``: a request whose outcome depends on the arming state, which the recording does
+not show (``reason`` names both outcomes)."""
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -53,3 +57,9 @@ class GateTransition(Event):
     """The model's arming state after the transition."""
     recorded_nav_state: int | None = None
     """``disagreement``: the nav_state the recording shows (None for an ack disagreement)."""
+    t_earliest: float | None = None
+    """A loss whose time is a window (PX4's 10 Hz check pass at a phase the recording does not
+    show): ``t`` is its latest time, this its earliest. None: ``t`` is the time."""
+    seen_in: str | None = None
+    """Where the recording shows PX4 doing it (e.g. ``PX4's failsafe_flags``), when the model
+    took the time from there."""

@@ -20,6 +20,7 @@ from fuzzoff.events import (
     CommandAck,
     Event,
     FailsafeFlags,
+    LandDetected,
     Parameter,
     SetAttitudeTarget,
     SetPositionTargetGlobal,
@@ -48,6 +49,7 @@ SET_ATTITUDE_TARGET = 82
 SET_POSITION_TARGET_LOCAL_NED = 84
 SET_POSITION_TARGET_GLOBAL_INT = 86
 AUTOPILOT_VERSION = 148
+EXTENDED_SYS_STATE = 245
 STATUSTEXT = 253
 LOCAL_POSITION_NED = 32
 
@@ -67,6 +69,7 @@ WANTED = frozenset(
         SYS_STATUS,
         RC_CHANNELS,
         MANUAL_CONTROL,
+        EXTENDED_SYS_STATE,
     }
 )
 """The only message ids decoded; the rest are framed and CRC-checked, not decoded."""
@@ -85,6 +88,8 @@ MAV_AUTOPILOT_PX4 = 12
 MAV_TYPE_GCS = 6
 MAV_MODE_FLAG_CUSTOM_MODE_ENABLED = 1
 MAV_MODE_FLAG_SAFETY_ARMED = 128
+MAV_LANDED_STATE_UNDEFINED = 0
+MAV_LANDED_STATE_ON_GROUND = 1
 MAV_SYS_STATUS_SENSOR_RC_RECEIVER = 1 << 16
 """SYS_STATUS bit PX4 sets present and healthy while it has manual control (RC or a MAVLink
 joystick: its ``manual_control_signal_lost`` is false)."""
@@ -105,6 +110,7 @@ _KIND_OF_ID: dict[int, tuple[str, ...]] = {
     PARAM_VALUE: (Parameter.kind,),
     AUTOPILOT_VERSION: (VehicleInfo.kind,),
     STATUSTEXT: (StatusText.kind,),
+    EXTENDED_SYS_STATE: (LandDetected.kind,),
 }
 
 
@@ -331,7 +337,10 @@ class _Decoder:
             RC_CHANNELS: self._rc_channels,
             MANUAL_CONTROL: self._manual_control,
             LOCAL_POSITION_NED: self._position,
+            EXTENDED_SYS_STATE: self._extended_sys_state,
         }
+        self.landed: dict[int, bool | None] = {}
+        """Vehicle sysid -> on the ground, as last said (events only on a change)."""
         self.manual: dict[int, bool] = {}
         """Vehicle sysid -> manual control present, as last said (events only on a change)."""
         self.sys_status: set[int] = set()
@@ -600,6 +609,21 @@ class _Decoder:
             return self._ignore(m, "not from an autopilot")
         vehicle = str(m.get_srcSystem())
         return (VehiclePosition(t=t, vehicle=vehicle, where=where, x=m.x, y=m.y, z=m.z),)
+
+    def _extended_sys_state(self, m: Any, t: float, where: Where) -> Iterable[Event]:
+        """PX4's ``landed_state``: ON_GROUND while its land detector says landed; IN_AIR,
+        TAKEOFF and LANDING otherwise (``maybe_landed`` shows as in the air here)."""
+        if not self._from_autopilot(m):
+            return self._ignore(m, "not from an autopilot")
+        sysid = m.get_srcSystem()
+        state = m.landed_state
+        landed = (
+            None if state == MAV_LANDED_STATE_UNDEFINED else state == MAV_LANDED_STATE_ON_GROUND
+        )
+        if sysid in self.landed and self.landed[sysid] == landed:
+            return ()
+        self.landed[sysid] = landed
+        return (LandDetected(t=t, vehicle=str(sysid), where=where, landed=landed),)
 
     def _statustext(self, m: Any, t: float, where: Where) -> Iterable[Event]:
         if not self._from_autopilot(m):

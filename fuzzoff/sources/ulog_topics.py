@@ -494,6 +494,16 @@ def failsafe_flags(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
         )
 
 
+def land_detected(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
+    """``vehicle_land_detected``: Commander refuses a disarm unless ``landed`` or
+    ``maybe_landed`` (gate spec 13a)."""
+    for t, w, ts, landed, maybe in zip(
+        c.t, c.where, c.ts, c.ob("landed"), c.ob("maybe_landed"), strict=True
+    ):
+        value = None if landed is None else bool(landed or maybe)
+        yield ev.LandDetected(t=t, where=w, sender_time_us=ts, origin=VEHICLE, landed=value)
+
+
 def command(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
     params = list(zip(*(c.f(f"param{k}") for k in range(1, 8)), strict=True))
     for t, w, ts, p, cmd, tsys, tcomp, ssys, scomp, external in zip(
@@ -600,6 +610,7 @@ TOPICS: dict[str, TopicSpec] = {
     "vehicle_control_mode": TopicSpec(ev.VehicleControlModeStatus.kind, control_mode_status),
     "failsafe_flags": TopicSpec(ev.FailsafeFlags.kind, failsafe_flags),
     "vehicle_status_flags": TopicSpec(ev.FailsafeFlags.kind, failsafe_flags),
+    "vehicle_land_detected": TopicSpec(ev.LandDetected.kind, land_detected),
 }
 """uORB topic -> what it becomes. Dict order = the order of events at the same microsecond."""
 

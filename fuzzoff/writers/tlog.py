@@ -37,6 +37,7 @@ from fuzzoff.events import (
     Command,
     CommandAck,
     Event,
+    LandDetected,
     MavlinkTarget,
     Parameter,
     SetAttitudeTarget,
@@ -79,6 +80,7 @@ SUPPORTED: tuple[type[Event], ...] = (
     VehicleInfo,
     VehicleStatus,
     VehiclePosition,
+    LandDetected,
 )
 """The event kinds a tlog carries (what ``fuzzoff.sources.tlog`` emits)."""
 
@@ -238,6 +240,10 @@ class _Writer:
             msg = mavlink.MAVLink_param_value_message(
                 event.name.encode("ascii")[:16], value, ptype, 1, 0
             )
+            return [self.link(self.autopilot_of(event)).pack(msg)]
+        if isinstance(event, LandDetected):
+            state = 0 if event.landed is None else 1 if event.landed else 2  # MAV_LANDED_STATE
+            msg = mavlink.MAVLink_extended_sys_state_message(0, state)
             return [self.link(self.autopilot_of(event)).pack(msg)]
         if isinstance(event, StatusText):
             msg = mavlink.MAVLink_statustext_message(

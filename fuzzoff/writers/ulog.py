@@ -106,6 +106,7 @@ class _Topics:
             ev.VehicleStatus: self._status,
             ev.VehicleControlModeStatus: self._control_mode_status,
             ev.FailsafeFlags: self._failsafe_flags,
+            ev.LandDetected: self._land_detected,
             ev.Command: self._command,
             ev.CommandAck: self._ack,
             ev.Parameter: self._parameter,
@@ -287,6 +288,11 @@ class _Topics:
             row = {f"condition_{k}_valid": v is not False for k, v in valid.items()}
             row |= {"offboard_control_signal_lost": lost_offboard, "rc_signal_lost": lost_manual}
             self._put("vehicle_status_flags", ts, row)
+
+    def _land_detected(self, e: ev.LandDetected, ts: int) -> None:
+        landed = bool(e.landed)
+        row: Row = {"landed": landed, "maybe_landed": landed, "ground_contact": landed}
+        self._put("vehicle_land_detected", ts, row)
 
     def _command(self, e: ev.Command, ts: int) -> None:
         row: Row = {f"param{i + 1}": p for i, p in enumerate(e.params)}

@@ -487,6 +487,27 @@ FORMATS: dict[str, list[tuple[str, list[str]]]] = {
             ],
         ),
     ],
+    "vehicle_land_detected": [
+        (
+            "1.14",
+            [
+                "uint64_t timestamp",
+                "bool freefall",
+                "bool ground_contact",
+                "bool maybe_landed",
+                "bool landed",
+                "bool in_ground_effect",
+                "bool in_descend",
+                "bool has_low_throttle",
+                "bool vertical_movement",
+                "bool horizontal_movement",
+                "bool rotational_movement",
+                "bool close_to_ground_or_skipped_check",
+                "bool at_rest",
+                "uint8_t[4] _padding0",
+            ],
+        ),
+    ],
     "vehicle_command": [
         (
             "legacy",

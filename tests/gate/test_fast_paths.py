@@ -194,7 +194,7 @@ def test_stamped_keepalives_that_lag_still_lose_the_signal() -> None:
         events.append(ControlMode(t=t, position=True, sender_time_us=stamp_us))
     trs = run("main", events, model=gate)
     lost = of("signal_lost", trs)
-    assert lost and math.isclose(lost[0].t, 1.5, abs_tol=1e-9)
+    assert lost and math.isclose(lost[0].t_earliest or 0.0, 1.5, abs_tol=1e-9)
 
 
 def test_a_stamp_that_jumps_back_moves_the_loss_earlier() -> None:
@@ -208,4 +208,4 @@ def test_a_stamp_that_jumps_back_moves_the_loss_earlier() -> None:
     events.append(in_offboard(1.7))  # a later event: the loss must come before it
     trs = run("main", events, t_end=3.0)
     lost = of("signal_lost", trs)
-    assert lost and math.isclose(lost[0].t, 1.5, abs_tol=1e-9)
+    assert lost and math.isclose(lost[0].t_earliest or 0.0, 1.5, abs_tol=1e-9)

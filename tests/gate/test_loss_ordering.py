@@ -1,11 +1,13 @@
 """The loss failsafe's place in time on 1.14+ (gate spec 2.1.3) and the timeline's order.
 
-Facts used (spec 2.1.3, Commander::run): the loss is detected at a ~10 Hz check pass; the
-failsafe reacts one Commander iteration (10 ms) later, because handleModeIntentionAndFailsafe()
-runs before the check block. A keep-alive that arrives after the check pass but before that
-iteration clears the flag first (offboardControlCheck forces a check pass), so no failsafe is
-run. Whatever the events, ``feed`` never returns a transition earlier than one it returned
-before.
+Facts used (spec 2.1.3, Commander::run): the loss is detected at a ~10 Hz check pass, so within
+one check period after the newest keep-alive is COM_OF_LOSS_T old; the failsafe reacts one
+Commander iteration (10 ms) later, because handleModeIntentionAndFailsafe() runs before the
+check block. A keep-alive that arrives after the check pass but before that iteration clears
+the flag first (offboardControlCheck forces a check pass), so no failsafe is run. Where the
+recording does not show PX4's pass, the loss is the window [timeout, timeout + 0.1 s], dated at
+its end, and a keep-alive inside the window ends it with no loss. Whatever the events, ``feed``
+never returns a transition earlier than one it returned before.
 """
 
 from __future__ import annotations
@@ -52,27 +54,43 @@ def _feed(px4: str, events: list[Event], t_end: float, **params: float) -> list[
     return out
 
 
+WINDOW_END = 2.1
+"""Newest keep-alive 1.0 s, COM_OF_LOSS_T 1 s: the loss window is 2.0-2.1 s."""
+
+
 @pytest.mark.parametrize("px4", TICK)
-def test_keepalive_at_the_check_pass_prevents_the_failsafe(px4: str) -> None:
-    """Keep-alives exactly COM_OF_LOSS_T apart (the fuzz reproducer: 0.2 s): each check pass
-    that lands on a gap's end sees the loss, the keep-alive at that instant clears it before
-    the failsafe iteration: no failsafe, the vehicle stays in OFFBOARD."""
+def test_keepalives_exactly_the_timeout_apart_take_no_loss(px4: str) -> None:
+    """Keep-alives exactly COM_OF_LOSS_T apart (the fuzz reproducer: 0.2 s): each arrives at
+    the start of its loss window, before any check pass can see it: no loss, no failsafe, the
+    vehicle stays in OFFBOARD."""
     events: list[Event] = [in_offboard(), *stream(0.0, 1.0, period=0.2)]
     trs = _feed(px4, events, 1.05, COM_OF_LOSS_T=0.2)
-    assert of("signal_lost", trs)  # the model sees the exact-timeout gaps (2.1: >=)
+    assert of("signal_lost", trs) == []
     assert of("failsafe", trs) == []
     assert {tr.nav_state for tr in trs} <= {OFFBOARD, None}
 
 
 @pytest.mark.parametrize("px4", TICK)
+@pytest.mark.parametrize("inside", [0.0, 0.05, 0.099])
+def test_keepalive_inside_the_window_takes_no_loss(px4: str, inside: float) -> None:
+    """A keep-alive 0-99 ms into the window: PX4 flags a loss only if its pass fell before it
+    (a phase the recording does not show); the model takes none."""
+    events: list[Event] = [in_offboard(), *stream(0.0, 1.0), ocm(round(2.0 + inside, 6))]
+    trs = _feed(px4, events, 2.5)
+    assert of("signal_lost", trs) == []
+    assert of("failsafe", trs) == []
+
+
+@pytest.mark.parametrize("px4", TICK)
 @pytest.mark.parametrize("late", [0.0, 0.004, 0.0099])
 def test_keepalive_before_the_failsafe_iteration_prevents_it(px4: str, late: float) -> None:
-    """Lost at the check pass at 2.0 s (newest keep-alive 1.0 s, COM_OF_LOSS_T 1 s); a
-    keep-alive at 2.0 s + ``late`` (< 10 ms) arrives before the failsafe iteration."""
-    events: list[Event] = [in_offboard(), *stream(0.0, 1.0), ocm(round(2.0 + late, 6))]
+    """Lost by the end of the window (2.1 s); a keep-alive at 2.1 s + ``late`` (< 10 ms)
+    arrives before the failsafe iteration."""
+    events: list[Event] = [in_offboard(), *stream(0.0, 1.0), ocm(round(WINDOW_END + late, 6))]
     trs = _feed(px4, events, 2.5)
-    assert [tr.t for tr in of("signal_lost", trs)] == [pytest.approx(2.0)]
-    assert [tr.t for tr in of("signal_available", trs)][-1] == pytest.approx(2.0 + late)
+    (lost,) = of("signal_lost", trs)
+    assert (lost.t_earliest, lost.t) == (pytest.approx(2.0), pytest.approx(WINDOW_END))
+    assert [tr.t for tr in of("signal_available", trs)][-1] == pytest.approx(WINDOW_END + late)
     assert of("failsafe", trs) == []
     assert of("offboard_resumed", trs) == []
 
@@ -80,38 +98,45 @@ def test_keepalive_before_the_failsafe_iteration_prevents_it(px4: str, late: flo
 @pytest.mark.parametrize("px4", TICK)
 @pytest.mark.parametrize("late", [ITERATION, 0.05])
 def test_keepalive_after_the_failsafe_iteration_comes_too_late(px4: str, late: float) -> None:
-    """A keep-alive at or after the failsafe iteration (check pass + 10 ms): the failsafe ran
-    (5.1: POSCTL by default) and the vehicle returns to OFFBOARD at the keep-alive."""
-    events: list[Event] = [in_offboard(), *stream(0.0, 1.0), ocm(round(2.0 + late, 6))]
+    """A keep-alive at or after the failsafe iteration (window end + 10 ms): the failsafe ran
+    (5.1: POSCTL by default), dated by its own window, and the vehicle returns to OFFBOARD at
+    the keep-alive."""
+    events: list[Event] = [in_offboard(), *stream(0.0, 1.0), ocm(round(WINDOW_END + late, 6))]
     trs = _feed(px4, events, 2.5)
     (failsafe,) = of("failsafe", trs)
-    assert failsafe.t == pytest.approx(2.0 + ITERATION)
+    assert failsafe.t == pytest.approx(WINDOW_END + ITERATION)
+    assert failsafe.t_earliest == pytest.approx(2.0 + ITERATION)
     assert failsafe.nav_state == POSCTL
+    assert "between 2.010 and 2.110 s" in failsafe.message
     (resumed,) = of("offboard_resumed", trs)
-    assert resumed.t == pytest.approx(2.0 + late)
+    assert resumed.t == pytest.approx(WINDOW_END + late)
     assert resumed.t >= failsafe.t
 
 
 @pytest.mark.parametrize("px4", TICK)
 def test_other_events_in_the_window_do_not_run_the_failsafe_early(px4: str) -> None:
-    """A setpoint and a recorded status between the check pass and the failsafe iteration
-    change nothing: the failsafe still comes at the iteration, not at those events."""
+    """A setpoint and a recorded status still in OFFBOARD between the window's end and the
+    failsafe iteration change nothing: the failsafe still comes at the iteration."""
     events: list[Event] = [
         in_offboard(),
         *stream(0.0, 1.0),
-        TrajectorySetpoint(t=2.003, position=(0.0, 0.0, -2.0)),
-        status(2.005, OFFBOARD, True, OFFBOARD),
+        TrajectorySetpoint(t=2.103, position=(0.0, 0.0, -2.0)),
+        status(2.105, OFFBOARD, True, OFFBOARD),
     ]
     trs = _feed(px4, events, 3.0)
     (failsafe,) = of("failsafe", trs)
-    assert failsafe.t == pytest.approx(2.0 + ITERATION)
+    assert failsafe.t == pytest.approx(WINDOW_END + ITERATION)
 
 
 @pytest.mark.parametrize("px4", TICK)
-def test_recording_ending_inside_the_window_runs_no_failsafe(px4: str) -> None:
-    """Nothing after the recording's end: a loss seen in its last 10 ms has no failsafe yet."""
-    trs = _feed(px4, [in_offboard(), *stream(0.0, 1.0)], 2.005)
-    assert len(of("signal_lost", trs)) == 1
+@pytest.mark.parametrize(("end", "losses"), [(2.05, 0), (2.105, 1)])
+def test_recording_ending_inside_the_window_runs_no_failsafe(
+    px4: str, end: float, losses: int
+) -> None:
+    """Nothing after the recording's end: inside the loss window nothing is decided yet; after
+    it, the loss but no failsafe yet."""
+    trs = _feed(px4, [in_offboard(), *stream(0.0, 1.0)], end)
+    assert len(of("signal_lost", trs)) == losses
     assert of("failsafe", trs) == []
 
 
@@ -165,8 +190,9 @@ def test_gate_command_output_is_in_time_order(tmp_path: Path) -> None:
 def test_lagging_timestamp_brings_the_loss_forward(px4: str) -> None:
     """2.1.1: a ROS 2 keep-alive whose own timestamp lags makes PX4 see an older sample. The
     first stamped keep-alive (1.0 s) sets the clock offset; one received at 1.95 s stamped
-    1.55 s expires at 2.05 s, seen at the 2.1 s check pass, even though an earlier unstamped
-    keep-alive (1.9 s) would have lasted until 2.4 s. The next keep-alive (2.2 s) ends it."""
+    1.55 s expires at 2.05 s, seen within the next check period, even though an earlier
+    unstamped keep-alive (1.9 s) would have lasted until 2.4 s. The next keep-alive (2.2 s)
+    ends it."""
 
     def sent(t: float, stamp_s: float) -> ControlMode:
         return ControlMode(t=t, position=True, origin="sent", sender_time_us=round(stamp_s * 1e6))
@@ -174,7 +200,8 @@ def test_lagging_timestamp_brings_the_loss_forward(px4: str) -> None:
     events: list[Event] = [in_offboard(), *stream(0.0, 0.9)]
     events += [sent(1.0, 1.0), ocm(1.3), ocm(1.6), ocm(1.9), sent(1.95, 1.55), sent(2.2, 0.0)]
     trs = _feed(px4, events, 2.5, COM_OF_LOSS_T=0.5)
-    assert [tr.t for tr in of("signal_lost", trs)] == [pytest.approx(2.1)]
+    (lost,) = of("signal_lost", trs)
+    assert (lost.t_earliest, lost.t) == (pytest.approx(2.05), pytest.approx(2.15))
     (failsafe,) = of("failsafe", trs)
-    assert failsafe.t == pytest.approx(2.1 + ITERATION)
+    assert failsafe.t == pytest.approx(2.15 + ITERATION)
     assert [tr.t for tr in of("signal_available", trs)][-1] == pytest.approx(2.2)
