@@ -352,7 +352,8 @@ def _run_events(
             not_checkable.setdefault(code, needs)
     unseen = sorted(v for v, run in runs.items() if run.offboard_seen)
     if unseen and settings.enabled("OFB002"):
-        findings.append(_stream_not_recorded(unseen, settings))
+        flag = any(runs[v].gate.follows_flag for v in unseen)
+        findings.append(_stream_not_recorded(unseen, info, settings, flag))
     if not runs:
         # No event at all: every rule that needs a stream is not checkable.
         empty = VehicleRun("", profile, settings, info, None)
@@ -379,24 +380,34 @@ def _run_events(
     return findings, stats
 
 
-def _stream_not_recorded(vehicles: list[str], settings: Settings) -> Finding:
+def _stream_not_recorded(
+    vehicles: list[str], info: RecordingInfo, settings: Settings, follows_flag: bool
+) -> Finding:
     """The one OFB002 of a recording without the sent stream that shows offboard in use."""
     codes = ", ".join(c for c in SENT_STREAM_RULES if settings.enabled(c))
-    who = ", ".join(vehicles)
+    who = f" on vehicle {', '.join(vehicles)}" if any(vehicles) else ""
+    missing = info.stream_missing or "does not hold the stream sent to the vehicle"
+    if follows_flag:
+        signal = (
+            "the gate model takes PX4's own recorded verdict "
+            "(failsafe_flags.offboard_control_signal_lost) as the offboard signal"
+        )
+    else:
+        signal = (
+            "the gate model takes the offboard signal as present and counts a loss only "
+            "where PX4's own failsafe is recorded"
+        )
     return Finding(
         code="OFB002",
         name=get_rule("OFB002").name,
         severity=settings.severity_of("OFB002", Severity.INFO),
         message=(
-            f"the recording shows offboard in use on vehicle {who} but holds no setpoint and "
-            "no command from a companion: a ground station's log (PX4 does not forward the "
-            f"messages addressed to itself). The stream rules ({codes}) cannot be checked "
-            "here: they need the companion's side of the link (a tlog recorded on the "
-            "companion or by a router forwarding its messages, the /fmu/in topics, or the "
-            "vehicle's ULog). Modes, acks and PX4's failsafe messages are still checked: the "
-            "gate model takes the offboard signal as present and counts a loss only where "
-            "PX4's own failsafe is recorded. If this is the companion's own log, it sent no "
-            "setpoint at all"
+            f"the recording shows offboard in use{who} but {missing}. The stream "
+            f"rules ({codes}) cannot be checked here: they need the companion's side of the "
+            "link (a tlog recorded on the companion or by a router forwarding its messages, "
+            "the /fmu/in topics, or a ULog with offboard_control_mode). Modes, acks and PX4's "
+            f"failsafe messages are still checked: {signal}. If this is the companion's own "
+            "log, it sent no setpoint at all"
         ),
         summary="no companion stream in the recording (a ground station's log?): stream rules "
         "not checked",

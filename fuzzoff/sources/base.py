@@ -76,7 +76,11 @@ class RecordingInfo:
     """Does the recording hold the stream sent to the vehicle, or at least the link that would
     carry it? False only where the reader can tell it does not: a ground station's tlog, with
     no setpoint and no command from a companion (PX4 does not forward messages addressed to
-    itself), where the absence of a stream says nothing about the sender."""
+    itself), or a ULog without ``offboard_control_mode`` (a logger profile that leaves it out,
+    a log cut to other topics), where the absence of a stream says nothing about the sender."""
+    stream_missing: str = ""
+    """With ``stream_recorded`` false: what the recording is, and why it cannot hold the
+    stream (the OFB002 finding says it)."""
 
     @property
     def sampled(self) -> bool:

@@ -218,6 +218,10 @@ class TlogSource(Source):
         companions = commanders - autopilots - ground_stations
         if not any(stats.by_id.get(i) for i in KEEPALIVE_IDS) and not companions:
             info.stream_recorded = False
+            info.stream_missing = (
+                "holds no setpoint and no command from a companion: a ground station's log "
+                "(PX4 does not forward the messages addressed to itself)"
+            )
             info.notes.append(
                 "no setpoint and no command from a companion in the log (a ground station's "
                 "log?): the stream sent to the vehicle is not in this recording"

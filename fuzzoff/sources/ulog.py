@@ -183,6 +183,16 @@ class UlogSource(Source):
                 if interval is not None:
                     current = info.sampled_intervals.get(kind)
                     info.sampled_intervals[kind] = min(interval, current or interval)
+        if "offboard_control_mode" not in ulog.message_formats:
+            # PX4's logger writes the format of every topic it subscribes at the start, data
+            # or not: a log without it was not logging the stream (a profile or a
+            # logger_topics.txt that leaves it out, a log cut to other topics). With the format
+            # and no data, no offboard source published one: the stream was not sent.
+            info.stream_recorded = False
+            info.stream_missing = (
+                "its logger did not log offboard_control_mode (no format for it: a logger "
+                "profile that leaves it out, or a log cut to other topics)"
+            )
         if _legacy_flags(datasets):
             info.kinds.add(ev.FailsafeFlags.kind)
         info.kinds.add(ev.VehicleInfo.kind)
