@@ -63,7 +63,10 @@ def resolve_profile(info: RecordingInfo, settings: Settings) -> Profile:
             detected_px4 = px4_profile_for(release)
         except ProfileError:
             detected_px4 = None
-    px4 = settings.px4 or detected_px4 or DEFAULT_PX4
+    fallback = DEFAULT_PX4
+    if info.px4_candidates and DEFAULT_PX4 not in info.px4_candidates:
+        fallback = info.px4_candidates[-1]  # the newest the recording fits
+    px4 = settings.px4 or detected_px4 or fallback
     vehicle = settings.vehicle or info.vehicle_type or DEFAULT_VEHICLE
     return Profile(
         px4=px4,
@@ -503,7 +506,7 @@ def lint_file(
     if settings.enabled("OFB003") and (
         not (profile.px4_detected and profile.vehicle_detected) or vehicle_assumed
     ):
-        findings.append(_assumed(profile, vehicle_assumed))
+        findings.append(_assumed(profile, vehicle_assumed, info.px4_candidates))
     findings = [f for f in findings if settings.enabled(f.code)]
     findings.sort(key=_sort_key)
     report.findings = findings
@@ -536,9 +539,17 @@ def _problem(exc: SourceError) -> SourceProblem:
     return SourceProblem(exc.what, exc.where)
 
 
-def _assumed(profile: Profile, vehicle_assumed: str | None = None) -> Finding:
+def _assumed(
+    profile: Profile, vehicle_assumed: str | None = None, candidates: Sequence[str] = ()
+) -> Finding:
     missing = []
-    if not profile.px4_detected:
+    if not profile.px4_detected and candidates:
+        fits = " or ".join(candidates)
+        missing.append(
+            f"PX4 version: its message definitions and topic names fit {fits} "
+            f"(assumed {profile.px4}; set --px4)"
+        )
+    elif not profile.px4_detected:
         missing.append(f"PX4 version (assumed {profile.px4}; set --px4)")
     if not profile.vehicle_detected:
         missing.append(f"vehicle type (assumed {profile.vehicle}; set --vehicle)")

@@ -452,7 +452,8 @@ class RequiredEstimateMissing(Check):
         if self.saw_mode and not self.ctx.has("failsafe_flags"):
             self.ctx.cannot_check(
                 "OFB305",
-                "needs the estimator validity flags (ULog failsafe_flags or vehicle_status_flags)",
+                "needs the estimator validity flags (failsafe_flags in a ULog or on /fmu/out, "
+                "vehicle_status_flags before 1.14)",
             )
 
 
