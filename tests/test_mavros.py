@@ -35,6 +35,8 @@ from fuzzoff.writers.rosbag1 import mavros_typestore
 ROS1 = mavros_typestore()
 T = ROS1.types
 S = math.sqrt(0.5)
+ONE = (1.0, 0.0, 0.0, 0.0)
+"""The identity quaternion (w, x, y, z)."""
 
 
 def header(sec: int = 0, nsec: int = 0) -> Any:
@@ -223,6 +225,21 @@ def test_setpoint_position_local_sets_position_and_yaw_mask() -> None:
     assert e.yaw == pytest.approx(0.0, abs=1e-9)  # ENU yaw 90 deg = north = NED yaw 0
     assert e.velocity == (0.0, 0.0, 0.0) and e.coordinate_frame == 1
     assert e.sender_time_us == 1_000_000
+
+
+def test_local_position_pose_is_the_vehicle_position_in_ned_once_a_second() -> None:
+    # MAVROS publishes PX4's LOCAL_POSITION_NED in ENU; OFB404 reads it back in NED
+    converter = MavrosConverter()
+    first = converter.convert("/uav1/mavros/local_position/pose", pose((1.0, 2.0, -1.78), ONE), 3.0)
+    (e,) = first
+    assert (e.kind, e.vehicle, (e.x, e.y, e.z)) == ("vehicle_position", "/uav1", (2.0, 1.0, 1.78))
+    later = [
+        converter.convert("/uav1/mavros/local_position/pose", pose((0, 0, 0), ONE), t)
+        for t in (3.5, 4.0)
+    ]
+    assert [len(events) for events in later] == [0, 1]
+    every = MavrosConverter(position_period_s=0.0)  # the HTML report's plots
+    assert every.convert("/mavros/local_position/pose", pose((0, 0, 0), ONE), 3.5)
 
 
 def test_setpoint_velocity_stamped_and_unstamped() -> None:

@@ -39,6 +39,7 @@ from fuzzoff.events import (
     TrajectorySetpoint,
     VehicleControlModeStatus,
     VehicleInfo,
+    VehiclePosition,
     VehicleStatus,
     event_to_dict,
 )
@@ -91,6 +92,8 @@ def flight(era: str) -> list[Event]:
         VehicleControlModeStatus(
             t=0.6, offboard_enabled=True, enabled=frozenset({"offboard", "position", "velocity"})
         ),
+        VehiclePosition(t=0.7, x=1.5, y=-2.0, z=0.25),
+        VehiclePosition(t=1.75, x=NAN, y=NAN, z=-1.5),  # xy_valid false: x and y mean nothing
     ]
     layout = "thrust_and_torque" if era in ("1.15", "1.17") else "actuator"
     if legacy:

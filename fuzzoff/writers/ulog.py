@@ -113,6 +113,7 @@ class _Topics:
             ev.VehicleControlModeStatus: self._control_mode_status,
             ev.FailsafeFlags: self._failsafe_flags,
             ev.LandDetected: self._land_detected,
+            ev.VehiclePosition: self._local_position,
             ev.Command: self._command,
             ev.CommandAck: self._ack,
             ev.Parameter: self._parameter,
@@ -299,6 +300,12 @@ class _Topics:
         landed = bool(e.landed)
         row: Row = {"landed": landed, "maybe_landed": landed, "ground_contact": landed}
         self._put("vehicle_land_detected", ts, row)
+
+    def _local_position(self, e: ev.VehiclePosition, ts: int) -> None:
+        xy = math.isfinite(e.x) and math.isfinite(e.y)
+        row: Row = {"x": e.x if xy else 0.0, "y": e.y if xy else 0.0, "xy_valid": xy}
+        row |= {"z": e.z if math.isfinite(e.z) else 0.0, "z_valid": math.isfinite(e.z)}
+        self._put("vehicle_local_position", ts, row)
 
     def _command(self, e: ev.Command, ts: int) -> None:
         row: Row = {f"param{i + 1}": p for i, p in enumerate(e.params)}
