@@ -29,6 +29,7 @@ from fuzzoff.events import (
     SetAttitudeTarget,
     SetPositionTargetLocal,
     TrajectorySetpoint,
+    VehiclePosition,
 )
 from fuzzoff.findings import Finding, Severity
 from tests.streams import OFFBOARD, POSCTL, ack, codes, every, ocm, status, switch
@@ -571,6 +572,45 @@ def test_ofb404_pxs_own_setpoints_in_a_ulog_are_not_judged() -> None:
         for k in range(20)
     ]
     assert codes(lint_events(events, px4="1.16", fmt="ulog"), "OFB404") == []
+
+
+def _drifted_ground(*events: Event) -> list[Event]:
+    """PX4 1.15 SIH on the ground: the estimator's local z has drifted to +1.78 m."""
+    head: list[Event] = [status(0.0, LOITER, armed=False), ControlMode(t=0.0, position=True)]
+    head += [VehiclePosition(t=0.5 * k, x=0.0, y=0.0, z=1.78) for k in range(6)]
+    return [*head, *events]
+
+
+def test_ofb404_a_client_sending_its_current_position_from_the_ground_is_not_enu() -> None:
+    # px4_ros_com's Python example on 1.15: the current position until its first setpoint
+    held = [TrajectorySetpoint(t=2.6 + 0.1 * k, position=(0.0, 0.0, 1.78)) for k in range(10)]
+    climb = [TrajectorySetpoint(t=3.6 + 0.1 * k, position=(0.0, 0.0, -5.0)) for k in range(10)]
+    events = _drifted_ground(*held, status(3.5, OFFBOARD, armed=True), *climb)
+    assert codes(lint_events(events), "OFB404") == []
+    # without the vehicle's position the origin stands for the ground: 1.78 m below it
+    blind = [e for e in events if not isinstance(e, VehiclePosition)]
+    (found,) = codes(lint_events(blind), "OFB404")
+    assert "no vehicle position" in found.message
+
+
+def test_ofb404_a_climb_in_enu_is_judged_against_the_vehicles_height() -> None:
+    events = _drifted_ground(TrajectorySetpoint(t=2.6, position=(0.0, 0.0, 5.0)))
+    (found,) = codes(lint_events(events), "OFB404")
+    assert found.severity is Severity.ERROR
+    assert "3.22 m below the vehicle (its local z = 1.78 m)" in found.message
+
+
+def test_ofb404_in_the_air_a_target_is_judged_against_the_ground_it_took_off_from() -> None:
+    events = _drifted_ground(
+        status(3.0, TAKEOFF, armed=True),
+        *[VehiclePosition(t=3.5 + 0.5 * k, x=0.0, y=0.0, z=1.78 - k) for k in range(8)],
+        status(8.0, OFFBOARD),
+        TrajectorySetpoint(t=8.1, position=(0.0, 0.0, 2.0)),  # a landing 0.22 m below: fine
+    )
+    assert codes(lint_events(events), "OFB404") == []
+    events.append(TrajectorySetpoint(t=8.2, position=(0.0, 0.0, 5.0)))
+    (found,) = codes(lint_events(events), "OFB404")
+    assert "3.22 m below the ground the vehicle took off from (z = 1.78 m)" in found.message
 
 
 def test_ofb404_thrust_pointing_down_on_a_multicopter() -> None:
