@@ -40,6 +40,7 @@ from fuzzoff.sources.mavros_frames import (
     enu_to_ned,
     flu_to_frd,
     orientation_enu_to_ned,
+    pose_rotation,
     quat_mul,
     quat_yaw,
     yaw_enu_to_ned,
@@ -422,9 +423,10 @@ def raw_attitude(
 def position_local(
     msg: Any, options: MavrosOptions, t: float, ns: str, where: Where
 ) -> SetPositionTargetLocal:
-    """``setpoint_position/local`` (PoseStamped): position + yaw, mask 0x9F8."""
+    """``setpoint_position/local`` (PoseStamped): position + yaw, mask 0x9F8. The orientation
+    goes through Eigen as MAVROS's does (``pose_rotation``: an all-zero one is the identity)."""
     pose = msg.pose
-    q = _quat(pose.orientation)
+    q = pose_rotation(_quat(pose.orientation))
     if options.mav_frame in BODY_FRAMES:
         position = flu_to_frd(_vec(pose.position))
         yaw = quat_yaw(quat_mul(AIRCRAFT_BASELINK_Q, q))
