@@ -308,6 +308,23 @@ def test_pxs_automatic_return_after_a_loss_is_not_a_request() -> None:
     assert [f.time_s for f in codes(found, "OFB101")] == [pytest.approx(6.0)]
 
 
+def test_pxs_return_to_offboard_as_it_disarms_after_a_landing_is_not_a_request() -> None:
+    # MAVROS-like: the stream stops as the vehicle lands in AUTO_LAND; after "Disarmed by
+    # landing" PX4 shows OFFBOARD again, disarmed (its user intention from before the landing,
+    # as 1.16.2 and 1.17.0 SITL did), with no stream running: nobody asked for it
+    land = 18
+    events = [status(0.0, POSCTL, armed=False), *ocm(every(0.0, 20.0, 0.05))]
+    events += [status(5.0, OFFBOARD, armed=False), status(10.0, OFFBOARD, armed=True)]
+    events += [status(20.01, land, armed=True), status(25.0, land, armed=True)]
+    events += [status(30.0, OFFBOARD, armed=False), status(31.0, OFFBOARD, armed=False)]
+    assert codes(lint_events(events, px4="1.16"), "OFB102") == []
+    # a user's switch while disarmed on the ground is still one
+    user = [status(0.0, POSCTL, armed=False), status(1.0, POSCTL, armed=False)]
+    user += [*ocm(every(1.5, 2.0, 0.05)), status(2.0, OFFBOARD, armed=False)]
+    (found,) = codes(lint_events(user, px4="1.16"), "OFB102")
+    assert found.time_s == 2.0 and "recorded mode" in found.message
+
+
 def test_ofb104_not_when_the_keepalive_stopped_with_the_setpoints() -> None:
     times = [t for t in every(0.0, 10.0, 0.1) if not 4.0 < t < 6.0]
     sp = [TrajectorySetpoint(t=t + 0.01, position=(0.0, 0.0, -2.0)) for t in times]
