@@ -408,6 +408,47 @@ def test_ofb304_changes_outside_offboard_are_not_reported() -> None:
     assert codes(lint_events(events), "OFB304") == []
 
 
+POSITION_MASK, BODY_VELOCITY_MASK = 0x9F8, 0xDC7
+
+
+def _mavlink(t: float, mask: int, frame: int = 1) -> SetPositionTargetLocal:
+    return SetPositionTargetLocal(
+        t=t, target_system=1, type_mask=mask, coordinate_frame=frame, velocity=(0.5, 0.0, 0.0)
+    )
+
+
+def test_ofb304_judges_the_flags_pxs_receiver_sets_from_mavlink_type_masks() -> None:
+    # no OffboardControlMode over MAVLink: a position segment, then a velocity segment
+    events: list[Event] = [status(0.0, OFFBOARD)]
+    events += [_mavlink(0.05 * k, POSITION_MASK) for k in range(40)]
+    events += [_mavlink(2.0 + 0.05 * k, BODY_VELOCITY_MASK, 8) for k in range(40)]
+    (found,) = codes(lint_events(events, fmt="tlog"), "OFB304")
+    assert found.time_s == pytest.approx(2.0)
+    assert "from 'position' to 'velocity'" in found.message and "type masks" in found.message
+
+
+def test_ofb304_interleaved_setpoint_types_are_one_stretch() -> None:
+    # a position setpoint at 10 Hz with a body-velocity nudge between them for 1 s, twice
+    events: list[Event] = [status(0.0, OFFBOARD)]
+    events += [_mavlink(0.1 * k, POSITION_MASK) for k in range(80)]
+    for start in (2.0, 5.0):
+        events += [_mavlink(start + 0.05 + 0.1 * k, BODY_VELOCITY_MASK, 8) for k in range(10)]
+    found = codes(lint_events(events, fmt="tlog"), "OFB304")
+    assert [(f.time_s, f.end_s) for f in found] == [
+        (pytest.approx(2.05), pytest.approx(3.0)),
+        (pytest.approx(5.05), pytest.approx(6.0)),
+    ]
+    assert all("changed 20 times" in f.message for f in found)
+    # the same alternation as a ULog's 10 Hz samples of the receiver's offboard_control_mode
+    sampled: list[Event] = [status(0.0, OFFBOARD)]
+    sampled += [
+        ControlMode(t=0.1 * k, position=not 20 < k < 30 or k % 3 != 0, velocity=True)
+        for k in range(80)
+    ]
+    (one,) = codes(lint_events(sampled, fmt="ulog"), "OFB304")
+    assert one.time_s == pytest.approx(2.1) and "times" in one.message
+
+
 def test_ofb305_at_the_request_and_not_checkable_without_flags() -> None:
     events = [
         status(0.0, POSCTL),
