@@ -47,6 +47,9 @@ class VehicleState:
     mode_recorded: bool = False
     """The recording carries the vehicle's mode (status topic, HEARTBEAT, MAVROS state)."""
     nav_state: int | None = None
+    status_nav_state: int | None = None
+    """The nav_state of the newest recorded status, without the acks applied: what PX4 had
+    switched to (its own flight tasks write the setpoint topics until that status)."""
     armed: bool | None = None
     predicted_offboard: bool = False
     """The gate model's verdict, used where the recording has no mode."""
@@ -118,7 +121,7 @@ class VehicleState:
     def _status(self, event: Event) -> None:
         assert isinstance(event, VehicleStatus)
         if event.nav_state is not None:
-            self.nav_state = event.nav_state
+            self.nav_state = self.status_nav_state = event.nav_state
         if event.armed is not None:
             self.armed = event.armed
 

@@ -654,6 +654,25 @@ def test_ofb404_in_the_air_a_target_is_judged_against_the_ground_it_took_off_fro
     assert "3.22 m below the ground the vehicle took off from (z = 1.78 m)" in found.message
 
 
+def test_a_ulogs_setpoint_between_the_receivers_ack_and_the_switch_is_pxs_own() -> None:
+    """PX4 1.17 SITL, acceleration-only MAVLink setpoints: the receiver acks the switch 24 ms
+    before Commander makes it, and PX4's AUTO_LOITER flight task writes trajectory_setpoint
+    (a position hold) in between: not the client's, no OFB401. Once the status says OFFBOARD,
+    a logged setpoint is the client's again."""
+    events: list[Event] = [status(0.0, LOITER, armed=False)]
+    events += [ControlMode(t=0.1 * k, acceleration=True, origin="vehicle") for k in range(1, 40)]
+    events += [switch(1.992), ack(1.992, 0), ack(2.004, 0), status(2.016, OFFBOARD, armed=False)]
+    own = TrajectorySetpoint(
+        t=2.0, position=(0.08, -0.03, 0.54), acceleration=(0.0, -0.06, -0.06), origin="vehicle"
+    )
+    events.append(own)
+    found = lint_events(events, px4="1.17", fmt="ulog")
+    assert codes(found, "OFB401") == []
+    late = TrajectorySetpoint(t=2.5, position=(0.0, 0.0, -2.0), origin="vehicle")
+    (mismatch,) = codes(lint_events([*events, late], px4="1.17", fmt="ulog"), "OFB401")
+    assert mismatch.time_s == 2.5
+
+
 def test_ofb404_thrust_pointing_down_on_a_multicopter() -> None:
     events = [
         status(0.0, OFFBOARD),
