@@ -641,6 +641,23 @@ def test_ofb404_a_climb_in_enu_is_judged_against_the_vehicles_height() -> None:
     assert "3.22 m below the vehicle (its local z = 1.78 m)" in found.message
 
 
+def test_ofb404_one_climb_in_enu_on_the_ground_is_one_finding() -> None:
+    # real PX4 SITL: the first setpoint comes before the first HEARTBEAT (disarmed), and PX4
+    # disarms the vehicle itself 10 s after it armed pushing into the ground, the stream going on
+    events: list[Event] = [
+        TrajectorySetpoint(t=0.1 * k, position=(0.0, 0.0, 2.5)) for k in range(200)
+    ]
+    events += [status(0.35, LOITER, armed=False), status(2.0, OFFBOARD, armed=True)]
+    events += [status(12.0, OFFBOARD, armed=False)]
+    (found,) = codes(lint_events(events), "OFB404")
+    assert found.time_s == 0.0
+    # a flight that lands is a new stretch on the ground: its next climb is judged again
+    flew = [status(0.0, LOITER, armed=False), status(1.0, TAKEOFF, armed=True)]
+    flew += [status(6.0, LOITER, armed=False)]
+    flew += [TrajectorySetpoint(t=7.0 + 0.1 * k, position=(0.0, 0.0, 2.5)) for k in range(5)]
+    assert [f.time_s for f in codes(lint_events(flew), "OFB404")] == [7.0]
+
+
 def test_ofb404_in_the_air_a_target_is_judged_against_the_ground_it_took_off_from() -> None:
     events = _drifted_ground(
         status(3.0, TAKEOFF, armed=True),

@@ -243,6 +243,10 @@ class FrameConventionSuspect(Check):
 
     def _on_ground(self) -> None:
         self.below.close_all()
+        if self.where == "ground":
+            # It never left the ground (the first status confirms where a recording starts, or
+            # PX4 disarmed a vehicle pushing into the ground): the same stretch, judged once.
+            return
         self.where, self.decided, self.flagged = "ground", False, False
 
     def _took_off(self) -> None:
