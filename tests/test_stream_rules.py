@@ -11,6 +11,7 @@ from fuzzoff.engine import run_events
 from fuzzoff.events import (
     Command,
     Dropout,
+    Event,
     SetPositionTargetLocal,
     TrajectorySetpoint,
     VehicleStatus,
@@ -323,6 +324,23 @@ def test_pxs_return_to_offboard_as_it_disarms_after_a_landing_is_not_a_request()
     user += [*ocm(every(1.5, 2.0, 0.05)), status(2.0, OFFBOARD, armed=False)]
     (found,) = codes(lint_events(user, px4="1.16"), "OFB102")
     assert found.time_s == 2.0 and "recorded mode" in found.message
+
+
+def test_a_heartbeat_sent_between_the_ack_and_the_switch_is_not_a_switch_back() -> None:
+    # PX4 1.16.2 SITL: the client sends its last setpoint, asks for AUTO_LAND, PX4 acks twice,
+    # and a HEARTBEAT 7 ms later still shows OFFBOARD (sent before Commander's new status);
+    # the next one, a second later, shows AUTO_LAND. The vehicle did not go back to OFFBOARD
+    land = 18
+    events: list[Event] = [status(0.0, OFFBOARD)]
+    events += [
+        SetPositionTargetLocal(t=t, target_system=1, type_mask=0x9F8, position=(0, 0, -2.5))
+        for t in every(0.0, 4.95, 0.1)
+    ]
+    to_land = Command(t=5.0, command=176, params=(1.0, 4.0, 6.0, 0.0, 0.0, 0.0, 0.0))
+    events += [to_land, ack(5.007, 0), ack(5.007, 0), status(5.014, OFFBOARD)]
+    events += [status(6.0, land), status(7.0, land)]
+    found = lint_events(events, px4="1.16", fmt="tlog")
+    assert codes(found, "OFB303") == [] and codes(found, "OFB101") == []
 
 
 def test_ofb104_not_when_the_keepalive_stopped_with_the_setpoints() -> None:
