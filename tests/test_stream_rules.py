@@ -10,8 +10,10 @@ from fuzzoff.config import Settings
 from fuzzoff.engine import run_events
 from fuzzoff.events import (
     Command,
+    ControlMode,
     Dropout,
     Event,
+    FailsafeFlags,
     SetPositionTargetLocal,
     TrajectorySetpoint,
     VehicleStatus,
@@ -341,6 +343,20 @@ def test_a_heartbeat_sent_between_the_ack_and_the_switch_is_not_a_switch_back() 
     events += [status(6.0, land), status(7.0, land)]
     found = lint_events(events, px4="1.16", fmt="tlog")
     assert codes(found, "OFB303") == [] and codes(found, "OFB101") == []
+
+
+def test_ofb102_follows_the_models_second_look_at_a_switch_the_logger_hid() -> None:
+    # MAVSDK's set-then-start on PX4 1.16.2 SITL, as its ULog holds it: the switch is logged
+    # 4 ms before PX4's flag turns available, and the logger missed the keep-alive PX4 had
+    lost = [FailsafeFlags(t=0.5, offboard_control_signal_lost=True)]
+    events: list[Event] = [status(0.0, 17, armed=True), *lost]
+    events += [switch(2.0), FailsafeFlags(t=2.004, offboard_control_signal_lost=False)]
+    events += [ack(2.004, 0), ack(2.008, 0), status(2.016, OFFBOARD)]
+    events += [ControlMode(t=2.1 + 0.1 * k, attitude=True, origin="vehicle") for k in range(20)]
+    found = lint_events(events, px4="1.16", fmt="ulog", sampled={"control_mode": 0.1})
+    (request,) = codes(found, "OFB102")
+    assert request.severity is Severity.INFO and "would: accept it" in request.message
+    assert codes(found, "OFB202") == [] and codes(found, "OFB103") == []
 
 
 def test_ofb104_not_when_the_keepalive_stopped_with_the_setpoints() -> None:

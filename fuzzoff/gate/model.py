@@ -690,6 +690,7 @@ class GateModel:
             "2.1.3",
             cause=None,
         )
+        self._cause = cmd  # the new verdict answers the command (OFB102 pairs them)
         if cmd.is_mode_switch:
             self._apply_switch(t, target, decision)
         else:
