@@ -63,7 +63,10 @@ def resolve_profile(info: RecordingInfo, settings: Settings) -> Profile:
             detected_px4 = px4_profile_for(release)
         except ProfileError:
             detected_px4 = None
-    px4 = settings.px4 or detected_px4 or DEFAULT_PX4
+    fallback = DEFAULT_PX4
+    if info.px4_candidates and DEFAULT_PX4 not in info.px4_candidates:
+        fallback = info.px4_candidates[-1]  # the newest the recording fits
+    px4 = settings.px4 or detected_px4 or fallback
     vehicle = settings.vehicle or info.vehicle_type or DEFAULT_VEHICLE
     return Profile(
         px4=px4,
@@ -352,7 +355,8 @@ def _run_events(
             not_checkable.setdefault(code, needs)
     unseen = sorted(v for v, run in runs.items() if run.offboard_seen)
     if unseen and settings.enabled("OFB002"):
-        findings.append(_stream_not_recorded(unseen, settings))
+        flag = any(runs[v].gate.follows_flag for v in unseen)
+        findings.append(_stream_not_recorded(unseen, info, settings, flag))
     if not runs:
         # No event at all: every rule that needs a stream is not checkable.
         empty = VehicleRun("", profile, settings, info, None)
@@ -379,24 +383,34 @@ def _run_events(
     return findings, stats
 
 
-def _stream_not_recorded(vehicles: list[str], settings: Settings) -> Finding:
+def _stream_not_recorded(
+    vehicles: list[str], info: RecordingInfo, settings: Settings, follows_flag: bool
+) -> Finding:
     """The one OFB002 of a recording without the sent stream that shows offboard in use."""
     codes = ", ".join(c for c in SENT_STREAM_RULES if settings.enabled(c))
-    who = ", ".join(vehicles)
+    who = f" on vehicle {', '.join(vehicles)}" if any(vehicles) else ""
+    missing = info.stream_missing or "does not hold the stream sent to the vehicle"
+    if follows_flag:
+        signal = (
+            "the gate model takes PX4's own recorded verdict "
+            "(failsafe_flags.offboard_control_signal_lost) as the offboard signal"
+        )
+    else:
+        signal = (
+            "the gate model takes the offboard signal as present and counts a loss only "
+            "where PX4's own failsafe is recorded"
+        )
     return Finding(
         code="OFB002",
         name=get_rule("OFB002").name,
         severity=settings.severity_of("OFB002", Severity.INFO),
         message=(
-            f"the recording shows offboard in use on vehicle {who} but holds no setpoint and "
-            "no command from a companion: a ground station's log (PX4 does not forward the "
-            f"messages addressed to itself). The stream rules ({codes}) cannot be checked "
-            "here: they need the companion's side of the link (a tlog recorded on the "
-            "companion or by a router forwarding its messages, the /fmu/in topics, or the "
-            "vehicle's ULog). Modes, acks and PX4's failsafe messages are still checked: the "
-            "gate model takes the offboard signal as present and counts a loss only where "
-            "PX4's own failsafe is recorded. If this is the companion's own log, it sent no "
-            "setpoint at all"
+            f"the recording shows offboard in use{who} but {missing}. The stream "
+            f"rules ({codes}) cannot be checked here: they need the companion's side of the "
+            "link (a tlog recorded on the companion or by a router forwarding its messages, "
+            "the /fmu/in topics, or a ULog with offboard_control_mode). Modes, acks and PX4's "
+            f"failsafe messages are still checked: {signal}. If this is the companion's own "
+            "log, it sent no setpoint at all"
         ),
         summary="no companion stream in the recording (a ground station's log?): stream rules "
         "not checked",
@@ -492,7 +506,7 @@ def lint_file(
     if settings.enabled("OFB003") and (
         not (profile.px4_detected and profile.vehicle_detected) or vehicle_assumed
     ):
-        findings.append(_assumed(profile, vehicle_assumed))
+        findings.append(_assumed(profile, vehicle_assumed, info.px4_candidates))
     findings = [f for f in findings if settings.enabled(f.code)]
     findings.sort(key=_sort_key)
     report.findings = findings
@@ -525,9 +539,17 @@ def _problem(exc: SourceError) -> SourceProblem:
     return SourceProblem(exc.what, exc.where)
 
 
-def _assumed(profile: Profile, vehicle_assumed: str | None = None) -> Finding:
+def _assumed(
+    profile: Profile, vehicle_assumed: str | None = None, candidates: Sequence[str] = ()
+) -> Finding:
     missing = []
-    if not profile.px4_detected:
+    if not profile.px4_detected and candidates:
+        fits = " or ".join(candidates)
+        missing.append(
+            f"PX4 version: its message definitions and topic names fit {fits} "
+            f"(assumed {profile.px4}; set --px4)"
+        )
+    elif not profile.px4_detected:
         missing.append(f"PX4 version (assumed {profile.px4}; set --px4)")
     if not profile.vehicle_detected:
         missing.append(f"vehicle type (assumed {profile.vehicle}; set --vehicle)")

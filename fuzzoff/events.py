@@ -584,9 +584,11 @@ class StatusText(Event):
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class VehiclePosition(Event):
-    """Where the vehicle estimates it is, local NED in metres (ULog ``vehicle_local_position``,
-    MAVLink ``LOCAL_POSITION_NED``). Read only for the HTML report's plots (``Source.plot_data``):
-    no rule judges it."""
+    """Where the vehicle estimates it is, local NED in metres (ULog and ROS 2
+    ``vehicle_local_position``, MAVLink ``LOCAL_POSITION_NED``, MAVROS ``local_position/pose``
+    turned back into NED); NaN where PX4 marks the coordinate invalid. OFB404 compares vertical
+    setpoints with its ``z``; a plain lint reads one per ``sources.base.POSITION_PERIOD_S``, the
+    HTML report's plots every one."""
 
     kind: ClassVar[str] = "vehicle_position"
 

@@ -28,6 +28,11 @@ from fuzzoff.events import (
     VehicleStatus,
 )
 
+STALE_STATUS_S = 0.05
+"""A status that still shows the mode an accepted switch left, this soon after its ack, was
+sent before the switch took effect (PX4's MAVLink HEARTBEAT can go out between Commander's
+ack and its new vehicle_status: 7 ms later on 1.16.2 SITL), not a switch back."""
+
 DOUBLE_ACK_WINDOW_S = 0.1
 """A second ack for the same command within this window replaces a first that was ACCEPTED
 (gate spec 4.3: PX4 1.16/1.17's receiver acks ACCEPTED, Commander's verdict follows)."""
@@ -47,6 +52,9 @@ class VehicleState:
     mode_recorded: bool = False
     """The recording carries the vehicle's mode (status topic, HEARTBEAT, MAVROS state)."""
     nav_state: int | None = None
+    status_nav_state: int | None = None
+    """The nav_state of the newest recorded status, without the acks applied: what PX4 had
+    switched to (its own flight tasks write the setpoint topics until that status)."""
     armed: bool | None = None
     predicted_offboard: bool = False
     """The gate model's verdict, used where the recording has no mode."""
@@ -70,6 +78,8 @@ class VehicleState:
     ``update`` once per event so that the stream rules need not each work it out again; compare
     with ``is`` (a gate transition dispatched meanwhile is never the current event)."""
     _pending: dict[int, _PendingSwitch] = field(default_factory=dict)
+    _left: tuple[float, int | None] | None = None
+    """(ack time, the mode before) of the newest accepted switch that changed ``nav_state``."""
 
     def _now_in_offboard(self) -> bool:
         if self.mode_recorded:
@@ -117,8 +127,11 @@ class VehicleState:
 
     def _status(self, event: Event) -> None:
         assert isinstance(event, VehicleStatus)
-        if event.nav_state is not None:
-            self.nav_state = event.nav_state
+        left = self._left
+        if left is not None and (event.t - left[0] > STALE_STATUS_S or event.nav_state != left[1]):
+            self._left = left = None
+        if event.nav_state is not None and left is None:
+            self.nav_state = self.status_nav_state = event.nav_state
         if event.armed is not None:
             self.armed = event.armed
 
@@ -177,11 +190,15 @@ class VehicleState:
             pending.before = self.nav_state
             pending.first_accepted = ack.accepted  # the receiver's own ack is ACCEPTED
         pending.acked_at = ack.t
+        self._left = None
         if ack.accepted and self.mode_recorded:
+            before = self.nav_state
             if pending.to_offboard:
                 self.nav_state = NAV_STATE_OFFBOARD
             elif self.nav_state == NAV_STATE_OFFBOARD:
                 self.nav_state = None  # left offboard for a mode the status will name
+            if self.nav_state != before:
+                self._left = (ack.t, pending.before)
 
 
 _UPDATERS: tuple[tuple[type, Callable[[VehicleState, Event], None]], ...] = (

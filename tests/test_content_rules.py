@@ -29,6 +29,7 @@ from fuzzoff.events import (
     SetAttitudeTarget,
     SetPositionTargetLocal,
     TrajectorySetpoint,
+    VehiclePosition,
 )
 from fuzzoff.findings import Finding, Severity
 from tests.streams import OFFBOARD, POSCTL, ack, codes, every, ocm, status, switch
@@ -407,6 +408,47 @@ def test_ofb304_changes_outside_offboard_are_not_reported() -> None:
     assert codes(lint_events(events), "OFB304") == []
 
 
+POSITION_MASK, BODY_VELOCITY_MASK = 0x9F8, 0xDC7
+
+
+def _mavlink(t: float, mask: int, frame: int = 1) -> SetPositionTargetLocal:
+    return SetPositionTargetLocal(
+        t=t, target_system=1, type_mask=mask, coordinate_frame=frame, velocity=(0.5, 0.0, 0.0)
+    )
+
+
+def test_ofb304_judges_the_flags_pxs_receiver_sets_from_mavlink_type_masks() -> None:
+    # no OffboardControlMode over MAVLink: a position segment, then a velocity segment
+    events: list[Event] = [status(0.0, OFFBOARD)]
+    events += [_mavlink(0.05 * k, POSITION_MASK) for k in range(40)]
+    events += [_mavlink(2.0 + 0.05 * k, BODY_VELOCITY_MASK, 8) for k in range(40)]
+    (found,) = codes(lint_events(events, fmt="tlog"), "OFB304")
+    assert found.time_s == pytest.approx(2.0)
+    assert "from 'position' to 'velocity'" in found.message and "type masks" in found.message
+
+
+def test_ofb304_interleaved_setpoint_types_are_one_stretch() -> None:
+    # a position setpoint at 10 Hz with a body-velocity nudge between them for 1 s, twice
+    events: list[Event] = [status(0.0, OFFBOARD)]
+    events += [_mavlink(0.1 * k, POSITION_MASK) for k in range(80)]
+    for start in (2.0, 5.0):
+        events += [_mavlink(start + 0.05 + 0.1 * k, BODY_VELOCITY_MASK, 8) for k in range(10)]
+    found = codes(lint_events(events, fmt="tlog"), "OFB304")
+    assert [(f.time_s, f.end_s) for f in found] == [
+        (pytest.approx(2.05), pytest.approx(3.0)),
+        (pytest.approx(5.05), pytest.approx(6.0)),
+    ]
+    assert all("changed 20 times" in f.message for f in found)
+    # the same alternation as a ULog's 10 Hz samples of the receiver's offboard_control_mode
+    sampled: list[Event] = [status(0.0, OFFBOARD)]
+    sampled += [
+        ControlMode(t=0.1 * k, position=not 20 < k < 30 or k % 3 != 0, velocity=True)
+        for k in range(80)
+    ]
+    (one,) = codes(lint_events(sampled, fmt="ulog"), "OFB304")
+    assert one.time_s == pytest.approx(2.1) and "times" in one.message
+
+
 def test_ofb305_at_the_request_and_not_checkable_without_flags() -> None:
     events = [
         status(0.0, POSCTL),
@@ -571,6 +613,81 @@ def test_ofb404_pxs_own_setpoints_in_a_ulog_are_not_judged() -> None:
         for k in range(20)
     ]
     assert codes(lint_events(events, px4="1.16", fmt="ulog"), "OFB404") == []
+
+
+def _drifted_ground(*events: Event) -> list[Event]:
+    """PX4 1.15 SIH on the ground: the estimator's local z has drifted to +1.78 m."""
+    head: list[Event] = [status(0.0, LOITER, armed=False), ControlMode(t=0.0, position=True)]
+    head += [VehiclePosition(t=0.5 * k, x=0.0, y=0.0, z=1.78) for k in range(6)]
+    return [*head, *events]
+
+
+def test_ofb404_a_client_sending_its_current_position_from_the_ground_is_not_enu() -> None:
+    # px4_ros_com's Python example on 1.15: the current position until its first setpoint
+    held = [TrajectorySetpoint(t=2.6 + 0.1 * k, position=(0.0, 0.0, 1.78)) for k in range(10)]
+    climb = [TrajectorySetpoint(t=3.6 + 0.1 * k, position=(0.0, 0.0, -5.0)) for k in range(10)]
+    events = _drifted_ground(*held, status(3.5, OFFBOARD, armed=True), *climb)
+    assert codes(lint_events(events), "OFB404") == []
+    # without the vehicle's position the origin stands for the ground: 1.78 m below it
+    blind = [e for e in events if not isinstance(e, VehiclePosition)]
+    (found,) = codes(lint_events(blind), "OFB404")
+    assert "no vehicle position" in found.message
+
+
+def test_ofb404_a_climb_in_enu_is_judged_against_the_vehicles_height() -> None:
+    events = _drifted_ground(TrajectorySetpoint(t=2.6, position=(0.0, 0.0, 5.0)))
+    (found,) = codes(lint_events(events), "OFB404")
+    assert found.severity is Severity.ERROR
+    assert "3.22 m below the vehicle (its local z = 1.78 m)" in found.message
+
+
+def test_ofb404_one_climb_in_enu_on_the_ground_is_one_finding() -> None:
+    # real PX4 SITL: the first setpoint comes before the first HEARTBEAT (disarmed), and PX4
+    # disarms the vehicle itself 10 s after it armed pushing into the ground, the stream going on
+    events: list[Event] = [
+        TrajectorySetpoint(t=0.1 * k, position=(0.0, 0.0, 2.5)) for k in range(200)
+    ]
+    events += [status(0.35, LOITER, armed=False), status(2.0, OFFBOARD, armed=True)]
+    events += [status(12.0, OFFBOARD, armed=False)]
+    (found,) = codes(lint_events(events), "OFB404")
+    assert found.time_s == 0.0
+    # a flight that lands is a new stretch on the ground: its next climb is judged again
+    flew = [status(0.0, LOITER, armed=False), status(1.0, TAKEOFF, armed=True)]
+    flew += [status(6.0, LOITER, armed=False)]
+    flew += [TrajectorySetpoint(t=7.0 + 0.1 * k, position=(0.0, 0.0, 2.5)) for k in range(5)]
+    assert [f.time_s for f in codes(lint_events(flew), "OFB404")] == [7.0]
+
+
+def test_ofb404_in_the_air_a_target_is_judged_against_the_ground_it_took_off_from() -> None:
+    events = _drifted_ground(
+        status(3.0, TAKEOFF, armed=True),
+        *[VehiclePosition(t=3.5 + 0.5 * k, x=0.0, y=0.0, z=1.78 - k) for k in range(8)],
+        status(8.0, OFFBOARD),
+        TrajectorySetpoint(t=8.1, position=(0.0, 0.0, 2.0)),  # a landing 0.22 m below: fine
+    )
+    assert codes(lint_events(events), "OFB404") == []
+    events.append(TrajectorySetpoint(t=8.2, position=(0.0, 0.0, 5.0)))
+    (found,) = codes(lint_events(events), "OFB404")
+    assert "3.22 m below the ground the vehicle took off from (z = 1.78 m)" in found.message
+
+
+def test_a_ulogs_setpoint_between_the_receivers_ack_and_the_switch_is_pxs_own() -> None:
+    """PX4 1.17 SITL, acceleration-only MAVLink setpoints: the receiver acks the switch 24 ms
+    before Commander makes it, and PX4's AUTO_LOITER flight task writes trajectory_setpoint
+    (a position hold) in between: not the client's, no OFB401. Once the status says OFFBOARD,
+    a logged setpoint is the client's again."""
+    events: list[Event] = [status(0.0, LOITER, armed=False)]
+    events += [ControlMode(t=0.1 * k, acceleration=True, origin="vehicle") for k in range(1, 40)]
+    events += [switch(1.992), ack(1.992, 0), ack(2.004, 0), status(2.016, OFFBOARD, armed=False)]
+    own = TrajectorySetpoint(
+        t=2.0, position=(0.08, -0.03, 0.54), acceleration=(0.0, -0.06, -0.06), origin="vehicle"
+    )
+    events.append(own)
+    found = lint_events(events, px4="1.17", fmt="ulog")
+    assert codes(found, "OFB401") == []
+    late = TrajectorySetpoint(t=2.5, position=(0.0, 0.0, -2.0), origin="vehicle")
+    (mismatch,) = codes(lint_events([*events, late], px4="1.17", fmt="ulog"), "OFB401")
+    assert mismatch.time_s == 2.5
 
 
 def test_ofb404_thrust_pointing_down_on_a_multicopter() -> None:

@@ -368,6 +368,21 @@ def test_a_hold_counts_only_while_armed() -> None:
     assert every_unintended_outcome_is_explained(scenario, FuzzContext()) == []
 
 
+def test_a_hold_ends_when_the_vehicle_disarms() -> None:
+    """A MAVROS state that shows OFFBOARD armed for 0.1 ms and then disarmed (a campaign's
+    shrunk example): the failsafe hold runs until the next setpoint 1.5 s later, but the
+    vehicle flies none of it."""
+
+    def setpoint(t: float) -> SetPositionTargetLocal:
+        return SetPositionTargetLocal(t=t, target_system=1, type_mask=0xDF8, transport="mavros")
+
+    states = [(0.003, 2, False), (0.0031, 2, True), (0.0032, 14, True), (0.0033, 14, False)]
+    events: list[Event] = [setpoint(0.0), setpoint(1.5), setpoint(2.0)]
+    events += [VehicleStatus(t=t, nav_state=n, armed=a) for t, n, a in states]
+    scenario = Scenario("1.16", "mc", "mavros", tuple(sorted(events, key=lambda e: e.t)))
+    assert every_unintended_outcome_is_explained(scenario, FuzzContext()) == []
+
+
 def test_a_jittered_command_keeps_the_vehicles_ack_after_it() -> None:
     """``switch_rejected.mcap``: the vehicle rejects the switch at 2.0 s with an ack 10 ms
     later. A jitter delays the command by up to 0.9 s; the recorded ack answers it, so it

@@ -264,10 +264,13 @@ def test_the_timeline_has_the_position_messages_and_labelled_commands(tmp_path: 
     assert "<b>offboard" not in page  # sent as escaped JSON, shown as text by the script
 
 
-def test_a_plain_lint_reads_no_position() -> None:
-    recording = CORPORA / "real" / "sample_px4_events.ulg"
-    assert "vehicle_position" not in lint_file(recording).stats["kinds"]
-    assert "vehicle_position" in lint_one(recording, Settings()).stats["kinds"]
+def test_a_plain_lint_reads_the_position_once_a_second_and_the_report_every_one(
+    tmp_path: Path,
+) -> None:
+    # OFB404 needs the vehicle's height on the ground; a lint decodes one position a second
+    recording = _flight(tmp_path / "flight.tlog")  # 20 Hz for 5 s
+    assert lint_file(recording).stats["kinds"]["vehicle_position"] == 5
+    assert lint_one(recording, Settings()).stats["kinds"]["vehicle_position"] == 100
 
 
 def test_the_recordings_start_on_the_wall_clock() -> None:

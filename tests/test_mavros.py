@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -14,6 +15,7 @@ from fuzzoff.events import (
     SetPositionTargetLocal,
     VehicleStatus,
 )
+from fuzzoff.sources import open_source
 from fuzzoff.sources.mavros import (
     MavrosConverter,
     MavrosOptions,
@@ -31,10 +33,13 @@ from fuzzoff.sources.mavros_frames import (
 )
 from fuzzoff.sources.mavros_msgs import mavros_typedefs
 from fuzzoff.writers.rosbag1 import mavros_typestore
+from tests.helpers import CORPORA
 
 ROS1 = mavros_typestore()
 T = ROS1.types
 S = math.sqrt(0.5)
+ONE = (1.0, 0.0, 0.0, 0.0)
+"""The identity quaternion (w, x, y, z)."""
 
 
 def header(sec: int = 0, nsec: int = 0) -> Any:
@@ -223,6 +228,49 @@ def test_setpoint_position_local_sets_position_and_yaw_mask() -> None:
     assert e.yaw == pytest.approx(0.0, abs=1e-9)  # ENU yaw 90 deg = north = NED yaw 0
     assert e.velocity == (0.0, 0.0, 0.0) and e.coordinate_frame == 1
     assert e.sender_time_us == 1_000_000
+
+
+def test_local_position_pose_is_the_vehicle_position_in_ned_once_a_second() -> None:
+    # MAVROS publishes PX4's LOCAL_POSITION_NED in ENU; OFB404 reads it back in NED
+    converter = MavrosConverter()
+    first = converter.convert("/uav1/mavros/local_position/pose", pose((1.0, 2.0, -1.78), ONE), 3.0)
+    (e,) = first
+    assert (e.kind, e.vehicle, (e.x, e.y, e.z)) == ("vehicle_position", "/uav1", (2.0, 1.0, 1.78))
+    later = [
+        converter.convert("/uav1/mavros/local_position/pose", pose((0, 0, 0), ONE), t)
+        for t in (3.5, 4.0)
+    ]
+    assert [len(events) for events in later] == [0, 1]
+    every = MavrosConverter(position_period_s=0.0)  # the HTML report's plots
+    assert every.convert("/mavros/local_position/pose", pose((0, 0, 0), ONE), 3.5)
+
+
+def _local_setpoints(path: Path) -> list[Any]:
+    with open_source(path) as source:
+        source.probe()
+        return [e for e in source.events() if e.kind == "set_position_target_local_ned"]
+
+
+def test_an_unset_orientation_is_sent_as_mavros_sends_it() -> None:
+    # the PX4 docs' offb_node never sets the pose's orientation: all zero in ROS 1. MAVROS
+    # turns it into an Eigen transform, whose rotation is the identity: yaw pi/2 in NED, as the
+    # SET_POSITION_TARGET_LOCAL_NED PX4 received in the same example's run shows
+    bag = _local_setpoints(CORPORA / "examples" / "mavros_offb_node.bag")
+    received = _local_setpoints(CORPORA / "examples" / "runs" / "mavros_offb_node.tlog")
+    assert {round(e.yaw, 6) for e in bag} == {round(e.yaw, 6) for e in received} == {1.570796}
+    assert {e.position for e in bag} == {e.position for e in received}
+
+
+def test_a_pose_orientation_of_another_length_is_the_rotation_nearest_eigens_matrix() -> None:
+    # a yaw of 2.9 rad in ENU scaled to length 0.3: Eigen's matrix is 0.91 I + 0.09 R, whose
+    # rotation factor turns by atan2(0.09 sin 2.9, 0.91 + 0.09 cos 2.9) about the same axis
+    half = 2.9 / 2
+    scaled = (0.3 * math.cos(half), 0.0, 0.0, 0.3 * math.sin(half))
+    e = one("/mavros/setpoint_position/local", pose((0.0, 0.0, 2.0), scaled))
+    turned = math.atan2(0.09 * math.sin(2.9), 0.91 + 0.09 * math.cos(2.9))
+    assert e.yaw == pytest.approx(math.pi / 2 - turned, abs=1e-9)
+    unit = one("/mavros/setpoint_position/local", pose((0.0, 0.0, 2.0), (S, 0.0, 0.0, S)))
+    assert unit.yaw == pytest.approx(0.0, abs=1e-9)  # a unit quaternion is used as it is
 
 
 def test_setpoint_velocity_stamped_and_unstamped() -> None:

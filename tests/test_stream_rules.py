@@ -10,7 +10,10 @@ from fuzzoff.config import Settings
 from fuzzoff.engine import run_events
 from fuzzoff.events import (
     Command,
+    ControlMode,
     Dropout,
+    Event,
+    FailsafeFlags,
     SetPositionTargetLocal,
     TrajectorySetpoint,
     VehicleStatus,
@@ -306,6 +309,54 @@ def test_pxs_automatic_return_after_a_loss_is_not_a_request() -> None:
     found = lint_events(events)
     assert codes(found, "OFB102") == []
     assert [f.time_s for f in codes(found, "OFB101")] == [pytest.approx(6.0)]
+
+
+def test_pxs_return_to_offboard_as_it_disarms_after_a_landing_is_not_a_request() -> None:
+    # MAVROS-like: the stream stops as the vehicle lands in AUTO_LAND; after "Disarmed by
+    # landing" PX4 shows OFFBOARD again, disarmed (its user intention from before the landing,
+    # as 1.16.2 and 1.17.0 SITL did), with no stream running: nobody asked for it
+    land = 18
+    events = [status(0.0, POSCTL, armed=False), *ocm(every(0.0, 20.0, 0.05))]
+    events += [status(5.0, OFFBOARD, armed=False), status(10.0, OFFBOARD, armed=True)]
+    events += [status(20.01, land, armed=True), status(25.0, land, armed=True)]
+    events += [status(30.0, OFFBOARD, armed=False), status(31.0, OFFBOARD, armed=False)]
+    assert codes(lint_events(events, px4="1.16"), "OFB102") == []
+    # a user's switch while disarmed on the ground is still one
+    user = [status(0.0, POSCTL, armed=False), status(1.0, POSCTL, armed=False)]
+    user += [*ocm(every(1.5, 2.0, 0.05)), status(2.0, OFFBOARD, armed=False)]
+    (found,) = codes(lint_events(user, px4="1.16"), "OFB102")
+    assert found.time_s == 2.0 and "recorded mode" in found.message
+
+
+def test_a_heartbeat_sent_between_the_ack_and_the_switch_is_not_a_switch_back() -> None:
+    # PX4 1.16.2 SITL: the client sends its last setpoint, asks for AUTO_LAND, PX4 acks twice,
+    # and a HEARTBEAT 7 ms later still shows OFFBOARD (sent before Commander's new status);
+    # the next one, a second later, shows AUTO_LAND. The vehicle did not go back to OFFBOARD
+    land = 18
+    events: list[Event] = [status(0.0, OFFBOARD)]
+    events += [
+        SetPositionTargetLocal(t=t, target_system=1, type_mask=0x9F8, position=(0, 0, -2.5))
+        for t in every(0.0, 4.95, 0.1)
+    ]
+    to_land = Command(t=5.0, command=176, params=(1.0, 4.0, 6.0, 0.0, 0.0, 0.0, 0.0))
+    events += [to_land, ack(5.007, 0), ack(5.007, 0), status(5.014, OFFBOARD)]
+    events += [status(6.0, land), status(7.0, land)]
+    found = lint_events(events, px4="1.16", fmt="tlog")
+    assert codes(found, "OFB303") == [] and codes(found, "OFB101") == []
+
+
+def test_ofb102_follows_the_models_second_look_at_a_switch_the_logger_hid() -> None:
+    # MAVSDK's set-then-start on PX4 1.16.2 SITL, as its ULog holds it: the switch is logged
+    # 4 ms before PX4's flag turns available, and the logger missed the keep-alive PX4 had
+    lost = [FailsafeFlags(t=0.5, offboard_control_signal_lost=True)]
+    events: list[Event] = [status(0.0, 17, armed=True), *lost]
+    events += [switch(2.0), FailsafeFlags(t=2.004, offboard_control_signal_lost=False)]
+    events += [ack(2.004, 0), ack(2.008, 0), status(2.016, OFFBOARD)]
+    events += [ControlMode(t=2.1 + 0.1 * k, attitude=True, origin="vehicle") for k in range(20)]
+    found = lint_events(events, px4="1.16", fmt="ulog", sampled={"control_mode": 0.1})
+    (request,) = codes(found, "OFB102")
+    assert request.severity is Severity.INFO and "would: accept it" in request.message
+    assert codes(found, "OFB202") == [] and codes(found, "OFB103") == []
 
 
 def test_ofb104_not_when_the_keepalive_stopped_with_the_setpoints() -> None:

@@ -39,6 +39,7 @@ from fuzzoff.events import (
     TrajectorySetpoint,
     VehicleControlModeStatus,
     VehicleInfo,
+    VehiclePosition,
     VehicleStatus,
     event_to_dict,
 )
@@ -91,6 +92,8 @@ def flight(era: str) -> list[Event]:
         VehicleControlModeStatus(
             t=0.6, offboard_enabled=True, enabled=frozenset({"offboard", "position", "velocity"})
         ),
+        VehiclePosition(t=0.7, x=1.5, y=-2.0, z=0.25),
+        VehiclePosition(t=1.75, x=NAN, y=NAN, z=-1.5),  # xy_valid false: x and y mean nothing
     ]
     layout = "thrust_and_torque" if era in ("1.15", "1.17") else "actuator"
     if legacy:
@@ -476,6 +479,35 @@ def test_auto_mission_log_gives_no_stream_findings(tmp_path: Path) -> None:
         info = source.probe()
     assert "control_mode" not in info.kinds  # no offboard source: PX4 never published it
     assert info.sampled_intervals["trajectory"] == 0.2
+
+
+def _switch_without_stream() -> list[Event]:
+    """Armed in Position, a switch to OFFBOARD that PX4 rejects, no offboard_control_mode."""
+    return [
+        VehicleStatus(t=0.0, nav_state=2, armed=True, user_intention=2),
+        Command(t=2.0, command=176, params=(1.0, 6.0, 0.0, 0.0, 0.0, 0.0, 0.0)),
+        CommandAck(t=2.01, command=176, result=1),
+        VehicleStatus(t=4.0, nav_state=2, armed=True, user_intention=2),
+    ]
+
+
+def test_a_logger_subscribed_to_the_stream_shows_that_none_was_sent(tmp_path: Path) -> None:
+    # PX4's logger writes offboard_control_mode's format from the start: no data = no stream
+    path = write_ulog(tmp_path / "sent_nothing.ulg", _switch_without_stream())
+    result = run_cli(["lint", str(path), "--format", "json"])
+    codes = [f["code"] for f in json.loads(result.stdout)["files"][0]["findings"]]
+    assert "OFB102" in codes and "OFB201" in codes and "OFB002" not in codes
+
+
+def test_a_logger_not_logging_the_stream_cannot_judge_it(tmp_path: Path) -> None:
+    # a logger_topics.txt without offboard_control_mode: the stream rules are not checkable
+    path = write_ulog(tmp_path / "not_logged.ulg", _switch_without_stream(), subscribed=())
+    result = run_cli(["lint", str(path), "--format", "json"])
+    findings = json.loads(result.stdout)["files"][0]["findings"]
+    codes = [f["code"] for f in findings]
+    assert "OFB102" not in codes and "OFB201" in codes
+    (note,) = [f for f in findings if f["code"] == "OFB002"]
+    assert "did not log offboard_control_mode" in note["message"]
 
 
 def test_a_damaged_record_is_skipped_and_reported_with_the_last_good_time(tmp_path: Path) -> None:

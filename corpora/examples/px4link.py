@@ -8,7 +8,8 @@ extrapolated at the measured speed. A 10 Hz client is then 10 Hz in the ULog, as
 real vehicle whose clock runs at the same rate as the companion's.
 
 The tlog holds what the driver sent and the vehicle messages it listened to (HEARTBEAT,
-COMMAND_ACK, STATUSTEXT, EXTENDED_SYS_STATE, SYS_STATUS), each record stamped with PX4's clock
+COMMAND_ACK, STATUSTEXT, EXTENDED_SYS_STATE, SYS_STATUS, and LOCAL_POSITION_NED at the rate the
+run keeps the ULog's ``vehicle_local_position``), each record stamped with PX4's clock
 (``EPOCH_US`` + PX4 boot time in microseconds) so that it lines up with the ULog.
 """
 
@@ -125,7 +126,13 @@ class Link:
     """The MAVLink API link of one PX4 instance (PX4 sends to 14540+N, listens on 14580+N)."""
 
     def __init__(
-        self, instance: int, tlog: Path, system: int, component: int, status_from_acks: bool
+        self,
+        instance: int,
+        tlog: Path,
+        system: int,
+        component: int,
+        status_from_acks: bool,
+        position_hz: float = 0.0,
     ) -> None:
         self.target_system = instance + 1
         self.target_component = 1
@@ -148,6 +155,10 @@ class Link:
         """command -> (custom_mode before, custom_mode it asks for)."""
         self.requested_arm: bool | None = None
         self.pending: list[tuple[int, str, int | bool]] = []
+        self.position_period_us = round(1e6 / position_hz) if position_hz else 0
+        """LOCAL_POSITION_NED kept in the tlog at most this often (0: none), as the ULog's
+        ``vehicle_local_position`` is cut (``runs.cut_ulog``), to keep files under 1 MB."""
+        self.position_due = 0
 
     # -- receiving
     def pump(self, timeout: float = 0.0) -> None:
@@ -173,6 +184,11 @@ class Link:
             return
         if kind == "LOCAL_POSITION_NED":
             self.view.x, self.view.y, self.view.z, self.view.vz = msg.x, msg.y, msg.z, msg.vz
+            if self.position_period_us and self.clock.ready:
+                now = self.clock.now_us()
+                if now >= self.position_due:
+                    self._record(now, msg.get_msgbuf())
+                    self.position_due = now + self.position_period_us - 2000
             return
         if kind not in LISTENED or not self.clock.ready:
             return

@@ -38,7 +38,7 @@ from pyulog import ULog
 
 HERE = Path(__file__).resolve().parent
 RUNS = HERE / "runs"
-WORK = Path("/tmp/fuzzoff-examples")
+WORK = Path(os.environ.get("FUZZOFF_EXAMPLES_WORK", "/tmp/fuzzoff-examples"))
 
 ULOG_TOPICS = (
     "vehicle_status",
@@ -448,7 +448,14 @@ def run_scenario(scenario: Scenario, instance: int) -> None:
     marks: dict[str, int] = {}
     gcs_done: list[tuple[int, str]] = []
     with px4(scenario.release, instance, workdir, env) as run:
-        link = Link(instance, tlog, MAVROS_SYSTEM, MAVROS_COMPONENT, scenario.transport == "ros2")
+        link = Link(
+            instance,
+            tlog,
+            MAVROS_SYSTEM,
+            MAVROS_COMPONENT,
+            scenario.transport == "ros2",
+            scenario.local_position_hz,
+        )
         try:
             link.wait_for("a clock", lambda: link.clock.ready, 60)
             link.wait_for("pre-arm checks", lambda: link.view.prearm_ok, 120)

@@ -451,15 +451,24 @@ def main() -> None:
 SWITCH_SEEN_IN_BAG = 4.0
 """A MAVROS bag records no commands: the request shows as the ``state`` change at 4.0 s."""
 
+INTERLEAVED: list[Planted] = [("OFB304", "info", EXTRA_FROM)]
+"""A second setpoint type between the main ones: PX4's receiver sets offboard_control_mode from
+each message's type mask, so the first true field alternates; one OFB304 for the stretch."""
+
 OTHER_RULES: dict[str, list[Planted]] = {
     # The arm request in OFFBOARD is refused, and the gate model gives the reason: with
     # MAV_FWDEXTSP = 0 the setpoints are no keep-alive (gate spec 4.2, 6.1).
     "ofb509_rover_not_forwarded": [("OFB201", "error", ARM + 0.01)],
+    "good_copter_body_velocity": INTERLEAVED,
+    "ofb507_rover_heading_by_attitude": INTERLEAVED,
 }
 """Findings of other rules a tlog case also shows, each judged by hand against the rule text.
 Every flight also gets OFB701 at the request (the gate model's loss-action summary, info)."""
 
-BAG_OTHER_RULES: dict[str, list[Planted]] = {}
+BAG_OTHER_RULES: dict[str, list[Planted]] = {
+    "good_copter_body_velocity": INTERLEAVED,
+    "ofb507_rover_heading_by_attitude": INTERLEAVED,
+}
 """The same for the MAVROS bags."""
 
 

@@ -14,9 +14,11 @@ connection skips that step) or sent (through pymavlink's send callback):
 
 Both clients connect to PX4's listening port from a port of their own (PX4 answers to the
 address it last heard from), so nothing binds the fixed ports other PX4 instances send to.
-PX4's ULog is kept beside them. ``trim`` then cuts the onboard log to the message types named in
-``KEPT`` (the telemetry PX4 streams at 50-100 Hz on that link would take megabytes) through
-pymavlink's reader, writing each kept message's own packet bytes back unchanged.
+``trim`` then cuts the onboard log to the message types named in ``KEPT`` (the telemetry PX4
+streams at 50-100 Hz on that link would take megabytes) through pymavlink's reader, writing each
+kept message's own packet bytes back unchanged. PX4's own ULog of the flight becomes
+``NAME.ulg`` (``cut_ulog``: pyulog keeps the topics fuzzoff's lint reads, with
+``vehicle_local_position`` at 10 Hz, and writes them back), so one flight has three recordings.
 
 Scenarios:
 
@@ -257,6 +259,25 @@ def trim(full: Path, target: Path) -> tuple[int, int]:
     return kept, dropped
 
 
+def cut_ulog(source: Path, target: Path) -> None:
+    """PX4's ULog cut to the topics fuzzoff's lint reads (header, info, parameters, formats and
+    logged messages kept), ``vehicle_local_position`` thinned from ~125 Hz to 10 Hz."""
+    from pyulog import ULog
+
+    from fuzzoff.sources.ulog import LOADED_TOPICS
+
+    log = ULog(str(source), message_name_filter_list=list(LOADED_TOPICS))
+    for data in log.data_list:
+        if data.name == "vehicle_local_position":
+            stamps = data.data["timestamp"]
+            keep = [0]
+            for i in range(1, len(stamps)):
+                if stamps[i] - stamps[keep[-1]] >= 98_000:
+                    keep.append(i)
+            data.data = {name: values[keep] for name, values in data.data.items()}
+    log.write_ulog(str(target))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("scenario", choices=("clean", "loss"))
@@ -287,6 +308,8 @@ def main() -> None:
     gcs_target = args.out / f"{name}.gcs.tlog"
     gcs_target.write_bytes(gcs.read_bytes())
     ulogs = sorted((work / "px4" / "log").rglob("*.ulg"))
+    if ulogs:
+        cut_ulog(ulogs[-1], args.out / f"{name}.ulg")
     print(f"PX4 {release}: {work}; onboard kept {kept}, dropped {dropped}; ulogs {ulogs}")
 
 

@@ -1,9 +1,12 @@
 """What the ROS 2 / uORB content rules share: whose setpoint it is, the mode note, episodes.
 
 A ULog logs PX4's own setpoints next to the external controller's, so a logged (origin
-``vehicle``) setpoint counts as external only in offboard and only when the declared first
-true field selects its topic (fuzzoff/tables/control_mode.py). Messages recorded on their way
-to the vehicle (origin ``sent``: ROS 2 ``/fmu/in``, MAVLink) are always external.
+``vehicle``) setpoint counts as external only in offboard as the recorded status says it (not
+at an accepted ack: PX4 1.16 and 1.17 ack a switch from the MAVLink receiver before Commander
+makes it, and PX4's flight task still writes ``trajectory_setpoint`` until the status changes)
+and only when the declared first true field selects its topic
+(fuzzoff/tables/control_mode.py). Messages recorded on their way to the vehicle (origin
+``sent``: ROS 2 ``/fmu/in``, MAVLink) are always external.
 """
 
 from __future__ import annotations
@@ -13,7 +16,7 @@ from operator import attrgetter
 
 from fuzzoff.checks._runs import first_of_each
 from fuzzoff.checks.base import CheckContext
-from fuzzoff.events import Event, Where
+from fuzzoff.events import NAV_STATE_OFFBOARD, Event, Where
 from fuzzoff.findings import Severity
 
 
@@ -26,9 +29,12 @@ def from_external(ctx: CheckContext, event: Event) -> bool:
     """Was this setpoint written by the external controller (see the module docstring)?"""
     if event.origin == "sent":
         return True
-    if event.origin != "vehicle" or not ctx.state.in_offboard:
+    state = ctx.state
+    if event.origin != "vehicle" or not state.in_offboard:
         return False
-    row = ctx.row_for(ctx.state.declared_flag)
+    if state.mode_recorded and state.status_nav_state != NAV_STATE_OFFBOARD:
+        return False  # accepted, but PX4 has not switched yet: its own flight task writes
+    row = ctx.row_for(state.declared_flag)
     return row is not None and event.kind in row.allowed
 
 

@@ -121,10 +121,15 @@ class RecordedSwitches:
     """Tells a user's switch to OFFBOARD from PX4's automatic return, on the recorded mode alone.
 
     Where no commands are recorded (MAVROS bags: services are not recorded) the recorded entry
-    into OFFBOARD is the request. But after a loss failsafe PX4 returns to OFFBOARD by itself
-    when the stream resumes (gate spec 5.1, D9): an entry that follows an exit made while the
-    keep-alive was older than the loss timeout (less the 10 Hz evaluation slack) is that
-    return, not a request.
+    into OFFBOARD is the request. But PX4 enters OFFBOARD by itself twice:
+
+    * after a loss failsafe it returns when the stream resumes (gate spec 5.1, D9): an entry
+      that follows an exit made while the keep-alive was older than the loss timeout (less the
+      10 Hz evaluation slack) is that return;
+    * when it disarms after a landing (an auto land, a Return), its mode goes back to the
+      user's intention from before, OFFBOARD (SITL 1.16.2 and 1.17.0: AUTO_LAND armed, then
+      OFFBOARD disarmed): an entry shown disarmed right after a status that showed the vehicle
+      armed is that, with or without a stream. A user's switch cannot disarm the vehicle.
     """
 
     SLACK_S = 0.15
@@ -132,6 +137,7 @@ class RecordedSwitches:
     def __init__(self, ctx: CheckContext) -> None:
         self.ctx = ctx
         self.was_offboard: bool | None = None
+        self.was_armed: bool | None = None
         self.left_by_failsafe = False
 
     def entered_by_request(self, event: VehicleStatus, last_keepalive: float | None) -> bool:
@@ -140,6 +146,10 @@ class RecordedSwitches:
             return False
         was, now = self.was_offboard, event.in_offboard
         self.was_offboard = now
+        was_armed, self.was_armed = self.was_armed, event.armed
+        if was is False and now and was_armed and event.armed is False:
+            self.left_by_failsafe = False
+            return False  # disarmed after a landing: PX4 went back to the user's intention
         if was and not now:
             age = None if last_keepalive is None else event.t - last_keepalive
             self.left_by_failsafe = age is None or age >= loss_timeout(self.ctx) - self.SLACK_S

@@ -6,6 +6,7 @@ Seed 000 "The OffboardControlMode PX4 message" (1.15+; rover table in "Рове�
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from itertools import chain
 from operator import attrgetter
 
@@ -21,12 +22,13 @@ from fuzzoff.events import (
     Event,
     FailsafeFlags,
     MavlinkTarget,
+    Parameter,
     SetAttitudeTarget,
     VehicleStatus,
     Where,
 )
-from fuzzoff.gate import GateTransition
-from fuzzoff.gate.receiver import DROPPED, ReceiverContext, receive
+from fuzzoff.gate import GateTransition, ocm
+from fuzzoff.gate.receiver import DROPPED, SHAPES, ReceiverContext, Shape, receive
 from fuzzoff.state import VehicleState
 from fuzzoff.tables.control_mode import (
     SETPOINT_NAMES,
@@ -335,52 +337,182 @@ class DeclaredSetpointMissing(Check):
         self._mav_due(t_end + 1e-9)
 
 
+@dataclass(slots=True)
+class _Stretch:
+    """Changes of the first true field close together: one finding."""
+
+    start: float
+    where: Where
+    first: str
+    flags: list[str]
+    last: float
+    changes: int = 1
+
+
 class ControlModeChanged(Check):
-    """OFB304: the first true field changes while in offboard (info)."""
+    """OFB304: the first true field PX4 receives changes while in offboard (info).
+
+    On ROS 2 (and in a ULog) that is ``OffboardControlMode`` as recorded; over MAVLink there is
+    none, and PX4's receiver sets the flags from each setpoint's type mask (gate spec 6), so
+    the same flight judged from its tlog and from its ULog (which logs the receiver's
+    ``offboard_control_mode``) tells the same changes. Changes less than ``stretch_s`` apart are
+    one finding: a stream that interleaves setpoint types switches the flags with every
+    message, which the logger's 10 Hz samples of it show as an irregular alternation."""
 
     codes = ("OFB304",)
-    wants = (ControlMode, VehicleStatus, GateTransition)
+    wants = (
+        ControlMode,
+        *MAVLINK_SETPOINTS,
+        VehicleStatus,
+        GateTransition,
+        FailsafeFlags,
+        Parameter,
+    )
 
     def __init__(self, ctx: CheckContext) -> None:
         super().__init__(ctx)
         self.flag: str | None = None
+        self.stretch_s = float(ctx.option("OFB304", "stretch_s"))
+        self.open: _Stretch | None = None
+        self.memo: dict[Shape, str | None] = {}
+        """The first flag PX4's receiver sets for a MAVLink setpoint, by the message's shape
+        (``receiver.shape``): emptied when a parameter or an estimate may change the answer."""
 
     def on_event(self, event: Event) -> None:
+        if isinstance(event, FailsafeFlags | Parameter):
+            self.memo.clear()
+            return
         if not self.ctx.state.in_offboard:
             self.flag = None
+            self._close()
             return
-        if not isinstance(event, ControlMode):
+        if isinstance(event, ControlMode):
+            flag = event.first_flag()
+        elif isinstance(event, MavlinkTarget):
+            flag = self._mavlink_flag(event)
+        else:
             return
-        flag = event.first_flag()
         if flag is None:
-            return  # OFB301's case
+            return  # OFB301's case, or a setpoint PX4 drops (OFB6xx)
         if self.flag is not None and flag != self.flag:
-            self.ctx.report(
-                "OFB304",
-                f"OffboardControlMode's first true field changed from '{self.flag}' to "
-                f"'{flag}' in offboard: PX4 switches its controller chain mid-flight"
-                f"{mode_note(self.ctx)}",
-                event.t,
-                event.where,
-                short=f"declaration changed from '{self.flag}' to '{flag}' in offboard",
-            )
+            self._changed(event, flag)
         self.flag = flag
 
     def on_batch(self, batch: StreamBatch) -> None:
-        """Every OCM of a run has the run's declared first flag (a change of it ends a run), so
-        only the first can report a change; the rest leave ``flag`` as it is."""
-        if ControlMode not in batch.classes():
+        """An OCM run carries the run's declared first flag (a change of it ends a run), so
+        only its first message can change it; a MAVLink run is judged by the flag each message
+        implies, replayed only where one differs."""
+        classes = batch.classes()
+        mavlink = batch.of(MAVLINK_SETPOINTS) if classes & _MAVLINK else []
+        if ControlMode not in classes and not mavlink:
             return
         if not batch.state.in_offboard:
             self.flag = None
+            self._close()
             return
-        flag = batch.state.declared_flag
-        if flag is None:
+        if ControlMode in classes:
+            if mavlink:
+                self.replay(batch)
+                return
+            flag = batch.state.declared_flag
+            if flag is None:
+                return
+            if self.flag is not None and flag != self.flag:
+                self.replay(batch)
+                return
+            self.flag = flag
             return
-        if self.flag is not None and flag != self.flag:
+        flags = self._run_flags(mavlink, classes)
+        flags.discard(None)
+        if not flags:
+            return
+        if len(flags) > 1 or (self.flag is not None and self.flag not in flags):
             self.replay(batch)
             return
-        self.flag = flag
+        (self.flag,) = flags
+
+    def _run_flags(self, mavlink: list[Event], classes: frozenset[type[Event]]) -> set[str | None]:
+        """The first flags a run's MAVLink setpoints imply: by their distinct shapes where the
+        run has one setpoint class (a MAVLink stream: one shape, one lookup), else one by one."""
+        if len(classes) == 1:
+            (cls,) = classes
+            shapes = set(map(SHAPES[cls], mavlink))
+            if None not in shapes and all(key in self.memo for key in shapes):
+                return {self.memo[key] for key in shapes}  # type: ignore[index]
+        return set(map(self._mavlink_flag, mavlink))
+
+    def _mavlink_flag(self, event: Event) -> str | None:
+        assert isinstance(event, MavlinkTarget)
+        key = SHAPES[type(event)](event)
+        if key is not None:
+            try:
+                return self.memo[key]
+            except KeyError:
+                pass
+        mask, _, _, _ = receive(event, self.ctx.gate.receiver)
+        flag = None if mask == DROPPED else ocm.FLAG_NAMES.get(ocm.first_flag(mask))
+        if key is not None:
+            self.memo[key] = flag
+        return flag
+
+    def _changed(self, event: Event, flag: str) -> None:
+        assert self.flag is not None
+        stretch = self.open
+        if stretch is not None and event.t - stretch.last <= self.stretch_s:
+            stretch.last = event.t
+            stretch.changes += 1
+            if flag not in stretch.flags:
+                stretch.flags.append(flag)
+            return
+        self._close()
+        self.open = _Stretch(event.t, event.where, self.flag, [self.flag, flag], event.t)
+
+    def _close(self) -> None:
+        stretch, self.open = self.open, None
+        if stretch is None:
+            return
+        mavlink = self.ctx.has(*_MAVLINK_KINDS) and not self.ctx.has(ControlMode.kind)
+        field = (
+            "the first true field PX4's receiver sets from the setpoints' type masks"
+            if mavlink
+            else "OffboardControlMode's first true field"
+        )
+        what = "implied flags" if mavlink else "declaration"
+        if stretch.changes == 1:
+            first, then = stretch.flags
+            message = (
+                f"{field} changed from '{first}' to '{then}' in offboard: PX4 switches its "
+                "controller chain mid-flight"
+            )
+            end = None
+        else:
+            among = ", ".join(f"'{f}'" for f in stretch.flags)
+            message = (
+                f"{field} changed {stretch.changes} times in offboard, between {among}, until "
+                f"{stretch.last:.3f} s (each change less than {self.stretch_s:g} s after the "
+                "one before: setpoint types interleaved): PX4 switches its controller chain "
+                "at every change"
+            )
+            end = stretch.last
+        if stretch.changes == 1:
+            short = f"{what} changed from '{stretch.flags[0]}' to '{stretch.flags[1]}' in offboard"
+        else:
+            short = f"{what} changed {stretch.changes} times in offboard (interleaved types)"
+        self.ctx.report(
+            "OFB304",
+            message + mode_note(self.ctx),
+            stretch.start,
+            stretch.where,
+            end=end,
+            short=short,
+        )
+
+    def finish(self, t_end: float) -> None:
+        self._close()
+
+
+_MAVLINK = frozenset(MAVLINK_SETPOINTS)
+_MAVLINK_KINDS = tuple(cls.kind for cls in MAVLINK_SETPOINTS)
 
 
 class RequiredEstimateMissing(Check):
@@ -452,7 +584,8 @@ class RequiredEstimateMissing(Check):
         if self.saw_mode and not self.ctx.has("failsafe_flags"):
             self.ctx.cannot_check(
                 "OFB305",
-                "needs the estimator validity flags (ULog failsafe_flags or vehicle_status_flags)",
+                "needs the estimator validity flags (failsafe_flags in a ULog or on /fmu/out, "
+                "vehicle_status_flags before 1.14)",
             )
 
 

@@ -4,10 +4,17 @@ Three signs of a frame mix-up that a real flight almost never shows, each an err
 vehicle would fly into the ground (or push into it instead of climbing):
 
 * from the ground, the first sizeable vertical command points down: a position more than ``z_m``
-  below the start point (``z`` > 0 in NED) or a vertical velocity above ``vz_mps`` (``vz`` > 0 is
-  descending): a climb written in ENU;
-* in the air, a position target more than ``z_m`` below the local origin: a height written in
-  ENU (a descent by velocity is an ordinary command there, so only positions are judged);
+  below the vehicle (``z`` larger than the vehicle's local z, NED) or a vertical velocity above
+  ``vz_mps`` (``vz`` > 0 is descending): a climb written in ENU;
+* in the air, a position target more than ``z_m`` below the ground the vehicle took off from: a
+  height written in ENU (a descent by velocity is an ordinary command there, so only positions
+  are judged).
+
+The vehicle's height is its estimate's local z where the recording has it (``VehiclePosition``:
+ULog and ROS 2 ``vehicle_local_position``, MAVLink LOCAL_POSITION_NED, MAVROS
+``local_position/pose``): an estimator's z drifts on the ground (PX4 1.15's SIH to +1.8 m), and a
+client that sends its current position before the takeoff sends that z. Where the recording
+has no position, the local origin (z = 0) stands for both;
 * a multicopter attitude or rates setpoint whose ``thrust_body`` z is above ``thrust_z`` (FRD
   thrust points up as negative z): thrust written in FLU.
 
@@ -37,6 +44,7 @@ from fuzzoff.events import (
     RatesSetpoint,
     SetPositionTargetLocal,
     TrajectorySetpoint,
+    VehiclePosition,
     VehicleStatus,
 )
 from fuzzoff.gate import GateTransition
@@ -106,6 +114,7 @@ class FrameConventionSuspect(Check):
         AttitudeSetpoint,
         RatesSetpoint,
         VehicleStatus,
+        VehiclePosition,
         Command,
         GateTransition,
     )
@@ -129,6 +138,10 @@ class FrameConventionSuspect(Check):
         """The last recorded arming state (None: not recorded yet)."""
         self.status_offboard = False
         """The last recorded status says OFFBOARD (a ULog's logged setpoints count only then)."""
+        self.vehicle_z: float | None = None
+        """The vehicle's newest valid local z (NED), where the recording has its position."""
+        self.ground_z: float | None = None
+        """Its local z when last on the ground: where a target in the air is below ground."""
         self.thrust_types = (AttitudeSetpoint, RatesSetpoint)
         self.vertical_types = (TrajectorySetpoint, SetPositionTargetLocal)
 
@@ -143,7 +156,7 @@ class FrameConventionSuspect(Check):
                 self.replay(batch)
                 return
             if self.where == "air" and not self.flagged:
-                if self._any_below(vertical):
+                if self._any_below(vertical, self._ground() + self.z_m):
                     self.replay(batch)
                     return
                 if self.below.open:
@@ -161,13 +174,17 @@ class FrameConventionSuspect(Check):
             for kind in dict.fromkeys(event.kind for event in thrust):
                 self.thrust.good(kind)
 
-    def _any_below(self, events: list[Event]) -> bool:
-        """Could any of ``events`` be a position target below the origin (NaN never is)? The
+    def _any_below(self, events: list[Event], limit: float) -> bool:
+        """Could any of ``events`` be a position target below ``limit`` (NaN never is)? The
         raw z of every message first (a MAVLink mask or frame only takes positions away)."""
         raw = map(_POSITION_Z, map(_POSITION, events))
-        if not any(map(gt, raw, repeat(self.z_m))):
+        if not any(map(gt, raw, repeat(limit))):
             return False
-        return any(map(gt, map(_position_z, events), repeat(self.z_m)))
+        return any(map(gt, map(_position_z, events), repeat(limit)))
+
+    def _ground(self) -> float:
+        """The ground's local z: where the vehicle last was on the ground, else the origin."""
+        return 0.0 if self.ground_z is None else self.ground_z
 
     def _mine(self, events: list[Event]) -> list[Event]:
         """The external controller's messages among a run's: as sent, or logged while the
@@ -185,6 +202,12 @@ class FrameConventionSuspect(Check):
     def on_event(self, event: Event) -> None:
         if isinstance(event, VehicleStatus):
             self._status(event)
+            return
+        if isinstance(event, VehiclePosition):
+            if math.isfinite(event.z):
+                self.vehicle_z = event.z
+                if self.where == "ground":
+                    self.ground_z = event.z
             return
         if isinstance(event, Command):
             if event.command in (MAV_CMD_NAV_TAKEOFF, MAV_CMD_NAV_VTOL_TAKEOFF):
@@ -220,6 +243,10 @@ class FrameConventionSuspect(Check):
 
     def _on_ground(self) -> None:
         self.below.close_all()
+        if self.where == "ground":
+            # It never left the ground (the first status confirms where a recording starts, or
+            # PX4 disarmed a vehicle pushing into the ground): the same stretch, judged once.
+            return
         self.where, self.decided, self.flagged = "ground", False, False
 
     def _took_off(self) -> None:
@@ -227,41 +254,58 @@ class FrameConventionSuspect(Check):
 
     def _from_ground(self, event: Event) -> None:
         z, vz = vertical_command(event)
-        down = (math.isfinite(z) and z > self.z_m) or (math.isfinite(vz) and vz > self.vz_mps)
-        up = (math.isfinite(z) and z < -self.z_m) or (math.isfinite(vz) and vz < -self.vz_mps)
+        here = 0.0 if self.vehicle_z is None else self.vehicle_z
+        below = math.isfinite(z) and z > here + self.z_m
+        down = below or (math.isfinite(vz) and vz > self.vz_mps)
+        up = (math.isfinite(z) and z < here - self.z_m) or (math.isfinite(vz) and vz < -self.vz_mps)
         if not (down or up):
-            return  # small commands (a zero setpoint before the switch) decide nothing
+            return  # small commands (the vehicle's own position before the switch) decide nothing
         self.decided = True
         if not down:
             self.where = "air"  # it climbs: what follows is judged as in the air
             return
         self.flagged = True
-        what = f"z = {z:g} m" if math.isfinite(z) and z > self.z_m else f"vz = {vz:g} m/s"
+        if not below:
+            what = short = f"vz = {vz:g} m/s, downwards in NED"
+        elif self.vehicle_z is None:
+            what = f"z = {z:g} m, below the local origin (the recording has no vehicle position)"
+            short = f"z = {z:g} m, below the origin"
+        else:
+            what = f"z = {z:g} m, {z - here:.2f} m below the vehicle (its local z = {here:g} m)"
+            short = f"z = {z:g} m, {z - here:.2f} m below the vehicle"
         self.ctx.report(
             "OFB404",
-            f"the first vertical command since the vehicle was on the ground is {what}, "
-            "downwards in NED: looks like a climb written in ENU (up positive); PX4 expects "
-            "NED and keeps the vehicle on the ground, pushing into it "
+            f"the first vertical command since the vehicle was on the ground is {what}: looks "
+            "like a climb written in ENU (up positive); PX4 expects NED and keeps the vehicle "
+            "on the ground, pushing into it "
             f"(thresholds z_m = {self.z_m:g}, vz_mps = {self.vz_mps:g})",
             event.t,
             event.where,
-            short=f"first climb from the ground is {what}, down in NED: ENU?",
+            short=f"first vertical command from the ground is {short}: a climb in ENU?",
         )
 
     def _in_the_air(self, event: Event) -> None:
         z = vertical_command(event)[0]
-        if not (math.isfinite(z) and z > self.z_m):
+        ground = self._ground()
+        if not (math.isfinite(z) and z > ground + self.z_m):
             self.below.good(event.kind)
             return
+        if self.ground_z is None:
+            where = short = "below the local origin"
+        else:
+            where = (
+                f"{z - ground:.2f} m below the ground the vehicle took off from (z = {ground:g} m)"
+            )
+            short = f"{z - ground:.2f} m below the ground it took off from"
         self.below.bad(
             event.kind,
             event.t,
             event.where,
-            f"position target z = {z:g} m, below the local origin, after a takeoff (or in a "
-            "mode that takes off) since the vehicle was last on the ground: looks like a "
-            "height written in ENU (up positive); PX4 expects NED and flies the vehicle down "
-            f"towards it, into the ground (threshold z_m = {self.z_m:g})",
-            short=f"position target z = {z:g} m in the air, below the origin in NED: ENU?",
+            f"position target z = {z:g} m, {where}, after a takeoff (or in a mode that takes "
+            "off) since the vehicle was last on the ground: looks like a height written in ENU "
+            "(up positive); PX4 expects NED and flies the vehicle down towards it, into the "
+            f"ground (threshold z_m = {self.z_m:g})",
+            short=f"position target z = {z:g} m in the air, {short}: ENU?",
         )
 
     def _thrust(self, event: AttitudeSetpoint | RatesSetpoint) -> None:

@@ -34,6 +34,7 @@ from fuzzoff.events import (
 )
 from fuzzoff.findings import Severity
 from fuzzoff.gate import GateTransition
+from fuzzoff.gate.model import SAME_ITERATION_S
 from fuzzoff.state import DOUBLE_ACK_WINDOW_S
 
 NEAR_LOSS_FRACTION = 0.8
@@ -271,8 +272,15 @@ class StreamBeforeRequest(Check):
         self.last: float | None = None
         self.gate_verdict: dict[int, GateTransition] = {}
         self.switches = RecordedSwitches(ctx)
+        self.held: tuple[Event, str, GateTransition, float | None, float | None] | None = None
+        """A request the gate model rejected, held for one Commander iteration: PX4's flag may
+        show, in the same iteration, the keep-alive a ULog's logger missed, and the model then
+        judges the request again (its new verdict names the same command)."""
 
     def on_event(self, event: Event) -> None:
+        held = self.held
+        if held is not None:
+            self._settle(event)
         if event is self.ctx.state.keepalive:  # first: nearly every message is one
             last = self.last
             if last is None:
@@ -306,6 +314,9 @@ class StreamBeforeRequest(Check):
     def on_batch(self, batch: StreamBatch) -> None:
         """Fast path: no gap in the run (nor from ``last`` to it) can break the unbroken stream,
         as ``on_event`` tests it: only ``last`` moves (and ``run_start`` at the very first)."""
+        if self.held is not None:
+            self.replay(batch)  # any message may end the held request's iteration
+            return
         if not batch.keepalives():
             return
         run = keepalive_run(batch)
@@ -316,19 +327,48 @@ class StreamBeforeRequest(Check):
             self.run_start = run.times[0]
         self.last = run.times[-1]
 
+    def _settle(self, event: Event) -> None:
+        """Report the held request once its iteration is over, or with the verdict the model
+        gave it again (a later verdict naming the same command)."""
+        assert self.held is not None
+        request, what, verdict, last, run_start = self.held
+        again = event if isinstance(event, GateTransition) else None
+        if again is not None and again.cause is request and again.what.endswith("accepted"):
+            self.held = None
+            self._report(request, what, again, last, run_start)
+        elif event.t - request.t > SAME_ITERATION_S:
+            self.held = None
+            self._report(request, what, verdict, last, run_start)
+
     def _judge(self, event: Event, what: str) -> None:
-        t = event.t
-        fresh = self.last is not None and t - self.last < self.max_gap
-        if fresh and self.run_start is not None and t - self.run_start >= self.min_stream:
+        verdict = self.gate_verdict.get(id(event))
+        if verdict is not None and verdict.what.endswith("rejected"):
+            if self.held is not None:
+                self._report(*self.held)
+            self.held = (event, what, verdict, self.last, self.run_start)
             return
-        if self.last is None:
+        self._report(event, what, verdict, self.last, self.run_start)
+
+    def _report(
+        self,
+        event: Event,
+        what: str,
+        verdict: GateTransition | None,
+        last: float | None,
+        run_start: float | None,
+    ) -> None:
+        """The finding for a request, with the keep-alive as it stood at the request."""
+        t = event.t
+        fresh = last is not None and t - last < self.max_gap
+        if fresh and run_start is not None and t - run_start >= self.min_stream:
+            return
+        if last is None:
             had = "no keep-alive at all before it"
         elif not fresh:
-            had = f"the last keep-alive {t - self.last:.2f} s before it"
+            had = f"the last keep-alive {t - last:.2f} s before it"
         else:
-            assert self.run_start is not None
-            had = f"only {t - self.run_start:.2f} s of unbroken keep-alive before it"
-        verdict = self.gate_verdict.get(id(event))
+            assert run_start is not None
+            had = f"only {t - run_start:.2f} s of unbroken keep-alive before it"
         severity = Severity.INFO  # the docs' second: no PX4 release enforces it (D1)
         if verdict is None:
             would = (
@@ -356,16 +396,21 @@ class StreamBeforeRequest(Check):
             f"{what} with {had}; docs: stream for at least {self.min_stream:.0f} s first; "
             f"{px4_label(self.ctx)} would: {would}"
         )
-        if self.last is None:
+        if last is None:
             stream = "with no keep-alive"
         elif not fresh:
-            stream = f"{t - self.last:.2f} s after the last keep-alive"
+            stream = f"{t - last:.2f} s after the last keep-alive"
         else:
-            stream = f"after {t - (self.run_start or t):.2f} s of keep-alive"
+            stream = f"after {t - (run_start or t):.2f} s of keep-alive"
         short = f"{what} {stream} (docs: {self.min_stream:g} s of it)"
         if brief:
             short += f"; {px4_label(self.ctx)} {brief}"
         self.ctx.report("OFB102", message, t, event.where, severity=severity, short=short)
+
+    def finish(self, t_end: float) -> None:
+        if self.held is not None:
+            self._report(*self.held)
+            self.held = None
 
 
 @cache

@@ -162,6 +162,10 @@ def hazards(transitions: Sequence[GateTransition], t_end: float) -> list[Hazard]
             )
             if armed_at is None:
                 continue
+            # ...and only while it stays armed: a disarm ends what the controller flies
+            end = next(
+                (x.t for x in transitions if armed_at < x.t < end and x.armed is False), end
+            )
             hold = WAIT_S if tr.reason.startswith(NO_SETPOINT_YET) else HOLD_S
             if end - armed_at < hold:
                 continue

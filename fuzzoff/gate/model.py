@@ -126,8 +126,13 @@ class GateModel:
         self.params = default_params(self.px4) | self.overrides
         self.est = Estimates()
         self.stream_recorded = stream_recorded
-        """False: the recording cannot show the keep-alive (a ground station's tlog). The
-        signal is then taken as present, and lost only where PX4's own failsafe is recorded."""
+        """False: the recording cannot show the keep-alive (a ground station's tlog, a ULog
+        without ``offboard_control_mode``). The signal is then PX4's own recorded verdict
+        (``failsafe_flags.offboard_control_signal_lost``) where the recording has it; else it
+        is taken as present, and lost only where PX4's own failsafe is recorded."""
+        self.follows_flag = False
+        """Without the stream: PX4's ``offboard_control_signal_lost`` has been seen, and the
+        signal follows it from then on (the mode history no longer decides it)."""
         self.signal = make_signal(self.px4, self.params)
         if not stream_recorded:
             self.signal = UnseenSignal(self.signal.timeout)
@@ -685,6 +690,7 @@ class GateModel:
             "2.1.3",
             cause=None,
         )
+        self._cause = cmd  # the new verdict answers the command (OFB102 pairs them)
         if cmd.is_mode_switch:
             self._apply_switch(t, target, decision)
         else:
@@ -713,8 +719,36 @@ class GateModel:
         self._dirty = False
         self.landed.land_detected(event)
 
+    def _follow_flag(self, event: FailsafeFlags) -> None:
+        """Without the stream, PX4's own verdict is the signal: the flag is what Commander's
+        check pass decided, and the failsafe follows it in the same iteration."""
+        lost = event.offboard_control_signal_lost
+        if lost is None:
+            return
+        self.follows_flag = True
+        t = event.t
+        if lost and self.signal.available:
+            self.signal.mark_lost()
+            self._signal_changed(t)
+            reason = "PX4's recorded offboard_control_signal_lost (the stream is not recorded)"
+            self._emit(t, "signal_lost", f"offboard signal lost: {reason}", "2", reason=reason)
+            self._refresh(t)
+        elif not lost and self.signal.keepalive(t, True):
+            self._signal_changed(t)
+            self._emit(
+                t,
+                "signal_available",
+                "offboard signal available: PX4's recorded offboard_control_signal_lost "
+                "(the stream is not recorded)",
+                "2",
+            )
+            self._refresh(t)
+
     def _on_failsafe_flags(self, event: FailsafeFlags) -> None:
-        self._recorded_flag(event)
+        if self.stream_recorded:
+            self._recorded_flag(event)
+        else:
+            self._follow_flag(event)
         if self.est.update(event):
             self._verdicts.clear()
             self._mask_changed()
@@ -1112,7 +1146,7 @@ class GateModel:
             self._start(status)
             return
         self.compare.remember(status)
-        if not self.stream_recorded:
+        if not self.stream_recorded and not self.follows_flag:
             self._recorded_loss(status)
         if status.armed is not None and self.armed is None:
             state = "armed" if status.armed else "disarmed"
@@ -1132,7 +1166,7 @@ class GateModel:
         armed, intention = self._unseen_inputs(status)
         if armed or intention is not None:
             self._adopt(status.t, status, intention, silent=True)
-        if not self.stream_recorded:
+        if not self.stream_recorded and not self.follows_flag:
             self._recorded_back(status)
         self.compare.observe(status, self._nav)
 
@@ -1196,17 +1230,19 @@ class GateModel:
         if intention is None:
             intention = status.nav_state
         self.user_intention = intention
-        if not self.stream_recorded:
+        if not self.stream_recorded and not self.follows_flag:
             self._emit(
                 t,
                 "signal_available",
                 "offboard signal taken as present: the recording holds no keep-alive sent to "
-                "the vehicle; only a failsafe PX4 recorded counts as its loss",
+                "the vehicle; PX4's recorded offboard_control_signal_lost decides it where "
+                "the recording has it, else only a failsafe PX4 recorded counts as its loss",
                 self.signal.spec,
             )
         # Assumption: a recording that starts in OFFBOARD starts with a live stream.
         if (
-            status.nav_state == NAV_STATE_OFFBOARD
+            not self.follows_flag
+            and status.nav_state == NAV_STATE_OFFBOARD
             and not self.signal.available
             and self.signal.keepalive(t, True)
         ):

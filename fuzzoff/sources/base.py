@@ -24,6 +24,13 @@ def path_text(path: Path | str) -> str:
     return os.fsencode(path).decode("utf-8", "backslashreplace")
 
 
+POSITION_PERIOD_S = 1.0
+"""A plain lint reads the vehicle's position at most this often per vehicle and topic (the
+first message of each period; the others are not decoded): OFB404 compares a setpoint with
+the vehicle's height on the ground, which moves slowly, and every event between two runs of
+setpoints costs the checks a run (``StreamBatch``). The HTML report reads every one."""
+
+
 class SourceError(Exception):
     """The recording cannot be read at all. ``str()`` is the one line the user sees."""
 
@@ -64,6 +71,9 @@ class RecordingInfo:
     format: str
     kinds: set[str] = field(default_factory=set)
     px4_version: str | None = None
+    px4_candidates: list[str] = field(default_factory=list)
+    """Where the recording does not name its release but narrows it (a ROS 2 recording's
+    message definitions and topic names): the profiles it fits, oldest first."""
     vehicle_type: str | None = None
     vehicles: list[str] = field(default_factory=list)
     message_count: int | None = None
@@ -76,7 +86,11 @@ class RecordingInfo:
     """Does the recording hold the stream sent to the vehicle, or at least the link that would
     carry it? False only where the reader can tell it does not: a ground station's tlog, with
     no setpoint and no command from a companion (PX4 does not forward messages addressed to
-    itself), where the absence of a stream says nothing about the sender."""
+    itself), or a ULog without ``offboard_control_mode`` (a logger profile that leaves it out,
+    a log cut to other topics), where the absence of a stream says nothing about the sender."""
+    stream_missing: str = ""
+    """With ``stream_recorded`` false: what the recording is, and why it cannot hold the
+    stream (the OFB002 finding says it)."""
 
     @property
     def sampled(self) -> bool:
@@ -96,8 +110,9 @@ class Source(abc.ABC):
         """The user's ``--px4`` profile, set before ``open()``: readers that must choose message
         definitions the recording does not carry (Humble-era ROS 2 bags) start from it."""
         self.plot_data = False
-        """Set before ``events()`` for the HTML report: readers then also yield what only its
-        plots show (``VehiclePosition``); a plain lint does not pay for it."""
+        """Set before ``events()`` for the HTML report: readers then yield every recorded
+        ``VehiclePosition`` (a plain lint gets at most one per ``POSITION_PERIOD_S``) and what
+        dates the recording."""
         self.start_time_s: float | None = None
         """The recording's first time on the wall clock (UNIX seconds), where it has one; set
         by ``events()``. ``t`` of every event counts from it."""

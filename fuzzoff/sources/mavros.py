@@ -29,15 +29,18 @@ from fuzzoff.events import (
     SetAttitudeTarget,
     SetPositionTargetGlobal,
     SetPositionTargetLocal,
+    VehiclePosition,
     VehicleStatus,
     Where,
 )
 from fuzzoff.modes import mavros_mode_to_nav_state
+from fuzzoff.sources.base import POSITION_PERIOD_S
 from fuzzoff.sources.mavros_frames import (
     AIRCRAFT_BASELINK_Q,
     enu_to_ned,
     flu_to_frd,
     orientation_enu_to_ned,
+    pose_rotation,
     quat_mul,
     quat_yaw,
     yaw_enu_to_ned,
@@ -78,6 +81,7 @@ TOPIC_TYPES: dict[str, str] = {
     "setpoint_attitude/thrust": _MSG + "Thrust",
     "setpoint_accel/accel": _GEO + "Vector3Stamped",
     "state": _MSG + "State",
+    "local_position/pose": _GEO + "PoseStamped",
 }
 """MAVROS topic (after the ``mavros/`` namespace) -> the message type MAVROS subscribes with."""
 
@@ -93,6 +97,7 @@ TOPIC_KINDS: dict[str, str] = {
     "setpoint_attitude/thrust": SetAttitudeTarget.kind,
     "setpoint_accel/accel": SetPositionTargetLocal.kind,
     "state": VehicleStatus.kind,
+    "local_position/pose": VehiclePosition.kind,
 }
 """MAVROS topic -> the event kind it becomes (``RecordingInfo.kinds``)."""
 
@@ -194,6 +199,10 @@ class MavrosConverter:
     """
 
     options: MavrosOptions = field(default_factory=MavrosOptions)
+    position_period_s: float = POSITION_PERIOD_S
+    """``local_position/pose`` kept at most this often per vehicle (0: every one, the HTML
+    report's plots)."""
+    _position_due: dict[str, float] = field(default_factory=dict)
     _body: dict[str, _Pending] = field(default_factory=dict)
     _thrust: dict[str, _Pending] = field(default_factory=dict)
     _handlers: dict[str, Handler | None] = field(default_factory=dict)
@@ -221,6 +230,8 @@ class MavrosConverter:
             return lambda msg, t, index: state_to_status(
                 msg, t=t, vehicle=ns, where=Where(topic, index)
             )
+        if name == "local_position/pose":
+            return lambda msg, t, index: self._position(msg, t, ns, Where(topic, index))
         if name in ("setpoint_attitude/attitude", "setpoint_attitude/cmd_vel"):
 
             def body(msg: Any, t: float, index: int | None) -> Event | None:
@@ -244,6 +255,25 @@ class MavrosConverter:
             return make(msg, options, t, ns, Where(topic, index))
 
         return setpoint
+
+    def _position(self, msg: Any, t: float, ns: str, where: Where) -> Event | None:
+        """``local_position/pose``: where MAVROS says the vehicle is, ENU, from PX4's
+        LOCAL_POSITION_NED (MAVROS turns NED into ENU; this turns it back)."""
+        period = self.position_period_s
+        if period:
+            if t < self._position_due.get(ns, -math.inf):
+                return None
+            self._position_due[ns] = t + period - 1e-3
+        x, y, z = enu_to_ned(_vec(msg.pose.position))
+        return VehiclePosition(
+            t=t,
+            vehicle=ns,
+            where=where,
+            sender_time_us=stamp_to_time_boot_us(msg.header),
+            x=x,
+            y=y,
+            z=z,
+        )
 
     def _pair(self, ns: str) -> Event | None:
         body, thrust = self._body.get(ns), self._thrust.get(ns)
@@ -393,9 +423,10 @@ def raw_attitude(
 def position_local(
     msg: Any, options: MavrosOptions, t: float, ns: str, where: Where
 ) -> SetPositionTargetLocal:
-    """``setpoint_position/local`` (PoseStamped): position + yaw, mask 0x9F8."""
+    """``setpoint_position/local`` (PoseStamped): position + yaw, mask 0x9F8. The orientation
+    goes through Eigen as MAVROS's does (``pose_rotation``: an all-zero one is the identity)."""
     pose = msg.pose
-    q = _quat(pose.orientation)
+    q = pose_rotation(_quat(pose.orientation))
     if options.mav_frame in BODY_FRAMES:
         position = flu_to_frd(_vec(pose.position))
         yaw = quat_yaw(quat_mul(AIRCRAFT_BASELINK_Q, q))

@@ -53,6 +53,57 @@ def quat_yaw(q: Quat) -> float:
     return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
 
+def pose_rotation(q: Quat) -> Quat:
+    """The rotation MAVROS takes from a ``geometry_msgs/Pose`` orientation (``setpoint_position``).
+
+    MAVROS does not use the message's quaternion as it is: ``tf2::fromMsg`` (ROS 1:
+    ``tf::poseMsgToEigen``) builds an ``Eigen::Affine3d`` from it, whose linear part is Eigen's
+    ``toRotationMatrix()`` of the quaternion as given (no normalisation), and the plugin takes
+    ``Eigen::Quaterniond(tr.rotation())``: the rotation factor of that matrix's polar
+    decomposition (SVD, the last column's sign fixed so the determinant is +1, Eigen 3.4). So a
+    unit quaternion is kept, the all-zero quaternion a program leaves unset (ROS 1's default)
+    becomes the identity (yaw 0 in ENU, pi/2 in NED), and any other length gives the rotation
+    nearest that matrix. The returned quaternion is a unit one (w >= 0 where it can be)."""
+    w, x, y, z = q
+    norm2 = w * w + x * x + y * y + z * z
+    if not math.isfinite(norm2) or abs(norm2 - 1.0) <= 1e-12:
+        return q  # a unit quaternion: toRotationMatrix() is a rotation, its own polar factor
+    import numpy as np  # only for malformed orientations: not the hot path
+
+    tx, ty, tz = 2.0 * x, 2.0 * y, 2.0 * z
+    matrix = np.array(
+        [
+            [1.0 - (ty * y + tz * z), ty * x - tz * w, tz * x + ty * w],
+            [ty * x + tz * w, 1.0 - (tx * x + tz * z), tz * y - tx * w],
+            [tz * x - ty * w, tz * y + tx * w, 1.0 - (tx * x + ty * y)],
+        ]
+    )
+    u, _, vt = np.linalg.svd(matrix)
+    if np.linalg.det(u @ vt) < 0.0:
+        u[:, 2] = -u[:, 2]
+    return quat_from_matrix((u @ vt).tolist())
+
+
+def quat_from_matrix(m: list[list[float]]) -> Quat:
+    """A rotation matrix as a unit quaternion (w, x, y, z), as Eigen's ``Quaterniond(matrix)``
+    (Shepperd's method: the largest of w, x, y, z is taken from the diagonal)."""
+    trace = m[0][0] + m[1][1] + m[2][2]
+    if trace > 0.0:
+        t = math.sqrt(trace + 1.0)
+        w, k = 0.5 * t, 0.5 / t
+        return (w, (m[2][1] - m[1][2]) * k, (m[0][2] - m[2][0]) * k, (m[1][0] - m[0][1]) * k)
+    i = max(range(3), key=lambda n: m[n][n])
+    j, k_ = (i + 1) % 3, (i + 2) % 3
+    t = math.sqrt(m[i][i] - m[j][j] - m[k_][k_] + 1.0)
+    v = [0.0, 0.0, 0.0]
+    v[i] = 0.5 * t
+    t = 0.5 / t
+    w = (m[k_][j] - m[j][k_]) * t
+    v[j] = (m[j][i] + m[i][j]) * t
+    v[k_] = (m[k_][i] + m[i][k_]) * t
+    return (w, v[0], v[1], v[2])
+
+
 NED_ENU_Q: Quat = quat_from_rpy(math.pi, 0.0, math.pi / 2)
 AIRCRAFT_BASELINK_Q: Quat = quat_from_rpy(math.pi, 0.0, 0.0)
 

@@ -336,6 +336,57 @@ def _control_mode_status(fields: frozenset[str], vehicle: str, origin: Origin) -
     return build
 
 
+ESTIMATES = (
+    "local_position",
+    "local_velocity",
+    "local_altitude",
+    "global_position",
+    "attitude",
+    "angular_velocity",
+    "home_position",
+)
+"""``FailsafeFlags`` ``<estimate>_invalid`` fields, negated into ``FailsafeFlags`` events."""
+
+
+def _failsafe_flags(fields: frozenset[str], vehicle: str, origin: Origin) -> Builder:
+    manual = "manual_control_signal_lost" if "manual_control_signal_lost" in fields else None
+    invalid = tuple((name, f"{name}_invalid") for name in ESTIMATES if f"{name}_invalid" in fields)
+
+    def build(m: Any, t: float, where: Where, ts: int) -> Event:
+        return ev.FailsafeFlags(
+            t=t,
+            vehicle=vehicle,
+            where=where,
+            sender_time_us=ts,
+            origin=origin,
+            offboard_control_signal_lost=m.offboard_control_signal_lost,
+            manual_control_signal_lost=getattr(m, manual) if manual else None,
+            **{f"{name}_valid": not getattr(m, field) for name, field in invalid},
+        )
+
+    return build
+
+
+def _local_position(fields: frozenset[str], vehicle: str, origin: Origin) -> Builder:
+    """``VehicleLocalPosition``; a coordinate PX4 marks invalid is NaN (as from a ULog)."""
+    nan = ev.NAN
+
+    def build(m: Any, t: float, where: Where, ts: int) -> Event:
+        xy = m.xy_valid
+        return ev.VehiclePosition(
+            t=t,
+            vehicle=vehicle,
+            where=where,
+            sender_time_us=ts,
+            origin=origin,
+            x=m.x if xy else nan,
+            y=m.y if xy else nan,
+            z=m.z if m.z_valid else nan,
+        )
+
+    return build
+
+
 BUILDERS: dict[str, Callable[[frozenset[str], str, Origin], Builder]] = {
     "OffboardControlMode": _control_mode,
     "TrajectorySetpoint": _trajectory,
@@ -357,6 +408,8 @@ BUILDERS: dict[str, Callable[[frozenset[str], str, Origin], Builder]] = {
     "VehicleCommandAck": _ack,
     "VehicleStatus": _status,
     "VehicleControlMode": _control_mode_status,
+    "FailsafeFlags": _failsafe_flags,
+    "VehicleLocalPosition": _local_position,
 }
 """px4_msgs message name -> builder factory (fields of the definition, vehicle, origin)."""
 
@@ -379,4 +432,6 @@ KIND_OF: dict[str, str] = {
     "VehicleCommandAck": ev.CommandAck.kind,
     "VehicleStatus": ev.VehicleStatus.kind,
     "VehicleControlMode": ev.VehicleControlModeStatus.kind,
+    "FailsafeFlags": ev.FailsafeFlags.kind,
+    "VehicleLocalPosition": ev.VehiclePosition.kind,
 }

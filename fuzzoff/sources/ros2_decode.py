@@ -9,6 +9,7 @@ bytes): a payload that does not is never passed on half-understood; the topic be
 
 from __future__ import annotations
 
+import math
 import struct
 from dataclasses import dataclass, field
 from functools import cache
@@ -237,6 +238,23 @@ class TopicDecoder:
 
 
 @dataclass(slots=True)
+class ThinnedTopicDecoder(TopicDecoder):
+    """A topic read at most once per ``period_s`` of log time (the vehicle's position in a
+    plain lint, ``POSITION_PERIOD_S``): the first message of each period is decoded, the
+    others are counted and skipped undecoded."""
+
+    period_s: float = 0.0
+    due: float = -math.inf
+
+    def event(self, raw: bytes | memoryview, t: float) -> Event | None:
+        if t < self.due:
+            self.index += 1
+            return None
+        self.due = (t // self.period_s + 1) * self.period_s
+        return TopicDecoder.event(self, raw, t)
+
+
+@dataclass(slots=True)
 class Ros2Decoding:
     """The per-recording choice of definitions, and the problems it found.
 
@@ -250,6 +268,13 @@ class Ros2Decoding:
     evidence: set[str] | None = None
     """Releases every definition seen so far fits (for profile detection)."""
     notes: list[str] = field(default_factory=list)
+    position_period_s: float = 0.0
+    """``VehicleLocalPosition`` read at most this often per topic (0: every message)."""
+
+    def thin_positions(self, period_s: float) -> None:
+        """Read the vehicle's position at most once per ``period_s`` (MAVROS's too)."""
+        self.position_period_s = period_s
+        self.mavros.position_period_s = period_s
 
     def connection(
         self, topic: str, msgtype: str, embedded: str | None, fmt: str = "msg"
@@ -276,8 +301,14 @@ class Ros2Decoding:
             head, sep, _ = topic.partition("/fmu/")
             vehicle = head if sep else ""
             origin = "vehicle" if message in OUTPUT_MESSAGES else "sent"
-        decoder = TopicDecoder(topic, message, vehicle, origin, ref, self)
+        if message == "VehicleLocalPosition" and self.position_period_s:
+            decoder: TopicDecoder = ThinnedTopicDecoder(
+                topic, message, vehicle, origin, ref, self, period_s=self.position_period_s
+            )
+        else:
+            decoder = TopicDecoder(topic, message, vehicle, origin, ref, self)
         self.decoders.append(decoder)
+        self._note_naming(decoder)
         if embedded and embedded.strip():
             try:
                 definition = Definition.make(px4_msgs.type_name(message), embedded, "embedded", fmt)
@@ -291,6 +322,16 @@ class Ros2Decoding:
             self._note_evidence(message, definition)
             decoder.use(definition)
         return decoder
+
+    def _note_naming(self, decoder: TopicDecoder) -> None:
+        """A PX4 topic name tells releases too: its ``_vN`` suffix is the message's
+        ``MESSAGE_VERSION`` in the releases that publish it so (none = 0), and the v1.13
+        naming is 1.13's. A name that fits none (a bridge renamed it) tells nothing."""
+        if decoder.ref is None:
+            return
+        fits = set(self.candidates(decoder))
+        if fits:
+            self.evidence = fits if self.evidence is None else self.evidence & fits
 
     def _note_evidence(self, message: str, definition: Definition) -> None:
         fits = {
@@ -353,10 +394,18 @@ class Ros2Decoding:
         return chosen, ""
 
     def detected_release(self) -> str | None:
-        """The one release every embedded or chosen definition fits, if exactly one."""
+        """The one release every embedded or chosen definition and every PX4 topic name fits,
+        if exactly one."""
         if self.evidence and len(self.evidence) == 1:
             return next(iter(self.evidence))
         return None
+
+    def fitting_releases(self) -> list[str]:
+        """The releases (oldest first) the definitions and topic names fit, where they narrow
+        it to several: the release is then not known, but it is one of these."""
+        if not self.evidence or len(self.evidence) == 1:
+            return []
+        return [r for r in px4_msgs.RELEASES if r in self.evidence]
 
     def vehicle_from(self, decoder: Decoder | None, raw: bytes | memoryview) -> str | None:
         """The vehicle type one ``VehicleStatus`` payload names (None for anything else)."""

@@ -33,6 +33,8 @@ MESSAGE_FOR_NAME: dict[str, str] = {
     "vehicle_command_ack": "VehicleCommandAck",
     "vehicle_status": "VehicleStatus",
     "vehicle_control_mode": "VehicleControlMode",
+    "failsafe_flags": "FailsafeFlags",
+    "vehicle_local_position": "VehicleLocalPosition",
 }
 """Topic base name -> px4_msgs message: the topics fuzzoff decodes."""
 
@@ -40,7 +42,15 @@ NAME_FOR_MESSAGE: dict[str, str] = {}
 for _name, _msg in MESSAGE_FOR_NAME.items():
     NAME_FOR_MESSAGE.setdefault(_msg, _name)
 
-OUTPUT_MESSAGES = frozenset({"VehicleCommandAck", "VehicleStatus", "VehicleControlMode"})
+OUTPUT_MESSAGES = frozenset(
+    {
+        "VehicleCommandAck",
+        "VehicleStatus",
+        "VehicleControlMode",
+        "FailsafeFlags",
+        "VehicleLocalPosition",
+    }
+)
 """Messages PX4 publishes (``/fmu/out``); the rest are inputs to PX4."""
 
 

@@ -26,7 +26,13 @@ from rosbags.rosbag1 import ReaderError
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 from fuzzoff.events import Event
-from fuzzoff.sources.base import RecordingInfo, Source, SourceError, SourceProblem
+from fuzzoff.sources.base import (
+    POSITION_PERIOD_S,
+    RecordingInfo,
+    Source,
+    SourceError,
+    SourceProblem,
+)
 from fuzzoff.sources.mavros import TOPIC_KINDS, Handler, MavrosConverter, mavros_topic
 from fuzzoff.sources.mavros_msgs import mavros_typedefs
 from fuzzoff.sources.rosbag1_chunkwise import ChunkwiseReader
@@ -227,7 +233,7 @@ class Rosbag1Source(Source):
 
         ``start_ns[0]`` is the recording's first time (set by the salvage once it has read it).
         """
-        converter = MavrosConverter()
+        converter = MavrosConverter(position_period_s=0.0 if self.plot_data else POSITION_PERIOD_S)
         handlers: dict[int, tuple[Handler | None, Callable[[bytes], Any]]] = {}
         counts: dict[int, int] = {}
         first_bad: SourceProblem | None = None

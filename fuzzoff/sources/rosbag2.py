@@ -23,7 +23,13 @@ from ruamel.yaml import YAML
 from fuzzoff.events import Event
 from fuzzoff.profiles import ROVER_ASSUMED
 from fuzzoff.sources import mcap_indexed, px4_msgs
-from fuzzoff.sources.base import RecordingInfo, Source, SourceError, SourceProblem
+from fuzzoff.sources.base import (
+    POSITION_PERIOD_S,
+    RecordingInfo,
+    Source,
+    SourceError,
+    SourceProblem,
+)
 from fuzzoff.sources.mavros import mavros_topic
 from fuzzoff.sources.mcap_stream import McapStream
 from fuzzoff.sources.ros2_decode import Decoder, Ros2Decoding, TopicDecoder, message_of
@@ -112,6 +118,7 @@ class Rosbag2Source(Source):
 
     def open(self) -> None:
         self.decoding.release = px4_msgs.release_for(self.px4_hint)
+        self.decoding.thin_positions(0.0 if self.plot_data else POSITION_PERIOD_S)
         if not self.path.exists():
             raise SourceError(self.path, "no such file or folder")
         try:
@@ -217,6 +224,7 @@ class Rosbag2Source(Source):
         info.kinds = self.decoding.kinds()
         info.vehicles = self.decoding.vehicles()
         info.px4_version = self.decoding.detected_release()
+        info.px4_candidates = self.decoding.fitting_releases()
         info.vehicle_type = self._vehicle
         self._rover(info)
         info.notes.extend(self._notes)

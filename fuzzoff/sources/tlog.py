@@ -33,7 +33,13 @@ from fuzzoff.events import (
 )
 from fuzzoff.modes import custom_mode_to_nav_state, nav_state_name, split_custom_mode
 from fuzzoff.profiles import MAV_TYPE_VEHICLE
-from fuzzoff.sources.base import RecordingInfo, Source, SourceError, SourceProblem
+from fuzzoff.sources.base import (
+    POSITION_PERIOD_S,
+    RecordingInfo,
+    Source,
+    SourceError,
+    SourceProblem,
+)
 from fuzzoff.sources.tlog_frames import Framer, FrameStats, message_name
 
 HEARTBEAT = 0
@@ -70,12 +76,13 @@ WANTED = frozenset(
         RC_CHANNELS,
         MANUAL_CONTROL,
         EXTENDED_SYS_STATE,
+        LOCAL_POSITION_NED,
     }
 )
 """The only message ids decoded; the rest are framed and CRC-checked, not decoded."""
 
-PLOT_WANTED = WANTED | {LOCAL_POSITION_NED}
-"""With ``plot_data``: also the vehicle's position, for the HTML report."""
+THINNED = {LOCAL_POSITION_NED: round(POSITION_PERIOD_S * 1e6)}
+"""Decoded at most once per period per vehicle in a plain lint (``POSITION_PERIOD_S``)."""
 
 PROBE_WANTED = frozenset({HEARTBEAT, AUTOPILOT_VERSION, COMMAND_LONG, COMMAND_INT, SET_MODE})
 """The probe's decodes: who is who, the release, and who sends commands (rare messages)."""
@@ -218,6 +225,10 @@ class TlogSource(Source):
         companions = commanders - autopilots - ground_stations
         if not any(stats.by_id.get(i) for i in KEEPALIVE_IDS) and not companions:
             info.stream_recorded = False
+            info.stream_missing = (
+                "holds no setpoint and no command from a companion: a ground station's log "
+                "(PX4 does not forward the messages addressed to itself)"
+            )
             info.notes.append(
                 "no setpoint and no command from a companion in the log (a ground station's "
                 "log?): the stream sent to the vehicle is not in this recording"
@@ -235,8 +246,9 @@ class TlogSource(Source):
         if self._fatal:
             return  # the probe already raised the one SourceError for this file
         self.probe()
-        wanted = PLOT_WANTED if self.plot_data else WANTED
-        framer = self._framer = Framer(self._file(), self._size, wanted, verify=True)
+        thinned = None if self.plot_data else THINNED
+        framer = Framer(self._file(), self._size, WANTED, verify=True, thinned=thinned)
+        self._framer = framer
         decoder = _Decoder(self._autopilots, self._vehicles())
         first_ts: int | None = None
         try:

@@ -40,7 +40,7 @@ import os
 import re
 import struct
 from collections import Counter
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from typing import Any, BinaryIO
 
@@ -120,10 +120,21 @@ class Framer:
     leaves it off to stay cheap, so its counts may include a packet that later proves corrupt.
     """
 
-    def __init__(self, fh: BinaryIO, size: int, wanted: frozenset[int], verify: bool) -> None:
+    def __init__(
+        self,
+        fh: BinaryIO,
+        size: int,
+        wanted: frozenset[int],
+        verify: bool,
+        thinned: Mapping[int, int] | None = None,
+    ) -> None:
         self.fh = fh
         self.wanted = wanted
         self.verify = verify
+        self.thinned: Mapping[int, int] = thinned or {}
+        """Wanted ids decoded at most once per period (µs) per sender system: the first packet
+        of each period of the log's clock; the others are framed and CRC-checked only."""
+        self._due_at: dict[tuple[int, int], int] = {}
         self.stats = FrameStats(size=size)
         self.mav = mavlink.MAVLink(None)
         self.mav.robust_parsing = True
@@ -175,6 +186,16 @@ class Framer:
         crc = mavlink.x25crc(buf[pos + 9 : crc_at])
         crc.accumulate(_EXTRA_BYTE[extra])
         return bool(crc.crc == expected)
+
+    def _due(self, buf: bytes, pos: int, msgid: int, ts: int) -> bool:
+        """Is this packet of a thinned id the first of its period for its sender system?"""
+        sysid = buf[pos + 13] if buf[pos + 8] == 0xFD else buf[pos + 11]
+        period = self.thinned[msgid]
+        key = (msgid, sysid)
+        if ts < self._due_at.get(key, -1):
+            return False
+        self._due_at[key] = (ts // period + 1) * period
+        return True
 
     def _plausible(self, ts: int) -> bool:
         last = self.stats.last_ts
@@ -234,7 +255,7 @@ class Framer:
                 pos, buf, n = self._resync(pos, "implausible timestamp")
                 continue
             msg: Any = None
-            if msgid in wanted:
+            if msgid in wanted and (msgid not in self.thinned or self._due(buf, pos, msgid, ts)):
                 try:
                     msg = decode(bytearray(buf[pos + 8 : end]))
                 except (mavlink.MAVError, struct.error, ValueError, TypeError, IndexError):

@@ -22,13 +22,12 @@ import numpy as np
 
 from fuzzoff import events as ev
 from fuzzoff.profiles import MAV_TYPE_VEHICLE, PX4_VEHICLE_TYPE, ProfileError, px4_profile_for
-from fuzzoff.sources.base import RecordingInfo, Source, SourceError
+from fuzzoff.sources.base import POSITION_PERIOD_S, RecordingInfo, Source, SourceError
 from fuzzoff.sources.ulog_load import Loaded, load
 from fuzzoff.sources.ulog_topics import (
     EXTRA_TOPICS,
     GPS_TOPICS,
     MAIN_STATE_TO_NAV,
-    PLOT_TOPICS,
     TOPICS,
     Chunk,
     Context,
@@ -36,7 +35,7 @@ from fuzzoff.sources.ulog_topics import (
 )
 
 LOADED_TOPICS: tuple[str, ...] = (*TOPICS, *EXTRA_TOPICS)
-PLOT_LOADED_TOPICS: tuple[str, ...] = (*LOADED_TOPICS, *PLOT_TOPICS, *GPS_TOPICS)
+PLOT_LOADED_TOPICS: tuple[str, ...] = (*LOADED_TOPICS, *GPS_TOPICS)
 CHUNK_ROWS = 4096
 """Rows turned into Python values at a time (bounds memory on long logs)."""
 
@@ -183,6 +182,16 @@ class UlogSource(Source):
                 if interval is not None:
                     current = info.sampled_intervals.get(kind)
                     info.sampled_intervals[kind] = min(interval, current or interval)
+        if "offboard_control_mode" not in ulog.message_formats:
+            # PX4's logger writes the format of every topic it subscribes at the start, data
+            # or not: a log without it was not logging the stream (a profile or a
+            # logger_topics.txt that leaves it out, a log cut to other topics). With the format
+            # and no data, no offboard source published one: the stream was not sent.
+            info.stream_recorded = False
+            info.stream_missing = (
+                "its logger did not log offboard_control_mode (no format for it: a logger "
+                "profile that leaves it out, or a log cut to other topics)"
+            )
         if _legacy_flags(datasets):
             info.kinds.add(ev.FailsafeFlags.kind)
         info.kinds.add(ev.VehicleInfo.kind)
@@ -232,7 +241,7 @@ class UlogSource(Source):
         ulog = self._load().ulog
         t0 = int(ulog.start_timestamp)
         context = self._context(info)
-        specs = {**TOPICS, **PLOT_TOPICS} if self.plot_data else TOPICS
+        specs = TOPICS
         ranks = {name: rank for rank, name in enumerate(specs, start=10)}
         topics: list[_Stream] = []
         datasets = self._datasets()
@@ -244,7 +253,10 @@ class UlogSource(Source):
                 continue
             rank = ranks[d.name] * 256 + d.multi_id
             topic = d.name if d.multi_id == 0 else f"{d.name}_{d.multi_id}"
-            topics.append(_stream(d.data, topic, rank, t0, spec.decode, context))
+            keep = None
+            if spec.kind == ev.VehiclePosition.kind and not self.plot_data:
+                keep = _one_per_period(d.data["timestamp"], POSITION_PERIOD_S)
+            topics.append(_stream(d.data, topic, rank, t0, spec.decode, context, keep))
         legacy = _legacy_flags(datasets)
         if legacy is not None:
             rank = (len(ranks) + 10) * 256
@@ -520,12 +532,33 @@ def _merged_order(streams: list[_Stream]) -> Any:
     return np.concatenate([np.zeros(len(preamble.keys), dtype=np.int32), merged])
 
 
-def _stream(cols: Any, topic: str, rank: int, t0: int, decode: Any, context: Context) -> _Stream:
-    """One topic instance's events in timestamp order, made a chunk at a time."""
+def _one_per_period(ts: Any, period_s: float) -> Any:
+    """The rows to read of a topic thinned to one per ``period_s``: the first logged row of
+    each period of the log's clock (a row's ``where`` index still names its logged place)."""
+    with np.errstate(all="ignore"):
+        bucket = ts.astype(np.float64) // (period_s * 1e6)
+    _, first = np.unique(bucket, return_index=True)
+    return np.sort(first)
+
+
+def _stream(
+    cols: Any,
+    topic: str,
+    rank: int,
+    t0: int,
+    decode: Any,
+    context: Context,
+    keep: Any = None,
+) -> _Stream:
+    """One topic instance's events in timestamp order, made a chunk at a time (``keep``: only
+    those rows)."""
     ts = cols["timestamp"]
     n = len(ts)
     order: Any = None
-    if n > 1 and bool(np.any(ts[1:] < ts[:-1])):
+    if keep is not None:
+        order = keep[np.argsort(ts[keep], kind="stable")]
+        n = len(order)
+    elif n > 1 and bool(np.any(ts[1:] < ts[:-1])):
         order = np.argsort(ts, kind="stable")
     keys = ts if order is None else ts[order]
     return _Stream(keys, rank, order, _chunks(cols, order, n, topic, t0, decode, context))

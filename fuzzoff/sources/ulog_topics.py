@@ -475,6 +475,20 @@ def _valid(c: Chunk, estimate: str) -> list[bool | None]:
     return [None] * c.n
 
 
+def local_position(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
+    """``vehicle_local_position``; a coordinate PX4 marks invalid (``xy_valid``, ``z_valid``)
+    is NaN: the estimator's value then means nothing."""
+    nan = math.nan
+    xy_ok = c.b("xy_valid") if c.has("xy_valid") else repeat(True)
+    z_ok = c.b("z_valid") if c.has("z_valid") else repeat(True)
+    for t, w, ts, x, y, z, xy, zv in zip(
+        c.t, c.where, c.ts, c.f("x"), c.f("y"), c.f("z"), xy_ok, z_ok, strict=False
+    ):
+        if not xy:
+            x = y = nan
+        yield ev.VehiclePosition(t=t, where=w, sender_time_us=ts, x=x, y=y, z=z if zv else nan)
+
+
 def failsafe_flags(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
     manual = (
         "manual_control_signal_lost" if c.has("manual_control_signal_lost") else "rc_signal_lost"
@@ -611,22 +625,13 @@ TOPICS: dict[str, TopicSpec] = {
     "failsafe_flags": TopicSpec(ev.FailsafeFlags.kind, failsafe_flags),
     "vehicle_status_flags": TopicSpec(ev.FailsafeFlags.kind, failsafe_flags),
     "vehicle_land_detected": TopicSpec(ev.LandDetected.kind, land_detected),
+    "vehicle_local_position": TopicSpec(ev.VehiclePosition.kind, local_position),
 }
 """uORB topic -> what it becomes. Dict order = the order of events at the same microsecond."""
 
 EXTRA_TOPICS = ("commander_state",)
 """Loaded but not turned into events of their own (merged into ``vehicle_status``)."""
 
-
-def local_position(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
-    for t, w, ts, x, y, z in zip(c.t, c.where, c.ts, c.f("x"), c.f("y"), c.f("z"), strict=True):
-        yield ev.VehiclePosition(t=t, where=w, sender_time_us=ts, x=x, y=y, z=z)
-
-
-PLOT_TOPICS: dict[str, TopicSpec] = {
-    "vehicle_local_position": TopicSpec(ev.VehiclePosition.kind, local_position),
-}
-"""Loaded only for the HTML report's plots (``Source.plot_data``); after ``TOPICS`` in order."""
 
 GPS_TOPICS = ("vehicle_gps_position",)
 """Loaded for the plots too: the first fix with a UTC time dates the log (a ULog's own clock

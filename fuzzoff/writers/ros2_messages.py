@@ -17,7 +17,7 @@ import numpy as np
 
 from fuzzoff import events as ev
 from fuzzoff.sources import px4_msgs
-from fuzzoff.sources.ros2_convert import ARMING_STATE_ARMED
+from fuzzoff.sources.ros2_convert import ARMING_STATE_ARMED, ESTIMATES
 from fuzzoff.sources.ros2_topics import topic_for
 
 START_NS = 1_700_000_000_000_000_000
@@ -45,6 +45,8 @@ _MESSAGE_OF: dict[type[ev.Event], str] = {
     ev.CommandAck: "VehicleCommandAck",
     ev.VehicleStatus: "VehicleStatus",
     ev.VehicleControlModeStatus: "VehicleControlMode",
+    ev.FailsafeFlags: "FailsafeFlags",
+    ev.VehiclePosition: "VehicleLocalPosition",
 }
 
 _NUMPY = {
@@ -185,6 +187,16 @@ def _event_values(event: ev.Event, message: str, names: set[str]) -> dict[str, A
             if name.startswith("flag_control_") and name.endswith("_enabled"):
                 v[name] = name[len("flag_control_") : -len("_enabled")] in event.enabled
         v["flag_control_offboard_enabled"] = event.offboard_enabled
+    elif isinstance(event, ev.FailsafeFlags):
+        v["offboard_control_signal_lost"] = bool(event.offboard_control_signal_lost)
+        v["manual_control_signal_lost"] = bool(event.manual_control_signal_lost)
+        for name in ESTIMATES:
+            valid = getattr(event, f"{name}_valid")
+            v[f"{name}_invalid"] = valid is False
+    elif isinstance(event, ev.VehiclePosition):
+        xy, z = math.isfinite(event.x) and math.isfinite(event.y), math.isfinite(event.z)
+        v.update(x=event.x if xy else 0.0, y=event.y if xy else 0.0, z=event.z if z else 0.0)
+        v.update(xy_valid=xy, z_valid=z, v_xy_valid=xy, v_z_valid=z)
     return v
 
 

@@ -47,6 +47,12 @@ VEHICLE_PARAMS: dict[str, tuple[int, int]] = {
 
 STATUS_VEHICLE_TYPE = {"mc": 1, "fw": 2, "vtol": 1}
 
+SUBSCRIBED = ("offboard_control_mode",)
+"""Topics of PX4's default logger profile whose format a log holds even when nothing was
+published: the logger writes the format of every subscribed topic at the start (PX4 logs
+``offboard_control_mode`` for every offboard source, so its format without data says no
+stream was sent; a log without the format was not logging it)."""
+
 _RELEASE = re.compile(r"^v?(\d+)\.(\d+)(?:\.(\d+))?(?:-?(\w+))?")
 _RELEASE_TYPE = {"alpha": 64, "beta": 128, "rc": 192}
 
@@ -107,6 +113,7 @@ class _Topics:
             ev.VehicleControlModeStatus: self._control_mode_status,
             ev.FailsafeFlags: self._failsafe_flags,
             ev.LandDetected: self._land_detected,
+            ev.VehiclePosition: self._local_position,
             ev.Command: self._command,
             ev.CommandAck: self._ack,
             ev.Parameter: self._parameter,
@@ -294,6 +301,12 @@ class _Topics:
         row: Row = {"landed": landed, "maybe_landed": landed, "ground_contact": landed}
         self._put("vehicle_land_detected", ts, row)
 
+    def _local_position(self, e: ev.VehiclePosition, ts: int) -> None:
+        xy = math.isfinite(e.x) and math.isfinite(e.y)
+        row: Row = {"x": e.x if xy else 0.0, "y": e.y if xy else 0.0, "xy_valid": xy}
+        row |= {"z": e.z if math.isfinite(e.z) else 0.0, "z_valid": math.isfinite(e.z)}
+        self._put("vehicle_local_position", ts, row)
+
     def _command(self, e: ev.Command, ts: int) -> None:
         row: Row = {f"param{i + 1}": p for i, p in enumerate(e.params)}
         row |= {
@@ -391,6 +404,7 @@ def write_ulog(
     layout: str | None = None,
     vehicle_type: str | None = None,
     start_us: int = DEFAULT_START_US,
+    subscribed: Iterable[str] = SUBSCRIBED,
 ) -> Path:
     """Write ``events`` as a ULog of ``px4_version`` (None: no ``ver_sw_release`` at all).
 
@@ -401,6 +415,8 @@ def write_ulog(
     ``thrust_and_torque``/``direct_actuator`` flags. ``params`` are the initial parameters
     (added to a few defaults); ``Parameter`` events at t > 0 become parameter changes.
     ``vehicle_type`` (or a ``VehicleInfo`` event) sets ``CA_AIRFRAME``/``MAV_TYPE``.
+    ``subscribed``: topics whose format is written without data, as PX4's logger does for
+    the topics of its profile (``()``: a logger that did not log the offboard stream).
     """
     era = layout or era_for(px4_version)
     stream = list(events)
@@ -415,7 +431,7 @@ def write_ulog(
     ulog._initial_parameters = dict(initial)
     ulog._changed_parameters = topics.changed_params
     columns = {topic: (_columns(rows), len(rows)) for topic, rows in topics.rows.items()}
-    _add_topics(ulog, columns, era)
+    _add_topics(ulog, columns, era, subscribed)
     for ts, level, text in topics.logged:
         message = ULog.MessageLogging.__new__(ULog.MessageLogging)
         message.log_level, message.timestamp, message.message = level, ts, text
@@ -463,13 +479,22 @@ def _new_ulog(px4_version: str | None, start_us: int) -> Any:
     return ulog
 
 
-def _add_topics(ulog: Any, topics: Mapping[str, tuple[Mapping[str, Any], int]], era: str) -> None:
+def _add_topics(
+    ulog: Any,
+    topics: Mapping[str, tuple[Mapping[str, Any], int]],
+    era: str,
+    subscribed: Iterable[str] = SUBSCRIBED,
+) -> None:
     formats: dict[str, Any] = {name: _format(name, fields) for name, fields in NESTED.items()}
     for msg_id, topic in enumerate(sorted(topics)):
         fields = fields_for(topic, era) or FORMATS[topic][0][1]  # before it existed: its first
         formats[topic] = _format(topic, fields)
         columns, rows = topics[topic]
         ulog._data_list.append(_dataset(topic, msg_id, columns, rows, formats))
+    for topic in subscribed:
+        own = fields_for(topic, era)
+        if topic not in formats and own is not None:
+            formats[topic] = _format(topic, own)
     ulog._message_formats = formats
 
 
