@@ -180,7 +180,7 @@ def run(args: argparse.Namespace) -> int:
     report, rows = gate_report(args.path, args, controllers=not args.no_controllers)
     text = _json(report, rows) if args.format == "json" else _terminal(report, rows)
     write_output(text, args.output)
-    for line in report.problems:
+    for line in [*report.problems, *report.malformed]:
         print(f"fuzzoff: {printable(line)}", file=sys.stderr)
     if not report.complete:
         return 2
