@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from mcap.exceptions import McapError
+from mcap.reader import SeekingReader
 from mcap.records import Channel, Chunk, DataEnd, Footer, Message, Schema
 from mcap.stream_reader import CRCValidationError, StreamReader, breakup_chunk
 
@@ -61,6 +62,14 @@ class McapStream:
         self.fh: io.BufferedReader | None = None
         self.size = 0
         self.footer = False
+        self.data_end = False
+        """The DataEnd record was read: every chunk came before it (damage after it costs no
+        message)."""
+        self.summary_said = False
+        """The caller already said what is wrong with the summary section."""
+        self.orphans = 0
+        """Messages on a channel no Channel record defined (it sat in a skipped chunk)."""
+        self._orphan_at: str | None = None
 
     def channel(self, record: Channel) -> None:
         if record.id in self.decoders:
@@ -73,9 +82,28 @@ class McapStream:
         msgtype = schema.name if schema is not None else ""
         self.decoders[record.id] = self.connect(record.topic, msgtype, text, fmt)
 
+    def use_summary(self) -> None:
+        """Schemas and channels from the summary section (where it can be read): a channel
+        whose only Channel record sits in a chunk that proves damaged still decodes in the
+        chunks after it."""
+        try:
+            with self.path.open("rb") as fh:
+                size = self.path.stat().st_size
+                summary = SeekingReader(fh, record_size_limit=max(size, 1)).get_summary()
+        except Exception:  # no usable summary: channels come from the chunks
+            return
+        if summary is None:
+            return
+        self.schemas.update(summary.schemas)
+        for record in summary.channels.values():
+            self.channel(record)
+
     def records(self) -> Iterator[Any]:
         """Top-level records, chunks broken up (CRC checked); problems recorded, never raised."""
         self.size = self.path.stat().st_size
+        if not self.size:
+            self.problems.append(SourceProblem("empty file (0 bytes)"))
+            return
         with self.path.open("rb") as fh:
             self.fh = fh
             reader = StreamReader(
@@ -89,6 +117,8 @@ class McapStream:
                     else:
                         if type(record) is Footer:
                             self.footer = True
+                        elif type(record) is DataEnd:
+                            self.data_end = True
                         yield record
                     good = fh.tell()
             except CRCValidationError as exc:
@@ -102,10 +132,23 @@ class McapStream:
                     self._cut(good, "corrupt record")
             except Exception as exc:
                 self._cut(good, _reason(exc))
+            else:
+                end = fh.tell()  # after the closing magic bytes
+                if end < self.size:
+                    what = (
+                        f"{self.size - end} bytes after the end of the MCAP file, not read "
+                        "(every record before them was)"
+                    )
+                    self.problems.append(SourceProblem(what, f"byte {end}", lost=False))
             finally:
                 self.fh = None
 
     def _cut(self, offset: int, why: str) -> None:
+        if self.data_end:  # every chunk was read: the summary after them cannot be
+            if not self.summary_said:
+                what = f"summary section unreadable ({why}); every chunk before it was read"
+                self.problems.append(SourceProblem(what, f"byte {offset}", lost=False))
+            return
         self.problems.append(
             SourceProblem(
                 f"{why}: nothing after the last whole record could be read (truncated or "
@@ -154,6 +197,8 @@ class McapStream:
                     t0 = self.t0_ns = record.log_time
                 decoder = decoders.get(record.channel_id)
                 if decoder is None or record.log_time <= after:
+                    if record.channel_id not in decoders:
+                        self._orphan(record)
                     continue
                 event = decoder.event(record.data, (record.log_time - t0) / 1e9)
                 if event is not None:
@@ -167,6 +212,17 @@ class McapStream:
         yield from order.flush()
         self.messages = messages
         self.late = order.late
+        if self.orphans:
+            what = (
+                f"{self.orphans} messages on channels that no readable record defines (their "
+                "Channel record was in a skipped chunk, or is missing) were not read"
+            )
+            self.problems.append(SourceProblem(what, self._orphan_at))
+
+    def _orphan(self, record: Message) -> None:
+        if not self.orphans and self.fh is not None:
+            self._orphan_at = f"in the chunk ending at byte {self.fh.tell()}"
+        self.orphans += 1
 
     def scan(self) -> tuple[int | None, str | None]:
         """Channels, the earliest log time and the vehicle type, for a file without a usable
