@@ -31,7 +31,7 @@ from fuzzoff.engine import Timeline, lint_file
 from fuzzoff.findings import FileReport
 from fuzzoff.gate import GateTransition
 from fuzzoff.modes import nav_state_name
-from fuzzoff.report.sanitize import printable
+from fuzzoff.report.sanitize import escape_bidi, printable
 
 
 def add_parser(sub: Any) -> None:
@@ -171,7 +171,7 @@ def _json(report: FileReport, rows: dict[str, list[Row]]) -> str:
             }
         ],
     }
-    return json.dumps(data, indent=2, ensure_ascii=False) + "\n"
+    return escape_bidi(json.dumps(data, indent=2, ensure_ascii=False)) + "\n"
 
 
 def run(args: argparse.Namespace) -> int:
