@@ -34,7 +34,7 @@ from fuzzoff.events import (
 from fuzzoff.modes import custom_mode_to_nav_state, nav_state_name, split_custom_mode
 from fuzzoff.profiles import MAV_TYPE_VEHICLE
 from fuzzoff.sources.base import RecordingInfo, Source, SourceError, SourceProblem
-from fuzzoff.sources.tlog_frames import Framer, FrameStats, message_name
+from fuzzoff.sources.tlog_frames import RESYNC_LIMIT, Framer, FrameStats, message_name
 
 HEARTBEAT = 0
 SYS_STATUS = 1
@@ -179,6 +179,7 @@ class TlogSource(Source):
             return self._info
         info = RecordingInfo(str(self.path), self.format)
         framer = Framer(self._file(), self._size, PROBE_WANTED, verify=False)
+        framer.on_chunk = self.on_progress
         autopilots = self._autopilots
         ground_stations: set[tuple[int, int]] = set()
         commanders: set[tuple[int, int]] = set()
@@ -237,6 +238,7 @@ class TlogSource(Source):
         self.probe()
         wanted = PLOT_WANTED if self.plot_data else WANTED
         framer = self._framer = Framer(self._file(), self._size, wanted, verify=True)
+        framer.on_chunk = self.on_progress
         decoder = _Decoder(self._autopilots, self._vehicles())
         first_ts: int | None = None
         try:
@@ -271,7 +273,20 @@ class TlogSource(Source):
             return round((ts - first_ts) / 1e6, 6)
 
         lines: list[SourceProblem] = []
-        for region in stats.regions:
+        regions = stats.regions
+        if stats.stopped_at is not None:  # the last region: where the search gave up
+            last = regions[-1]
+            regions = regions[:-1]
+            lines.append(
+                SourceProblem(
+                    f"no MAVLink packet in the {RESYNC_LIMIT >> 20} MiB after byte {last.start}: "
+                    f"reading stopped, the last {stats.size - stats.stopped_at} bytes were "
+                    "not read",
+                    f"byte {stats.stopped_at}",
+                    t_of(last.ts_us),
+                )
+            )
+        for region in regions:
             size = region.end - region.start
             lines.append(
                 SourceProblem(
