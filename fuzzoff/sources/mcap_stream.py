@@ -11,13 +11,19 @@ from __future__ import annotations
 
 import io
 from collections.abc import Callable, Iterator
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 from mcap.exceptions import McapError
 from mcap.reader import SeekingReader
 from mcap.records import Channel, Chunk, DataEnd, Footer, Message, Schema
-from mcap.stream_reader import CRCValidationError, StreamReader, breakup_chunk
+from mcap.stream_reader import (
+    CRCValidationError,
+    StreamReader,
+    breakup_chunk,
+    get_chunk_data_stream,
+)
 
 from fuzzoff.events import Event
 from fuzzoff.sources.base import SourceProblem
@@ -28,6 +34,8 @@ Connect = Callable[[str, str, str | None, str], Decoder | None]
 """(topic, message type, embedded definition, its format) -> decoder or None."""
 
 MAGIC = b"\x89MCAP0\r\n"
+CHUNK_FIELDS = 8 + 8 + 8 + 4 + 4 + 8
+"""A chunk record's fixed fields: times, size, CRC, the compression's and the data's lengths."""
 MAX_CHUNK_INFLATION = 1 << 30
 """A chunk claiming to inflate to more than this is treated as corrupt (bounded memory)."""
 
@@ -113,7 +121,7 @@ class McapStream:
             try:
                 for record in reader.records:
                     if type(record) is Chunk:
-                        yield from self._chunk(record, fh.tell())
+                        yield from self._chunk(record, good, fh.tell())
                     else:
                         if type(record) is Footer:
                             self.footer = True
@@ -157,7 +165,18 @@ class McapStream:
             )
         )
 
-    def _chunk(self, chunk: Chunk, end: int) -> Iterator[Any]:
+    def _chunk(self, chunk: Chunk, start: int, end: int) -> Iterator[Any]:
+        """The records of the chunk record at [start, end), or none and a problem."""
+        fields = CHUNK_FIELDS + len(chunk.compression.encode()) + len(chunk.data)
+        if end - start - 9 != fields:
+            # A header damaged where no CRC covers it: its data length and sizes read short
+            # (zeroed), the record's own length stepped over the rest, and the chunk would
+            # give no message and no error.
+            what = f"chunk header damaged (its fields fill {fields} of its {end - start - 9} bytes)"
+            self.problems.append(
+                SourceProblem(f"{what}; its messages were skipped", f"byte {start}")
+            )
+            return
         if chunk.uncompressed_size > MAX_CHUNK_INFLATION:
             self.problems.append(
                 SourceProblem(
@@ -166,7 +185,18 @@ class McapStream:
             )
             return
         try:
-            records = breakup_chunk(chunk, validate_crc=True)
+            data, length = get_chunk_data_stream(chunk, validate_crc=True)
+            if length != chunk.uncompressed_size:
+                # Its header was damaged where no CRC covers it (or the CRC itself): parsed,
+                # the bytes would give no message and no error.
+                what = (
+                    f"chunk header damaged (it says {chunk.uncompressed_size} bytes of "
+                    f"records, its data holds {length}); its messages were skipped"
+                )
+                self.problems.append(SourceProblem(what, f"chunk ending at byte {end}"))
+                return
+            whole = replace(chunk, compression="", data=data.read(length), uncompressed_crc=0)
+            records = breakup_chunk(whole)
         except CRCValidationError:
             self.problems.append(
                 SourceProblem(
