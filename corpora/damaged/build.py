@@ -23,6 +23,14 @@ Failures the damage campaign found (shrunk by Hypothesis), kept here:
   fields no longer fill its record), beside OFB004 (the summary's index of it disagrees). The
   readable part shows the hole: a 1.5 s keep-alive gap before the switch (OFB101 at 0.5 s,
   OFB102 and OFB202 at the switch).
+* ``mcap_one_chunk_flips``: corpora/stream/ofb104_good.mcap (one chunk) with three bits
+  flipped: in the header, in the chunk's type byte (a chunk read as a SummaryOffset record) and
+  in its compression's name. The summary's index disagreed, the file was read front to back,
+  and the chunk, parsed as another record, gave no message and no error. Now OFB001: the record
+  type that has no place in the data section, and nothing was read (no vehicle type: OFB003).
+* ``mcap_chunk_type_flipped`` (OFB004, the case above with a sound summary): the second
+  chunk's type byte reads 0x0e; its index and every other header field agree, so its messages
+  are read through the summary, and the line says so.
 * ``metadata_start_digit``: corpora/rosbag2/two_vehicles with one bit flipped in a digit of
   metadata.yaml's starting time: every time moved by that much in silence. Now OFB004, and the
   data files' own first time is used (the findings of the intact bag).
@@ -96,7 +104,12 @@ def mcap_cases(data: bytes) -> dict[str, tuple[bytes, str]]:
     # The chunk index copies its chunk's times: one of them wrong made rosbags skip the chunk.
     index_at = no_crc.index(struct.pack("<QQ", fourth.message_start_time, fourth.message_end_time))
     message_index = min(fourth.message_index_offsets.values())
+    second = sorted(summary.chunk_indexes, key=lambda c: c.chunk_start_offset)[1]
     return {
+        "mcap_chunk_type_flipped": (
+            patched(data, second.chunk_start_offset, b"\x0e"),
+            "a record of type 0x0e in the data section; its messages were read through",
+        ),
         "mcap_trailing_garbage": (
             data + b"\n-- appended by a copy tool --\n" * 8,
             "bytes after the end of the MCAP file",
@@ -122,6 +135,15 @@ def chunk_header_zeroed(data: bytes) -> bytes:
     second = sorted(summary.chunk_indexes, key=lambda c: c.chunk_start_offset)[1]
     at = second.chunk_start_offset + 3
     return patched(data, at, bytes(44))
+
+
+def one_chunk_flips() -> bytes:
+    """The campaign's case: ('flip', 29, 41, 2) on ofb104_good.mcap, three bits 41 bytes apart."""
+    data = bytearray((ROOT / "corpora" / "stream" / "ofb104_good.mcap").read_bytes())
+    assert data[70] == 0x06  # the chunk's type byte
+    for k, at in enumerate((29, 70, 111)):
+        data[at] ^= 1 << (2 + k)
+    return bytes(data)
 
 
 def metadata_start_digit(folder: Path) -> None:
@@ -179,6 +201,16 @@ def main() -> None:
         profile=MCAP_PROFILE,
         stderr=says,
     )
+    (HERE / "mcap_one_chunk_flips.mcap").write_bytes(one_chunk_flips())
+    nothing = [
+        {"code": "OFB001", "severity": "error", "time_s": None},
+        {"code": "OFB003", "severity": "info", "time_s": None},
+        MALFORMED,
+    ]
+    says = ["a record of type 0x0e in the data section (a damaged record type)"]
+    profile = {"px4": "1.15", "vehicle": "mc", "detected": False}
+    spec = {"exit_status": 2, "complete": False, "profile": profile, "stderr": says}
+    expected("mcap_one_chunk_flips", "mcap_one_chunk_flips.mcap", nothing, **spec)
     folder = HERE / "metadata_start_digit"
     shutil.rmtree(folder, ignore_errors=True)
     shutil.copytree(ROOT / "corpora" / "rosbag2" / "two_vehicles", folder)

@@ -38,6 +38,10 @@ KNOWN_OPCODES = frozenset(int(op) for op in Opcode)
 class Damage:
     what: str
     offset: int
+    kind: str = "summary"
+    """``summary``; or, in the data section, ``type`` (a record of a type that has no place
+    there: whatever it held is not read front to back) or ``length`` (a length or an end that
+    the streaming reader also stops at)."""
 
     def line(self) -> str:
         return f"{self.what} at byte {self.offset}"
@@ -103,9 +107,8 @@ def _index_disagrees(fh: BinaryIO, index: ChunkIndex, data_end: int) -> str | No
     if len(head) < 9 + CHUNK_HEADER:
         return "points past the end"
     stream = ReadDataStream(io.BytesIO(head))
-    if stream.read1() != Opcode.CHUNK:
-        return "points at no chunk"
-    stream.read8()  # the record's length: ``framing_damage`` judges it
+    stream.read1()  # the record's type and length: ``framing_damage`` judges them (a chunk
+    stream.read8()  # whose type byte was hit is still there, where its index says)
     if (stream.read8(), stream.read8()) != (index.message_start_time, index.message_end_time):
         return "disagrees with it on its message times"
     if stream.read8() != index.uncompressed_size:
@@ -143,17 +146,29 @@ def framing_damage(path: Path) -> Damage | None:
             header = fh.read(9)
             stream = ReadDataStream(io.BytesIO(header))
             opcode, length = stream.read1(), stream.read8()
-            if opcode == 0 or (opcode in KNOWN_OPCODES and opcode not in _DATA_SECTION):
-                return Damage(f"a record of type {opcode:#04x} in the data section", at)
+            if _misplaced(opcode):
+                return Damage(f"a record of type {opcode:#04x} in the data section", at, "type")
             if length > end - at - 9:
-                return Damage(f"a record claims {length} bytes, more than the file holds", at)
+                what = f"a record claims {length} bytes, more than the file holds"
+                return Damage(what, at, "length")
             if opcode == Opcode.CHUNK and length < CHUNK_HEADER:
-                return Damage(f"a chunk record of {length} bytes, too short for a chunk", at)
+                what = f"a chunk record of {length} bytes, too short for a chunk"
+                return Damage(what, at, "length")
             if opcode == Opcode.DATA_END:
-                return None if at + 9 + length == end else Damage("the data section ends early", at)
+                if at + 9 + length == end:
+                    return None
+                return Damage("the data section ends early", at, "length")
             at += 9 + length
             fh.seek(at)
-        return Damage("the data section has no DataEnd record", at)
+        return Damage("the data section has no DataEnd record", at, "length")
+
+
+def _misplaced(opcode: int) -> bool:
+    """A record type that has no place in the data section: 0, a summary record, or one of the
+    types MCAP reserves for itself and does not define (private records use 0x80 and up)."""
+    if opcode in KNOWN_OPCODES:
+        return opcode not in _DATA_SECTION
+    return opcode < 0x80
 
 
 _DATA_SECTION = frozenset(

@@ -568,6 +568,10 @@ class Rosbag2Source(Source):
         """fuzzoff's streaming MCAP reader: CRC-checked chunk by chunk, past bad chunks.
         ``refused``: why rosbags could not open the file, said if the stream finds nothing
         wrong (it was read whole, but something in it is malformed)."""
+        misplaced = mcap_check.framing_damage(path)
+        if misplaced is not None and misplaced.kind == "type":  # read past by the stream
+            what = f"{misplaced.what} (a damaged record type): what it held was not read"
+            self.problems.append(SourceProblem(what, self._at(path, misplaced.offset)))
         stream = McapStream(path, self.decoding, self._t0, self._connect, after_ns=after_ns)
         stream.summary_said = path in self._stream_only
         if not stream.summary_said:
