@@ -58,7 +58,7 @@ def test_a_data_record_whose_size_reads_0_is_reported_and_the_flight_read_on(
     whole = [e for e in events(REAL) if isinstance(e, VehicleStatus)]
     damaged = [e for e in events(path) if isinstance(e, VehicleStatus)]
     assert damaged[-1].t == whole[-1].t  # read on to the end of the flight
-    assert len(damaged) >= 0.9 * len(whole)
+    assert len(damaged) > row + len(whole) // 2  # most of what follows the damage
 
 
 @pytest.fixture(scope="module")

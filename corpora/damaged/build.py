@@ -21,8 +21,9 @@ Failures the damage campaign found (shrunk by Hypothesis), kept here:
   (its length's high bytes, times, sizes, CRC, compression and data length): the chunk read as
   empty, without an error, and its 1.5 s of stream vanished in silence. Now OFB001 (the chunk's
   fields no longer fill its record), beside OFB004 (the summary's index of it disagrees). The
-  readable part shows the hole: a 1.5 s keep-alive gap before the switch (OFB101 at 0.5 s,
-  OFB102 and OFB202 at the switch).
+  readable part shows the hole: a 1.5 s keep-alive gap before the switch (OFB101 at 0.5 s; at
+  the switch the newest keep-alive is 1.5 s old, so PX4 1.15 would reject it: OFB102 an error,
+  OFB202 as the recording shows it accepted).
 * ``mcap_one_chunk_flips``: corpora/stream/ofb104_good.mcap (one chunk) with three bits
   flipped: in the header, in the chunk's type byte (a chunk read as a SummaryOffset record) and
   in its compression's name. The summary's index disagreed, the file was read front to back,
@@ -64,17 +65,16 @@ assert _spec is not None and _spec.loader is not None
 rosbag1_build = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(rosbag1_build)
 
-MCAP_FINDINGS = [
-    {"code": "OFB002", "severity": "info", "time_s": None},
-    {"code": "OFB701", "severity": "info", "time_s": 2.0},
-]
-"""corpora/mcap/good_flight.expected.json: the same flight."""
+
+def intact(expected_json: str) -> dict[str, Any]:
+    """The planted expectations of an undamaged corpus recording (the same flight)."""
+    spec: dict[str, Any] = json.loads((ROOT / "corpora" / expected_json).read_text())
+    return spec
+
+
+MCAP_FINDINGS = intact("mcap/good_flight.expected.json")["findings"]
 MCAP_PROFILE = {"px4": "1.15", "vehicle": "mc", "detected": True}
-BAG_FINDINGS = [
-    {"code": "OFB701", "severity": "info", "time_s": 3.5},
-    {"code": "OFB003", "severity": "info", "time_s": None},
-]
-"""corpora/rosbag1/offboard_good.expected.json: the same flight."""
+BAG_FINDINGS = intact("rosbag1/offboard_good.expected.json")["findings"]
 MALFORMED = {"code": "OFB004", "severity": "info", "time_s": None}
 
 
@@ -187,7 +187,7 @@ def main() -> None:
         {"code": "OFB002", "severity": "info", "time_s": None},
         MALFORMED,
         {"code": "OFB101", "severity": "error", "time_s": 0.5},
-        {"code": "OFB102", "severity": "warning", "time_s": 2.0},
+        {"code": "OFB102", "severity": "error", "time_s": 2.0},
         {"code": "OFB202", "severity": "warning", "time_s": 2.01},
         {"code": "OFB701", "severity": "info", "time_s": 2.02},
     ]
@@ -215,13 +215,13 @@ def main() -> None:
     shutil.rmtree(folder, ignore_errors=True)
     shutil.copytree(ROOT / "corpora" / "rosbag2" / "two_vehicles", folder)
     metadata_start_digit(folder)
-    intact = json.loads((ROOT / "corpora" / "rosbag2" / "two_vehicles.expected.json").read_text())
+    bag_spec = intact("rosbag2/two_vehicles.expected.json")
     expected(
         "metadata_start_digit",
         "metadata_start_digit",
-        [*intact["findings"], MALFORMED],
-        exit_status=intact["exit_status"],
-        profile=intact["profile"],
+        [*bag_spec["findings"], MALFORMED],
+        exit_status=bag_spec["exit_status"],
+        profile=bag_spec["profile"],
         stderr=["metadata.yaml's starting time is", "the data files' times were used"],
     )
     for name, (damaged, says) in bag_cases(bag.read_bytes()).items():
