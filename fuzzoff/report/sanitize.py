@@ -9,6 +9,7 @@ _BIDI = "\u061c\u200e\u200f\u202a-\u202e\u2066-\u2069"
 letter mark, left-to-right and right-to-left marks, embeddings, overrides and isolates."""
 _UNPRINTABLE = re.compile(f"[\\x00-\\x1f\\x7f-\\x9f\\u2028\\u2029{_BIDI}]")
 _REORDERING = re.compile(f"[\\u2028\\u2029{_BIDI}]")
+_BIDI_ONLY = re.compile(f"[{_BIDI}]")
 
 
 CI_TEXT_LIMIT = 2000
@@ -34,3 +35,9 @@ def escape_bidi(text: str) -> str:
     where the escape means the character itself: parsers get the same strings back. In XML
     (JUnit) the escape is shown as written, as on the terminal."""
     return _REORDERING.sub(lambda m: f"\\u{ord(m.group()):04x}", text)
+
+
+def show_bidi(text: str) -> str:
+    """Bidi controls in ``text`` written out as ``\\uNNNN`` (the rest as it is): for strings a
+    script draws as labels, where a control would reorder what is shown."""
+    return _BIDI_ONLY.sub(lambda m: f"\\u{ord(m.group()):04x}", text)
