@@ -228,3 +228,15 @@ def test_channels_a_skipped_chunk_defined_are_read_or_counted(chunked: Path) -> 
     (orphans,) = [x for x in lines if "on channels that no readable record defines" in x]
     counted = int(orphans.split(f"{chunked}: ", 1)[1].split()[0])
     assert control_modes(chunked) + counted // 2 <= with_summary < 400
+
+
+def test_ofb004_is_a_rule_like_any_other() -> None:
+    path = CORPORA / "damaged" / "mcap_trailing_garbage.mcap"
+    said = run_cli(["lint", str(path), "--format", "json"])
+    assert said.returncode == 0 and "bytes after the end of the MCAP file" in said.stderr
+    quiet = run_cli(["lint", str(path), "--format", "json", "--ignore", "OFB004"])
+    assert quiet.returncode == 0 and quiet.stderr == ""
+    (report,) = json.loads(quiet.stdout)["files"]
+    assert "OFB004" not in [f["code"] for f in report["findings"]]
+    strict = run_cli(["lint", str(path), "--format", "json", "--fail-on", "info"])
+    assert strict.returncode == 1  # an info finding at the info fail level
