@@ -240,3 +240,17 @@ def test_ofb004_is_a_rule_like_any_other() -> None:
     assert "OFB004" not in [f["code"] for f in report["findings"]]
     strict = run_cli(["lint", str(path), "--format", "json", "--fail-on", "info"])
     assert strict.returncode == 1  # an info finding at the info fail level
+
+
+def test_a_topic_name_flipped_in_the_database_is_not_vouched_for(sqlite_bag: Path) -> None:
+    # One bit of a topic's name in the database's topics table (the campaign's case): the data
+    # then hold a topic metadata.yaml does not list. Which of the two is damaged cannot be
+    # told (a metadata.yaml from another bag reads the same), so the file is incomplete.
+    db3 = sqlite_bag / "two_vehicles.db3"
+    data = db3.read_bytes()
+    at = data.rindex(b"/px4_1/fmu/out/vehicle_status") + len("/px4_1/fm")
+    db3.write_bytes(data[:at] + bytes([data[at] ^ 0x40]) + data[at + 1 :])  # 'u' -> '5'
+    code, report, (line,) = lint(sqlite_bag)
+    assert code == 2 and report["complete"] is False
+    assert "metadata.yaml does not list /px4_1/fm5/out/vehicle_status" in line
+    assert "one of them is damaged or from another recording" in line

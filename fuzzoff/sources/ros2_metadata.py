@@ -104,34 +104,44 @@ def _shown(value: Any) -> str:
     return text if len(text) <= 32 else text[:31] + "…"
 
 
-def data_start(files: list[Path]) -> int | None:
-    """The earliest message time in the data files, from their own indexes (a database's
-    timestamp index, an MCAP's statistics); None where a file cannot say cheaply."""
-    starts = []
+Span = tuple[int, int]
+"""The first and the last message time, in ns."""
+
+
+def data_span(files: list[Path]) -> Span | None:
+    """The first and last message times in the data files, from their own indexes (a
+    database's timestamp index, an MCAP's statistics); None where a file cannot say cheaply."""
+    spans = []
     for path in files:
-        start = _sqlite_start(path) if path.suffix == ".db3" else _mcap_start(path)
-        if start is None:
+        span = _sqlite_span(path) if path.suffix == ".db3" else _mcap_span(path)
+        if span is None:
             return None
-        if start >= 0:
-            starts.append(start)
-    return min(starts) if starts else None
+        if span[0] <= span[1]:
+            spans.append(span)
+    if not spans:
+        return None
+    return min(a for a, _ in spans), max(b for _, b in spans)
 
 
-def _sqlite_start(path: Path) -> int | None:
+_EMPTY: Span = (1, 0)
+
+
+def _sqlite_span(path: Path) -> Span | None:
     try:
         db = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
         try:
             row = db.execute(
-                "SELECT MIN(timestamp) FROM messages WHERE typeof(timestamp) = 'integer'"
+                "SELECT MIN(timestamp), MAX(timestamp) FROM messages "
+                "WHERE typeof(timestamp) = 'integer'"
             ).fetchone()
         finally:
             db.close()
     except (sqlite3.Error, UnicodeDecodeError, MemoryError):
         return None
-    return int(row[0]) if row and row[0] is not None else -1
+    return (int(row[0]), int(row[1])) if row and row[0] is not None else _EMPTY
 
 
-def _mcap_start(path: Path) -> int | None:
+def _mcap_span(path: Path) -> Span | None:
     try:
         with path.open("rb") as fh:
             summary = SeekingReader(fh, record_size_limit=path.stat().st_size).get_summary()
@@ -139,8 +149,10 @@ def _mcap_start(path: Path) -> int | None:
         return None
     if summary is None or summary.statistics is None:
         return None
-    statistics = summary.statistics
-    return int(statistics.message_start_time) if statistics.message_count else -1
+    stats = summary.statistics
+    if not stats.message_count:
+        return _EMPTY
+    return int(stats.message_start_time), int(stats.message_end_time)
 
 
 def differs(listed_ns: int, start_ns: int) -> str | None:

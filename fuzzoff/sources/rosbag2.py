@@ -158,8 +158,13 @@ class Rosbag2Source(Source):
         if unlisted:
             with suppress(Exception):
                 reader.close()
-            fault = f"metadata.yaml does not list {_some(unlisted)}, which the data files hold"
-            self._salvage_plan(ValueError(fault), fault)
+            # One of the two is damaged: a topic renamed in the database reads the same as a
+            # metadata.yaml from another bag, so the data files are read but not vouched for.
+            fault = (
+                f"metadata.yaml does not list {_some(unlisted)}, which the data files hold "
+                "(one of them is damaged or from another recording)"
+            )
+            self._salvage_plan(ValueError(fault), fault, lost=True)
             return
         self._reader = reader
 
@@ -205,10 +210,13 @@ class Rosbag2Source(Source):
             unlisted.update(t for t, m in held - listed if _decoded_topic(t, m))
         return sorted(unlisted)
 
-    def _salvage_plan(self, exc: BaseException, fault: str | None = None) -> None:
+    def _salvage_plan(
+        self, exc: BaseException, fault: str | None = None, lost: bool = False
+    ) -> None:
         """rosbags could not open the bag as a whole, or ``fault`` is what its metadata.yaml
         gets wrong (``ros2_metadata``): the data files, to read one by one. A metadata.yaml at
-        fault is said, and the folder's own data files are read: nothing is lost by it."""
+        fault is said, and the folder's own data files are read: nothing is lost by it, unless
+        the two disagree on what the data holds (``lost``: which is damaged cannot be told)."""
         if self.path.is_file():
             self._files = [self.path]
             return
@@ -231,7 +239,7 @@ class Rosbag2Source(Source):
         if fault is not None:
             names = _some([path.name for path in files])
             what = f"{fault}; the data files were read instead: {names}"
-            self.problems.append(SourceProblem(what, lost=False))
+            self.problems.append(SourceProblem(what, lost=lost))
         self._files = files
 
     def _files_from_metadata(self, meta: Path) -> list[Path] | None:
@@ -255,7 +263,7 @@ class Rosbag2Source(Source):
             info.message_count = reader.message_count
             self._t0 = reader.start_time if reader.message_count else None
             if self._t0 is not None and self.path.is_dir():
-                self._t0 = self._data_time(self._t0)
+                self._t0 = self._data_time(reader)
             for conn in reader.connections:
                 self._decoder(conn.topic, conn.msgtype, conn.msgdef)
             if reader.ros_distro:
@@ -288,15 +296,27 @@ class Rosbag2Source(Source):
             "rover-ackermann, rover-differential or rover-mecanum)"
         )
 
-    def _data_time(self, listed_ns: int) -> int:
-        """The bag's start: metadata.yaml's, unless the data files' first message disagrees
-        (a metadata.yaml from another recording shifted every time by the difference)."""
-        start = ros2_metadata.data_start(self._data_files(self.path))
-        if start is None:
-            return listed_ns
-        differs = ros2_metadata.differs(listed_ns, start)
-        if differs is None:
-            return listed_ns
+    def _data_time(self, reader: Any) -> int:
+        """The bag's start. metadata.yaml states it, with the bag's duration; the data files
+        hold the messages' own times. Where the two disagree, the one whose span matches the
+        data's is believed: metadata.yaml from another recording (every time shifted by the
+        difference) gives way to the data; a database whose earliest time alone disagrees
+        (a damaged timestamp: its last agrees with metadata.yaml) keeps metadata.yaml's."""
+        listed, listed_end = reader.start_time, reader.end_time - 1
+        span = ros2_metadata.data_span(self._data_files(self.path))
+        if span is None or span[0] == listed:
+            return int(listed)
+        start, end = span
+        if end == listed_end:
+            way = "before" if start < listed else "after"
+            what = (
+                f"the first message is {abs(listed - start) / 1e9:.3f} s {way} the bag's start, "
+                "as metadata.yaml and the last message agree on it (a damaged timestamp?); "
+                "metadata.yaml's start was used"
+            )
+            self.problems.append(SourceProblem(what, "messages.timestamp"))
+            return int(listed)
+        differs = ros2_metadata.differs(listed, start)
         what = f"{differs}; the data files' times were used"
         self.problems.append(SourceProblem(what, lost=False))
         return start
