@@ -32,6 +32,10 @@ Failures the damage campaign found (shrunk by Hypothesis), kept here:
 * ``mcap_chunk_type_flipped`` (OFB004, the case above with a sound summary): the second
   chunk's type byte reads 0x0e; its index and every other header field agree, so its messages
   are read through the summary, and the line says so.
+* ``bag_index_zeroed``: 16 zero bytes in the index of ``chunked.bag`` (in a chunk-info
+  record): read through that index, messages were missed with only OFB004 said. An index
+  whose records do not read is not trusted: the bag is read in file order (OFB001, reindex
+  advised) and every message is there (the findings of the intact flight).
 * ``metadata_start_digit``: corpora/rosbag2/two_vehicles with one bit flipped in a digit of
   metadata.yaml's starting time: every time moved by that much in silence. Now OFB004, and the
   data files' own first time is used (the findings of the intact bag).
@@ -159,7 +163,13 @@ def bag_cases(data: bytes) -> dict[str, tuple[bytes, str]]:
     bio.readline()
     Header.read(bio, RecordType.BAGHEADER)
     data_len_at = bio.tell()  # the bag header record's data length, after its header
+    index_pos = Header.read(io.BytesIO(data[13:]), RecordType.BAGHEADER).get_uint64("index_pos")
+    assert index_pos < 50078 < len(data)  # the campaign's place: a chunk-info record
     return {
+        "bag_index_zeroed": (
+            patched(data, 50078, bytes(16)),
+            "index damaged at byte",
+        ),
         "bag_header_data_len": (
             patched(data, data_len_at, b"\xff\xff\xff\xff"),
             "the bag header's data length runs past the end",
@@ -226,6 +236,11 @@ def main() -> None:
     )
     for name, (damaged, says) in bag_cases(bag.read_bytes()).items():
         (HERE / f"{name}.bag").write_bytes(damaged)
+        if name == "bag_index_zeroed":
+            unread = {"code": "OFB001", "severity": "error", "time_s": None}
+            spec = {"exit_status": 2, "complete": False, "stderr": [says]}
+            expected(name, f"{name}.bag", [unread, *BAG_FINDINGS], **spec)
+            continue
         expected(name, f"{name}.bag", [*BAG_FINDINGS, MALFORMED], stderr=[says])
 
 

@@ -68,12 +68,15 @@ class Rosbag1Source(Source):
         except Exception as exc:  # rosbags asserts and struct errors on corrupt index records
             self._open_damaged(f"{type(exc).__name__}: {exc}")
             return
-        self._reader = reader
         damage = framing_damage(self.path)
+        if damage is not None and damage[2]:  # the index itself: it cannot say where messages are
+            reader.close()
+            self._open_damaged(f"index damaged ({damage[0]} at byte {damage[1]})")
+            return
+        self._reader = reader
         if damage is not None:  # read around through the index: said once that read is done
-            what, at = damage
-            what += "; the messages were read through the bag's index"
-            self._framing = SourceProblem(what, f"byte {at}", lost=False)
+            what = f"{damage[0]}; the messages were read through the bag's index"
+            self._framing = SourceProblem(what, f"byte {damage[1]}", lost=False)
         self._wanted = [c for c in reader.connections if mavros_topic(c.topic, c.msgtype)]
         self._total = sum(c.msgcount for c in self._wanted)
         self._typestore = self._build_typestore(self._wanted)

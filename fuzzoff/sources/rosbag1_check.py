@@ -21,8 +21,13 @@ BEFORE_INDEX = frozenset({RecordType.CHUNK, RecordType.IDXDATA, RecordType.CONNE
 IN_INDEX = frozenset({RecordType.CONNECTION, RecordType.CHUNK_INFO})
 
 
-def framing_damage(path: Path) -> tuple[str, int] | None:
-    """(what is wrong, at which byte) for the first record whose framing is damaged, or None."""
+Damage = tuple[str, int, bool]
+"""What is wrong, at which byte, and whether it is in the index (then the index cannot be
+trusted: its records say where the messages are)."""
+
+
+def framing_damage(path: Path) -> Damage | None:
+    """The first record whose framing is damaged, or None."""
     with path.open("rb") as bio:
         size = os.fstat(bio.fileno()).st_size
         if bio.readline() != MAGIC:
@@ -36,23 +41,21 @@ def framing_damage(path: Path) -> tuple[str, int] | None:
         at = bio.tell()
         length = _length(bio, size)
         if length is None:
-            return f"the bag header's data length runs past the end (byte {size})", at
+            return f"the bag header's data length runs past the end (byte {size})", at, False
         bio.seek(length, os.SEEK_CUR)
         if bio.tell() > index_pos:
-            return "the bag header's data length runs into the index", at
+            return "the bag header's data length runs into the index", at, False
         while bio.tell() < index_pos:
             wrong = _record(bio, index_pos, BEFORE_INDEX)
             if wrong is not None:
-                return wrong
+                return (*wrong, False)
         for _ in range(records):
             wrong = _record(bio, size, IN_INDEX)
             if wrong is not None:
-                return wrong
+                return (*wrong, True)
         if bio.tell() < size:
-            return (
-                f"{size - bio.tell()} bytes after the bag's index, not part of the bag",
-                bio.tell(),
-            )
+            what = f"{size - bio.tell()} bytes after the bag's index, not part of the bag"
+            return what, bio.tell(), False
     return None
 
 
