@@ -36,6 +36,14 @@ Failures the damage campaign found (shrunk by Hypothesis), kept here:
   record): read through that index, messages were missed with only OFB004 said. An index
   whose records do not read is not trusted: the bag is read in file order (OFB001, reindex
   advised) and every message is there (the findings of the intact flight).
+* ``bag_chunk_info_zeroed``: 12 zero bytes a little further, in the same chunk-info record's
+  message counts: its framing reads, but rosbags skipped the chunk. The chunk infos are
+  checked against the chunks' own index records: the same as above.
+* ``mcap_bag_channel_zeroed``: 23 zero bytes over a Channel record in the summary of
+  corpora/rosbag2/stream_lost_mcap (no summary CRC from rosbag2's writer): rosbags dropped
+  that channel's 79 messages, and fuzzoff took the summary's statistics for the data's count.
+  A summary without a channel its chunk indexes name is not trusted: read front to back, every
+  message (the findings of the intact bag and one OFB004).
 * ``metadata_start_digit``: corpora/rosbag2/two_vehicles with one bit flipped in a digit of
   metadata.yaml's starting time: every time moved by that much in silence. Now OFB004, and the
   data files' own first time is used (the findings of the intact bag).
@@ -170,6 +178,7 @@ def bag_cases(data: bytes) -> dict[str, tuple[bytes, str]]:
             patched(data, 50078, bytes(16)),
             "index damaged at byte",
         ),
+        "bag_chunk_info_zeroed": (patched(data, 50082, bytes(12)), "index damaged at byte"),
         "bag_header_data_len": (
             patched(data, data_len_at, b"\xff\xff\xff\xff"),
             "the bag header's data length runs past the end",
@@ -221,6 +230,20 @@ def main() -> None:
     profile = {"px4": "1.15", "vehicle": "mc", "detected": False}
     spec = {"exit_status": 2, "complete": False, "profile": profile, "stderr": says}
     expected("mcap_one_chunk_flips", "mcap_one_chunk_flips.mcap", nothing, **spec)
+    folder = HERE / "mcap_bag_channel_zeroed"
+    shutil.rmtree(folder, ignore_errors=True)
+    shutil.copytree(ROOT / "corpora" / "rosbag2" / "stream_lost_mcap", folder)
+    data_file = folder / "stream_lost_mcap.mcap"
+    data_file.write_bytes(patched(data_file.read_bytes(), 34270, bytes(23)))
+    lost_spec = intact("rosbag2/stream_lost_mcap.expected.json")
+    expected(
+        "mcap_bag_channel_zeroed",
+        "mcap_bag_channel_zeroed",
+        [*lost_spec["findings"], MALFORMED],
+        exit_status=lost_spec["exit_status"],
+        profile=lost_spec["profile"],
+        stderr=["the summary lacks the channel 5 its chunk indexes name"],
+    )
     folder = HERE / "metadata_start_digit"
     shutil.rmtree(folder, ignore_errors=True)
     shutil.copytree(ROOT / "corpora" / "rosbag2" / "two_vehicles", folder)
@@ -236,7 +259,7 @@ def main() -> None:
     )
     for name, (damaged, says) in bag_cases(bag.read_bytes()).items():
         (HERE / f"{name}.bag").write_bytes(damaged)
-        if name == "bag_index_zeroed":
+        if name in ("bag_index_zeroed", "bag_chunk_info_zeroed"):
             unread = {"code": "OFB001", "severity": "error", "time_s": None}
             spec = {"exit_status": 2, "complete": False, "stderr": [says]}
             expected(name, f"{name}.bag", [unread, *BAG_FINDINGS], **spec)

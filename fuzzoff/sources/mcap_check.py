@@ -23,7 +23,7 @@ from typing import BinaryIO
 
 from mcap.data_stream import ReadDataStream
 from mcap.opcode import Opcode
-from mcap.records import ChunkIndex, Footer
+from mcap.records import Channel, ChunkIndex, Footer
 from mcap.stream_reader import StreamReader
 
 MAGIC = b"\x89MCAP0\r\n"
@@ -79,12 +79,20 @@ def summary_damage(path: Path) -> Damage | None:
                 )
         fh.seek(footer.summary_start)
         indexes: list[ChunkIndex] = []
+        channels: set[int] = set()
         try:
             for record in StreamReader(fh, skip_magic=True, record_size_limit=size).records:
                 if isinstance(record, ChunkIndex):
                     indexes.append(record)
+                elif isinstance(record, Channel):
+                    channels.add(record.id)
         except Exception as exc:  # mcap's errors, struct and decode errors on damaged records
             what = f"summary section unreadable ({type(exc).__name__})"
+            return Damage(what, footer.summary_start)
+        named = {c for index in indexes for c in index.message_index_offsets}
+        if channels and not named <= channels:  # rosbags would not read an undefined channel
+            lacking = min(named - channels)
+            what = f"the summary lacks the channel {lacking} its chunk indexes name"
             return Damage(what, footer.summary_start)
         for index in indexes:
             wrong = _index_disagrees(fh, index, footer.summary_start)
@@ -124,6 +132,28 @@ def _index_disagrees(fh: BinaryIO, index: ChunkIndex, data_end: int) -> str | No
         return "disagrees with it on its compressed size"
     if index.chunk_length != stream.count + index.compressed_size:
         return "disagrees with it on its length"
+    return _message_indexes_disagree(fh, index)
+
+
+def _message_indexes_disagree(fh: BinaryIO, index: ChunkIndex) -> str | None:
+    """Each channel's offset must lead to that channel's MessageIndex record after the chunk:
+    rosbags counts a chunk's messages per channel from these offsets, and skips the chunk for
+    a channel it finds none of."""
+    first = index.chunk_start_offset + index.chunk_length
+    last = first + index.message_index_length
+    for channel_id, offset in index.message_index_offsets.items():
+        if not first <= offset < last:
+            return "points to message indexes outside its own"
+        fh.seek(offset)
+        head = fh.read(9 + 2)
+        if len(head) < 11:
+            return "points to message indexes past the end"
+        stream = ReadDataStream(io.BytesIO(head))
+        if stream.read1() != Opcode.MESSAGE_INDEX:
+            return "points to no message index"
+        stream.read8()
+        if stream.read2() != channel_id:
+            return "disagrees with its message indexes on their channels"
     return None
 
 

@@ -173,11 +173,12 @@ def differs(listed_ns: int, start_ns: int) -> str | None:
 
 
 def held_messages(files: list[Path], topics: set[tuple[str, str]]) -> int | None:
-    """How many messages on ``topics`` (name, type) the data files hold, by their own count (a
-    database's rows, an MCAP's statistics); None where a file cannot say."""
+    """How many messages on ``topics`` (name, type) the data files hold, counted in the data
+    (a database's rows); None where only an index could say (an MCAP's statistics are part
+    of the summary that may be what is damaged)."""
     total = 0
     for path in files:
-        held = _sqlite_held(path, topics) if path.suffix == ".db3" else _mcap_held(path, topics)
+        held = _sqlite_held(path, topics) if path.suffix == ".db3" else None
         if held is None:
             return None
         total += held
@@ -197,20 +198,3 @@ def _sqlite_held(path: Path, topics: set[tuple[str, str]]) -> int | None:
     except (sqlite3.Error, UnicodeDecodeError, MemoryError):
         return None
     return sum(int(count) for name, msgtype, count in rows if (name, msgtype) in topics)
-
-
-def _mcap_held(path: Path, topics: set[tuple[str, str]]) -> int | None:
-    try:
-        with path.open("rb") as fh:
-            summary = SeekingReader(fh, record_size_limit=path.stat().st_size).get_summary()
-    except Exception:  # no usable summary
-        return None
-    if summary is None or summary.statistics is None:
-        return None
-    counts = summary.statistics.channel_message_counts
-    held = 0
-    for channel_id, channel in summary.channels.items():
-        schema = summary.schemas.get(channel.schema_id)
-        if (channel.topic, schema.name if schema is not None else "") in topics:
-            held += counts.get(channel_id, 0)
-    return held

@@ -29,7 +29,7 @@ from fuzzoff.events import Event
 from fuzzoff.sources.base import RecordingInfo, Source, SourceError, SourceProblem
 from fuzzoff.sources.mavros import TOPIC_KINDS, Handler, MavrosConverter, mavros_topic
 from fuzzoff.sources.mavros_msgs import mavros_typedefs
-from fuzzoff.sources.rosbag1_check import framing_damage
+from fuzzoff.sources.rosbag1_check import chunk_infos_disagree, walk
 from fuzzoff.sources.rosbag1_chunkwise import ChunkwiseReader
 from fuzzoff.sources.rosbag1_salvage import SalvageReader, bag_header_index_pos
 from fuzzoff.sources.typedefs import bounded
@@ -68,15 +68,16 @@ class Rosbag1Source(Source):
         except Exception as exc:  # rosbags asserts and struct errors on corrupt index records
             self._open_damaged(f"{type(exc).__name__}: {exc}")
             return
-        damage = framing_damage(self.path)
-        if damage is not None and damage[2]:  # the index itself: it cannot say where messages are
+        found = walk(self.path)
+        wrong = chunk_infos_disagree(found, reader.chunk_infos)
+        if found.in_index or wrong is not None:  # the index cannot say where messages are
             reader.close()
-            self._open_damaged(f"index damaged ({damage[0]} at byte {damage[1]})")
+            self._open_damaged(f"index damaged ({wrong or 'a record does not read'})")
             return
         self._reader = reader
-        if damage is not None:  # read around through the index: said once that read is done
-            what = f"{damage[0]}; the messages were read through the bag's index"
-            self._framing = SourceProblem(what, f"byte {damage[1]}", lost=False)
+        if found.damage is not None:  # read around through the index: said once that is done
+            what = f"{found.damage[0]}; the messages were read through the bag's index"
+            self._framing = SourceProblem(what, f"byte {found.damage[1]}", lost=False)
         self._wanted = [c for c in reader.connections if mavros_topic(c.topic, c.msgtype)]
         self._total = sum(c.msgcount for c in self._wanted)
         self._typestore = self._build_typestore(self._wanted)
