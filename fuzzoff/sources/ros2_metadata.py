@@ -127,18 +127,26 @@ _EMPTY: Span = (1, 0)
 
 
 def _sqlite_span(path: Path) -> Span | None:
+    """Each bound alone, as SQLite answers it from the timestamp index without a scan; a
+    bound that is not an integer (SQLite sorts text and blobs after numbers) only then
+    through the scan that leaves such rows out."""
     try:
         db = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
         try:
-            row = db.execute(
-                "SELECT MIN(timestamp), MAX(timestamp) FROM messages "
-                "WHERE typeof(timestamp) = 'integer'"
-            ).fetchone()
+            low = db.execute("SELECT MIN(timestamp) FROM messages").fetchone()[0]
+            high = db.execute("SELECT MAX(timestamp) FROM messages").fetchone()[0]
+            if low is None:
+                return _EMPTY
+            if type(low) is not int or type(high) is not int:
+                low, high = db.execute(
+                    "SELECT MIN(timestamp), MAX(timestamp) FROM messages "
+                    "WHERE typeof(timestamp) = 'integer'"
+                ).fetchone()
         finally:
             db.close()
     except (sqlite3.Error, UnicodeDecodeError, MemoryError):
         return None
-    return (int(row[0]), int(row[1])) if row and row[0] is not None else _EMPTY
+    return (int(low), int(high)) if low is not None else _EMPTY
 
 
 def _mcap_span(path: Path) -> Span | None:
