@@ -59,6 +59,10 @@ CASES = {
     "tlog": Case(CORPORA / "tlog" / "good_offboard.tlog", lenient=True, endless=True),
     "ulog": Case(CORPORA / "ulog" / "switch_rejected.ulg", lenient=True, endless=True),
     "ulog-real": Case(CORPORA / "real" / "sample_log_small.ulg", lenient=True, endless=True),
+    "tlog-px4": Case(CORPORA / "sitl" / "clean_offboard-1.16.2.tlog", lenient=True, endless=True),
+    "ulog-px4": Case(
+        CORPORA / "sitl" / "disarmed_switch_no_stream-1.18.0-alpha1.ulg", lenient=True, endless=True
+    ),
     "mcap": Case(CORPORA / "damaged" / "chunked.mcap", lenient=False),
     "mcap-one-chunk": Case(CORPORA / "stream" / "ofb104_good.mcap", lenient=False),
     "rosbag2-sqlite3": Case(CORPORA / "rosbag2" / "two_vehicles", lenient=True),
