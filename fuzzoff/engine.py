@@ -451,6 +451,13 @@ def lint_file(
         source = open_source(path)
         source.px4_hint = settings.px4
         source.plot_data = plot_data
+
+        def show() -> None:
+            fraction = source.progress() if progress is not None else None
+            if progress is not None and fraction is not None:
+                progress(fraction)
+
+        source.on_progress = show if progress is not None else None
         source.open()
     except SourceError as exc:
         report = FileReport(name, "unknown", resolve_profile(RecordingInfo(name, "?"), settings))
@@ -472,10 +479,7 @@ def lint_file(
         report = FileReport(name, source.format, profile)
 
         def tick(_: int) -> None:
-            if progress is not None:
-                fraction = source.progress()
-                if fraction is not None:
-                    progress(fraction)
+            show()
 
         findings, stats = run_events(
             _until_unreadable(source.events(), source.problems),
@@ -488,20 +492,34 @@ def lint_file(
         )
     finally:
         source.close()
+    malformed = get_rule("OFB004")
     for problem in source.problems:
         line = problem.line(name)
-        report.problems.append(line)
-        findings.append(
-            Finding(
-                "OFB001",
-                unreadable.name,
-                Severity.ERROR,
-                line,
-                time_s=problem.time_s,
-                summary=_unreadable(problem),
+        if problem.lost:
+            report.problems.append(line)
+            findings.append(
+                Finding(
+                    "OFB001",
+                    unreadable.name,
+                    Severity.ERROR,
+                    line,
+                    time_s=problem.time_s,
+                    summary=_unreadable(problem),
+                )
             )
-        )
-    report.complete = not source.problems
+        else:
+            report.malformed.append(line)
+            findings.append(
+                Finding(
+                    "OFB004",
+                    malformed.name,
+                    settings.severity_of("OFB004", Severity.INFO),
+                    line,
+                    time_s=problem.time_s,
+                    summary=_unreadable(problem),
+                )
+            )
+    report.complete = not report.problems
     vehicle_assumed = info.vehicle_assumed if settings.vehicle is None else None
     if settings.enabled("OFB003") and (
         not (profile.px4_detected and profile.vehicle_detected) or vehicle_assumed

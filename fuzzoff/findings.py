@@ -142,6 +142,8 @@ class FileReport:
     findings: list[Finding] = field(default_factory=list)
     problems: list[str] = field(default_factory=list)
     """One line per part of the input that could not be read (OFB001 messages)."""
+    malformed: list[str] = field(default_factory=list)
+    """One line per malformed part that was read around with nothing lost (OFB004 messages)."""
     stats: dict[str, Any] = field(default_factory=dict)
     extras: dict[str, Any] = field(default_factory=dict)
     """Optional data for rich reports (gate timeline, keep-alive series)."""

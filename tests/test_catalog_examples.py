@@ -2,7 +2,7 @@
 
 The test stream is the rule's behaviour as tiny event lists (``[test_stream]`` in its TOML page,
 shown by ``fuzzoff rule CODE --verbose``); the page's Example and Use instead sections show client
-code instead. OFB001-OFB003 are about the input and the profile, not about a stream: they are
+code instead. OFB001-OFB004 are about the input and the profile, not about a stream: they are
 exempt, and listed here so that the exemption is visible.
 """
 
@@ -20,7 +20,7 @@ from fuzzoff.findings import Finding
 from fuzzoff.profiles import DEFAULT_PX4, DEFAULT_VEHICLE, Profile
 from fuzzoff.sources.base import RecordingInfo
 
-NOT_STREAM_RULES = {"OFB001", "OFB002", "OFB003"}
+NOT_STREAM_RULES = {"OFB001", "OFB002", "OFB003", "OFB004"}
 """Rules about reading the file or choosing the profile: no event stream can show them."""
 
 RULES = [rule for code, rule in load_catalog().items() if code not in NOT_STREAM_RULES]

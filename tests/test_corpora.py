@@ -4,7 +4,8 @@ Each ``corpora/**/NAME.expected.json`` names its ``recording`` (relative to the 
 extra command-line ``args``, the ``exit_status``, whether the file is ``complete``, and the exact
 list of ``findings`` (``code``, ``severity``, ``time_s`` or null, optional ``vehicle``), paired
 as ``fuzzoff replay`` pairs them (``compare``: times within ``TIME_TOLERANCE_S``); every finding
-must be listed (no extras, none missing).
+must be listed (no extras, none missing). An optional ``stderr`` lists what the lines about the
+file's damage must say.
 """
 
 from __future__ import annotations
@@ -39,6 +40,8 @@ def test_corpus_recording_gives_expected_findings(expected_file: Path) -> None:
     if "profile" in spec:
         for key, value in spec["profile"].items():
             assert file_report["profile"][key] == value, key
+    for says in spec.get("stderr", []):
+        assert says in result.stderr, result.stderr
 
 
 def test_corpus_recordings_stay_small() -> None:

@@ -21,7 +21,7 @@ from fuzzoff.sources import px4_msgs
 from tests.helpers import ROOT, run_cli
 
 RULES = list(load_catalog().values())
-TOOL_RULES = {"OFB001", "OFB002", "OFB003"}
+TOOL_RULES = {"OFB001", "OFB002", "OFB003", "OFB004"}
 """Rules about reading the recording: their references are this project's own docs."""
 
 DOCS_PAGE = re.compile(r"^https://docs\.px4\.io/(main|v1\.1[3-8])/en/[a-z0-9_/]+\.html(#[\w-]+)?$")

@@ -22,12 +22,13 @@ of these topics lacks) and OFB701 (the loss parameters assumed, at the offboard 
 * ``wrong_release_payload``: the good flight whose VehicleControlMode payloads are 1.15's while
   the embedded definitions are 1.18's (profile main): OFB001 at its first message (never
   decoded half-right); exit status 2, the other topics' findings kept.
-* ``truncated``: the stream-lost flight cut at 80 %: OFB001 (no footer), exit status 2; the
-  findings of the readable part (OFB101, OFB103) are kept.
+* ``truncated``: the stream-lost flight cut in its last chunk: OFB001 (no footer), exit status
+  2; the findings of the readable part (OFB101, OFB103) are kept.
 """
 
 from __future__ import annotations
 
+import io
 import json
 import sys
 from pathlib import Path
@@ -37,6 +38,7 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
 from flights import Flight  # noqa: E402
+from mcap.reader import SeekingReader  # noqa: E402
 
 from fuzzoff.events import Event, VehicleControlModeStatus  # noqa: E402
 from fuzzoff.writers.mcap import write_mcap  # noqa: E402
@@ -151,7 +153,12 @@ def main() -> None:
 
     path = write_mcap(HERE / "truncated.mcap", lost.events(), release=RELEASE, chunk_size=2048)
     data = path.read_bytes()
-    path.write_bytes(data[: len(data) * 8 // 10])
+    # Cut in the middle of the last chunk: a cut in the summary after it loses no message
+    # (corpora/damaged says so, as OFB004).
+    summary = SeekingReader(io.BytesIO(data)).get_summary()
+    assert summary is not None
+    last = max(summary.chunk_indexes, key=lambda c: c.chunk_start_offset)
+    path.write_bytes(data[: last.chunk_start_offset + last.chunk_length // 2])
     write_expected(
         "truncated",
         "truncated.mcap",

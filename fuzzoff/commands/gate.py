@@ -31,7 +31,7 @@ from fuzzoff.engine import Timeline, lint_file
 from fuzzoff.findings import FileReport
 from fuzzoff.gate import GateTransition
 from fuzzoff.modes import nav_state_name
-from fuzzoff.report.sanitize import printable
+from fuzzoff.report.sanitize import escape_bidi, printable
 
 
 def add_parser(sub: Any) -> None:
@@ -171,7 +171,7 @@ def _json(report: FileReport, rows: dict[str, list[Row]]) -> str:
             }
         ],
     }
-    return json.dumps(data, indent=2, ensure_ascii=False) + "\n"
+    return escape_bidi(json.dumps(data, indent=2, ensure_ascii=False)) + "\n"
 
 
 def run(args: argparse.Namespace) -> int:
@@ -180,7 +180,7 @@ def run(args: argparse.Namespace) -> int:
     report, rows = gate_report(args.path, args, controllers=not args.no_controllers)
     text = _json(report, rows) if args.format == "json" else _terminal(report, rows)
     write_output(text, args.output)
-    for line in report.problems:
+    for line in [*report.problems, *report.malformed]:
         print(f"fuzzoff: {printable(line)}", file=sys.stderr)
     if not report.complete:
         return 2

@@ -62,18 +62,17 @@ def _lint(
     args: argparse.Namespace, paths: list[str], settings: Settings, formats: set[str]
 ) -> Report:
     """One lint for every report asked for: with the timelines the HTML report plots, with a
-    progress bar where a terminal report goes to a terminal (rich is imported only then: the
-    machine-readable formats need not pay for it at start-up)."""
+    progress bar on stderr where a person watches it, whatever the reports' formats (a long
+    file, or one that is garbage after a good start, can take a while; rich is imported only
+    then: the machine-readable formats need not pay for it at start-up)."""
     if "html" in formats:
         return lint_with_timelines(paths, settings, jobs=args.jobs)
-    if formats == {"terminal"} and not args.no_progress and args.jobs == 1:
+    if sys.stderr.isatty() and not args.no_progress and args.jobs == 1:
         from rich.console import Console
 
         from fuzzoff.report.terminal import lint_with_progress
 
-        screen = Console(highlight=False)
-        if screen.is_terminal:
-            return lint_with_progress(paths, settings, screen)
+        return lint_with_progress(paths, settings, Console(stderr=True, highlight=False))
     return lint_paths(paths, settings, jobs=args.jobs)
 
 
@@ -127,7 +126,8 @@ def run(args: argparse.Namespace) -> int:
             _terminal(args, report, settings, output)
         else:
             write_output(renderer(fmt)(report, settings), output)
+    malformed = settings.enabled("OFB004")  # read around, nothing lost: the user may silence it
     for f in report.files:
-        for line in f.problems:
+        for line in [*f.problems, *(f.malformed if malformed else [])]:
             print(f"fuzzoff: {printable(line)}", file=sys.stderr)
     return report.exit_status(settings.fail_on)

@@ -138,8 +138,9 @@ def run_fleet(
             terminal(args, report, settings, output)
         else:
             write_output(renderer(fmt)(report, settings), output)
+    malformed = settings.enabled("OFB004")  # as a plain lint: read around, may be silenced
     for f in report.files:
-        for line in f.problems:
+        for line in [*f.problems, *(f.malformed if malformed else [])]:
             print(f"fuzzoff: {printable(line)}", file=sys.stderr)
     return report.exit_status(settings.fail_on)
 

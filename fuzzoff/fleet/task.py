@@ -104,6 +104,7 @@ def renamed(report: FileReport, local: str, target: str) -> FileReport:
     path appears in the report's path, its problem lines and OFB001 messages."""
     report.path = target
     report.problems = [p.replace(local, target) for p in report.problems]
+    report.malformed = [p.replace(local, target) for p in report.malformed]
     report.findings = [
         dataclasses.replace(f, message=f.message.replace(local, target))
         if local in f.message

@@ -16,7 +16,7 @@
   exception, and its findings are a prefix of the whole file's. *Prefix*: every finding of the
   cut file that is before ``cut_t - EDGE_S`` (``cut_t`` = time of the last event the cut file
   still gives) is also a finding of the whole file; findings without a time, OFB001 (the cut
-  itself), OFB002 and OFB003 are left out: they describe the file, not the stream. So is a
+  itself), OFB002, OFB003 and OFB004 are left out: they describe the file, not the stream. So is a
   finding about a stretch that runs into that edge (its ``end_s``): the cut closed the stretch,
   and its verdict (OFB105's percentiles, say) is on the part the cut left.
 * ``gate_invariants_hold`` (e): invariants of the gate spec, on the sent stream (see
@@ -54,7 +54,7 @@ TOLERANCE_S = 0.15
 EDGE_S = 2.5
 """Findings this close to a cut are left out of the prefix comparison: rules judge windows
 (a gap, a stretch, the answer to a request) that the cut ends early."""
-FILE_LEVEL = frozenset({"OFB001", "OFB002", "OFB003"})
+FILE_LEVEL = frozenset({"OFB001", "OFB002", "OFB003", "OFB004"})
 
 
 @dataclass(slots=True)

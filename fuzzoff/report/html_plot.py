@@ -31,7 +31,7 @@ from fuzzoff.events import (
 from fuzzoff.findings import Finding
 from fuzzoff.modes import NAV_STATE_NAMES, custom_mode_to_nav_state, nav_state_name
 from fuzzoff.profiles import Profile
-from fuzzoff.report.sanitize import printable
+from fuzzoff.report.sanitize import printable, show_bidi
 
 BUCKETS = 2000
 """Keep-alive intervals are reduced to a min and a max per bucket: at most 4,000 points, enough
@@ -445,7 +445,8 @@ def vehicle_plot(
 def as_script_data(value: Any) -> str:
     """JSON for a ``<script type="application/json">`` element: ``<``, ``>`` and ``&`` written
     as escapes, so no text from a recording can close the element or open a comment; NaN and
-    infinity (not JSON) become null."""
+    infinity (not JSON) become null; bidi controls in its strings are shown as ``\\uNNNN``, as
+    everywhere else in the report (they would reorder the labels the script draws)."""
     text = json.dumps(_finite(value), ensure_ascii=False, separators=(",", ":"))
     return (
         text.replace("<", "\\u003c")
@@ -459,6 +460,8 @@ def as_script_data(value: Any) -> str:
 def _finite(value: Any) -> Any:
     if isinstance(value, float):
         return value if math.isfinite(value) else None
+    if isinstance(value, str):
+        return show_bidi(value)
     if isinstance(value, dict):
         return {k: _finite(v) for k, v in value.items()}
     if isinstance(value, list | tuple):

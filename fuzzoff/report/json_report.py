@@ -9,6 +9,7 @@ from typing import Any
 from fuzzoff import __version__
 from fuzzoff.config import Settings
 from fuzzoff.findings import Report
+from fuzzoff.report.sanitize import escape_bidi
 
 
 def _clean(value: Any) -> Any:
@@ -31,4 +32,4 @@ def report_dict(report: Report) -> dict[str, Any]:
 
 
 def render(report: Report, settings: Settings) -> str:
-    return json.dumps(report_dict(report), indent=2, ensure_ascii=False) + "\n"
+    return escape_bidi(json.dumps(report_dict(report), indent=2, ensure_ascii=False)) + "\n"

@@ -14,7 +14,7 @@ import xml.etree.ElementTree as ET
 from fuzzoff.catalog import Rule, load_catalog
 from fuzzoff.config import Settings
 from fuzzoff.findings import FileReport, Finding, Report
-from fuzzoff.report.sanitize import CI_TEXT_LIMIT, printable
+from fuzzoff.report.sanitize import CI_TEXT_LIMIT, escape_bidi, printable
 
 _NOT_XML = re.compile("[^\t\n\r\x20-\x7e\xa0-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
 _NOT_CHECKABLE = re.compile(r"^(OFB\d{3}) \(")
@@ -22,8 +22,9 @@ _NOT_CHECKABLE = re.compile(r"^(OFB\d{3}) \(")
 
 
 def xml_text(text: str) -> str:
-    """Characters XML 1.0 cannot hold (controls, ANSI escapes, lone surrogates) as ``\\xNN``."""
-    return _NOT_XML.sub(lambda m: f"\\x{ord(m.group()):02x}", text)
+    """Characters XML 1.0 cannot hold (controls, ANSI escapes, lone surrogates) as ``\\xNN``,
+    and those that reorder text in a CI view (bidi controls) as ``\\uNNNN``."""
+    return escape_bidi(_NOT_XML.sub(lambda m: f"\\x{ord(m.group()):02x}", text))
 
 
 def finding_line(finding: Finding) -> str:

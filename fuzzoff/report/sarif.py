@@ -24,7 +24,7 @@ from fuzzoff import __version__
 from fuzzoff.catalog import Rule, load_catalog, render_page
 from fuzzoff.config import Settings
 from fuzzoff.findings import Finding, Report, Severity
-from fuzzoff.report.sanitize import CI_TEXT_LIMIT, printable
+from fuzzoff.report.sanitize import CI_TEXT_LIMIT, escape_bidi, printable
 
 SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
 INFORMATION_URI = "https://pypi.org/project/fuzzoff/"
@@ -151,7 +151,7 @@ def sarif_log(report: Report, settings: Settings, root: Path | None = None) -> d
         notifications.extend(
             {
                 "level": "error",
-                "message": {"text": line},
+                "message": {"text": printable(line, CI_TEXT_LIMIT)},
                 "locations": [{"physicalLocation": {"artifactLocation": ref}}],
             }
             for line in file.problems
@@ -181,4 +181,4 @@ def sarif_log(report: Report, settings: Settings, root: Path | None = None) -> d
 
 
 def render(report: Report, settings: Settings) -> str:
-    return json.dumps(sarif_log(report, settings), indent=2, ensure_ascii=False) + "\n"
+    return escape_bidi(json.dumps(sarif_log(report, settings), indent=2, ensure_ascii=False)) + "\n"

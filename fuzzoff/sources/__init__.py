@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import importlib
+import os
 import re
 import stat
 from collections.abc import Iterable, Iterator
@@ -67,13 +68,19 @@ def _special(mode: int) -> str:
 
 
 def _detect_bag_folder(path: Path) -> str:
+    """The storage of a bag folder: its data files say it (metadata.yaml may be missing, cut
+    short or another bag's); metadata.yaml only where they do not (file-compressed data)."""
+    suffixes = {p.suffix for p in path.iterdir() if p.suffix in (".db3", ".mcap")}
+    if suffixes == {".mcap"}:
+        return "rosbag2-mcap"
+    if suffixes == {".db3"}:
+        return "rosbag2-sqlite3"
     meta = path / "metadata.yaml"
     if meta.is_file():
         text = meta.read_text(errors="replace")
         return "rosbag2-mcap" if "storage_identifier: mcap" in text else "rosbag2-sqlite3"
-    files = sorted(p for p in path.iterdir() if p.suffix in (".db3", ".mcap"))
-    if files:
-        return "rosbag2-mcap" if files[0].suffix == ".mcap" else "rosbag2-sqlite3"
+    if suffixes:
+        return "rosbag2-sqlite3"
     raise SourceError(path, "a folder without metadata.yaml or .db3/.mcap files is not a ROS 2 bag")
 
 
@@ -81,9 +88,9 @@ _BAG_PART = re.compile(r"^(?P<stem>.+)_(?P<n>\d+)\.(?:db3|mcap)$")
 
 
 def is_bag_folder(path: Path) -> bool:
-    """A folder that is one ROS 2 bag (with its metadata.yaml, or a bag whose recorder
-    crashed before writing it), not a folder of recordings to search."""
-    return (path / "metadata.yaml").is_file() or _is_bag_without_metadata(path)
+    """A folder that is one ROS 2 bag (with its metadata.yaml, whatever state that is in, or a
+    bag whose recorder crashed before writing it), not a folder of recordings to search."""
+    return os.path.lexists(path / "metadata.yaml") or _is_bag_without_metadata(path)
 
 
 def _is_bag_without_metadata(path: Path) -> bool:

@@ -2,14 +2,15 @@
 
 A reader never judges. It raises ``SourceError`` when the file cannot be read at all (empty,
 foreign, no header) and records a ``SourceProblem`` when part of it cannot be read (truncated,
-corrupt), after yielding every event it could read before that point.
+corrupt), after yielding every event it could read before that point. Damage that cost no data
+(trailing garbage, a broken index read around) is a ``SourceProblem`` with ``lost=False``.
 """
 
 from __future__ import annotations
 
 import abc
 import os
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import TracebackType
@@ -30,6 +31,14 @@ first message of each period; the others are not decoded): OFB404 compares a set
 the vehicle's height on the ground, which moves slowly, and every event between two runs of
 setpoints costs the checks a run (``StreamBatch``). The HTML report reads every one."""
 
+WHAT_LIMIT = 300
+WHERE_LIMIT = 120
+"""A problem's line stays short whatever the file names in it (a garbage topic name)."""
+
+
+def _cut(text: str, limit: int) -> str:
+    return text if len(text) <= limit else text[: limit - 1] + "…"
+
 
 class SourceError(Exception):
     """The recording cannot be read at all. ``str()`` is the one line the user sees."""
@@ -41,8 +50,8 @@ class SourceError(Exception):
         super().__init__(self.line())
 
     def line(self) -> str:
-        at = f" at {self.where}" if self.where else ""
-        return f"{self.path}: {self.what}{at}"
+        at = f" at {_cut(self.where, WHERE_LIMIT)}" if self.where else ""
+        return f"{self.path}: {_cut(self.what, WHAT_LIMIT)}{at}"
 
 
 @dataclass(frozen=True, slots=True)
@@ -52,10 +61,13 @@ class SourceProblem:
     what: str
     where: str | None = None
     time_s: float | None = None
+    lost: bool = True
+    """False for a malformed part the reader read around without losing a message (OFB004,
+    the file stays complete); True for data not read (OFB001)."""
 
     def line(self, path: str) -> str:
-        at = f" at {self.where}" if self.where else ""
-        return f"{path}: {self.what}{at}"
+        at = f" at {_cut(self.where, WHERE_LIMIT)}" if self.where else ""
+        return f"{path}: {_cut(self.what, WHAT_LIMIT)}{at}"
 
 
 @dataclass(slots=True)
@@ -106,6 +118,9 @@ class Source(abc.ABC):
         self.path = path
         self.problems: list[SourceProblem] = []
         self.stats: dict[str, Any] = {}
+        self.on_progress: Callable[[], None] | None = None
+        """Set by the caller that shows progress: a reader that reads a long stretch without
+        an event (a tlog's garbage) calls it now and then."""
         self.px4_hint: str | None = None
         """The user's ``--px4`` profile, set before ``open()``: readers that must choose message
         definitions the recording does not carry (Humble-era ROS 2 bags) start from it."""

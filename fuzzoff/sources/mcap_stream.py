@@ -11,12 +11,19 @@ from __future__ import annotations
 
 import io
 from collections.abc import Callable, Iterator
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 from mcap.exceptions import McapError
+from mcap.reader import SeekingReader
 from mcap.records import Channel, Chunk, DataEnd, Footer, Message, Schema
-from mcap.stream_reader import CRCValidationError, StreamReader, breakup_chunk
+from mcap.stream_reader import (
+    CRCValidationError,
+    StreamReader,
+    breakup_chunk,
+    get_chunk_data_stream,
+)
 
 from fuzzoff.events import Event
 from fuzzoff.sources.base import SourceProblem
@@ -27,6 +34,8 @@ Connect = Callable[[str, str, str | None, str], Decoder | None]
 """(topic, message type, embedded definition, its format) -> decoder or None."""
 
 MAGIC = b"\x89MCAP0\r\n"
+CHUNK_FIELDS = 8 + 8 + 8 + 4 + 4 + 8
+"""A chunk record's fixed fields: times, size, CRC, the compression's and the data's lengths."""
 MAX_CHUNK_INFLATION = 1 << 30
 """A chunk claiming to inflate to more than this is treated as corrupt (bounded memory)."""
 
@@ -61,6 +70,14 @@ class McapStream:
         self.fh: io.BufferedReader | None = None
         self.size = 0
         self.footer = False
+        self.data_end = False
+        """The DataEnd record was read: every chunk came before it (damage after it costs no
+        message)."""
+        self.summary_said = False
+        """The caller already said what is wrong with the summary section."""
+        self.orphans = 0
+        """Messages on a channel no Channel record defined (it sat in a skipped chunk)."""
+        self._orphan_at: str | None = None
 
     def channel(self, record: Channel) -> None:
         if record.id in self.decoders:
@@ -73,9 +90,28 @@ class McapStream:
         msgtype = schema.name if schema is not None else ""
         self.decoders[record.id] = self.connect(record.topic, msgtype, text, fmt)
 
+    def use_summary(self) -> None:
+        """Schemas and channels from the summary section (where it can be read): a channel
+        whose only Channel record sits in a chunk that proves damaged still decodes in the
+        chunks after it."""
+        try:
+            with self.path.open("rb") as fh:
+                size = self.path.stat().st_size
+                summary = SeekingReader(fh, record_size_limit=max(size, 1)).get_summary()
+        except Exception:  # no usable summary: channels come from the chunks
+            return
+        if summary is None:
+            return
+        self.schemas.update(summary.schemas)
+        for record in summary.channels.values():
+            self.channel(record)
+
     def records(self) -> Iterator[Any]:
         """Top-level records, chunks broken up (CRC checked); problems recorded, never raised."""
         self.size = self.path.stat().st_size
+        if not self.size:
+            self.problems.append(SourceProblem("empty file (0 bytes)"))
+            return
         with self.path.open("rb") as fh:
             self.fh = fh
             reader = StreamReader(
@@ -85,10 +121,12 @@ class McapStream:
             try:
                 for record in reader.records:
                     if type(record) is Chunk:
-                        yield from self._chunk(record, fh.tell())
+                        yield from self._chunk(record, good, fh.tell())
                     else:
                         if type(record) is Footer:
                             self.footer = True
+                        elif type(record) is DataEnd:
+                            self.data_end = True
                         yield record
                     good = fh.tell()
             except CRCValidationError as exc:
@@ -102,10 +140,23 @@ class McapStream:
                     self._cut(good, "corrupt record")
             except Exception as exc:
                 self._cut(good, _reason(exc))
+            else:
+                end = fh.tell()  # after the closing magic bytes
+                if end < self.size:
+                    what = (
+                        f"{self.size - end} bytes after the end of the MCAP file, not read "
+                        "(every record before them was)"
+                    )
+                    self.problems.append(SourceProblem(what, f"byte {end}", lost=False))
             finally:
                 self.fh = None
 
     def _cut(self, offset: int, why: str) -> None:
+        if self.data_end:  # every chunk was read: the summary after them cannot be
+            if not self.summary_said:
+                what = f"summary section unreadable ({why}); every chunk before it was read"
+                self.problems.append(SourceProblem(what, f"byte {offset}", lost=False))
+            return
         self.problems.append(
             SourceProblem(
                 f"{why}: nothing after the last whole record could be read (truncated or "
@@ -114,7 +165,18 @@ class McapStream:
             )
         )
 
-    def _chunk(self, chunk: Chunk, end: int) -> Iterator[Any]:
+    def _chunk(self, chunk: Chunk, start: int, end: int) -> Iterator[Any]:
+        """The records of the chunk record at [start, end), or none and a problem."""
+        fields = CHUNK_FIELDS + len(chunk.compression.encode()) + len(chunk.data)
+        if end - start - 9 != fields:
+            # A header damaged where no CRC covers it: its data length and sizes read short
+            # (zeroed), the record's own length stepped over the rest, and the chunk would
+            # give no message and no error.
+            what = f"chunk header damaged (its fields fill {fields} of its {end - start - 9} bytes)"
+            self.problems.append(
+                SourceProblem(f"{what}; its messages were skipped", f"byte {start}")
+            )
+            return
         if chunk.uncompressed_size > MAX_CHUNK_INFLATION:
             self.problems.append(
                 SourceProblem(
@@ -123,7 +185,18 @@ class McapStream:
             )
             return
         try:
-            records = breakup_chunk(chunk, validate_crc=True)
+            data, length = get_chunk_data_stream(chunk, validate_crc=True)
+            if length != chunk.uncompressed_size:
+                # Its header was damaged where no CRC covers it (or the CRC itself): parsed,
+                # the bytes would give no message and no error.
+                what = (
+                    f"chunk header damaged (it says {chunk.uncompressed_size} bytes of "
+                    f"records, its data holds {length}); its messages were skipped"
+                )
+                self.problems.append(SourceProblem(what, f"chunk ending at byte {end}"))
+                return
+            whole = replace(chunk, compression="", data=data.read(length), uncompressed_crc=0)
+            records = breakup_chunk(whole)
         except CRCValidationError:
             self.problems.append(
                 SourceProblem(
@@ -154,6 +227,8 @@ class McapStream:
                     t0 = self.t0_ns = record.log_time
                 decoder = decoders.get(record.channel_id)
                 if decoder is None or record.log_time <= after:
+                    if record.channel_id not in decoders:
+                        self._orphan(record)
                     continue
                 event = decoder.event(record.data, (record.log_time - t0) / 1e9)
                 if event is not None:
@@ -167,6 +242,17 @@ class McapStream:
         yield from order.flush()
         self.messages = messages
         self.late = order.late
+        if self.orphans:
+            what = (
+                f"{self.orphans} messages on channels that no readable record defines (their "
+                "Channel record was in a skipped chunk, or is missing) were not read"
+            )
+            self.problems.append(SourceProblem(what, self._orphan_at))
+
+    def _orphan(self, record: Message) -> None:
+        if not self.orphans and self.fh is not None:
+            self._orphan_at = f"in the chunk ending at byte {self.fh.tell()}"
+        self.orphans += 1
 
     def scan(self) -> tuple[int | None, str | None]:
         """Channels, the earliest log time and the vehicle type, for a file without a usable

@@ -35,6 +35,7 @@ from fuzzoff.sources.base import (
 )
 from fuzzoff.sources.mavros import TOPIC_KINDS, Handler, MavrosConverter, mavros_topic
 from fuzzoff.sources.mavros_msgs import mavros_typedefs
+from fuzzoff.sources.rosbag1_check import chunk_infos_disagree, walk
 from fuzzoff.sources.rosbag1_chunkwise import ChunkwiseReader
 from fuzzoff.sources.rosbag1_salvage import SalvageReader, bag_header_index_pos
 from fuzzoff.sources.typedefs import bounded
@@ -56,6 +57,8 @@ class Rosbag1Source(Source):
         self._wanted: list[Connection] = []
         self._done = 0
         self._total = 0
+        self._framing: SourceProblem | None = None
+        """Damage the index read steps around; said if that read loses nothing."""
 
     # -- opening -------------------------------------------------------------------------------
 
@@ -71,7 +74,16 @@ class Rosbag1Source(Source):
         except Exception as exc:  # rosbags asserts and struct errors on corrupt index records
             self._open_damaged(f"{type(exc).__name__}: {exc}")
             return
+        found = walk(self.path)
+        wrong = chunk_infos_disagree(found, reader.chunk_infos)
+        if found.in_index or wrong is not None:  # the index cannot say where messages are
+            reader.close()
+            self._open_damaged(f"index damaged ({wrong or 'a record does not read'})")
+            return
         self._reader = reader
+        if found.damage is not None:  # read around through the index: said once that is done
+            what = f"{found.damage[0]}; the messages were read through the bag's index"
+            self._framing = SourceProblem(what, f"byte {found.damage[1]}", lost=False)
         self._wanted = [c for c in reader.connections if mavros_topic(c.topic, c.msgtype)]
         self._total = sum(c.msgcount for c in self._wanted)
         self._typestore = self._build_typestore(self._wanted)
@@ -157,9 +169,17 @@ class Rosbag1Source(Source):
             return
         reader = self._reader
         if reader is None or not self._wanted:
+            self._said_framing()
             return
         self.set_start(reader.start_time / 1e9 if reader.message_count else None)
         yield from self._convert(self._indexed_then_in_file_order(reader), [reader.start_time])
+        self._said_framing()
+
+    def _said_framing(self) -> None:
+        """The framing damage the index read stepped around, unless something was lost after
+        all (then that line says what; this one would say the opposite)."""
+        if self._framing is not None and not any(p.lost for p in self.problems):
+            self.problems.append(self._framing)
 
     def _indexed_then_in_file_order(
         self, reader: ChunkwiseReader

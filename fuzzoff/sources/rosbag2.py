@@ -13,6 +13,7 @@ import re
 import sqlite3
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import suppress
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -22,7 +23,7 @@ from ruamel.yaml import YAML
 
 from fuzzoff.events import Event
 from fuzzoff.profiles import ROVER_ASSUMED
-from fuzzoff.sources import mcap_indexed, px4_msgs
+from fuzzoff.sources import mcap_check, mcap_indexed, px4_msgs, ros2_metadata
 from fuzzoff.sources.base import (
     POSITION_PERIOD_S,
     RecordingInfo,
@@ -82,6 +83,16 @@ def _decoded_topic(topic: Any, msgtype: Any) -> bool:
     return message_of(topic, msgtype)[0] is not None or mavros_topic(topic, msgtype) is not None
 
 
+_SQLITE_TYPES = {str: "text", bytes: "blob", float: "real", type(None): "null"}
+"""The SQLite storage class of a value Python's sqlite3 returned."""
+
+
+def _some(names: list[str]) -> str:
+    """The first three names, and how many more."""
+    more = f" and {len(names) - 3} more" if len(names) > 3 else ""
+    return ", ".join(names[:3]) + more
+
+
 def _why(exc: BaseException) -> str:
     if isinstance(exc, UnicodeDecodeError):  # see SQLITE_ERRORS
         return "damaged text in its schema"
@@ -113,6 +124,14 @@ class Rosbag2Source(Source):
         self._last_ns = -1
         self._untyped = False
         """A topic without a text name or type was met (said once)."""
+        self._untimed_count = 0
+        self._untimed_first = ""
+        self._untimed_where = ""
+        """Messages whose time is not an integer, and the first one's file and value."""
+        self._framing: SourceProblem | None = None
+        """Damage the summary's index steps around; said if that read loses nothing."""
+        self._stream_only: set[Path] = set()
+        """MCAP files read front to back whatever rosbags makes of them (summary damaged)."""
 
     # -- opening -----------------------------------------------------------------------------
 
@@ -121,6 +140,13 @@ class Rosbag2Source(Source):
         self.decoding.thin_positions(0.0 if self.plot_data else POSITION_PERIOD_S)
         if not self.path.exists():
             raise SourceError(self.path, "no such file or folder")
+        if self._summary_damaged():
+            return
+        if self.path.is_dir():
+            fault = ros2_metadata.fault(self.path, self._data_files(self.path))
+            if fault is not None:
+                self._salvage_plan(ValueError(fault), fault)
+                return
         try:
             reader = Reader(self.path)
             reader.open()
@@ -132,25 +158,50 @@ class Rosbag2Source(Source):
             # their topics themselves.
             with suppress(Exception):
                 reader.close()
-            what = (
-                "metadata.yaml: a topic's name, type or message count is malformed; "
-                "read the data files directly"
-            )
-            self.problems.append(SourceProblem(what))
-            self._salvage_plan(ValueError(what))
+            fault = "metadata.yaml: a topic's name, type or message count is malformed"
+            self._salvage_plan(ValueError(fault), fault)
             return
         unlisted = self._unlisted_topics(reader) if self.path.is_dir() else []
         if unlisted:
             with suppress(Exception):
                 reader.close()
-            what = (
-                f"metadata.yaml does not list {', '.join(unlisted)}, which the data files hold; "
-                "read the data files directly"
+            # One of the two is damaged: a topic renamed in the database reads the same as a
+            # metadata.yaml from another bag, so the data files are read but not vouched for.
+            fault = (
+                f"metadata.yaml does not list {_some(unlisted)}, which the data files hold "
+                "(one of them is damaged or from another recording)"
             )
-            self.problems.append(SourceProblem(what))
-            self._salvage_plan(ValueError(what))
+            self._salvage_plan(ValueError(fault), fault, lost=True)
             return
         self._reader = reader
+
+    def _summary_damaged(self) -> bool:
+        """A one-file MCAP recording whose summary cannot be trusted (``mcap_check``) is read
+        front to back, as if it had none: through the summary, rosbags would skip what a
+        damaged chunk index leaves out. Damage to the data section's record headers is read
+        around through the summary, and said (nothing is lost by either)."""
+        mcap_file = self._single_mcap(self.path)
+        if mcap_file is None:
+            return False
+        try:
+            damage = mcap_check.summary_damage(mcap_file)
+            framing = None if damage is not None else mcap_check.framing_damage(mcap_file)
+        except OSError as exc:
+            raise SourceError(mcap_file, f"cannot read: {exc.strerror or exc}") from None
+        if framing is not None:  # said once that read is done (``_finish``)
+            what = f"{framing.what}; its messages were read through the summary's chunk index"
+            self._framing = SourceProblem(what, self._at(mcap_file, framing.offset), lost=False)
+        if damage is None:
+            return False
+        what = f"{damage.what}; read front to back without the summary"
+        self.problems.append(SourceProblem(what, self._at(mcap_file, damage.offset), lost=False))
+        self._files = [mcap_file]
+        self._stream_only.add(mcap_file)
+        return True
+
+    def _at(self, path: Path, offset: int) -> str:
+        """``byte N``, after the data file's name in a bag folder."""
+        return f"byte {offset}" if path == self.path else f"{path.name} byte {offset}"
 
     def _unlisted_topics(self, reader: Any) -> list[str]:
         """PX4 or MAVROS topics a data file names that metadata.yaml leaves out (an edited or
@@ -166,32 +217,36 @@ class Rosbag2Source(Source):
             unlisted.update(t for t, m in held - listed if _decoded_topic(t, m))
         return sorted(unlisted)
 
-    def _salvage_plan(self, exc: BaseException) -> None:
-        """rosbags could not open the bag as a whole: find the data files to read one by one."""
+    def _salvage_plan(
+        self, exc: BaseException, fault: str | None = None, lost: bool = False
+    ) -> None:
+        """rosbags could not open the bag as a whole, or ``fault`` is what its metadata.yaml
+        gets wrong (``ros2_metadata``): the data files, to read one by one. A metadata.yaml at
+        fault is said, and the folder's own data files are read: nothing is lost by it, unless
+        the two disagree on what the data holds (``lost``: which is damaged cannot be told)."""
         if self.path.is_file():
             self._files = [self.path]
             return
-        meta = self.path / "metadata.yaml"
-        files = self._files_from_metadata(meta)
-        if files is None:
-            files = sorted(p for p in self.path.iterdir() if p.suffix in DATA_SUFFIXES)
+        listed = (
+            None if fault is not None else self._files_from_metadata(self.path / "metadata.yaml")
+        )
+        if listed is None:
+            files = self._data_files(self.path)
             if not files:
-                raise SourceError(self.path, f"not a readable ROS 2 bag ({_why(exc)})")
-            if meta.is_file():
-                what = f"metadata.yaml cannot be used ({_why(exc)})"
-            else:
-                what = "metadata.yaml is missing"
-            names = ", ".join(p.name for p in files)
-            self.problems.append(SourceProblem(f"{what}; read the data files directly: {names}"))
+                raise SourceError(self.path, f"not a readable ROS 2 bag ({fault or _why(exc)})")
+            fault = fault or f"metadata.yaml cannot be used ({_why(exc)})"
         else:
-            missing = [p for p in files if not p.is_file()]
-            for p in missing:
-                self.problems.append(
-                    SourceProblem("data file listed in metadata.yaml is missing", p.name)
-                )
-            files = [p for p in files if p.is_file()]
+            for path in listed:
+                if not path.is_file():
+                    what = "data file listed in metadata.yaml is missing"
+                    self.problems.append(SourceProblem(what, path.name))
+            files = [path for path in listed if path.is_file()]
             if not files:
                 raise SourceError(self.path, "none of the bag's data files exist")
+        if fault is not None:
+            names = _some([path.name for path in files])
+            what = f"{fault}; the data files were read instead: {names}"
+            self.problems.append(SourceProblem(what, lost=lost))
         self._files = files
 
     def _files_from_metadata(self, meta: Path) -> list[Path] | None:
@@ -214,6 +269,8 @@ class Rosbag2Source(Source):
             reader = self._reader
             info.message_count = reader.message_count
             self._t0 = reader.start_time if reader.message_count else None
+            if self._t0 is not None and self.path.is_dir():
+                self._t0 = self._data_time(reader)
             for conn in reader.connections:
                 self._decoder(conn.topic, conn.msgtype, conn.msgdef)
             if reader.ros_distro:
@@ -246,6 +303,31 @@ class Rosbag2Source(Source):
             f"a rover ({said}) but not which kind (assumed {ROVER_ASSUMED}; set --vehicle "
             "rover-ackermann, rover-differential or rover-mecanum)"
         )
+
+    def _data_time(self, reader: Any) -> int:
+        """The bag's start. metadata.yaml states it, with the bag's duration; the data files
+        hold the messages' own times. Where the two disagree, the one whose span matches the
+        data's is believed: metadata.yaml from another recording (every time shifted by the
+        difference) gives way to the data; a database whose earliest time alone disagrees
+        (a damaged timestamp: its last agrees with metadata.yaml) keeps metadata.yaml's."""
+        listed, listed_end = reader.start_time, reader.end_time - 1
+        span = ros2_metadata.data_span(self._data_files(self.path))
+        if span is None or span[0] == listed:
+            return int(listed)
+        start, end = span
+        if end == listed_end:
+            way = "before" if start < listed else "after"
+            what = (
+                f"the first message is {abs(listed - start) / 1e9:.3f} s {way} the bag's start, "
+                "as metadata.yaml and the last message agree on it (a damaged timestamp?); "
+                "metadata.yaml's start was used"
+            )
+            self.problems.append(SourceProblem(what, "messages.timestamp"))
+            return int(listed)
+        differs = ros2_metadata.differs(listed, start)
+        what = f"{differs}; the data files' times were used"
+        self.problems.append(SourceProblem(what, lost=False))
+        return start
 
     def _presample(self, reader: Any) -> None:
         """Choose bundled definitions now, from each topic's first message, so the release
@@ -282,7 +364,7 @@ class Rosbag2Source(Source):
             if not conn.msgcount:
                 continue
             # Only the first seconds: a time-bounded query stays cheap on a large sqlite bag.
-            window = reader.start_time + STATUS_WINDOW_NS
+            window = (self._t0 or reader.start_time) + STATUS_WINDOW_NS
             try:
                 _, _, raw = next(iter(reader.messages(connections=[conn], stop=window)))
             except Exception:  # none in the window, or damage the main pass reports
@@ -295,6 +377,8 @@ class Rosbag2Source(Source):
         starts = []
         for path in self._files:
             try:
+                if path in self._stream_only:
+                    raise ValueError("read front to back")
                 with Reader(path) as reader:
                     for conn in reader.connections:
                         self._decoder(conn.topic, conn.msgtype, conn.msgdef)
@@ -328,7 +412,9 @@ class Rosbag2Source(Source):
                 ).fetchone()
                 if first is not None and self._vehicle is None:
                     self._vehicle = self.decoding.vehicle_from(decoder, first[0])
-            row = db.execute("SELECT MIN(timestamp) FROM messages").fetchone()
+            row = db.execute(
+                "SELECT MIN(timestamp) FROM messages WHERE typeof(timestamp) = 'integer'"
+            ).fetchone()
             return int(row[0]) if row and row[0] is not None else None
         except SQLITE_ERRORS:
             return None
@@ -384,9 +470,12 @@ class Rosbag2Source(Source):
         self._last_ns = -1
         try:
             for key, stamp, raw in messages:
+                count += 1
+                if stamp.__class__ is not int:  # SQLite keeps any type in any column
+                    self._untimed(stamp, where)
+                    continue
                 if t0 is None:
                     t0 = self._t0 = stamp
-                count += 1
                 self._last_ns = stamp
                 event = by_id[key](raw, (stamp - t0) / 1e9)
                 if event is not None:
@@ -396,7 +485,7 @@ class Rosbag2Source(Source):
             if mcap_file is not None:
                 # rosbags stops at the first bad chunk; the streaming reader skips it and
                 # goes on (only messages after the last one already read are taken).
-                yield from self._salvage_mcap(mcap_file, after_ns=self._last_ns)
+                yield from self._salvage_mcap(mcap_file, self._last_ns, refused=_why(exc))
             else:
                 self.problems.append(
                     SourceProblem(
@@ -406,14 +495,41 @@ class Rosbag2Source(Source):
         else:
             listed = sum(conn.msgcount for conn in selected)
             if count < listed:  # e.g. a metadata.yaml whose topics the database does not have
-                index = "metadata.yaml" if where.is_dir() else where.name
-                what = (
-                    f"{listed - count} of the {listed} messages {index} lists on the PX4 topics "
-                    "are not in the data (the two disagree)"
-                )
-                self.problems.append(SourceProblem(what))
+                self._fewer(where, selected, count, listed)
         finally:
             self._messages += count
+
+    def _fewer(self, where: Path, selected: list[Any], count: int, listed: int) -> None:
+        """Fewer messages were read than the index lists. If the data files hold no more than
+        were read, the index is what is wrong (metadata.yaml from another recording, a
+        damaged count): said, nothing lost; else the rest were not read."""
+        index = "metadata.yaml" if where.is_dir() else where.name
+        topics = {(conn.topic, conn.msgtype) for conn in selected}
+        held = ros2_metadata.held_messages(self._data_files(where), topics)
+        if held is not None and held <= count:
+            what = (
+                f"{index} lists {listed} messages on the PX4 topics, the data files hold "
+                f"{held}: every one was read"
+            )
+            self.problems.append(SourceProblem(what, lost=False))
+            return
+        what = (
+            f"{listed - count} of the {listed} messages {index} lists on the PX4 topics "
+            "are not in the data (the two disagree)"
+        )
+        self.problems.append(SourceProblem(what))
+
+    def _untimed(self, stamp: Any, where: Path) -> None:
+        """A message whose time is not an integer (a damaged database): skipped, counted."""
+        if self._untimed_count == 0:
+            shown = repr(stamp)
+            shown = shown if len(shown) <= 24 else shown[:23] + "…"
+            kind = _SQLITE_TYPES.get(type(stamp), type(stamp).__name__)
+            self._untimed_first = f"{kind} {shown}"
+            self._untimed_where = "messages.timestamp" + (
+                "" if where.is_dir() else f" in {where.name}"
+            )
+        self._untimed_count += 1
 
     def _by_connection(self, reader: Any, selected: list[Any]) -> tuple[EventMakers, Messages]:
         """rosbags' own reading: (connection id, time, payload) of the selected connections."""
@@ -456,12 +572,15 @@ class Rosbag2Source(Source):
         return sorted(p for p in where.iterdir() if p.suffix in DATA_SUFFIXES)
 
     def _read_file(self, path: Path) -> Iterator[Event]:
+        if path in self._stream_only:
+            yield from self._salvage_mcap(path)
+            return
         try:
             reader = Reader(path)
             reader.open()
         except Exception as exc:
             if path.suffix == ".mcap":
-                yield from self._salvage_mcap(path)
+                yield from self._salvage_mcap(path, refused=_why(exc))
             else:
                 yield from self._salvage_sqlite(path, exc)
             return
@@ -471,15 +590,34 @@ class Rosbag2Source(Source):
             with suppress(Exception):
                 reader.close()
 
-    def _salvage_mcap(self, path: Path, after_ns: int = -1) -> Iterator[Event]:
-        """fuzzoff's streaming MCAP reader: CRC-checked chunk by chunk, past bad chunks."""
+    def _salvage_mcap(
+        self, path: Path, after_ns: int = -1, refused: str | None = None
+    ) -> Iterator[Event]:
+        """fuzzoff's streaming MCAP reader: CRC-checked chunk by chunk, past bad chunks.
+        ``refused``: why rosbags could not open the file, said if the stream finds nothing
+        wrong (it was read whole, but something in it is malformed)."""
+        misplaced = mcap_check.framing_damage(path)
+        if misplaced is not None and misplaced.kind == "type":  # read past by the stream
+            what = f"{misplaced.what} (a damaged record type): what it held was not read"
+            self.problems.append(SourceProblem(what, self._at(path, misplaced.offset)))
         stream = McapStream(path, self.decoding, self._t0, self._connect, after_ns=after_ns)
+        stream.summary_said = path in self._stream_only
+        if not stream.summary_said:
+            stream.use_summary()
         yield from stream.events()
         if self._t0 is None:
             self._t0 = stream.t0_ns
         self._messages += stream.messages
         for problem in stream.problems:
-            self.problems.append(SourceProblem(problem.what, f"{path.name} {problem.where or ''}"))
+            where = problem.where
+            if path != self.path:
+                where = f"{path.name} {where}" if where else path.name
+            self.problems.append(replace(problem, where=where))
+        if refused is not None and not stream.problems:
+            what = f"rosbags cannot open it ({refused}); read front to back, every record read"
+            self.problems.append(
+                SourceProblem(what, None if path == self.path else path.name, lost=False)
+            )
 
     def _salvage_sqlite(self, path: Path, exc: BaseException) -> Iterator[Event]:
         """Row by row with Python's sqlite3, in row order, until the damage (formats.md 5)."""
@@ -503,6 +641,9 @@ class Rosbag2Source(Source):
             try:
                 for topic_id, stamp, raw in rows:
                     count += 1
+                    if stamp.__class__ is not int:
+                        self._untimed(stamp, path)
+                        continue
                     if t0 is None:
                         t0 = self._t0 = stamp
                     decoder = topics.get(topic_id)
@@ -524,8 +665,8 @@ class Rosbag2Source(Source):
         else:
             self.problems.append(
                 SourceProblem(
-                    f"rosbags cannot read this database ({_why(exc)}); all {count} rows "
-                    "were salvaged with sqlite3",
+                    f"rosbags cannot read this database ({_why(exc)}); it was read row by "
+                    f"row with sqlite3 ({count} rows)",
                     path.name,
                 )
             )
@@ -544,7 +685,17 @@ class Rosbag2Source(Source):
     def _finish(self) -> None:
         if self._t0 is not None:
             self.set_start(self._t0 / 1e9)
+        if self._untimed_count:
+            n = self._untimed_count
+            many = f"{n} messages whose timestamp is not an integer were"
+            what = (
+                f"{many if n > 1 else '1 message whose timestamp is not an integer was'} not "
+                f"read (the first: {self._untimed_first})"
+            )
+            self.problems.append(SourceProblem(what, self._untimed_where))
         self.problems.extend(self.decoding.problems())
+        if self._framing is not None and not any(p.lost for p in self.problems):
+            self.problems.append(self._framing)
         self.stats["messages"] = self._messages
         if self._info is not None:
             self._info.notes.extend(self.decoding.notes)

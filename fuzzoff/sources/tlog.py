@@ -40,7 +40,7 @@ from fuzzoff.sources.base import (
     SourceError,
     SourceProblem,
 )
-from fuzzoff.sources.tlog_frames import Framer, FrameStats, message_name
+from fuzzoff.sources.tlog_frames import RESYNC_LIMIT, Framer, FrameStats, message_name
 
 HEARTBEAT = 0
 SYS_STATUS = 1
@@ -186,6 +186,7 @@ class TlogSource(Source):
             return self._info
         info = RecordingInfo(str(self.path), self.format)
         framer = Framer(self._file(), self._size, PROBE_WANTED, verify=False)
+        framer.on_chunk = self.on_progress
         autopilots = self._autopilots
         ground_stations: set[tuple[int, int]] = set()
         commanders: set[tuple[int, int]] = set()
@@ -249,6 +250,7 @@ class TlogSource(Source):
         thinned = None if self.plot_data else THINNED
         framer = Framer(self._file(), self._size, WANTED, verify=True, thinned=thinned)
         self._framer = framer
+        framer.on_chunk = self.on_progress
         decoder = _Decoder(self._autopilots, self._vehicles())
         first_ts: int | None = None
         try:
@@ -283,7 +285,20 @@ class TlogSource(Source):
             return round((ts - first_ts) / 1e6, 6)
 
         lines: list[SourceProblem] = []
-        for region in stats.regions:
+        regions = stats.regions
+        if stats.stopped_at is not None:  # the last region: where the search gave up
+            last = regions[-1]
+            regions = regions[:-1]
+            lines.append(
+                SourceProblem(
+                    f"no MAVLink packet in the {RESYNC_LIMIT >> 20} MiB after byte {last.start}: "
+                    f"reading stopped, the last {stats.size - stats.stopped_at} bytes were "
+                    "not read",
+                    f"byte {stats.stopped_at}",
+                    t_of(last.ts_us),
+                )
+            )
+        for region in regions:
             size = region.end - region.start
             lines.append(
                 SourceProblem(

@@ -70,6 +70,11 @@ large is doubted when there is no next record to confirm it."""
 RESYNC_WINDOW_US = (120_000_000, 86_400_000_000)
 """After bad bytes, a candidate record may be this much older / newer than the last good one."""
 
+RESYNC_LIMIT = 16 << 20
+"""Bytes searched for the next good record before giving up: a longer stretch without one is
+not a damaged tlog but something else (a disk image, noise), and searching on would take minutes
+on a large file without a result."""
+
 MAX_UNKNOWN_IDS = 256
 """Distinct unknown message ids tracked one by one; beyond that they are only counted."""
 
@@ -108,6 +113,8 @@ class FrameStats:
     regions: list[Region] = field(default_factory=list)
     truncated_at: int | None = None
     """Offset of an incomplete last record, if the file ends inside one."""
+    stopped_at: int | None = None
+    """Where reading gave up: ``RESYNC_LIMIT`` bytes without a good record."""
     first_ts: int | None = None
     last_ts: int | None = None
     size: int = 0
@@ -142,6 +149,8 @@ class Framer:
         self.base = 0
         self.eof = False
         self.consumed = 0
+        self.on_chunk: Callable[[], None] | None = None
+        """Called after each chunk read, so a long stretch with no record still shows progress."""
 
     # -- buffer ---------------------------------------------------------------------------
 
@@ -152,6 +161,9 @@ class Framer:
             self.eof = True
         self.base += pos
         self.buf = self.buf[pos:] + chunk
+        self.consumed = self.base
+        if self.on_chunk is not None:
+            self.on_chunk()
         return 0
 
     # -- checks ---------------------------------------------------------------------------
@@ -368,6 +380,12 @@ class Framer:
             if self.eof:
                 self.stats.regions.append(Region(start_abs, self.base + n, why, self.stats.last_ts))
                 return n, buf, n
+            if self.base + qmin - start_abs > RESYNC_LIMIT:
+                stop = self.base + qmin
+                self.stats.regions.append(Region(start_abs, stop, why, self.stats.last_ts))
+                self.stats.stopped_at = stop
+                self.eof, self.buf = True, b""
+                return 0, b"", 0
             keep = max(0, qmin - 8)
             self._fill(keep)
             qmin -= keep

@@ -22,9 +22,16 @@ import numpy as np
 
 from fuzzoff import events as ev
 from fuzzoff.profiles import MAV_TYPE_VEHICLE, PX4_VEHICLE_TYPE, ProfileError, px4_profile_for
-from fuzzoff.sources.base import POSITION_PERIOD_S, RecordingInfo, Source, SourceError
-from fuzzoff.sources.ulog_load import Loaded, load
+from fuzzoff.sources.base import (
+    POSITION_PERIOD_S,
+    RecordingInfo,
+    Source,
+    SourceError,
+    SourceProblem,
+)
+from fuzzoff.sources.ulog_load import Loaded, load, quoted
 from fuzzoff.sources.ulog_topics import (
+    EXTRA_FIELDS,
     EXTRA_TOPICS,
     GPS_TOPICS,
     MAIN_STATE_TO_NAV,
@@ -32,6 +39,7 @@ from fuzzoff.sources.ulog_topics import (
     Chunk,
     Context,
     failsafe_flags,
+    renamed_fields,
 )
 
 LOADED_TOPICS: tuple[str, ...] = (*TOPICS, *EXTRA_TOPICS)
@@ -147,6 +155,7 @@ class UlogSource(Source):
                 self._failed = exc
                 raise
             self.problems.extend(self._loaded.problems)
+            self.problems.extend(_drop_renamed_fields(self._loaded.ulog))
             if self._loaded.library_output:
                 self.stats["pyulog_messages"] = self._loaded.library_output[:20]
         return self._loaded
@@ -400,6 +409,29 @@ def _utc_start(datasets: list[Any], t0: int) -> float | None:
                 i = int(found[0])
                 return (int(utc[i]) - (int(d.data["timestamp"][i]) - t0)) / 1e6
     return None
+
+
+def _drop_renamed_fields(ulog: Any) -> list[SourceProblem]:
+    """Topics whose format names a field one character away from one fuzzoff reads (see
+    ``renamed_fields``): set aside, one line each, as a format damaged in any other way."""
+    problems = []
+    kept = []
+    for data in ulog.data_list:
+        spec = TOPICS.get(data.name)
+        decode = spec.decode if spec is not None else None
+        renamed = renamed_fields(data.data, decode, EXTRA_FIELDS.get(data.name, ()))
+        if not renamed:
+            kept.append(data)
+            continue
+        wanted, found = renamed[0]
+        what = (
+            f"damaged format record of {quoted(data.name)} (a field {quoted(found)} where "
+            f"{quoted(wanted)} belongs, one character apart); its messages were not read"
+        )
+        start = ulog.format_offsets.get(data.name)
+        problems.append(SourceProblem(what, f"byte {start}" if start is not None else None))
+    ulog.data_list[:] = kept
+    return problems
 
 
 def _seconds(ts: int, t0: int) -> float:

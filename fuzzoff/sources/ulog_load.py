@@ -12,6 +12,12 @@ pyulog 1.3 falls short for a linter in four ways, wrapped here without re-parsin
 running end offset per section, which gives the truncation point) and the moment it first sets its
 corruption flag (with the last good timestamp). Both hooks are on pyulog's existing per-record
 calls, so the load costs the same as pyulog's own. Pinned to pyulog 1.3 (private attributes).
+
+Two more gaps are closed on the same calls: a record whose payload is too short for its type (a
+data record whose size field reads 0) makes pyulog stop reading as if the file had ended, so
+such a record is made corruption, which pyulog skips; and a format record (``F``) whose text a
+flipped byte damaged still parses, so each one is checked against the ULog grammar
+(``_format_damage``) and the topics it describes are set aside.
 """
 
 from __future__ import annotations
@@ -19,6 +25,7 @@ from __future__ import annotations
 import contextlib
 import io
 import os
+import re
 import struct
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -110,8 +117,44 @@ class _DefinitionsHandle:
         self.file.close()
 
 
+def _whole(record: type[Any]) -> type[Any]:
+    """pyulog's record class, raising ``ValueError`` where its payload is too short.
+
+    pyulog decodes each record inside a handler for corruption (``ValueError`` among others),
+    itself inside one for ``struct.error``, which it takes for the end of the file. A record too
+    short for its type (a size field damaged to 0) raised ``struct.error``: the rest of the file
+    was dropped in silence. As ``ValueError`` it is what it is: a damaged record, skipped."""
+
+    class Whole(record):  # type: ignore[misc]
+        def __init__(self, *args: Any, **kwargs: Any) -> None:
+            try:
+                super().__init__(*args, **kwargs)
+            except struct.error as exc:
+                raise ValueError(f"record too short ({exc})") from None
+
+    Whole.__name__ = Whole.__qualname__ = record.__name__
+    return Whole
+
+
+class _WholeData(ULog._MessageData):  # type: ignore[misc]
+    """A data record too short to hold its message id is corruption (see ``_whole``)."""
+
+    def initialize(self, data: bytes, header: Any, subscriptions: Any, ulog: Any) -> bool:
+        if len(data) < 2:
+            self.timestamp = 0
+            return True
+        return bool(super().initialize(data, header, subscriptions, ulog))
+
+
 class _TrackedULog(ULog):  # type: ignore[misc]
     """pyulog's ``ULog``, observed (see the module docstring)."""
+
+    _MessageInfo = _whole(ULog._MessageInfo)
+    _MessageParameterDefault = _whole(ULog._MessageParameterDefault)
+    MessageLogging = _whole(ULog.MessageLogging)
+    MessageLoggingTagged = _whole(ULog.MessageLoggingTagged)
+    MessageDropout = _whole(ULog.MessageDropout)
+    _MessageData = _WholeData
 
     def __init__(self, path: str, topics: Sequence[str] | None, header_only: bool) -> None:
         self._headers: list[tuple[str, _Header]] = []
@@ -119,8 +162,13 @@ class _TrackedULog(ULog):  # type: ignore[misc]
         self._corruption: _Corruption | None = None
         self.missing_formats: list[str] = []
         self.missing_format_offset: int | None = None
+        self.format_offsets: dict[str, int] = {}
+        """Format name -> where its ``F`` record starts."""
+        self.damaged_formats: dict[str, tuple[int, str]] = {}
+        """Format name -> (where its record starts, what is wrong with it)."""
         self._MessageHeader = self._new_header
         self._MessageAddLogged = self._add_logged
+        self.MessageFormat = self._format_record
         with open(path, "rb") as file:
             super().__init__(
                 _DefinitionsHandle(file),
@@ -155,14 +203,26 @@ class _TrackedULog(ULog):  # type: ignore[misc]
         self._headers.append((self._section, header))
         return header
 
+    def _format_record(self, data: bytes, header: _Header) -> Any:
+        """pyulog's ``MessageFormat``, with where it starts and what its text gets wrong."""
+        fmt = ULog.MessageFormat(data, header)
+        start = header.end - 3 - header.msg_size
+        self.format_offsets.setdefault(fmt.name, start)
+        damage = _format_damage(data)
+        if damage is not None:
+            self.damaged_formats.setdefault(fmt.name, (start, damage))
+        return fmt
+
     def _add_logged(self, data: bytes, header: Any, formats: dict[str, Any]) -> Any:
         try:
             return ULog._MessageAddLogged(data, header, formats)
+        except struct.error as exc:  # as ``_whole``
+            raise ValueError(f"record too short ({exc})") from None
         except KeyError:
             name = ULog.parse_string(data[3:])
+            # The name may be the damaged part: which topic lost its data cannot be known.
             if self.missing_format_offset is None and self._headers:
-                header = self._headers[-1][1]
-                self.missing_format_offset = header.end - 3 - header.msg_size
+                self.missing_format_offset = self._headers[-1][1].start
             if name not in self.missing_formats:
                 self.missing_formats.append(name)
             raise
@@ -223,8 +283,117 @@ def load(
     loaded = Loaded(ulog, library_output=output, size=size)
     to_s = seconds or (lambda ts: (ts - ulog.start_timestamp) / 1e6)
     loaded.problems.extend(_problems(ulog, size, header_only, to_s))
+    if not header_only:
+        loaded.problems.extend(_drop_damaged_formats(ulog, topics))
     loaded.problems.extend(_drop_unreadable_parameters(ulog))
     return loaded
+
+
+_IDENTIFIER = r"[A-Za-z_][A-Za-z0-9_]*"
+_NAME = re.compile(_IDENTIFIER)
+_FIELD = re.compile(rf"({_IDENTIFIER})(?:\[([1-9][0-9]*)\])? ({_IDENTIFIER})")
+_BASIC_TYPES = frozenset(ULog._UNPACK_TYPES)
+MAX_FORMAT_LINES = 5
+"""Damaged format records named one line each; the rest are counted."""
+
+
+def capped(text: str, limit: int = 40) -> str:
+    """A name from the file, cut: a damaged one can be any length (reports escape the rest)."""
+    return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
+def quoted(text: str, limit: int = 40) -> str:
+    return f"'{capped(text, limit)}'"
+
+
+def _format_damage(data: bytes) -> str | None:
+    """What a format record's text gets wrong, or None.
+
+    The ULog grammar is ``name:type field;type[n] field;...`` with C identifiers (PX4 generates
+    C structs from these), and every uORB message starts with ``uint64_t timestamp``. A flipped
+    byte in a field name or type usually still parses, and pyulog then decodes the topic under
+    the wrong name: its values read as absent, or its times as zero."""
+    try:
+        text = data.decode("ascii")
+    except UnicodeDecodeError:
+        return "bytes that are not text"
+    name, colon, body = text.partition(":")
+    if not colon or not _NAME.fullmatch(name):
+        return f"a topic name that is not an identifier: {quoted(name)}"
+    items = body.split(";")
+    if items and not items[-1]:
+        items.pop()  # the ';' that ends the last field
+    seen: set[str] = set()
+    for item in items:
+        match = _FIELD.fullmatch(item)
+        if match is None:
+            return f"a field that is not 'type name': {quoted(item)}"
+        member = match.group(3)
+        if member in seen:
+            return f"the field {quoted(member)} twice"
+        seen.add(member)
+    if not any(item == "uint64_t timestamp" for item in items):
+        return "no 'uint64_t timestamp' field"
+    return None
+
+
+def _drop_damaged_formats(ulog: _TrackedULog, topics: Sequence[str] | None) -> list[SourceProblem]:
+    """Each damaged format record, one line, and the data of every topic it describes (itself
+    or nested in it) taken out: decoded under a damaged definition, values would be wrong
+    without a sign. A record that only topics fuzzoff does not read depend on costs nothing:
+    it is said as a malformed part (``lost=False``)."""
+    formats = ulog.message_formats
+    damaged = dict(ulog.damaged_formats)
+    for name, fmt in formats.items():
+        for type_name, _, _member in fmt.fields:
+            if type_name not in _BASIC_TYPES and type_name not in formats and name not in damaged:
+                where = ulog.format_offsets.get(name, 16)
+                damaged[name] = (where, f"a field of a type no format defines: {quoted(type_name)}")
+    if not damaged:
+        return []
+    users = _users(formats, set(damaged))
+    read = set(topics) if topics is not None else None
+    kept = []
+    lost: dict[str, set[str]] = {}
+    for data in ulog.data_list:
+        hit = [d for d, names in users.items() if data.name in names]
+        if hit and (read is None or data.name in read):
+            for d in hit:
+                lost.setdefault(d, set()).add(data.name)
+        else:
+            kept.append(data)
+    ulog.data_list[:] = kept
+    problems = []
+    for name, (start, why) in sorted(damaged.items(), key=lambda item: item[1][0]):
+        gone = sorted(lost.get(name, ()))
+        what = f"damaged format record of {quoted(name)} ({why})"
+        if gone:
+            what += f"; the messages of {', '.join(quoted(t) for t in gone)} were not read"
+        else:
+            what += "; no topic fuzzoff reads depends on it"
+        problems.append(SourceProblem(what, f"byte {start}", lost=bool(gone)))
+    if len(problems) > MAX_FORMAT_LINES:
+        rest = problems[MAX_FORMAT_LINES:]
+        problems = problems[:MAX_FORMAT_LINES]
+        what = f"{len(rest)} more damaged format records"
+        problems.append(SourceProblem(what, lost=any(p.lost for p in rest)))
+    return problems
+
+
+def _users(formats: dict[str, Any], damaged: set[str]) -> dict[str, set[str]]:
+    """Damaged format -> the formats that are it or nest it, at any depth."""
+    users: dict[str, set[str]] = {}
+    for name in damaged:
+        found = {name}
+        grown = True
+        while grown:
+            grown = False
+            for other, fmt in formats.items():
+                if other not in found and any(t in found for t, _, _ in fmt.fields):
+                    found.add(other)
+                    grown = True
+        users[name] = found
+    return users
 
 
 def _drop_unreadable_parameters(ulog: Any) -> list[SourceProblem]:
@@ -245,9 +414,9 @@ def _drop_unreadable_parameters(ulog: Any) -> list[SourceProblem]:
 
 
 def _some(names: list[str]) -> str:
-    """The first three names, and how many more."""
+    """The first three names (each cut, see ``capped``), and how many more."""
     more = f" and {len(names) - 3} more" if len(names) > 3 else ""
-    return ", ".join(names[:3]) + more
+    return ", ".join(capped(name) for name in names[:3]) + more
 
 
 def _number(value: Any) -> bool:
@@ -266,7 +435,10 @@ def _reason(exc: Exception) -> str:
 
 
 def _problems(
-    ulog: _TrackedULog, size: int, header_only: bool, to_s: Callable[[int], float]
+    ulog: _TrackedULog,
+    size: int,
+    header_only: bool,
+    to_s: Callable[[int], float],
 ) -> list[SourceProblem]:
     """At most one problem: the first thing that went wrong (later damage follows from it)."""
     definitions = ulog.last_header("definitions")
@@ -282,8 +454,8 @@ def _problems(
         return [SourceProblem("truncated in the definition section", f"byte {size}")]
     if ulog.missing_formats:
         what = (
-            f"broken definition section: no message format for topic {_some(ulog.missing_formats)} "
-            "(its data cannot be decoded)"
+            "broken definition section: no message format for topic "
+            f"{_some(ulog.missing_formats)} (its data cannot be decoded)"
         )
         where = f"byte {ulog.missing_format_offset} (the topic's subscription record)"
         return [SourceProblem(what, where)]

@@ -9,6 +9,7 @@ a ULog is PX4's own copy of what it received or computed.
 
 from __future__ import annotations
 
+import contextlib
 import math
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass
@@ -111,6 +112,12 @@ class Chunk:
         """Array field ``name[0..size)`` as tuples (typed loosely: the size varies by field),
         made as the decoder's ``zip`` reads them (one pass), like ``where``."""
         return zip(*(self.f(f"{name}[{k}]") for k in range(size)), strict=True)
+
+    def matching(self, prefix: str, suffix: str) -> list[str]:
+        """The fields named ``prefix...suffix``, in layout order."""
+        if isinstance(self.cols, _Watched):
+            self.cols.patterns.add((prefix, suffix))
+        return [name for name in self.cols if name.startswith(prefix) and name.endswith(suffix)]
 
     def width(self, name: str) -> int:
         """The length of array field ``name`` in this layout."""
@@ -435,9 +442,7 @@ _FLAG_PREFIX, _FLAG_SUFFIX = "flag_control_", "_enabled"
 
 
 def control_mode_status(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
-    names = [
-        name for name in c.cols if name.startswith(_FLAG_PREFIX) and name.endswith(_FLAG_SUFFIX)
-    ]
+    names = c.matching(_FLAG_PREFIX, _FLAG_SUFFIX)
     short = [name[len(_FLAG_PREFIX) : -len(_FLAG_SUFFIX)] for name in names]
     columns = [c.b(name) for name in names]
     for t, w, ts, offboard, *flags in zip(
@@ -629,10 +634,75 @@ TOPICS: dict[str, TopicSpec] = {
 }
 """uORB topic -> what it becomes. Dict order = the order of events at the same microsecond."""
 
-EXTRA_TOPICS = ("commander_state",)
-"""Loaded but not turned into events of their own (merged into ``vehicle_status``)."""
+EXTRA_FIELDS: dict[str, tuple[str, ...]] = {"commander_state": ("timestamp", "main_state")}
+"""Topics loaded but not turned into events of their own (merged into ``vehicle_status``),
+with the fields read from them."""
+EXTRA_TOPICS = tuple(EXTRA_FIELDS)
 
 
 GPS_TOPICS = ("vehicle_gps_position",)
 """Loaded for the plots too: the first fix with a UTC time dates the log (a ULog's own clock
 is the time since boot)."""
+
+
+class _Watched(Mapping[str, Any]):
+    """A topic's columns that note every field name a decoder asks for."""
+
+    def __init__(self, cols: Columns) -> None:
+        self.cols = cols
+        self.asked: set[str] = set()
+        self.patterns: set[tuple[str, str]] = set()
+        """(prefix, suffix) of the fields read by pattern (``Chunk.matching``)."""
+
+    def __contains__(self, name: object) -> bool:
+        if isinstance(name, str):
+            self.asked.add(name)
+        return name in self.cols
+
+    def __getitem__(self, name: str) -> Any:
+        self.asked.add(name)
+        return self.cols[name]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.cols)
+
+    def __len__(self) -> int:
+        return len(self.cols)
+
+
+def renamed_fields(
+    cols: Columns, decode: Decoder | None, read: Iterable[str] = ()
+) -> list[tuple[str, str]]:
+    """(wanted, found) pairs: a field ``decode`` (or the caller: ``read``) reads that this layout
+    lacks, beside a field not read whose name is as long and one character apart. No release
+    names its fields so; a byte flipped in the topic's format record does, and the field would
+    then read as absent (NaN, False) without a sign. The decoder is run on no rows to learn the
+    names it reads."""
+    watched = _Watched(cols)
+    watched.asked.update(read)
+    if decode is not None:
+        with contextlib.suppress(Exception):  # a decoder that needs a row: the names so far
+            for _ in decode(Chunk(watched, slice(0, 0), "", 0), Context()):
+                pass
+    present = {name.split("[", 1)[0] for name in cols}
+    asked = {name.split("[", 1)[0] for name in watched.asked}
+    unread = sorted(present - asked)
+    pairs = [
+        (wanted, found)
+        for wanted in sorted(asked - present)
+        for found in unread
+        if len(wanted) == len(found) and _apart(wanted, found) == 1
+    ]
+    for prefix, suffix in sorted(watched.patterns):
+        pairs += [
+            (f"{prefix}...{suffix}", found)
+            for found in unread
+            if len(found) > len(prefix) + len(suffix)
+            and _apart(prefix, found[: len(prefix)]) + _apart(suffix, found[-len(suffix) :]) == 1
+        ]
+    return pairs
+
+
+def _apart(a: str, b: str) -> int:
+    """How many characters two names of one length differ in."""
+    return sum(x != y for x, y in zip(a, b, strict=True))
