@@ -267,13 +267,31 @@ PREEMPTED = (
 def _px4_only(verdict: Verdict, truth: Truth, t: float, flagged: bool) -> None:
     """The action and return PX4 took after a loss the model did not act on (preempted)."""
     settle = MODE_SETTLE_S if flagged else HEARTBEAT_SETTLE_S
-    after = [m for m in truth.modes if t - 0.001 <= m.t <= t + settle and m.nav_state != 14]
-    nav = after[0].nav_state if after else None
-    verdict.items.append(Item("failsafe action", t, nav_state_name(nav), "-", None, PREEMPTED))
-    later = [m for m in truth.modes if m.t > (after[0].t if after else t) + 0.001]
+    after = _px4_action(truth, t, settle)
+    verdict.items.append(Item("failsafe action", t, _action_name(after), "-", None, PREEMPTED))
+    later = [m for m in truth.modes if m.t > (after.t if after else t) + 0.001]
     back = bool(later) and later[0].nav_state == NAV_OFFBOARD and later[0].armed
     px4 = "back to OFFBOARD" if back else "stays"
     verdict.items.append(Item("automatic return", later[0].t if later else t, px4, "-", None))
+
+
+def _px4_action(truth: Truth, t: float, settle: float) -> Mode | None:
+    """PX4's failsafe action after its loss at ``t``: the first mode other than OFFBOARD, or
+    a disarm (COM_OBL_RC_ACT 7 disarms and leaves the mode as it was)."""
+    return next(
+        (
+            m
+            for m in truth.modes
+            if t - 0.001 <= m.t <= t + settle and (m.nav_state != NAV_OFFBOARD or not m.armed)
+        ),
+        None,
+    )
+
+
+def _action_name(mode: Mode | None) -> str:
+    if mode is None:
+        return "unknown"
+    return "disarmed" if not mode.armed else nav_state_name(mode.nav_state)
 
 
 def _preempted_loss(rows: list[dict[str, Any]], t: float, window: float) -> dict[str, Any] | None:
@@ -358,16 +376,19 @@ def _failsafe(
         None,
     )
     settle = MODE_SETTLE_S if flagged else HEARTBEAT_SETTLE_S
-    after = [m for m in truth.modes if t - 0.001 <= m.t <= t + settle and m.nav_state != 14]
-    px4_nav = after[0].nav_state if after else None
-    model_nav = failsafe["nav_state"] if failsafe else None
+    after = _px4_action(truth, t, settle)
+    px4_action = _action_name(after)
+    model_action = "unknown"
+    if failsafe is not None:
+        disarm = failsafe.get("action") == "DISARM"
+        model_action = "disarmed" if disarm else nav_state_name(failsafe["nav_state"])
     verdict.items.append(
         Item(
             "failsafe action",
             t,
-            nav_state_name(px4_nav),
-            f"{nav_state_name(model_nav)}: {failsafe['message'] if failsafe else ''}",
-            px4_nav == model_nav,
+            px4_action,
+            f"{model_action}: {failsafe['message'] if failsafe else ''}",
+            px4_action == model_action,
         )
     )
     back_model = next(
@@ -380,7 +401,7 @@ def _failsafe(
         None,
     )
     model_returns = back_model is not None and back_model["what"] == "offboard_resumed"
-    failsafe_t = after[0].t if after else t
+    failsafe_t = after.t if after else t
     later = [m for m in truth.modes if m.t > failsafe_t + 0.001]
     px4_returns = bool(later) and later[0].nav_state == NAV_OFFBOARD and later[0].armed
     verdict.items.append(
