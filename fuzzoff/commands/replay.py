@@ -225,17 +225,21 @@ def _stream(recording: Path, args: argparse.Namespace) -> int:
         from fuzzoff.fuzz.reproducers import load
 
         loaded = load(Path(args.path))
-        scenario, cut = loaded.scenario, loaded.cut_fraction
+        setup, cut = loaded.setup, loaded.cut_fraction
     except ReproducerError:
-        scenario, cut = None, None
+        setup, cut = None, None
     if cut is not None:
         print(
             f"fuzzoff: {printable(str(recording))} is the first {cut:.0%} of a recording (a"
             " truncation reproducer): PX4 gets that part only",
             file=sys.stderr,
         )
-    if scenario is not None:
-        params = {**dict(scenario.params), **params}
+    manual = False
+    if setup is not None:
+        # The setup's PX4 parameters (not fuzzoff's own assumption FUZZOFF_RC_PRESENT, which
+        # PX4 does not have: it is the joystick), the command line's win.
+        params = {**setup.params, **params}
+        manual = setup.manual_control
     record = (
         Path(args.record)
         if args.record
@@ -256,6 +260,7 @@ def _stream(recording: Path, args: argparse.Namespace) -> int:
             connect_timeout=args.connect_timeout,
             ready_timeout=args.ready_timeout,
             log=log,
+            manual=manual,
         )
     except (LinkError, SourceError) as exc:
         print(f"error: --to {target}: {printable(str(exc))}", file=sys.stderr)
