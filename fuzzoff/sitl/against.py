@@ -118,6 +118,8 @@ class Disagreement:
     shrunk_by: list[str] = field(default_factory=list)
     shrink_runs: int = 0
     reproducer: Path | None = None
+    second: Example | None = None
+    """The run that tried to confirm it (its evidence is kept when it did not)."""
 
 
 @dataclass(slots=True)
@@ -330,12 +332,13 @@ class Campaign:
         """Confirm ``found`` with a second run, shrink it, save it."""
         target = signature(found.differing[0])
         confirmed: bool | None = None
+        again = None
         for _ in range(CONFIRM_TRIES):
             again = self.send(found.scenario, "confirm")
             if again.status not in ("noise", "failed"):
                 confirmed = target in {signature(i) for i in again.differing}
                 break
-        case = Disagreement(found, confirmed, found)
+        case = Disagreement(found, confirmed, found, second=again)
         self.result.disagreements.append(case)
         if confirmed:
             self._shrink(case, target)
@@ -372,11 +375,15 @@ class Campaign:
             base=self.config.settings,
         )
         name = path.name[: -len(".expected.json")]
+        runs = [(kept, ".px4")]
+        if not case.confirmed and case.second is not None:
+            runs.append((case.second, ".second.px4"))
         evidence = {}
-        for source, suffix in ((kept.tlog, ".px4.tlog"), (kept.ulog, ".px4.ulg")):
-            if source is not None and source.exists():
-                shutil.copyfile(source, directory / f"{name}{suffix}")
-                evidence[suffix] = f"{name}{suffix}"
+        for run, infix in runs:
+            for source, suffix in ((run.tlog, ".tlog"), (run.ulog, ".ulg")):
+                if source is not None and source.exists():
+                    shutil.copyfile(source, directory / f"{name}{infix}{suffix}")
+                    evidence[infix + suffix] = f"{name}{infix}{suffix}"
         spec = json.loads(path.read_text())
         spec["property"] = None  # nothing the model alone can check again: PX4 must answer
         spec["against"] = against_block(self.config, case, evidence)
@@ -399,6 +406,15 @@ def against_block(
         "delivery": None if kept.delivery is None else kept.delivery.to_json(),
         "exchange_tlog": evidence.get(".px4.tlog"),
         "px4_ulog": evidence.get(".px4.ulg"),
+        "second_run": None
+        if case.second is None or case.confirmed
+        else {
+            "status": case.second.status,
+            "reason": case.second.reason or None,
+            "differ": [i.to_json() for i in case.second.differing],
+            "exchange_tlog": evidence.get(".second.px4.tlog"),
+            "px4_ulog": evidence.get(".second.px4.ulg"),
+        },
         "replay": f"fuzzoff replay NAME.expected.json --to udp:127.0.0.1:{port}",
     }
 

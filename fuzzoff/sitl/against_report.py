@@ -59,10 +59,12 @@ def to_terminal(result: AgainstResult) -> str:
     if result.stopped:
         lines.append(f"  stopped: {printable(result.stopped)}")
     confirmed = sum(1 for d in result.disagreements if d.confirmed)
+    edges = sum(1 for d in result.disagreements if d.kept.edge)
     lines.append(
         f"{_plural(len(search), 'stream')} in {result.seconds:.0f} s; "
         + (
-            f"{_plural(len(result.disagreements), 'disagreement')} ({confirmed} confirmed)"
+            f"{_plural(len(result.disagreements), 'disagreement')} ({confirmed} confirmed,"
+            f" {edges} at the loss check's phase)"
             if result.disagreements
             else "PX4 and the gate model agreed on every stream judged"
         )
@@ -82,6 +84,12 @@ def _disagreement(number: int, case: Disagreement, instance: int) -> list[str]:
         lines.append(f"    {printable(describe_item(item), 300)}")
     if case.kept.edge:
         lines.append(f"    note: {case.kept.edge}")
+    second = case.second
+    if second is not None and not case.confirmed:
+        again = "; ".join(describe_item(i) for i in second.differing) or second.reason or "agree"
+        lines.append(
+            f"    second run (stream {second.index}, {second.status}): {printable(again, 300)}"
+        )
     if case.reproducer is not None:
         lines.append(f"    reproducer {printable(str(case.reproducer))}")
         lines.append(
@@ -117,6 +125,7 @@ def _case(case: Disagreement) -> dict[str, Any]:
         "shrink_runs": case.shrink_runs,
         "shrunk_by": case.shrunk_by,
         "differ": [i.to_json() for i in case.kept.differing],
+        "second_run": None if case.second is None else _example(case.second),
         "edge": case.kept.edge,
         "reproducer": None if case.reproducer is None else str(case.reproducer),
     }

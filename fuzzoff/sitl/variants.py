@@ -7,8 +7,9 @@ The ones most likely to keep the disagreement come first:
 
 1. ``cut``: nothing after the disagreement (what PX4 did then cannot depend on it);
 2. ``plain setpoints``: every setpoint a LOCAL_NED position hold (the content did not matter);
-3. ``thinned to 10 Hz``: setpoints less than 0.1 s after the one kept before dropped (every
-   gap of 0.1 s or more, the ones the loss timeout is about, stays as it was);
+3. ``thinned to 10 Hz``: setpoints less than 0.1 s after the one kept before dropped, but both
+   ends of every gap of 0.1 s or more kept (the gaps the loss timeout is about stay as they
+   were);
 4. ``without <command>``: each command before the disagreement dropped in turn (a disarm and a
    leave first, the switch last).
 
@@ -101,9 +102,16 @@ def variants(scenario: Scenario, t: float) -> Iterator[tuple[str, Scenario]]:
 
 
 def _thinned(setpoints: Sequence[ev.Event]) -> list[ev.Event]:
+    """At most one setpoint per 0.1 s, keeping both ends of every gap of 0.1 s or more."""
     out: list[ev.Event] = []
-    for e in setpoints:
-        if not out or e.t - out[-1].t >= THIN_PERIOD_S - 1e-6:
+    for i, e in enumerate(setpoints):
+        follows = setpoints[i + 1].t - e.t if i + 1 < len(setpoints) else None
+        if (
+            not out
+            or e.t - out[-1].t >= THIN_PERIOD_S - 1e-6
+            or follows is None
+            or follows >= THIN_PERIOD_S - 1e-6
+        ):
             out.append(e)
     return out
 
