@@ -23,11 +23,12 @@ from fuzzoff.sitl import bundle, delivery
 from fuzzoff.sitl.against import AgainstConfig, Campaign, Disagreement, Example, with_start
 from fuzzoff.sitl.classify import edge_note, own_changes, shape, signature
 from fuzzoff.sitl.driver import NAV_LOITER
+from fuzzoff.sitl.link import COMPANION_SYSID
 from fuzzoff.sitl.replay import plan_from_tlog
 from fuzzoff.sitl.truth import Mode, Request, Truth
 from fuzzoff.sitl.variants import variants
-from fuzzoff.sitl.verdict import Item, Verdict
-from tests.helpers import run_cli
+from fuzzoff.sitl.verdict import Item, Verdict, compare
+from tests.helpers import CORPORA, run_cli
 
 NAV_POSCTL, NAV_OFFBOARD = 2, 14
 
@@ -315,3 +316,47 @@ def test_replay_to_sends_the_setups_parameters_and_a_joystick(
     assert out.returncode == 2 and "stop here" in out.stderr
     assert seen["params"] == {"COM_OF_LOSS_T": 0.5}
     assert seen["manual"] is True
+
+
+# ---------------------------------------------------------------- the verdict, on live runs
+
+EXCHANGES = CORPORA / "against" / "exchanges"
+
+
+def _judge(stem: str, params: dict[str, float]) -> Verdict:
+    release = stem.rsplit("-", 1)[1]
+    tlog, ulog = EXCHANGES / f"{stem}.tlog", EXCHANGES / f"{stem}.ulg"
+    return compare(tlog, release, ulog, params, COMPANION_SYSID)
+
+
+def test_an_arm_a_switch_and_a_disarm_sent_together_are_each_judged_on_their_own() -> None:
+    """PX4 1.15.4 armed, refused the switch (no stream yet) and disarmed, 0.1 ms apart, as
+    the model says; the verdict paired the arm with the switch's rejection before."""
+    verdict = _judge("arm_switch_disarm_same_ms-1.15.4", {"COM_OF_LOSS_T": 1.0})
+    judged = {(i.what, i.px4, i.model.split(":")[0]) for i in verdict.items if i.agree}
+    assert judged == {
+        ("arm", "accepted", "accepted"),
+        ("switch to OFFBOARD", "rejected (1)", "rejected"),
+        ("disarm", "accepted", "accepted"),
+    }
+    assert verdict.agree
+
+
+def test_a_loss_action_that_disarms_is_judged_as_a_disarm() -> None:
+    """COM_OBL_RC_ACT 7 on PX4 1.16.2: PX4 disarms and stays in OFFBOARD's nav state."""
+    verdict = _judge("loss_action_disarm-1.16.2", {"COM_OF_LOSS_T": 1.0, "COM_OBL_RC_ACT": 7.0})
+    (action,) = [i for i in verdict.items if i.what == "failsafe action"]
+    assert action.px4 == "disarmed" and action.model.startswith("disarmed:")
+    assert verdict.agree
+
+
+def test_losses_a_few_tenths_apart_are_each_paired_with_the_models_nearest() -> None:
+    """COM_OF_LOSS_T 0.2 and a jittered 5 Hz stream on PX4 1.15.4: PX4 ran four losses; the
+    model two of them at the same checks, and missed two whose keep-alive came back 6 ms
+    after its own check (33 ms after PX4's): the check's phase."""
+    verdict = _judge("losses_0_2s_apart-1.15.4", {"COM_OF_LOSS_T": 0.2, "COM_OBL_RC_ACT": 5.0})
+    timed = [i for i in verdict.items if i.what == "loss time"]
+    assert len(timed) == 2 and all(i.agree for i in timed)
+    assert all(i.px4.startswith("0.2") for i in timed)  # after the keep-alive before the flag
+    missed = [i for i in verdict.items if i.what == "offboard loss"]
+    assert [(i.px4, i.model) for i in missed] == [("lost", "no loss predicted")] * 2

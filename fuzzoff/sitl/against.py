@@ -198,7 +198,8 @@ class Campaign:
         self.result = AgainstResult(config)
         self.started = 0.0
         self.bench = Bench(config.build, config.instance, log)
-        self.work = Path(tempfile.mkdtemp(prefix="fuzzoff-against-"))
+        self.work = Path(tempfile.gettempdir())
+        """The streams and exchanges of the runs (a temporary folder while ``run`` runs)."""
 
     # -- budget
 
@@ -213,6 +214,7 @@ class Campaign:
 
     def run(self) -> AgainstResult:
         self.started = time.monotonic()
+        self.work = Path(tempfile.mkdtemp(prefix="fuzzoff-against-"))
         try:
             self.bench.start()
             self._search()
