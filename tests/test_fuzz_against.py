@@ -294,6 +294,9 @@ def test_a_disagreement_is_saved_as_a_reproducer_replay_reads(tmp_path: Path) ->
     out = run_cli(["replay", str(case.reproducer)])
     assert out.returncode == 0, out.stdout + out.stderr
     assert "findings: as expected" in out.stdout
+    assert "against PX4 1.15.4 (confirmed): it and the model differed" in out.stdout
+    assert "arm: PX4 rejected (1); model accepted: armed" in out.stdout
+    assert "--to udp:127.0.0.1:14580" in out.stdout
 
 
 def test_replay_to_sends_the_setups_parameters_and_a_joystick(

@@ -46,6 +46,8 @@ NOT_WITH_AGAINST = {
     "property": "--property",
     "px4": "--px4 (the release is the one of --against)",
     "param": "--param (the campaign draws the parameters and sets them on PX4)",
+    "seeds": "--seeds (one PX4, one seed: --seed)",
+    "scheduler": "--scheduler (the campaign runs one PX4 here)",
 }
 
 
@@ -65,7 +67,7 @@ def _release(text: str, px4_build: Path | None) -> str | None:
 
 def _checked(args: argparse.Namespace) -> None:
     for name, option in NOT_WITH_AGAINST.items():
-        if getattr(args, name):
+        if getattr(args, name, None):
             raise ConfigError(f"{option} does not go with --against")
     if args.vehicle and args.vehicle not in ("mc", "quadrotor", "multicopter"):
         raise ConfigError(f"--vehicle {args.vehicle}: the PX4 SITL bundles fly a multicopter")

@@ -171,14 +171,49 @@ def run(args: argparse.Namespace) -> int:
         "problems": still,
         "setup": None if reproducer.setup is None else reproducer.setup.to_json(),
     }
+    against = _against_block(reproducer.path)
+    if against is not None:
+        data["against"] = against
     if args.format == "json":
         text = json.dumps(data, indent=2) + "\n"
     else:
         text = _terminal(recording, prop, verdict, differ, still, again.on_stream)
         if reproducer.setup is not None:
             text += f"  on a live PX4: {reproducer.setup.describe()}\n"
+        if against is not None:
+            text += _against_text(against, args.path)
     write_output(text, args.output)
     return 1 if differ or still else 0
+
+
+def _against_block(path: Path) -> dict[str, Any] | None:
+    """The ``against`` object of a reproducer ``fuzzoff fuzz --against`` saved (what a real
+    PX4 did beside the model), or None."""
+    try:
+        block = json.loads(path.read_text()).get("against")
+    except (OSError, ValueError, AttributeError):
+        return None
+    return block if isinstance(block, dict) else None
+
+
+def _against_text(against: dict[str, Any], path: str) -> str:
+    differ = [d for d in against.get("differ", []) if isinstance(d, dict)]
+    state = {True: "confirmed", False: "seen once", None: "unconfirmed"}.get(
+        against.get("confirmed"), "unconfirmed"
+    )
+    lines = [
+        f"  against PX4 {printable(str(against.get('px4')))} ({state}): it and the model differed"
+    ]
+    for d in differ:
+        lines.append(
+            f"    {printable(str(d.get('what')))}: PX4 {printable(str(d.get('px4')))};"
+            f" model {printable(str(d.get('model')), 200)}"
+        )
+    lines.append(
+        f"  send it to a running PX4 again: fuzzoff replay {printable(path)} --to"
+        " udp:127.0.0.1:14580"
+    )
+    return "\n".join(lines) + "\n"
 
 
 def _terminal(

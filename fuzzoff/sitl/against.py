@@ -27,7 +27,7 @@ import shutil
 import tempfile
 import time
 from collections import Counter
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Literal
@@ -47,6 +47,7 @@ from fuzzoff.sitl.run import load_plan
 from fuzzoff.sitl.truth import read_truth
 from fuzzoff.sitl.variants import variants
 from fuzzoff.sitl.verdict import Item, Verdict, compare
+from fuzzoff.sources.base import SourceError
 
 Status = Literal["agree", "differ", "outside", "noise", "failed"]
 Log = Callable[[str], None]
@@ -298,13 +299,18 @@ class Campaign:
         example.first_sent_px4 = run.sent[0] if run.sent else None
         example.delivery = delivery.check(run.meant, run.sent)
         release = self.config.build.profile_release
-        verdict = compare(run.tlog, release, run.ulog, setup.params, COMPANION_SYSID)
+        try:
+            verdict = compare(run.tlog, release, run.ulog, setup.params, COMPANION_SYSID)
+            truth = None if run.ulog is None else read_truth(run.ulog)
+        except SourceError as exc:  # PX4 killed while writing its log, say
+            example.reason = f"the run's recordings cannot be judged: {exc.line()}"
+            return
         verdict.items = [i for i in verdict.items if i.t >= run.recording_from]
         example.verdict = verdict
         if verdict.problems and not verdict.items:
             example.reason = "; ".join(verdict.problems)
             return
-        own = [] if run.ulog is None else own_changes(read_truth(run.ulog), run.recording_from)
+        own = [] if truth is None else own_changes(truth, run.recording_from)
         first = min((i.t for i in example.differing), default=None)
         before = [c for c in own if first is not None and c.t <= first + OWN_CHANGE_SLACK_S]
         if not example.differing:
@@ -438,7 +444,3 @@ def _line(example: Example) -> str:
 
 def run_against(config: AgainstConfig, log: Log) -> AgainstResult:
     return Campaign(config, log).run()
-
-
-def iter_runs(result: AgainstResult, purpose: str) -> Iterator[Example]:
-    return (e for e in result.examples if e.purpose == purpose)

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 from collections import Counter
-from pathlib import Path
 from typing import Any
 
 from fuzzoff.report.sanitize import printable
@@ -158,7 +157,3 @@ def to_json(result: AgainstResult) -> str:
         "stopped": result.stopped,
     }
     return json.dumps(data, indent=2) + "\n"
-
-
-def reproducer_paths(result: AgainstResult) -> list[Path]:
-    return [c.reproducer for c in result.disagreements if c.reproducer is not None]

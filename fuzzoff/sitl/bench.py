@@ -261,7 +261,10 @@ class Bench:
         fresh = sorted(set(session.px4.ulogs()) - before, key=lambda p: p.stat().st_mtime)
         kept = None
         if fresh:
-            kept = trim(fresh[-1], ulog)
+            try:
+                kept = trim(fresh[-1], ulog)
+            except Exception as exc:  # pyulog raises bare exceptions on a damaged log
+                notes.append(f"PX4's ULog of this stream cannot be read ({exc}): the tlog")
             for path in fresh:
                 path.unlink(missing_ok=True)  # several MB each: keep only the cut copy
         else:
