@@ -363,3 +363,27 @@ def test_losses_a_few_tenths_apart_are_each_paired_with_the_models_nearest() -> 
     assert all(i.px4.startswith("0.2") for i in timed)  # after the keep-alive before the flag
     missed = [i for i in verdict.items if i.what == "offboard loss"]
     assert [(i.px4, i.model) for i in missed] == [("lost", "no loss predicted")] * 2
+
+
+def test_a_disagreement_confirmed_before_is_counted_not_followed_up_again(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    config = AgainstConfig(build=bundle.Build(tmp_path, "1.15.4"), save_dir=None)
+    campaign = Campaign(config, log=lambda line: None)
+    stream = _stream(TEN_HZ, PLAN)
+    sent: list[str] = []
+
+    def send(scenario: Scenario, purpose: str) -> Example:
+        sent.append(purpose)
+        verdict = Verdict("1.15.4", "ulog", [_item(3.0, "rejected (1)", "accepted: armed")])
+        example = Example(len(sent), scenario, "differ", verdict=verdict, purpose=purpose)
+        campaign.result.examples.append(example)
+        return example
+
+    monkeypatch.setattr(campaign, "send", send)
+    monkeypatch.setattr(campaign, "spent", lambda: True)  # no shrinking
+    campaign.searched(send(stream, "search"))
+    campaign.searched(send(stream, "search"))
+    assert sent == ["search", "confirm", "search"]
+    (case,) = campaign.result.disagreements
+    assert case.confirmed is True and case.seen_again == [3]

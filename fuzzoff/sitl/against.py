@@ -121,6 +121,8 @@ class Disagreement:
     reproducer: Path | None = None
     second: Example | None = None
     """The run that tried to confirm it (its evidence is kept when it did not)."""
+    seen_again: list[int] = field(default_factory=list)
+    """Later streams of the search that showed the same disagreement (not followed up)."""
 
 
 @dataclass(slots=True)
@@ -199,6 +201,8 @@ class Campaign:
         self.result = AgainstResult(config)
         self.started = 0.0
         self.bench = Bench(config.build, config.instance, log)
+        self.known: dict[tuple[str, str, str], Disagreement] = {}
+        """Disagreements followed up, by signature (a confirmed one is not followed again)."""
         self.work = Path(tempfile.gettempdir())
         """The streams and exchanges of the runs (a temporary folder while ``run`` runs)."""
 
@@ -248,9 +252,7 @@ class Campaign:
             shapes.add(shape(scenario))
             if self.spent():
                 raise _Stop
-            example = self.send(scenario, "search")
-            if example.status == "differ":
-                self.follow_up(example)
+            self.searched(self.send(scenario, "search"))
 
         strategy: st.SearchStrategy[Scenario] = scenarios(self.config.profile, "mc", "mavlink")
         test = given(strategy)(one)
@@ -262,6 +264,17 @@ class Campaign:
         test = seed(self.config.seed)(test)
         with _hypothesis_storage(), contextlib.suppress(_Stop):
             test()
+
+    def searched(self, example: Example) -> None:
+        """Follow a disagreement of the search up, unless it was confirmed before (then it is
+        counted against the first one, not confirmed and shrunk again)."""
+        if example.status != "differ":
+            return
+        again = self.known.get(signature(example.differing[0]))
+        if again is not None:
+            again.seen_again.append(example.index)
+        else:
+            self.follow_up(example)
 
     # -- one stream
 
@@ -349,6 +362,7 @@ class Campaign:
         case = Disagreement(found, confirmed, found, second=again)
         self.result.disagreements.append(case)
         if confirmed:
+            self.known[target] = case
             self._shrink(case, target)
         self._save(case)
 

@@ -79,6 +79,9 @@ def _disagreement(number: int, case: Disagreement, instance: int) -> list[str]:
     elif case.shrink_runs:
         head += f"; {case.shrink_runs} simpler variants agreed"
     lines = [head + ")"]
+    if case.seen_again:
+        streams = ", ".join(str(i) for i in case.seen_again)
+        lines.append(f"    seen again in streams {streams} (not followed up again)")
     for item in case.kept.differing:
         lines.append(f"    {printable(describe_item(item), 300)}")
     if case.kept.edge:
@@ -123,6 +126,7 @@ def _case(case: Disagreement) -> dict[str, Any]:
         "confirmed": case.confirmed,
         "shrink_runs": case.shrink_runs,
         "shrunk_by": case.shrunk_by,
+        "seen_again_in_streams": case.seen_again,
         "differ": [i.to_json() for i in case.kept.differing],
         "second_run": None if case.second is None else _example(case.second),
         "edge": case.kept.edge,
