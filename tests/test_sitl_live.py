@@ -1,8 +1,9 @@
 """Live runs against real PX4 SITL bundles (``../shared/px4-sitl``, or ``$FUZZOFF_PX4_SITL``).
 
-``make test`` runs one short check on one release (the issue's acceptance: ``fuzzoff replay
+``make test`` runs two short checks on one release (the issue's acceptance: ``fuzzoff replay
 corpora/tlog/stream_lost_in_offboard.tlog --to udp:127.0.0.1:14580+N`` against a running bundle
-prints PX4's outcome and the model's, and they agree); ``make test-sitl``
+prints PX4's outcome and the model's, and they agree; and a live fuzz campaign of one stream,
+``fuzzoff fuzz --against sitl:1.16.2 --examples 1``); ``make test-sitl``
 (``FUZZOFF_SITL_MATRIX=1``) runs every scenario on every bundled release with ``fuzzoff sitl
 run``, each compared with the gate model. Both are skipped, saying why, without the bundles.
 
@@ -67,6 +68,39 @@ def test_replay_to_a_running_px4_prints_its_outcome_beside_the_models(tmp_path: 
     assert "automatic return   PX4: back to OFFBOARD" in out.stdout
     assert "verdict: PX4 and the model agree" in out.stdout
     assert record.stat().st_size > 0
+
+
+@needs_bundles
+def test_a_live_campaign_sends_a_generated_stream_and_judges_what_px4_did(tmp_path: Path) -> None:
+    """``fuzzoff fuzz --against``: one stream drawn, sent to a PX4 the campaign starts, judged
+    beside the gate model (a disagreement is confirmed and saved, not shrunk here)."""
+    release = QUICK_RELEASE if QUICK_RELEASE in RELEASES else RELEASES[-1]
+    saved = tmp_path / "reproducers"
+    out = run_cli_process(
+        [
+            "fuzz",
+            "--against",
+            f"sitl:{release}",
+            "--examples",
+            "1",
+            "--shrink-runs",
+            "0",
+            "--instance",
+            str(_instance()),
+            "--save-dir",
+            str(saved),
+        ],
+        timeout=300,
+    )
+    assert out.returncode in (0, 1), out.stdout + out.stderr
+    assert f"fuzzoff fuzz --against sitl:{release}" in out.stdout
+    assert "streams       1 sent" in out.stdout
+    assert "switch to OFFBOARD: accepted" in out.stdout
+    assert "fuzzoff: search 1:" in out.stderr
+    if out.returncode == 1:
+        assert list(saved.glob("px4-*.expected.json")), out.stdout
+    else:
+        assert not saved.exists()
 
 
 def _matrix() -> list[object]:

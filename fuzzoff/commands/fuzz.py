@@ -16,7 +16,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from fuzzoff.commands import add_command
+from fuzzoff.commands import _against, add_command
 from fuzzoff.commands._common import (
     add_scheduler_option,
     parse_params,
@@ -89,6 +89,7 @@ def add_parser(sub: Any) -> None:
         help="one campaign per seed (0-199, or 3,7,11), merged into one report; each seed "
         "runs what --seed N runs (docs/fleet.md)",
     )
+    _against.add_arguments(parser)
     parser.set_defaults(run=run)
 
 
@@ -207,6 +208,9 @@ class _Progress:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.against is not None:  # a live campaign against a PX4 SITL
+        return _against.run(args)
+    _against.check_not_live(args)
     config = _config(args)
     label = f"--save-dir {args.save_dir}"
     if args.save_dir is None:

@@ -171,14 +171,49 @@ def run(args: argparse.Namespace) -> int:
         "problems": still,
         "setup": None if reproducer.setup is None else reproducer.setup.to_json(),
     }
+    against = _against_block(reproducer.path)
+    if against is not None:
+        data["against"] = against
     if args.format == "json":
         text = json.dumps(data, indent=2) + "\n"
     else:
         text = _terminal(recording, prop, verdict, differ, still, again.on_stream)
         if reproducer.setup is not None:
             text += f"  on a live PX4: {reproducer.setup.describe()}\n"
+        if against is not None:
+            text += _against_text(against, args.path)
     write_output(text, args.output)
     return 1 if differ or still else 0
+
+
+def _against_block(path: Path) -> dict[str, Any] | None:
+    """The ``against`` object of a reproducer ``fuzzoff fuzz --against`` saved (what a real
+    PX4 did beside the model), or None."""
+    try:
+        block = json.loads(path.read_text()).get("against")
+    except (OSError, ValueError, AttributeError):
+        return None
+    return block if isinstance(block, dict) else None
+
+
+def _against_text(against: dict[str, Any], path: str) -> str:
+    differ = [d for d in against.get("differ", []) if isinstance(d, dict)]
+    state = {True: "confirmed", False: "seen once", None: "unconfirmed"}.get(
+        against.get("confirmed"), "unconfirmed"
+    )
+    lines = [
+        f"  against PX4 {printable(str(against.get('px4')))} ({state}): it and the model differed"
+    ]
+    for d in differ:
+        lines.append(
+            f"    {printable(str(d.get('what')))}: PX4 {printable(str(d.get('px4')))};"
+            f" model {printable(str(d.get('model')), 200)}"
+        )
+    lines.append(
+        f"  send it to a running PX4 again: fuzzoff replay {printable(path)} --to"
+        " udp:127.0.0.1:14580"
+    )
+    return "\n".join(lines) + "\n"
 
 
 def _terminal(
@@ -225,17 +260,21 @@ def _stream(recording: Path, args: argparse.Namespace) -> int:
         from fuzzoff.fuzz.reproducers import load
 
         loaded = load(Path(args.path))
-        scenario, cut = loaded.scenario, loaded.cut_fraction
+        setup, cut = loaded.setup, loaded.cut_fraction
     except ReproducerError:
-        scenario, cut = None, None
+        setup, cut = None, None
     if cut is not None:
         print(
             f"fuzzoff: {printable(str(recording))} is the first {cut:.0%} of a recording (a"
             " truncation reproducer): PX4 gets that part only",
             file=sys.stderr,
         )
-    if scenario is not None:
-        params = {**dict(scenario.params), **params}
+    manual = False
+    if setup is not None:
+        # The setup's PX4 parameters (not fuzzoff's own assumption FUZZOFF_RC_PRESENT, which
+        # PX4 does not have: it is the joystick), the command line's win.
+        params = {**setup.params, **params}
+        manual = setup.manual_control
     record = (
         Path(args.record)
         if args.record
@@ -256,6 +295,7 @@ def _stream(recording: Path, args: argparse.Namespace) -> int:
             connect_timeout=args.connect_timeout,
             ready_timeout=args.ready_timeout,
             log=log,
+            manual=manual,
         )
     except (LinkError, SourceError) as exc:
         print(f"error: --to {target}: {printable(str(exc))}", file=sys.stderr)

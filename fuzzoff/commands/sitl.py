@@ -106,9 +106,9 @@ def run_command(args: argparse.Namespace) -> int:
                 args.scenario, build, args.instance, save_dir, params, env, log
             )
         else:
-            recording, params = _recording(Path(args.path), params)
+            recording, params, manual = _recording(Path(args.path), params)
             outcome = run.replay_on_bundle(
-                recording, build, args.instance, save_dir, params, args.speed, env, log
+                recording, build, args.instance, save_dir, params, args.speed, env, log, manual
             )
     except (LinkError, bundle.BundleError, SourceError) as exc:
         print(f"error: {printable(str(exc))}", file=sys.stderr)
@@ -116,10 +116,12 @@ def run_command(args: argparse.Namespace) -> int:
     return report(outcome, args.format, args.output)
 
 
-def _recording(path: Path, params: dict[str, float]) -> tuple[Path, dict[str, float]]:
-    """A tlog, or a reproducer's recording with its parameters (the command line's win)."""
+def _recording(path: Path, params: dict[str, float]) -> tuple[Path, dict[str, float], bool]:
+    """A tlog, or a reproducer's recording with its setup: its PX4 parameters (the command
+    line's win) and whether it assumed manual control (then a MAVLink joystick is sent)."""
     if not path.exists():
         raise ConfigError(f"no such file: {path}")
+    manual = False
     if path.name.endswith(".expected.json"):
         from fuzzoff.fuzz.reproducers import ReproducerError, load
 
@@ -127,11 +129,12 @@ def _recording(path: Path, params: dict[str, float]) -> tuple[Path, dict[str, fl
             reproducer = load(path)
         except ReproducerError as exc:
             raise ConfigError(str(exc)) from None
-        scenario_params = dict(reproducer.scenario.params) if reproducer.scenario else {}
-        path, params = reproducer.recording, {**scenario_params, **params}
+        setup = reproducer.setup
+        path, params = reproducer.recording, {**(setup.params if setup else {}), **params}
+        manual = setup is not None and setup.manual_control
     if path.suffix.lower() != ".tlog":
         raise ConfigError(f"{path}: a replay sends MAVLink: only a .tlog recording")
-    return path, params
+    return path, params, manual
 
 
 def report(outcome: Any, fmt: str, output: str | None) -> int:

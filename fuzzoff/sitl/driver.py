@@ -49,14 +49,15 @@ class Driver:
         self.steps.append(Step(self.now(), what, None if ack is None else ack.result))
         return ack
 
-    def _tick(self) -> None:
+    def tick(self) -> None:
+        """Send a joystick sample when one is due (a scenario with manual control)."""
         if self.manual and self.now() >= self._next_manual:
             self.link.manual_control()
             self._next_manual = self.now() + MANUAL_EVERY_S
 
     def wait(self, seconds: float) -> None:
         """Send nothing but the joystick (if any) for ``seconds`` of PX4's time."""
-        self.link.sleep_until(self.now() + seconds, self._tick)
+        self.link.sleep_until(self.now() + seconds, self.tick)
 
     def stream(self, setpoint: Setpoint, seconds: float, hz: float = 10.0) -> None:
         """Send ``setpoint`` at ``hz`` for ``seconds`` of PX4's time."""
@@ -64,8 +65,8 @@ class Driver:
         n = max(1, round(seconds * hz))
         for i in range(n):
             setpoint(self)
-            self._tick()
-            self.link.sleep_until(start + (i + 1) / hz, self._tick)
+            self.tick()
+            self.link.sleep_until(start + (i + 1) / hz, self.tick)
 
     def position(self, x: float, y: float, z: float, frame: int = MAV_FRAME_LOCAL_NED) -> Setpoint:
         def send(d: Driver) -> None:

@@ -34,6 +34,8 @@ COMPANION_SYSID = 245
 MAV_COMP_ID_ONBOARD_COMPUTER = 191
 MAV_AUTOPILOT_PX4 = 12
 PREARM_BIT = mavlink.MAV_SYS_STATUS_PREARM_CHECK
+RC_RECEIVER_BIT = mavlink.MAV_SYS_STATUS_SENSOR_RC_RECEIVER
+"""Present and healthy in SYS_STATUS while PX4 has manual control (an RC or a MAVLink joystick)."""
 MAV_MODE_FLAG_SAFETY_ARMED = 128
 MAV_CMD_DO_SET_MODE = 176
 MAV_CMD_COMPONENT_ARM_DISARM = 400
@@ -111,6 +113,9 @@ class VehicleView:
     heartbeat_host: float = 0.0
     prearm_known: bool = False
     prearm_ok: bool = False
+    manual_present: bool | None = None
+    """PX4's own verdict on manual control (SYS_STATUS), None before the first SYS_STATUS."""
+    sys_status_host: float = 0.0
     landed_state: int | None = None
     relative_alt_m: float | None = None
     acks: list[Ack] = field(default_factory=list)
@@ -226,6 +231,9 @@ class Link:
             # PX4 sets the bit in ``health`` only (not in ``present``) when its checks pass.
             view.prearm_ok = bool(msg.onboard_control_sensors_health & PREARM_BIT)
             view.prearm_known = view.prearm_known or view.prearm_ok
+            rc = msg.onboard_control_sensors_present & msg.onboard_control_sensors_health
+            view.manual_present = bool(rc & RC_RECEIVER_BIT)
+            view.sys_status_host = host
         elif kind == "EXTENDED_SYS_STATE":
             view.landed_state = msg.landed_state
         elif kind == "GLOBAL_POSITION_INT":

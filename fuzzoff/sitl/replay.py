@@ -14,6 +14,7 @@ the first one (``Link.sleep_until``), so a 1.0 s gap is 1.0 s where the gate mea
 from __future__ import annotations
 
 from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -147,11 +148,16 @@ def bring_to_start(link: Link, plan: Plan) -> list[str]:
     return notes
 
 
-def send(link: Link, plan: Plan, speed: float = 1.0) -> int:
-    """Send the plan's messages on PX4's clock; the count."""
+def send(
+    link: Link, plan: Plan, speed: float = 1.0, tick: Callable[[], None] | None = None
+) -> list[float]:
+    """Send the plan's messages on PX4's clock; the PX4 time each one went out (what the
+    tlog records for it). ``tick`` runs while waiting (a joystick beside the stream)."""
     target = link.target
     start = link.clock.now()
+    sent = []
     for t, msg in plan.messages:
-        link.sleep_until(start + t / speed)
+        link.sleep_until(start + t / speed, tick)
         link.send(readdress(msg, target))
-    return len(plan.messages)
+        sent.append(link.clock.now())
+    return sent

@@ -27,6 +27,8 @@ from fuzzoff.sitl.verdict import Verdict, compare
 TAIL_S = 1.5
 """After the last message, PX4's clock runs COM_OF_LOSS_T plus this before the run ends: a
 stream that ends in OFFBOARD is lost only then."""
+MANUAL_SETTLE_S = 1.5
+"""A joystick this long before the stream: PX4 reports manual control within a second."""
 Log = Callable[[str], None]
 
 
@@ -91,12 +93,35 @@ def _apply_params(link: Link, params: dict[str, float], log: Log) -> dict[str, f
     return before
 
 
-def _replay_on(link: Link, plan: replay.Plan, speed: float, timeout_s: float, log: Log) -> None:
+def start_joystick(driver: Driver, log: Log) -> None:
+    """A MAVLink joystick (MANUAL_CONTROL at 10 Hz) for ``MANUAL_SETTLE_S`` before the stream,
+    so that PX4 has manual control when it starts, as a reproducer's setup may say."""
+    driver.wait(MANUAL_SETTLE_S)
+    if driver.link.view.manual_present:
+        log("manual control present (a MAVLink joystick, MANUAL_CONTROL at 10 Hz), as assumed")
+    else:
+        log(
+            "PX4 does not report manual control from the MAVLink joystick (COM_RC_IN_MODE?):"
+            " the verdict's model follows PX4's SYS_STATUS"
+        )
+
+
+def _replay_on(
+    link: Link,
+    plan: replay.Plan,
+    speed: float,
+    timeout_s: float,
+    log: Log,
+    manual: bool = False,
+) -> None:
+    driver = Driver(link, manual=manual)
+    if manual:
+        start_joystick(driver, log)
     for note in replay.bring_to_start(link, plan):
         log(note)
-    sent = replay.send(link, plan, speed)
-    log(f"sent {sent} messages over {plan.duration / speed:.2f} s of PX4's clock")
-    Driver(link).wait(timeout_s + TAIL_S)
+    sent = replay.send(link, plan, speed, driver.tick)
+    log(f"sent {len(sent)} messages over {plan.duration / speed:.2f} s of PX4's clock")
+    driver.wait(timeout_s + TAIL_S)
 
 
 def load_plan(recording: Path) -> replay.Plan:
@@ -120,7 +145,10 @@ def replay_on_bundle(
     speed: float = 1.0,
     env: dict[str, str] | None = None,
     log: Log = print,
+    manual: bool = False,
 ) -> Outcome:
+    """``manual``: send a MAVLink joystick throughout (a reproducer that assumed manual
+    control present)."""
     plan = load_plan(recording)
     params = params or {}
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -137,7 +165,8 @@ def replay_on_bundle(
             link.recorder = recorder
             try:
                 link.request_version()
-                _replay_on(link, plan, speed, params.get("COM_OF_LOSS_T", 1.0), log)
+                timeout = params.get("COM_OF_LOSS_T", 1.0)
+                _replay_on(link, plan, speed, timeout, log, manual)
             finally:
                 link.recorder = None
                 recorder.close()
@@ -163,9 +192,10 @@ def replay_live(
     connect_timeout: float = 10.0,
     ready_timeout: float = 90.0,
     log: Log = print,
+    manual: bool = False,
 ) -> Outcome:
     """Replay into a running PX4 at ``target`` (its listening port); parameters set for the
-    replay are put back afterwards."""
+    replay are put back afterwards. ``manual``: a MAVLink joystick throughout."""
     plan = load_plan(recording)
     params = params or {}
     link = Link(target)
@@ -189,7 +219,7 @@ def replay_live(
         link.recorder = recorder
         try:
             link.request_version()
-            _replay_on(link, plan, speed, params.get("COM_OF_LOSS_T", 1.0), log)
+            _replay_on(link, plan, speed, params.get("COM_OF_LOSS_T", 1.0), log, manual)
         finally:
             link.recorder = None
             recorder.close()

@@ -118,17 +118,30 @@ def _accepted(result: int | None) -> str:
     return "accepted" if result == 0 else f"rejected ({result})"
 
 
-def _model_decision(rows: list[dict[str, Any]], t: float) -> dict[str, Any] | None:
-    kinds = {
-        "request_accepted",
-        "request_rejected",
-        "arm_accepted",
-        "arm_rejected",
-        "mode",
-        "disarmed",
-    }
-    near = [r for r in rows if r["what"] in kinds and abs(r["time_s"] - t) <= DECISION_S]
-    return min(near, key=lambda r: abs(r["time_s"] - t)) if near else None
+DECISIONS = {
+    "switch": frozenset({"request_accepted", "request_rejected", "mode"}),
+    "arm": frozenset({"arm_accepted", "arm_rejected"}),
+    "disarm": frozenset({"disarmed", "disarm_rejected"}),
+}
+"""The model's rows that answer each kind of request: an arm and a switch sent within a few
+milliseconds of each other are each paired with their own answer, not the nearest row."""
+
+
+def _model_decision(
+    rows: list[dict[str, Any]], t: float, kind: str, used: set[int]
+) -> dict[str, Any] | None:
+    near = [
+        r
+        for r in rows
+        if r["what"] in DECISIONS[kind]
+        and abs(r["time_s"] - t) <= DECISION_S
+        and id(r) not in used
+        and "from the recording" not in r["message"]  # the model following, not deciding
+    ]
+    row = min(near, key=lambda r: abs(r["time_s"] - t)) if near else None
+    if row is not None:
+        used.add(id(row))
+    return row
 
 
 def _model_accepts(row: dict[str, Any]) -> bool:
@@ -181,11 +194,14 @@ def _gate_disagreements(verdict: Verdict, rows: list[dict[str, Any]]) -> None:
 
 
 def _requests(verdict: Verdict, truth: Truth, rows: list[dict[str, Any]]) -> None:
+    shifted = [{**r, "time_s": r["px4_t"]} for r in rows]
+    used: set[int] = set()
     for request in truth.requests:
         if request.command not in REQUESTS:
             continue
         label = _request_label(request.command, request.param1, request.param2, request.param3)
-        row = _model_decision([{**r, "time_s": r["px4_t"]} for r in rows], request.t)
+        kind = "switch" if request.command == 176 else label
+        row = _model_decision(shifted, request.t, kind, used)
         px4 = _accepted(request.result)
         if row is None:
             verdict.items.append(
@@ -234,11 +250,15 @@ def _losses(
         and any(f["what"] == "failsafe" and 0 <= f["px4_t"] - r["px4_t"] <= 0.05 for f in rows[i:])
     ]
     px4 = _px4_losses(truth, flagged)
+    window = MATCH_S if flagged else HEARTBEAT_SETTLE_S
+    paired = _pair(px4, model, window)
     used: set[int] = set()
     for t in px4:
-        window = MATCH_S if flagged else HEARTBEAT_SETTLE_S
-        match = [r for r in model if abs(r["px4_t"] - t) <= window and id(r) not in used]
-        keepalive = truth.last_keepalive_before(t)
+        row_or_none = paired.get(t)
+        match = [] if row_or_none is None else [row_or_none]
+        # the newest keep-alive PX4 had before its flag (one logged at the flag's own
+        # microsecond came with the check that flagged the loss, or after it)
+        keepalive = truth.last_keepalive_before(t - KEEPALIVE_EPS_S)
         if not match:
             preempted = _preempted_loss(rows, t, window)
             if preempted is not None:
@@ -258,6 +278,30 @@ def _losses(
             )
 
 
+KEEPALIVE_EPS_S = 0.0005
+
+
+def _pair(
+    px4: list[float], model: list[dict[str, Any]], window: float
+) -> dict[float, dict[str, Any]]:
+    """Each of PX4's losses with the model's nearest one within ``window``, nearest pairs
+    first: with losses a few tenths of a second apart (COM_OF_LOSS_T 0.2 and a 4 Hz stream),
+    taking the earliest in the window paired each with the next one's."""
+    candidates = sorted(
+        (abs(r["px4_t"] - t), t, i)
+        for t in px4
+        for i, r in enumerate(model)
+        if abs(r["px4_t"] - t) <= window
+    )
+    paired: dict[float, dict[str, Any]] = {}
+    taken: set[int] = set()
+    for _, t, i in candidates:
+        if t not in paired and i not in taken:
+            paired[t] = model[i]
+            taken.add(i)
+    return paired
+
+
 PREEMPTED = (
     "not judged: PX4's mode change reached the model before its own 10 Hz check, and the model"
     " followed it as an unseen mode change instead of predicting the action"
@@ -267,13 +311,31 @@ PREEMPTED = (
 def _px4_only(verdict: Verdict, truth: Truth, t: float, flagged: bool) -> None:
     """The action and return PX4 took after a loss the model did not act on (preempted)."""
     settle = MODE_SETTLE_S if flagged else HEARTBEAT_SETTLE_S
-    after = [m for m in truth.modes if t - 0.001 <= m.t <= t + settle and m.nav_state != 14]
-    nav = after[0].nav_state if after else None
-    verdict.items.append(Item("failsafe action", t, nav_state_name(nav), "-", None, PREEMPTED))
-    later = [m for m in truth.modes if m.t > (after[0].t if after else t) + 0.001]
+    after = _px4_action(truth, t, settle)
+    verdict.items.append(Item("failsafe action", t, _action_name(after), "-", None, PREEMPTED))
+    later = [m for m in truth.modes if m.t > (after.t if after else t) + 0.001]
     back = bool(later) and later[0].nav_state == NAV_OFFBOARD and later[0].armed
     px4 = "back to OFFBOARD" if back else "stays"
     verdict.items.append(Item("automatic return", later[0].t if later else t, px4, "-", None))
+
+
+def _px4_action(truth: Truth, t: float, settle: float) -> Mode | None:
+    """PX4's failsafe action after its loss at ``t``: the first mode other than OFFBOARD, or
+    a disarm (COM_OBL_RC_ACT 7 disarms and leaves the mode as it was)."""
+    return next(
+        (
+            m
+            for m in truth.modes
+            if t - 0.001 <= m.t <= t + settle and (m.nav_state != NAV_OFFBOARD or not m.armed)
+        ),
+        None,
+    )
+
+
+def _action_name(mode: Mode | None) -> str:
+    if mode is None:
+        return "unknown"
+    return "disarmed" if not mode.armed else nav_state_name(mode.nav_state)
 
 
 def _preempted_loss(rows: list[dict[str, Any]], t: float, window: float) -> dict[str, Any] | None:
@@ -358,16 +420,19 @@ def _failsafe(
         None,
     )
     settle = MODE_SETTLE_S if flagged else HEARTBEAT_SETTLE_S
-    after = [m for m in truth.modes if t - 0.001 <= m.t <= t + settle and m.nav_state != 14]
-    px4_nav = after[0].nav_state if after else None
-    model_nav = failsafe["nav_state"] if failsafe else None
+    after = _px4_action(truth, t, settle)
+    px4_action = _action_name(after)
+    model_action = "unknown"
+    if failsafe is not None:
+        disarm = failsafe.get("action") == "DISARM"
+        model_action = "disarmed" if disarm else nav_state_name(failsafe["nav_state"])
     verdict.items.append(
         Item(
             "failsafe action",
             t,
-            nav_state_name(px4_nav),
-            f"{nav_state_name(model_nav)}: {failsafe['message'] if failsafe else ''}",
-            px4_nav == model_nav,
+            px4_action,
+            f"{model_action}: {failsafe['message'] if failsafe else ''}",
+            px4_action == model_action,
         )
     )
     back_model = next(
@@ -380,7 +445,7 @@ def _failsafe(
         None,
     )
     model_returns = back_model is not None and back_model["what"] == "offboard_resumed"
-    failsafe_t = after[0].t if after else t
+    failsafe_t = after.t if after else t
     later = [m for m in truth.modes if m.t > failsafe_t + 0.001]
     px4_returns = bool(later) and later[0].nav_state == NAV_OFFBOARD and later[0].armed
     verdict.items.append(
