@@ -247,3 +247,17 @@ def test_the_pre_commit_example_is_the_repositorys_hook() -> None:
     for key in ("id", "entry", "language", "files", "require_serial"):
         assert local[key] == hook[key], key
     assert local["additional_dependencies"] == ["fuzzoff"]
+
+
+def test_the_precision_table_is_what_the_corpus_gives() -> None:
+    """The README's precision table is today's: the corpus's expected findings (replayed by
+    the corpus tests) and the gate model against every recorded SITL run."""
+    sys.path.insert(0, str(ROOT / "corpora"))
+    try:
+        import precision
+    finally:
+        sys.path.remove(str(ROOT / "corpora"))
+    marker = "<!-- precision table:"
+    start = README.index("\n", README.index(marker)) + 1
+    shown = README[start : README.index("\n\n", README.index("| the gate model", start))] + "\n"
+    assert shown == precision.table()

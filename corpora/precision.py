@@ -1,0 +1,180 @@
+"""The README's precision table: what fuzzoff says on recordings real programs wrote.
+
+``.venv/bin/python corpora/precision.py`` prints the table from the corpus's expected findings
+(each replayed against today's ``fuzzoff lint`` by ``tests/test_examples_corpus.py``,
+``tests/test_real_world_precision.py`` and ``tests/test_corpora.py``) and from the gate
+model run on each recorded SITL exchange against PX4's own log (``fuzzoff.sitl.verdict``,
+as ``tests/test_sitl.py`` runs it). ``tests/test_readme.py`` fails when the README's copy
+differs from what this prints.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from collections import Counter
+from collections.abc import Iterable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+CORPORA = Path(__file__).resolve().parent
+LOUD = ("warning", "error")
+
+
+@dataclass(frozen=True)
+class Row:
+    recordings: str
+    what: str
+    clean: int
+    loud_on_clean: int
+    hazards: int
+    caught: int
+
+
+def _expected(path: Path) -> dict[str, Any]:
+    data: dict[str, Any] = json.loads(path.read_text())
+    return data
+
+
+def _loud(spec: dict[str, Any]) -> int:
+    return sum(f["severity"] in LOUD for f in spec["findings"])
+
+
+def _errors(spec: dict[str, Any]) -> set[str]:
+    return {f["code"] for f in spec["findings"] if f["severity"] == "error"}
+
+
+def examples_row() -> Row:
+    """The official examples as their sources send them; a hazard is named ``hazard_*``
+    and caught when it gives an error (its rule: ``tests/test_examples_corpus.py``)."""
+    specs = sorted((CORPORA / "examples").glob("*.expected.json"))
+    clean = [_expected(p) for p in specs if not p.name.startswith("hazard_")]
+    hazards = [_expected(p) for p in specs if p.name.startswith("hazard_")]
+    return Row(
+        "`corpora/examples/`",
+        "official examples reproduced from their sources (px4_ros_com C++ and Python, MAVROS"
+        " `offb_node` ROS 1 and ROS 2, px4-ros2-interface-lib, a ten-minute hold, a takeoff"
+        " then offboard, a rover), PX4's side from real SITL runs",
+        len(clean),
+        sum(map(_loud, clean)),
+        len(hazards),
+        sum(bool(_errors(h)) for h in hazards),
+    )
+
+
+def sitl_row() -> Row:
+    """PX4 SITL's own ULogs and the offboard link's tlogs; a hazard is caught when one of
+    the codes its expected file names is an error."""
+    specs = [_expected(p) for p in sorted((CORPORA / "sitl").glob("*.expected.json"))]
+    clean = [s for s in specs if s["kind"] == "clean"]
+    hazards = [s for s in specs if s["kind"] == "hazard"]
+    releases = sorted({s["px4_release"] for s in specs}, key=_release_key)
+    return Row(
+        "`corpora/sitl/`",
+        f"real PX4 SITL {', '.join(releases)}: its ULog and the tlog of its offboard link,"
+        " flown by pymavlink scenario programs and real MAVSDK 3 and 4",
+        len(clean),
+        sum(map(_loud, clean)),
+        len(hazards),
+        sum(bool(_errors(h) & set(h["hazard"])) for h in hazards),
+    )
+
+
+def tlog_row() -> Row:
+    """PX4's MAVLink as it sends it (development dialect), from both ends of the link."""
+    specs = [_expected(p) for p in sorted((CORPORA / "tlog").glob("px4_*.expected.json"))]
+    clean = [s for s in specs if s["exit_status"] == 0 and not _errors(s)]
+    hazards = [s for s in specs if s not in clean]
+    return Row(
+        "`corpora/tlog/px4_*`",
+        "real PX4 1.16.2 and 1.17.0 tlogs, the companion's and the ground station's"
+        " (a double ack, a loss)",
+        len(clean),
+        sum(map(_loud, clean)),
+        len(hazards),
+        sum(bool(_errors(h)) for h in hazards),
+    )
+
+
+def _release_key(release: str) -> tuple[int, ...]:
+    return tuple(int(p) for p in release.split("-")[0].split("."))
+
+
+def gate_agreement() -> Counter[tuple[str, bool | None]]:
+    """(kind, agree) over every recorded SITL exchange: the model run on the client's tlog
+    against PX4's ULog, as ``tests/test_sitl.py`` judges each."""
+    from fuzzoff.sitl.link import COMPANION_SYSID
+    from fuzzoff.sitl.verdict import compare
+
+    sitl = CORPORA / "sitl"
+    runs: dict[str, Any] = json.loads((sitl / "runs.json").read_text())
+    counts: Counter[tuple[str, bool | None]] = Counter()
+    for stem, run in sorted(runs.items()):
+        tlog, ulog = sitl / f"{stem}.tlog", sitl / f"{stem}.ulg"
+        if not (tlog.exists() and ulog.exists()):
+            continue
+        release = run["release"].split("-")[0]
+        verdict = compare(tlog, release, ulog, run.get("params") or {}, COMPANION_SYSID)
+        for item in verdict.items:
+            counts[(_kind(item.what), item.agree)] += 1
+    return counts
+
+
+def _kind(what: str) -> str:
+    if what in ("loss time", "failsafe action", "automatic return"):
+        return what
+    if what in ("offboard loss", "recorded vs model"):
+        return "offboard loss"
+    return "switch, arm or disarm"
+
+
+GATE_KINDS = {
+    "switch, arm or disarm": "switch, arm or disarm accepted or rejected",
+    "offboard loss": "stream loss predicted where PX4 lost the stream, and only there",
+    "loss time": "loss time within PX4's 10 Hz check window (ULog flag; 110 ms)",
+    "failsafe action": "failsafe action (POSCTL, Return, Land, disarm)",
+    "automatic return": "automatic return to OFFBOARD after the stream resumes",
+}
+
+
+def render(rows: Iterable[Row], gate: Counter[tuple[str, bool | None]]) -> str:
+    lines = [
+        "| recordings | what | clean | warning or error on a clean one | hazards | hazard"
+        " given as an error |",
+        "| --- | --- | --- | --- | --- | --- |",
+    ]
+    total = Row("all", "", 0, 0, 0, 0)
+    for r in rows:
+        lines.append(
+            f"| {r.recordings} | {r.what} | {r.clean} | {r.loud_on_clean} | {r.hazards} |"
+            f" {r.caught} |"
+        )
+        total = Row(
+            "all",
+            "",
+            total.clean + r.clean,
+            total.loud_on_clean + r.loud_on_clean,
+            total.hazards + r.hazards,
+            total.caught + r.caught,
+        )
+    lines.append(
+        f"| **all** | | **{total.clean}** | **{total.loud_on_clean}** | **{total.hazards}** |"
+        f" **{total.caught}** |"
+    )
+    lines += ["", "| the gate model against PX4 SITL | agree | differ | not judged |"]
+    lines.append("| --- | --- | --- | --- |")
+    for kind, label in GATE_KINDS.items():
+        agree, differ, unjudged = (gate[(kind, v)] for v in (True, False, None))
+        if kind == "offboard loss":  # each loss both saw is judged once, on its time
+            agree = sum(gate[("loss time", v)] for v in (True, False, None))
+        lines.append(f"| {label} | {agree} | {differ} | {unjudged} |")
+    return "\n".join(lines) + "\n"
+
+
+def table() -> str:
+    return render([examples_row(), sitl_row(), tlog_row()], gate_agreement())
+
+
+if __name__ == "__main__":
+    sys.stdout.write(table())
