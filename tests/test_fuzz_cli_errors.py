@@ -246,3 +246,16 @@ def test_replay_of_a_reproducer_whose_recording_is_not_readable_is_one_line(
     out = run_cli(["replay", str(path)])
     assert out.returncode == 2
     assert _one_error_line(out.stderr).startswith(f"fuzzoff: {recording}: ")
+
+
+@pytest.mark.parametrize(
+    ("px4", "said"),
+    [("2.0", "PX4 2.0 is not modelled"), ("1.19", "PX4 1.19 is not modelled"), ("1.4", "oldest")],
+)
+def test_a_px4_release_not_modelled_is_refused_as_lint_refuses_it(
+    tmp_path: Path, px4: str, said: str
+) -> None:
+    out = run_cli(["fuzz", "--px4", px4, "--examples", "1"], cwd=tmp_path)
+    assert out.returncode == 2 and out.stdout == "", "the campaign did not run"
+    line = _one_error_line(out.stderr)
+    assert "--px4" in line and said in line

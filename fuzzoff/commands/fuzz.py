@@ -23,13 +23,13 @@ from fuzzoff.commands._common import (
     settings_from_args,
     write_output,
 )
-from fuzzoff.config import ConfigError
+from fuzzoff.config import ConfigError, user_px4_profile
 from fuzzoff.fuzz.campaign import CampaignConfig, CampaignResult, PropertyResult, run_campaign
 from fuzzoff.fuzz.known import KNOWN
 from fuzzoff.fuzz.properties import PROPERTIES
 from fuzzoff.fuzz.reproducers import DEFAULT_DIR, save
 from fuzzoff.fuzz.scenario import TRANSPORTS
-from fuzzoff.profiles import ProfileError, px4_profile_for, vehicle_type_for
+from fuzzoff.profiles import ProfileError, vehicle_type_for
 from fuzzoff.report.sanitize import printable
 from fuzzoff.sources import SourceError, is_bag_folder
 
@@ -95,10 +95,12 @@ def add_parser(sub: Any) -> None:
 
 def _config(args: argparse.Namespace) -> CampaignConfig:
     try:
-        px4 = px4_profile_for(args.px4) if args.px4 else None
+        px4, note = user_px4_profile(args.px4) if args.px4 else (None, None)
         vehicle = vehicle_type_for(args.vehicle) if args.vehicle else None
     except ProfileError as exc:
-        raise ConfigError(str(exc)) from None
+        raise ConfigError(f"--px4: {exc}" if "PX4" in str(exc) else str(exc)) from None
+    if note:
+        print(f"fuzzoff: --px4: {note}", file=sys.stderr)
     if args.examples is not None and args.examples < 1:
         raise ConfigError("--examples must be at least 1")
     if args.budget is not None and not (math.isfinite(args.budget) and args.budget > 0):
