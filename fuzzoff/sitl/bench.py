@@ -251,6 +251,15 @@ class Bench:
                 link.view.heartbeat_host < since or link.view.sys_status_host < since
             ):
                 driver.wait(0.05)
+            # Ready to arm in that SYS_STATUS too: a health failure can come after the
+            # reset found PX4 ready ("Preflight Fail: horizontal velocity unstable" 0.5 s
+            # after a landing refused the stream's arm in a live 1.15 campaign).
+            deadline = time.monotonic() + READY_AGAIN_S
+            while not link.view.prearm_ok and time.monotonic() < deadline:
+                driver.wait(0.1)
+            if not link.view.prearm_ok:
+                said = link.view.statustexts[-1][1] if link.view.statustexts else "nothing"
+                notes.append(f"PX4 was not ready to arm when the stream began (it said: {said})")
             sent = replay.send(link, plan, 1.0, driver.tick)
             driver.wait(params.get("COM_OF_LOSS_T", 1.0) + TAIL_S)
         finally:
