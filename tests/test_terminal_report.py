@@ -205,8 +205,8 @@ def test_summaries_keep_the_key_fact_and_json_keeps_both(no_colour_env: None) ->
     assert str(findings["OFB101"]["message"]).startswith("keep-alive gap of 2.00 s in OFFBOARD")
     assert "docs: keep-alive at > 2 Hz" in str(findings["OFB101"]["message"])
     assert findings["OFB103"]["summary"] == (
-        "keep-alive stopped at 8.00 s: POSCTL 9.01-9.11 s; recorded: POSCTL between 9.00 and "
-        "10.00 s (mode sampled at 1 Hz)"
+        "keep-alive stopped at 8.00 s: POSCTL 9.01-9.11 s; recorded: POSCTL 9.00-10.00 s"
+        " (1 Hz status)"
     )
     assert findings["OFB701"]["summary"] == (
         "on a 1 s stream loss: POSCTL, back to OFFBOARD when it resumes"

@@ -55,6 +55,13 @@ class _Change:
             return f"{mode} between {self.before:.2f} and {self.t:.2f} s (mode sampled at 1 Hz)"
         return f"{mode} at {self.t:.2f} s"
 
+    def brief(self) -> str:
+        """``text`` for the one-line view: the sampled window as a range."""
+        mode = nav_state_name(self.nav)
+        if self.sampled and self.before is not None:
+            return f"{mode} {self.before:.2f}-{self.t:.2f} s (1 Hz status)"
+        return f"{mode} at {self.t:.2f} s"
+
 
 def loss_when(lost: GateTransition) -> str:
     """The time of the gate's ``signal_lost``: a window, or where the recording shows it."""
@@ -218,7 +225,7 @@ class OffboardLoss(Check):
         message, short = pending.message, pending.short
         if answer is not None:
             message += f"; recorded: {answer.text()}"
-            short += f"; recorded: {answer.text()}"
+            short += f"; recorded: {answer.brief()}"
         elif self.ctx.state.mode_recorded:
             message += f"; recorded: still {nav_state_name(self.ctx.state.nav_state)}"
             short += f"; recorded: still {nav_state_name(self.ctx.state.nav_state)}"
