@@ -74,8 +74,15 @@ def walk(path: Path) -> Walk:
                 found.in_index = True
                 return found
         if bio.tell() < size:
-            what = f"{size - bio.tell()} bytes after the bag's index, not part of the bag"
-            found.damage = what, bio.tell()
+            at = bio.tell()
+            if _record(bio, size, IN_INDEX, Walk()) is not None:
+                # an index record the header's counts leave out: rosbags stops before it,
+                # and the messages of the chunk it names are lost (a flipped chunk_count)
+                found.damage = "the bag header counts fewer index records than the index holds", at
+                found.in_index = True
+                return found
+            what = f"{size - at} bytes after the bag's index, not part of the bag"
+            found.damage = what, at
     return found
 
 
