@@ -21,11 +21,11 @@ from fuzzoff.fuzz.strategies import CommandPlan
 from fuzzoff.fuzz.streams import commands, echo, settle
 from fuzzoff.sitl import bundle, delivery
 from fuzzoff.sitl.against import AgainstConfig, Campaign, Disagreement, Example, with_start
-from fuzzoff.sitl.classify import edge_note, own_changes, shape, signature
+from fuzzoff.sitl.classify import edge_note, health_refusals, own_changes, shape, signature
 from fuzzoff.sitl.driver import NAV_LOITER
 from fuzzoff.sitl.link import COMPANION_SYSID
 from fuzzoff.sitl.replay import plan_from_tlog
-from fuzzoff.sitl.truth import Mode, Request, Truth
+from fuzzoff.sitl.truth import Mode, Request, Truth, read_truth
 from fuzzoff.sitl.variants import variants
 from fuzzoff.sitl.verdict import Item, Verdict, compare
 from tests.helpers import CORPORA, run_cli
@@ -363,6 +363,23 @@ def test_losses_a_few_tenths_apart_are_each_paired_with_the_models_nearest() -> 
     assert all(i.px4.startswith("0.2") for i in timed)  # after the keep-alive before the flag
     missed = [i for i in verdict.items if i.what == "offboard loss"]
     assert [(i.px4, i.model) for i in missed] == [("lost", "no loss predicted")] * 2
+
+
+def test_an_arm_px4_refused_for_its_own_health_checks_is_outside_the_gate() -> None:
+    """A live 1.15.4 campaign: PX4 refused an arm 0.9 s after 'Preflight Fail: horizontal
+    velocity unstable' (its estimator after the previous stream's landing); the model, which
+    knows nothing of health checks, accepted it. Named as PX4's own refusal, so the campaign
+    counts it outside the gate; the gate's own refusal (an arm in OFFBOARD with no stream,
+    'Arming denied: Resolve system health failures first' alone) is not."""
+    verdict = _judge("arm_refused_health-1.15.4", {"COM_OF_LOSS_T": 0.2})
+    (arm,) = [i for i in verdict.items if i.what == "arm"]
+    assert (arm.px4, arm.agree) == ("rejected (1)", False)
+    (own,) = health_refusals(read_truth(EXCHANGES / "arm_refused_health-1.15.4.ulg"), 0.0)
+    assert own.t == pytest.approx(arm.t, abs=0.01)
+    assert "horizontal velocity unstable" in own.describe()
+    for release in ("1.15.4", "1.16.2", "1.17.0"):
+        gate_refusal = read_truth(CORPORA / "sitl" / f"disarmed_switch_no_stream-{release}.ulg")
+        assert health_refusals(gate_refusal, 0.0) == []
 
 
 def test_a_disagreement_confirmed_before_is_counted_not_followed_up_again(

@@ -40,7 +40,7 @@ from fuzzoff.fuzz.scenario import Scenario
 from fuzzoff.profiles import px4_profile_for
 from fuzzoff.sitl import bundle, delivery
 from fuzzoff.sitl.bench import Bench
-from fuzzoff.sitl.classify import edge_note, own_changes, shape, signature
+from fuzzoff.sitl.classify import edge_note, health_refusals, own_changes, shape, signature
 from fuzzoff.sitl.driver import NAV_LOITER
 from fuzzoff.sitl.link import COMPANION_SYSID, LinkError
 from fuzzoff.sitl.run import load_plan
@@ -324,6 +324,8 @@ class Campaign:
             example.reason = "; ".join(verdict.problems)
             return
         own = [] if truth is None else own_changes(truth, run.recording_from)
+        own += [] if truth is None else health_refusals(truth, run.recording_from)
+        own.sort(key=lambda change: change.t)
         first = min((i.t for i in example.differing), default=None)
         before = [c for c in own if first is not None and c.t <= first + OWN_CHANGE_SLACK_S]
         if not example.differing:

@@ -12,7 +12,7 @@ from fuzzoff.sitl.against import AgainstResult, Disagreement, Example, describe_
 STATUS_TEXT = {
     "agree": "agree",
     "differ": "differ",
-    "outside": "outside the gate (PX4 changed mode or arming by itself first)",
+    "outside": "outside the gate (PX4 changed mode or arming, or refused an arm, by itself first)",
     "noise": "noise (the host did not send the stream as meant)",
     "failed": "not run",
 }

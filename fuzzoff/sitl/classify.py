@@ -79,6 +79,38 @@ def own_changes(truth: Truth, since: float) -> list[OwnChange]:
     return out
 
 
+MAV_CMD_COMPONENT_ARM_DISARM = 400
+HEALTH_TEXT_S = 1.5
+"""PX4 reports a failed health check when it finds it and refuses an arm while it stands: its
+text may come a second or so before the refusal."""
+HEALTH_WORDS = ("preflight fail",)
+"""Which check failed; "Arming denied: Resolve system health failures first" alone is also
+what PX4 says when it refuses an arm in OFFBOARD without a stream, the gate's own refusal."""
+GATE_WORDS = ("offboard", "mode", "control signal")
+
+
+def health_refusals(truth: Truth, since: float) -> list[OwnChange]:
+    """Arms PX4 refused for its own health checks (an estimator that has not settled after a
+    landing: "Preflight Fail: horizontal velocity unstable"), which the gate model does not
+    model; not a refusal for the mode (OFFBOARD without a signal), which it does."""
+    out = []
+    for request in truth.requests:
+        if request.t < since or request.command != MAV_CMD_COMPONENT_ARM_DISARM:
+            continue
+        if request.param1 != 1.0 or request.result in (0, None):
+            continue
+        texts = [
+            text.strip()
+            for t, text in truth.texts
+            if request.t - HEALTH_TEXT_S <= t <= request.t + LOOP_S
+            and not text.startswith(QUIET_TEXTS)
+        ]
+        low = " ".join(texts).lower()
+        if any(w in low for w in HEALTH_WORDS) and not any(w in low for w in GATE_WORDS):
+            out.append(OwnChange(request.t, "refused the arm", tuple(texts[:3])))
+    return out
+
+
 def shape(scenario: Scenario) -> tuple[object, ...]:
     """A stream at 0.1 s resolution, as far as PX4's offboard gate can tell it apart."""
     from fuzzoff.sitl.variants import label
