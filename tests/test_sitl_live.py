@@ -104,19 +104,11 @@ def test_a_live_campaign_sends_a_generated_stream_and_judges_what_px4_did(tmp_pa
 
 
 def _matrix() -> list[object]:
-    cases = []
-    for release in RELEASES:
-        for name in scenarios_for(release):
-            marks = []
-            if name == "disarm_in_flight":
-                marks.append(
-                    pytest.mark.xfail(
-                        strict=True,
-                        reason="issue 18: PX4 refuses a disarm in flight; the model accepts it",
-                    )
-                )
-            cases.append(pytest.param(release, name, marks=marks, id=f"{name}-{release}"))
-    return cases
+    return [
+        pytest.param(release, name, id=f"{name}-{release}")
+        for release in RELEASES
+        for name in scenarios_for(release)
+    ]
 
 
 @needs_bundles
