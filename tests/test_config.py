@@ -309,7 +309,7 @@ def test_a_mistyped_key_gets_a_did_you_mean(tmp_path: Path, text: str, hint: str
 @pytest.mark.parametrize(
     ("value", "complaint"),
     [
-        ("2.0", "PX4 2.0 is not modelled: the newest release modelled is 1.18 (profile main)"),
+        ("2.0", "PX4 2.0 is not modelled: the newest release modelled is 1.18; give --px4 main"),
         ("1.19.0", "PX4 1.19.0 is not modelled"),
         ("1.4", "PX4 1.4 is not modelled: the oldest release modelled is 1.5"),
     ],

@@ -16,7 +16,7 @@ from fuzzoff.config import Settings
 from fuzzoff.engine import Timeline, run_events
 from fuzzoff.events import Event, VehicleStatus, Where, event_from_dict, event_to_dict
 from fuzzoff.findings import Finding
-from fuzzoff.profiles import Profile
+from fuzzoff.profiles import Profile, px4_profile_for
 from fuzzoff.sources.base import RecordingInfo
 
 TransportName = Literal["ros2", "mavlink", "mavros"]
@@ -45,7 +45,12 @@ class Scenario:
 
     @property
     def profile(self) -> Profile:
-        return Profile(px4=self.px4, vehicle=self.vehicle, px4_detected=True, vehicle_detected=True)
+        return Profile(
+            px4=px4_profile_for(self.px4),
+            vehicle=self.vehicle,
+            px4_detected=True,
+            vehicle_detected=True,
+        )
 
     @property
     def duration(self) -> float:
@@ -58,7 +63,11 @@ class Scenario:
         would replace the scenario's profile with the one detected from the file."""
         base = base or Settings()
         return replace(
-            base, px4=self.px4, vehicle=self.vehicle, params=dict(self.params), discovery=None
+            base,
+            px4=px4_profile_for(self.px4),
+            vehicle=self.vehicle,
+            params=dict(self.params),
+            discovery=None,
         )
 
     def lint_args(self) -> list[str]:

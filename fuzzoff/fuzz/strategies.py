@@ -19,7 +19,8 @@ from typing import Any
 
 from hypothesis import strategies as st
 
-from fuzzoff.profiles import PX4_PROFILES, VEHICLE_TYPES, at_least
+from fuzzoff import releases
+from fuzzoff.profiles import VEHICLE_TYPES
 
 NAN = math.nan
 f32 = st.floats(min_value=-200.0, max_value=200.0, width=32, allow_nan=False)
@@ -31,8 +32,8 @@ f32 = st.floats(min_value=-200.0, max_value=200.0, width=32, allow_nan=False)
 def px4_versions(transport: str | None = None) -> st.SearchStrategy[str]:
     """Modelled PX4 profiles; ROS 2 direct needs the boolean control mode of 1.13+."""
     if transport == "ros2":
-        return st.sampled_from([p for p in PX4_PROFILES if at_least(p, "1.13")])
-    return st.sampled_from(PX4_PROFILES)
+        return st.sampled_from([r.name for r in releases.RELEASES if r.control_mode_flags])
+    return st.sampled_from(releases.names())
 
 
 def vehicle_types() -> st.SearchStrategy[str]:
@@ -159,8 +160,8 @@ OCM_FLAGS_115 = (
 def control_modes(draw: st.DrawFn, px4: str) -> dict[str, Any]:
     """``OffboardControlMode`` flags of the release's layout: usually one flag, sometimes a
     mix, sometimes none (OFB301)."""
-    names = OCM_FLAGS_115 if at_least(px4, "1.15") else OCM_FLAGS_BEFORE_115
-    layout = "thrust_and_torque" if at_least(px4, "1.15") else "actuator"
+    layout = releases.get(px4).control_mode
+    names = OCM_FLAGS_115 if layout == "thrust_and_torque" else OCM_FLAGS_BEFORE_115
     chosen = draw(
         st.one_of(
             st.sampled_from(names).map(lambda n: {n}),

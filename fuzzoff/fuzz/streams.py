@@ -22,14 +22,14 @@ from typing import Any
 from hypothesis import strategies as st
 
 from fuzzoff import events as ev
+from fuzzoff import releases
 from fuzzoff.fuzz import strategies as fs
 from fuzzoff.fuzz.scenario import AUTOPILOT, COMPANION, TRANSPORTS, Scenario, TransportName
 from fuzzoff.gate import GateModel
 from fuzzoff.gate.params import default_params, loss_timeout
 from fuzzoff.modes import mavros_mode_to_nav_state, nav_state_to_mavros_mode
-from fuzzoff.profiles import Profile, at_least, is_rover
+from fuzzoff.profiles import Profile, is_rover, px4_profile_for
 from fuzzoff.sources import px4_msgs
-from fuzzoff.sources.px4_msgs import release_for
 
 MIN_STEP = 0.0001
 """Distinct receive times: events never share a timestamp (the readers' order for equal
@@ -135,7 +135,9 @@ def echo(
     """The vehicle's answers the gate model predicts: a COMMAND_ACK per command (two for a
     MAVLink mode switch on 1.16/1.17, gate spec 4.3), and for MAVROS the state at 1 Hz and at
     each change."""
-    profile = Profile(px4=px4, vehicle=vehicle, px4_detected=True, vehicle_detected=True)
+    profile = Profile(
+        px4=px4_profile_for(px4), vehicle=vehicle, px4_detected=True, vehicle_detected=True
+    )
     vid = "1" if transport == "mavlink" else ""
     model = GateModel(profile, params, vid, armed=False)  # the simulated vehicle boots disarmed
     out: list[ev.Event] = []
@@ -162,7 +164,7 @@ def echo(
         transitions = model.feed(event)
         clock = max(clock, event.t)
         if isinstance(event, ev.Command) and acks:
-            out += _acks(event, transitions, px4, transport, vid)
+            out += _acks(event, transitions, profile.release.acks_switch_twice, transport, vid)
         if status:
             note(event.t)
     return out
@@ -181,7 +183,7 @@ def _status(t: float, model: GateModel, vid: str) -> ev.VehicleStatus:
 def _acks(
     cmd: ev.Command,
     transitions: Sequence[Any],
-    px4: str,
+    twice: bool,
     transport: TransportName,
     vid: str,
 ) -> list[ev.Event]:
@@ -202,7 +204,7 @@ def _acks(
             sender_time_us=round(t * 1e6) if stamp else None,
         )
 
-    if transport == "mavlink" and cmd.is_mode_switch and px4 in ("1.16", "1.17"):
+    if transport == "mavlink" and cmd.is_mode_switch and twice:
         out.append(ack(cmd.t + 0.002, 0))
     out.append(ack(cmd.t + 0.008, result))
     return out
@@ -226,7 +228,12 @@ _MESSAGE = {
 
 def _published(kind: str, px4: str) -> bool:
     """Does the release's px4_msgs have this setpoint's message (rover topics vary)?"""
-    return px4_msgs.definition(release_for(px4) or "main", _MESSAGE[kind]) is not None
+    return px4_msgs.definition(_msg_folder(px4), _MESSAGE[kind]) is not None
+
+
+def _msg_folder(px4: str) -> str:
+    """The px4_msgs folder of the release (the newest one for a release before ROS 2)."""
+    return releases.get(px4).msg_folder or releases.RELEASES[-1].msg_folder or "main"
 
 
 _WIRE_NAME = {"normalized_steering_angle": "normalized_steering_setpoint"}
@@ -240,7 +247,7 @@ def _carried(kind: str, px4: str, values: dict[str, Any]) -> dict[str, Any]:
     if kind not in _MESSAGE:
         return values
     name = _MESSAGE[kind]
-    text = px4_msgs.definition(release_for(px4) or "main", name)
+    text = px4_msgs.definition(_msg_folder(px4), name)
     if text is None:
         return values
     wire = px4_msgs.field_names(px4_msgs.type_name(name), text)
@@ -249,7 +256,7 @@ def _carried(kind: str, px4: str, values: dict[str, Any]) -> dict[str, Any]:
 
 def _ros2_setpoint_kinds(vehicle: str, px4: str) -> list[str]:
     kinds = ["trajectory", "trajectory", "attitude", "rates", "none"]
-    if is_rover(vehicle) and at_least(px4, "1.16"):
+    if is_rover(vehicle) and releases.get(px4).rover_setpoints:
         kinds += [k for k in fs.ROVER_KINDS if _published(k, px4)] * 2
     return kinds
 
@@ -280,7 +287,7 @@ def ros2_sent(draw: st.DrawFn, px4: str, vehicle: str, times: list[float]) -> li
     # A rover program publishes a combination of rover setpoints (OFB502, OFB504).
     most = 3 if is_rover(vehicle) else 1
     any_kinds = st.lists(st.sampled_from(choices), min_size=1, max_size=most, unique=True)
-    if is_rover(vehicle) and at_least(px4, "1.16"):
+    if is_rover(vehicle) and releases.get(px4).rover_setpoints:
         combos = [c for c in fs.ROVER_COMBINATIONS if all(_published(k, px4) for k in c)]
         kinds = draw(
             st.one_of(any_kinds, st.sampled_from(combos).map(list)) if combos else any_kinds
@@ -365,7 +372,8 @@ def scenarios(
         transport if transport is not None else draw(st.sampled_from(TRANSPORTS))
     )
     px4 = px4 or draw(fs.px4_versions(chosen))
-    if chosen == "ros2" and not at_least(px4, "1.13"):
+    release = releases.get(px4)
+    if chosen == "ros2" and not release.control_mode_flags:
         chosen = "mavlink"  # the ROS 2 control mode does not exist before 1.13
     vehicle = vehicle or draw(fs.vehicle_types())
     params = draw(fs.gate_params(px4))
@@ -376,7 +384,7 @@ def scenarios(
         sent = draw(ros2_sent(px4, vehicle, times))
     else:
         sent = draw(mavlink_sent(times, chosen))
-    plan = draw(fs.command_plans(duration, chosen == "ros2" and at_least(px4, "1.15")))
+    plan = draw(fs.command_plans(duration, chosen == "ros2" and release.handles_set_nav_state))
     if chosen == "mavros":
         plan = replace(plan, acks=False)
     sent = settle([*sent, *commands(plan, chosen)])
