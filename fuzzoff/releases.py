@@ -19,7 +19,7 @@ from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 from typing import Literal
 
-PX4Profile = Literal["legacy", "1.11", "1.13", "1.14", "1.15", "1.16", "1.17", "main"]
+PX4Profile = Literal["legacy", "1.11", "1.13", "1.14", "1.15", "1.16", "1.17", "1.18", "main"]
 """The names of the modelled releases (``--px4`` values), oldest first."""
 
 LossSignal = Literal["fixed", "age", "hysteresis", "tick"]
@@ -290,10 +290,10 @@ V1_17 = replace(
     ulog_era="1.17",
 )
 
-MAIN = replace(
+V1_18 = replace(
     V1_17,
-    name="main",
-    covers="v1.18 / main: accepts_offboard_setpoints, thrust required for SET_ATTITUDE_TARGET",
+    name="1.18",
+    covers="v1.18: accepts_offboard_setpoints, thrust required for SET_ATTITUDE_TARGET, one ack",
     minors=(18,),
     attitude_flag_needs_attitude=True,
     yaw_sets_attitude_flags=True,
@@ -304,10 +304,17 @@ MAIN = replace(
     nav_rcl_hold_no_failsafe=True,
     setpoint_types_control_mode=True,
     rover_drive_modes=True,
-    msg_folder="main",
+    msg_folder="main",  # release/1.18's px4_msgs: main's layouts (one folder, see msg_folder)
 )
 
-RELEASES: tuple[Release, ...] = (LEGACY, V1_11, V1_13, V1_14, V1_15, V1_16, V1_17, MAIN)
+MAIN = replace(
+    V1_18,
+    name="main",
+    covers="main: PX4's development branch, modelled as v1.18.0-beta1 (as 1.18 today)",
+    minors=(),
+)
+
+RELEASES: tuple[Release, ...] = (LEGACY, V1_11, V1_13, V1_14, V1_15, V1_16, V1_17, V1_18, MAIN)
 """Oldest to newest, ``main`` last. Read it at call time (a test may extend it)."""
 
 

@@ -31,7 +31,7 @@ from tests.gate.streams import (
     stream,
     switch_offboard,
 )
-from tests.helpers import CORPORA, ROOT
+from tests.helpers import CORPORA, ROOT, run_cli
 
 RELEASES = list(releases.RELEASES)
 NAMES = [r.name for r in RELEASES]
@@ -175,3 +175,24 @@ def test_a_new_record_judges_a_lint_with_the_rules_of_its_range() -> None:
     (same,) = json.loads(copied.stdout)["files"]
     codes = [f["code"] for f in file["findings"]]
     assert codes and codes == [f["code"] for f in same["findings"]]
+
+
+# 1.18 beside main ----------------------------------------------------------------------------
+
+
+def test_px4_1_18_is_its_own_profile_with_no_note() -> None:
+    gap = str(CORPORA / "tlog" / "keepalive_gap_0_7s.tlog")
+    result = run_cli(["lint", gap, "--px4", "1.18.0", "--format", "json"])
+    assert json.loads(result.stdout)["files"][0]["profile"]["px4"] == "1.18"
+    assert "judged with profile" not in result.stderr
+    listed = json.loads(run_cli(["profiles", "--format", "json"]).stdout)["px4"]
+    assert [p["profile"] for p in listed][-2:] == ["1.18", "main"]
+
+
+@pytest.mark.parametrize(
+    "name", ["disarmed_switch_no_stream-1.18.0-alpha1.ulg", "acceleration_only-1.18.0-alpha1.tlog"]
+)
+def test_a_recording_of_px4_1_18_is_judged_with_profile_1_18(name: str) -> None:
+    result = run_cli(["lint", str(CORPORA / "sitl" / name), "--format", "json"])
+    (file,) = json.loads(result.stdout)["files"]
+    assert file["profile"]["px4"] == "1.18" and file["profile"]["px4_source"] == "recording"

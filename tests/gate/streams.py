@@ -18,7 +18,7 @@ from fuzzoff.gate import GateModel, GateTransition
 from fuzzoff.profiles import Profile
 
 ALL = list(releases.names())
-TICK = ["1.14", "1.15", "1.16", "1.17", "main"]
+TICK = [r.name for r in releases.RELEASES if r.tick_based]
 """Profiles with OffboardChecks at 10 Hz (gate spec 2.1)."""
 OLD = ["legacy", "1.11", "1.13"]
 RECEIVER_NEW = ["1.13", *TICK]
