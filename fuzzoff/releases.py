@@ -143,6 +143,8 @@ class Release:
     Releases whose messages are laid out alike share one folder: two equal folders would make
     every ROS 2 recording that fits them fit two releases, and name neither."""
     ulog_era: UlogEra
+    armed_error_state: bool
+    """``vehicle_status.arming_state`` 3 (ARMED_ERROR) is armed too (before v1.11)."""
 
     # -- parameters (13)
     param_defaults: Mapping[str, float] = field(compare=False)
@@ -201,6 +203,7 @@ LEGACY = Release(
     rover_setpoints=False,
     msg_folder=None,
     ulog_era="legacy",
+    armed_error_state=True,
     param_defaults=_params(COM_OF_LOSS_T=0.0, COM_DISARM_PRFLT=0.0, COM_OBL_ACT=0.0),
 )
 
@@ -213,6 +216,7 @@ V1_11 = replace(
     fixed_loss_s=None,
     handles_global_int=True,
     arming_unverified=False,
+    armed_error_state=False,
     loss_failsafe="state_machine",
     param_defaults=_params(COM_OF_LOSS_T=0.5, COM_DISARM_PRFLT=10.0, COM_OBL_ACT=0.0),
 )

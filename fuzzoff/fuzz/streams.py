@@ -232,8 +232,8 @@ def _published(kind: str, px4: str) -> bool:
 
 
 def _msg_folder(px4: str) -> str:
-    """The px4_msgs folder of the release (the newest one for a release before ROS 2)."""
-    return releases.get(px4).msg_folder or releases.RELEASES[-1].msg_folder or "main"
+    """The px4_msgs folder of the release (main's for a release before ROS 2)."""
+    return releases.get(px4).msg_folder or "main"
 
 
 _WIRE_NAME = {"normalized_steering_angle": "normalized_steering_setpoint"}
