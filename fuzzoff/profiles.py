@@ -46,7 +46,7 @@ def px4_profile_for(version: str) -> PX4Profile:
     text = version.strip()
     known = releases.names()
     if text in known:
-        return text  # type: ignore[return-value]  # a name of the table is a PX4Profile
+        return releases.names()[known.index(text)]
     match = _RELEASE.match(text)
     if match is None:
         raise ProfileError(

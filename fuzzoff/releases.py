@@ -326,9 +326,9 @@ class UnknownRelease(KeyError):
     """No record has this name."""
 
 
-def names() -> tuple[str, ...]:
+def names() -> tuple[PX4Profile, ...]:
     """The profile names, oldest first."""
-    return tuple(r.name for r in RELEASES)
+    return tuple(r.name for r in RELEASES)  # type: ignore[misc]  # a record's name is one
 
 
 _index: tuple[tuple[Release, ...], dict[str, Release]] = ((), {})

@@ -23,6 +23,7 @@ from fuzzoff.fuzz.known import KNOWN
 from fuzzoff.fuzz.scenario import Scenario
 from fuzzoff.fuzz.strategies import LOSS_TIMEOUTS, CommandPlan
 from fuzzoff.fuzz.streams import commands, settle
+from fuzzoff.releases import PX4Profile
 
 
 class OffboardSession(RuleBasedStateMachine):
@@ -30,7 +31,7 @@ class OffboardSession(RuleBasedStateMachine):
 
     def __init__(self) -> None:
         super().__init__()
-        self.px4 = "1.15"
+        self.px4: PX4Profile = "1.15"
         self.params: dict[str, float] = {}
         self.events: list[ev.Event] = []
         self.now = 0.0
@@ -39,7 +40,7 @@ class OffboardSession(RuleBasedStateMachine):
         px4=st.sampled_from([r.name for r in releases.RELEASES if r.control_mode_flags]),
         timeout=st.sampled_from(LOSS_TIMEOUTS),
     )
-    def start(self, px4: str, timeout: float) -> None:
+    def start(self, px4: PX4Profile, timeout: float) -> None:
         self.px4 = px4
         self.params = {"COM_OF_LOSS_T": timeout}
 

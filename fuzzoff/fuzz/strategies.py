@@ -21,6 +21,7 @@ from hypothesis import strategies as st
 
 from fuzzoff import releases
 from fuzzoff.profiles import VEHICLE_TYPES
+from fuzzoff.releases import PX4Profile
 
 NAN = math.nan
 f32 = st.floats(min_value=-200.0, max_value=200.0, width=32, allow_nan=False)
@@ -29,10 +30,11 @@ f32 = st.floats(min_value=-200.0, max_value=200.0, width=32, allow_nan=False)
 # --------------------------------------------------------------------------- profile, params
 
 
-def px4_versions(transport: str | None = None) -> st.SearchStrategy[str]:
+def px4_versions(transport: str | None = None) -> st.SearchStrategy[PX4Profile]:
     """Modelled PX4 profiles; ROS 2 direct needs the boolean control mode of 1.13+."""
     if transport == "ros2":
-        return st.sampled_from([r.name for r in releases.RELEASES if r.control_mode_flags])
+        flags = [r.control_mode_flags for r in releases.RELEASES]
+        return st.sampled_from([n for n, f in zip(releases.names(), flags, strict=True) if f])
     return st.sampled_from(releases.names())
 
 
@@ -44,7 +46,7 @@ LOSS_TIMEOUTS = (0.2, 0.5, 1.0, 1.5, 2.0)
 
 
 @st.composite
-def gate_params(draw: st.DrawFn, px4: str) -> dict[str, float]:
+def gate_params(draw: st.DrawFn, px4: PX4Profile) -> dict[str, float]:
     """``COM_OF_LOSS_T``, the loss action (``COM_OBL_RC_ACT``) and whether an RC is present."""
     params: dict[str, float] = {}
     if draw(st.booleans()):
@@ -157,7 +159,7 @@ OCM_FLAGS_115 = (
 
 
 @st.composite
-def control_modes(draw: st.DrawFn, px4: str) -> dict[str, Any]:
+def control_modes(draw: st.DrawFn, px4: PX4Profile) -> dict[str, Any]:
     """``OffboardControlMode`` flags of the release's layout: usually one flag, sometimes a
     mix, sometimes none (OFB301)."""
     layout = releases.get(px4).control_mode

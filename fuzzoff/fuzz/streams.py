@@ -28,7 +28,8 @@ from fuzzoff.fuzz.scenario import AUTOPILOT, COMPANION, TRANSPORTS, Scenario, Tr
 from fuzzoff.gate import GateModel
 from fuzzoff.gate.params import default_params, loss_timeout
 from fuzzoff.modes import mavros_mode_to_nav_state, nav_state_to_mavros_mode
-from fuzzoff.profiles import Profile, is_rover, px4_profile_for
+from fuzzoff.profiles import Profile, is_rover
+from fuzzoff.releases import PX4Profile
 from fuzzoff.sources import px4_msgs
 
 MIN_STEP = 0.0001
@@ -124,7 +125,7 @@ REJECT = {"request_rejected", "arm_rejected", "disarm_rejected"}
 
 def echo(
     sent: Sequence[ev.Event],
-    px4: str,
+    px4: PX4Profile,
     vehicle: str,
     params: dict[str, float],
     *,
@@ -135,9 +136,7 @@ def echo(
     """The vehicle's answers the gate model predicts: a COMMAND_ACK per command (two for a
     MAVLink mode switch on 1.16/1.17, gate spec 4.3), and for MAVROS the state at 1 Hz and at
     each change."""
-    profile = Profile(
-        px4=px4_profile_for(px4), vehicle=vehicle, px4_detected=True, vehicle_detected=True
-    )
+    profile = Profile(px4=px4, vehicle=vehicle, px4_detected=True, vehicle_detected=True)
     vid = "1" if transport == "mavlink" else ""
     model = GateModel(profile, params, vid, armed=False)  # the simulated vehicle boots disarmed
     out: list[ev.Event] = []
@@ -226,12 +225,12 @@ _MESSAGE = {
 }
 
 
-def _published(kind: str, px4: str) -> bool:
+def _published(kind: str, px4: PX4Profile) -> bool:
     """Does the release's px4_msgs have this setpoint's message (rover topics vary)?"""
     return px4_msgs.definition(_msg_folder(px4), _MESSAGE[kind]) is not None
 
 
-def _msg_folder(px4: str) -> str:
+def _msg_folder(px4: PX4Profile) -> str:
     """The px4_msgs folder of the release (main's for a release before ROS 2)."""
     return releases.get(px4).msg_folder or "main"
 
@@ -240,7 +239,7 @@ _WIRE_NAME = {"normalized_steering_angle": "normalized_steering_setpoint"}
 """Event fields whose message field was renamed in a release (1.17's RoverSteeringSetpoint)."""
 
 
-def _carried(kind: str, px4: str, values: dict[str, Any]) -> dict[str, Any]:
+def _carried(kind: str, px4: PX4Profile, values: dict[str, Any]) -> dict[str, Any]:
     """``values`` with NaN for the fields the release's message does not have (1.17 dropped
     RoverSteeringSetpoint's ``normalized_speed_diff``): a recording of that release cannot
     hold them, and its reader gives NaN, as PX4 would never see them."""
@@ -254,7 +253,7 @@ def _carried(kind: str, px4: str, values: dict[str, Any]) -> dict[str, Any]:
     return {k: v if k in wire or _WIRE_NAME.get(k) in wire else fs.NAN for k, v in values.items()}
 
 
-def _ros2_setpoint_kinds(vehicle: str, px4: str) -> list[str]:
+def _ros2_setpoint_kinds(vehicle: str, px4: PX4Profile) -> list[str]:
     kinds = ["trajectory", "trajectory", "attitude", "rates", "none"]
     if is_rover(vehicle) and releases.get(px4).rover_setpoints:
         kinds += [k for k in fs.ROVER_KINDS if _published(k, px4)] * 2
@@ -275,7 +274,7 @@ _ROS2_BUILD: dict[str, Callable[..., ev.Event]] = {
 
 
 @st.composite
-def ros2_sent(draw: st.DrawFn, px4: str, vehicle: str, times: list[float]) -> list[ev.Event]:
+def ros2_sent(draw: st.DrawFn, px4: PX4Profile, vehicle: str, times: list[float]) -> list[ev.Event]:
     """Keep-alive and setpoints of a ROS 2 companion (``/fmu/in``)."""
     flags = draw(fs.control_modes(px4))
     skew = draw(fs.clock_skews())
@@ -303,7 +302,7 @@ def ros2_sent(draw: st.DrawFn, px4: str, vehicle: str, times: list[float]) -> li
 
 @st.composite
 def _setpoint_series(
-    draw: st.DrawFn, kind: str, times: list[float], lag: float, px4: str
+    draw: st.DrawFn, kind: str, times: list[float], lag: float, px4: PX4Profile
 ) -> list[ev.Event]:
     """One setpoint topic following the keep-alive by ``lag``, maybe starting late or stopping
     early (stale setpoints under a live keep-alive: OFB104), frozen or moving."""
@@ -363,7 +362,7 @@ def mavlink_sent(draw: st.DrawFn, times: list[float], transport: TransportName) 
 @st.composite
 def scenarios(
     draw: st.DrawFn,
-    px4: str | None = None,
+    px4: PX4Profile | None = None,
     vehicle: str | None = None,
     transport: TransportName | None = None,
 ) -> Scenario:
@@ -371,17 +370,17 @@ def scenarios(
     chosen: TransportName = (
         transport if transport is not None else draw(st.sampled_from(TRANSPORTS))
     )
-    px4 = px4 or draw(fs.px4_versions(chosen))
-    release = releases.get(px4)
+    profile: PX4Profile = px4 if px4 is not None else draw(fs.px4_versions(chosen))
+    release = releases.get(profile)
     if chosen == "ros2" and not release.control_mode_flags:
         chosen = "mavlink"  # the ROS 2 control mode does not exist before 1.13
     vehicle = vehicle or draw(fs.vehicle_types())
-    params = draw(fs.gate_params(px4))
-    timeout = loss_timeout(px4, default_params(px4) | params)
+    params = draw(fs.gate_params(profile))
+    timeout = loss_timeout(profile, default_params(profile) | params)
     times = draw(fs.keepalive_times(timeout))
     duration = times[-1] if times else 0.0
     if chosen == "ros2":
-        sent = draw(ros2_sent(px4, vehicle, times))
+        sent = draw(ros2_sent(profile, vehicle, times))
     else:
         sent = draw(mavlink_sent(times, chosen))
     plan = draw(fs.command_plans(duration, chosen == "ros2" and release.handles_set_nav_state))
@@ -390,7 +389,7 @@ def scenarios(
     sent = settle([*sent, *commands(plan, chosen)])
     answers = echo(
         sent,
-        px4,
+        profile,
         vehicle,
         params,
         acks=plan.acks,
@@ -401,4 +400,6 @@ def scenarios(
     if chosen == "mavros":
         stream = [e for e in stream if not isinstance(e, ev.Command)]
         stream = settle(stream)
-    return Scenario(px4=px4, vehicle=vehicle, transport=chosen, events=tuple(stream), params=params)
+    return Scenario(
+        px4=profile, vehicle=vehicle, transport=chosen, events=tuple(stream), params=params
+    )

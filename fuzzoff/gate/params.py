@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from fuzzoff import releases
 from fuzzoff.profiles import Profile
+from fuzzoff.releases import PX4Profile
 
 RC_PRESENT = "FUZZOFF_RC_PRESENT"
 
@@ -31,7 +32,7 @@ GATE_PARAMS: tuple[str, ...] = (
 )
 
 
-def default_params(px4: str) -> dict[str, float]:
+def default_params(px4: PX4Profile) -> dict[str, float]:
     """The defaults of ``px4`` (a profile name) for every parameter in ``GATE_PARAMS``: those
     every release shares, then the release's own (``Release.param_defaults``)."""
     own = releases.get(px4).param_defaults
@@ -61,7 +62,7 @@ def effective_params(
     return default_params(profile.px4) | recorded | overrides
 
 
-def loss_timeout(px4: str, params: dict[str, float]) -> float:
+def loss_timeout(px4: PX4Profile, params: dict[str, float]) -> float:
     """The time without keep-alive after which the signal counts as lost (sections 2.1-2.3)."""
     fixed = releases.get(px4).fixed_loss_s
     if fixed is not None:
