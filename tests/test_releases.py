@@ -21,14 +21,17 @@ from tests.gate.streams import (
     LOITER,
     OFFBOARD,
     POSCTL,
+    TERMINATION,
     arm,
     flags,
     in_offboard,
     loss_times,
+    ocm,
     of,
     run,
     status,
     stream,
+    switch_mode,
     switch_offboard,
 )
 from tests.helpers import CORPORA, ROOT, run_cli
@@ -98,6 +101,41 @@ def test_an_attitude_target_without_thrust_keeps_the_stream_as_the_record_says(
     target = SetAttitudeTarget(t=1.0, type_mask=71, target_system=1, target_component=1)
     trs = run(release.name, [status(0.0, LOITER, True, LOITER), target], t_end=1.05)
     assert bool(of("signal_available", trs)) is not release.attitude_target_needs_thrust
+
+
+@pytest.mark.parametrize("release", FRAMEWORK, ids=by_name)
+def test_an_unknown_main_mode_is_answered_as_the_record_says(release: Release) -> None:
+    trs = run(release.name, [status(0.0, POSCTL, True, POSCTL), switch_mode(1.0, 42)])
+    rejected = release.unsupported_main_mode == "rejected"
+    assert any("unsupported main mode" in (t.message or "") for t in trs)
+    assert any("rejected" in t.message for t in trs) is rejected
+
+
+@pytest.mark.parametrize("release", FRAMEWORK, ids=by_name)
+def test_termination_is_left_or_not_as_the_record_says(release: Release) -> None:
+    events = [status(0.0, TERMINATION, True, TERMINATION), *stream(0.0, 1.0), switch_offboard(0.5)]
+    rejected = bool(of("request_rejected", run(release.name, events)))
+    assert rejected is release.never_leaves_termination
+
+
+@pytest.mark.parametrize("release", FRAMEWORK, ids=by_name)
+def test_the_acceleration_flag_needs_the_estimate_the_record_names(release: Release) -> None:
+    """Without a velocity estimate the acceleration flag keeps the signal only where it needs
+    the attitude instead; without an attitude estimate, only where it needs the velocity."""
+    no_velocity = [flags(0.0, local_velocity_valid=False), ocm(1.0, acceleration=True)]
+    no_attitude = [flags(0.0, attitude_valid=False), ocm(1.0, acceleration=True)]
+    needs_attitude = release.acceleration_needs_attitude
+    assert bool(of("signal_available", run(release.name, no_velocity))) is needs_attitude
+    assert bool(of("signal_available", run(release.name, no_attitude))) is not needs_attitude
+
+
+@pytest.mark.parametrize("release", FRAMEWORK, ids=by_name)
+def test_the_attitude_flag_needs_an_attitude_estimate_as_the_record_says(
+    release: Release,
+) -> None:
+    events = [flags(0.0, attitude_valid=False), ocm(1.0, attitude=True)]
+    available = bool(of("signal_available", run(release.name, events)))
+    assert available is not release.attitude_flag_needs_attitude
 
 
 @pytest.mark.parametrize("release", RELEASES, ids=by_name)
