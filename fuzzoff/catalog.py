@@ -25,9 +25,10 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
+from fuzzoff import releases
 from fuzzoff._version import __version__
 from fuzzoff.findings import Severity
-from fuzzoff.profiles import PX4_PROFILES, VEHICLE_TYPES
+from fuzzoff.profiles import VEHICLE_TYPES
 
 RULE_PAGE = "docs/rules/{code}.md"
 """Where a rule's page sits in the repository, relative to its root. The project publishes no web
@@ -122,7 +123,7 @@ class Rule:
         raise KeyError(f"{self.code} has no option {name!r}")
 
     def profiles_text(self) -> str:
-        px4 = "all" if self.px4 == PX4_PROFILES else ", ".join(self.px4)
+        px4 = "all" if self.px4 == releases.names() else ", ".join(self.px4)
         veh = "all" if self.vehicles == VEHICLE_TYPES else ", ".join(self.vehicles)
         return f"PX4 {px4}; vehicles {veh}"
 
@@ -224,7 +225,7 @@ def _load_rule(path: Path, data: dict[str, Any]) -> Rule:
             severity=Severity.parse(data["severity"]),
             summary=data["summary"].strip(),
             why=data["why"].strip(),
-            px4=_expand(profiles.get("px4", ["all"]), PX4_PROFILES, "PX4 profile", path),
+            px4=_expand(profiles.get("px4", ["all"]), releases.names(), "PX4 profile", path),
             vehicles=_expand(profiles.get("vehicles", ["all"]), VEHICLE_TYPES, "vehicle", path),
             references=references,
             docs_vs_code=data.get("docs_vs_code", "").strip(),

@@ -23,17 +23,17 @@ from difflib import get_close_matches
 from pathlib import Path
 from typing import Any
 
+from fuzzoff import releases
 from fuzzoff.catalog import expand_selectors, get_rule, load_catalog
 from fuzzoff.findings import Severity
 from fuzzoff.gate.params import GATE_PARAMS
 from fuzzoff.profiles import (
-    PX4_PROFILE_NOTES,
-    PX4_PROFILES,
     VEHICLE_TYPES,
     ProfileError,
     px4_profile_for,
     vehicle_type_for,
 )
+from fuzzoff.releases import PX4Profile
 
 
 class ConfigError(ValueError):
@@ -53,10 +53,6 @@ KNOWN_KEYS = {
     "per-file-ignores",
 }
 
-NEWEST_RELEASE = (1, 18)
-"""The newest PX4 release modelled: the ``main`` profile follows v1.18.0-beta1 (gate spec 0)."""
-OLDEST_RELEASE = (1, 5)
-"""The oldest release modelled (``legacy``: v1.5-v1.10)."""
 _RELEASE = re.compile(r"^v?(\d+)\.(\d+)(?:\.(\d+))?")
 
 
@@ -66,38 +62,42 @@ def did_you_mean(word: str, choices: Iterable[str]) -> str:
     return f" (did you mean {close[0]}?)" if close else ""
 
 
-def user_px4_profile(text: str) -> tuple[str, str | None]:
+def user_px4_profile(text: str) -> tuple[PX4Profile, str | None]:
     """The profile for a PX4 version the user names, and a note when its name differs.
 
     A release that does not exist or is not modelled is an error, not a guess: ``2.0`` is no
-    PX4 release and ``1.19`` would be judged by a model of 1.18. ``1.18`` is the ``main``
-    profile (gate spec 0), ``1.12`` the ``1.13`` one, ``1.5``-``1.10`` ``legacy``: the note
-    says so.
+    PX4 release and ``1.19`` would be judged by a model of 1.18. ``1.12`` is the ``1.13``
+    profile, ``1.5``-``1.10`` ``legacy``: the note says so.
     """
     name = text.strip()
-    if name in PX4_PROFILES:
-        return name, None
+    known = releases.names()
+    if name in known:
+        return px4_profile_for(name), None
     match = _RELEASE.match(name)
     if match is None:
         raise ProfileError(
-            f"unknown PX4 version {text!r}{did_you_mean(name, PX4_PROFILES)}: give a release "
-            f"such as 1.15.4, or one of {', '.join(PX4_PROFILES)}"
+            f"unknown PX4 version {text!r}{did_you_mean(name, known)}: give a release "
+            f"such as 1.15.4, or one of {', '.join(known)}"
         )
     release = (int(match.group(1)), int(match.group(2)))
     shown = f"{release[0]}.{release[1]}"
-    if release > NEWEST_RELEASE:
+    newest, oldest = releases.newest_listed(), releases.oldest_listed()
+    if release > newest:
         raise ProfileError(
-            f"PX4 {text} is not modelled: the newest release modelled is 1.18 (profile main); "
-            "give --px4 main to judge with it"
+            f"PX4 {text} is not modelled: the newest release modelled is "
+            f"{newest[0]}.{newest[1]}; give --px4 {releases.RELEASES[-1].name} to judge with "
+            "the newest profile"
         )
-    if release < OLDEST_RELEASE:
+    if release < oldest:
         raise ProfileError(
-            f"PX4 {text} is not modelled: the oldest release modelled is 1.5 (profile legacy)"
+            f"PX4 {text} is not modelled: the oldest release modelled is {oldest[0]}.{oldest[1]} "
+            f"(profile {releases.RELEASES[0].name})"
         )
     profile = px4_profile_for(name)
     if profile == shown:
         return profile, None
-    return profile, f"PX4 {shown} is judged with profile {profile} ({PX4_PROFILE_NOTES[profile]})"
+    covers = releases.get(profile).covers
+    return profile, f"PX4 {shown} is judged with profile {profile} ({covers})"
 
 
 def user_vehicle_type(text: str) -> str:
@@ -200,7 +200,7 @@ class Discovery:
 class Settings:
     """Everything that changes what a lint run reports."""
 
-    px4: str | None = None
+    px4: PX4Profile | None = None
     """Profile forced by the user (None = detect)."""
     vehicle: str | None = None
     select: frozenset[str] = frozenset()
@@ -215,7 +215,7 @@ class Settings:
     param_origins: Mapping[str, str] = field(default_factory=dict)
     """Parameter -> where its value was set: ``--param`` or the configuration file's path."""
     notes: tuple[str, ...] = ()
-    """What the user should hear about their settings (``--px4 1.18`` is judged as ``main``)."""
+    """What the user should hear about their settings (``--px4 1.12`` is judged as ``1.13``)."""
     discovery: Discovery | None = None
     """Set for a command-line run: each recording then takes its nearest configuration."""
 

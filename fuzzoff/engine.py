@@ -35,6 +35,7 @@ from fuzzoff.profiles import (
     ProfileError,
     px4_profile_for,
 )
+from fuzzoff.releases import PX4Profile
 from fuzzoff.sources import SourceError, open_source, recordings_in
 from fuzzoff.sources.base import RecordingInfo, SourceProblem, path_text
 from fuzzoff.state import VehicleState
@@ -57,7 +58,7 @@ threads linting at once may each restore the other's setting early, which costs 
 def resolve_profile(info: RecordingInfo, settings: Settings) -> Profile:
     """The user's choice wins; else what the recording says; else the defaults (OFB003)."""
     release = info.px4_version
-    detected_px4: str | None = None
+    detected_px4: PX4Profile | None = None
     if release:
         try:
             detected_px4 = px4_profile_for(release)
@@ -65,7 +66,7 @@ def resolve_profile(info: RecordingInfo, settings: Settings) -> Profile:
             detected_px4 = None
     fallback = DEFAULT_PX4
     if info.px4_candidates and DEFAULT_PX4 not in info.px4_candidates:
-        fallback = info.px4_candidates[-1]  # the newest the recording fits
+        fallback = px4_profile_for(info.px4_candidates[-1])  # the newest the recording fits
     px4 = settings.px4 or detected_px4 or fallback
     vehicle = settings.vehicle or info.vehicle_type or DEFAULT_VEHICLE
     return Profile(
@@ -464,9 +465,7 @@ def lint_file(
         report.complete = False
         report.problems.append(exc.line())
         report.findings.append(
-            Finding(
-                "OFB001", unreadable.name, Severity.ERROR, exc.line(), summary=_unreadable(exc)
-            )
+            Finding("OFB001", unreadable.name, Severity.ERROR, exc.line(), summary=_unreadable(exc))
         )
         return report
     try:

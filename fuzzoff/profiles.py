@@ -1,28 +1,17 @@
 """PX4 version profiles and vehicle types (gate spec section 0, rules.md "Profile").
 
 A profile is the pair (PX4 profile, vehicle type). ``--px4`` takes a release such as ``1.15.4``
-and maps it to the modelled profile; the report always says whether it was detected.
+and maps it to the modelled profile; the report always says whether it was detected. What each
+PX4 profile does is its record in ``fuzzoff/releases.py`` (``Profile.release``).
 """
 
 from __future__ import annotations
 
-import functools
 import re
 from dataclasses import dataclass
 
-PX4_PROFILES: tuple[str, ...] = ("legacy", "1.11", "1.13", "1.14", "1.15", "1.16", "1.17", "main")
-"""Ordered oldest to newest; ``1.11`` is the transition release of gate spec section 2.2."""
-
-PX4_PROFILE_NOTES: dict[str, str] = {
-    "legacy": "v1.5-v1.10: ignore_* control mode, fixed 500 ms loss timeout",
-    "1.11": "v1.11: legacy receiver, timestamp-age gate with COM_OF_LOSS_T (0.5 s)",
-    "1.13": "v1.12-v1.13: boolean OffboardControlMode, hysteresis gate, COM_OBL_ACT/COM_OBL_RC_ACT",
-    "1.14": "v1.14: new Commander, failsafe framework, disarmed switch always accepted",
-    "1.15": "v1.15: thrust_and_torque/direct_actuator flags, SET_NAV_STATE",
-    "1.16": "v1.16: acceleration needs attitude, 200 ms last-valid fallback, double mode ack",
-    "1.17": "v1.17: offboard loss without RC uses NAV_RCL_ACT, double mode ack",
-    "main": "v1.18 / main: accepts_offboard_setpoints, thrust required for SET_ATTITUDE_TARGET",
-}
+from fuzzoff import releases
+from fuzzoff.releases import PX4Profile, Release
 
 VEHICLE_TYPES: tuple[str, ...] = (
     "mc",
@@ -42,7 +31,7 @@ VEHICLE_NOTES: dict[str, str] = {
     "rover-mecanum": "mecanum rover",
 }
 
-DEFAULT_PX4 = "1.15"
+DEFAULT_PX4: PX4Profile = "1.15"
 DEFAULT_VEHICLE = "mc"
 
 _RELEASE = re.compile(r"^v?(\d+)\.(\d+)(?:\.(\d+))?")
@@ -52,29 +41,25 @@ class ProfileError(ValueError):
     """An unknown PX4 version or vehicle type (a usage error)."""
 
 
-def px4_profile_for(version: str) -> str:
+def px4_profile_for(version: str) -> PX4Profile:
     """Map a release (``1.15.4``, ``v1.17.0-beta1``) or a profile name to the modelled profile."""
     text = version.strip()
-    if text in PX4_PROFILES:
-        return text
+    known = releases.names()
+    if text in known:
+        return releases.names()[known.index(text)]
     match = _RELEASE.match(text)
     if match is None:
         raise ProfileError(
             f"unknown PX4 version {version!r}: give a release such as 1.15.4, "
-            f"or one of {', '.join(PX4_PROFILES)}"
+            f"or one of {', '.join(known)}"
         )
-    major, minor = int(match.group(1)), int(match.group(2))
-    if major != 1:
-        return "main" if major > 1 else "legacy"
-    if minor <= 10:
-        return "legacy"
-    if minor == 11:
-        return "1.11"
-    if minor in (12, 13):
-        return "1.13"
-    if minor >= 18:
-        return "main"
-    return f"1.{minor}"
+    found = releases.for_version(int(match.group(1)), int(match.group(2)))
+    return found.name  # type: ignore[return-value]
+
+
+def px4_notes() -> dict[str, str]:
+    """Profile name -> what it covers, oldest first (``fuzzoff profiles``)."""
+    return {r.name: r.covers for r in releases.RELEASES}
 
 
 def vehicle_type_for(name: str) -> str:
@@ -95,12 +80,6 @@ def vehicle_type_for(name: str) -> str:
     return text
 
 
-@functools.cache
-def at_least(profile: str, oldest: str) -> bool:
-    """True when ``profile`` is ``oldest`` or newer (cached: checks ask on every message)."""
-    return PX4_PROFILES.index(profile) >= PX4_PROFILES.index(oldest)
-
-
 def is_rover(vehicle: str) -> bool:
     return vehicle.startswith("rover")
 
@@ -109,7 +88,7 @@ def is_rover(vehicle: str) -> bool:
 class Profile:
     """The profile a recording is judged against, and where each half came from."""
 
-    px4: str = DEFAULT_PX4
+    px4: PX4Profile = DEFAULT_PX4
     vehicle: str = DEFAULT_VEHICLE
     px4_detected: bool = False
     """Known, not assumed (from the recording, or set by the user: see ``px4_forced``)."""
@@ -134,8 +113,10 @@ class Profile:
     def vehicle_source(self) -> str:
         return _source(self.vehicle_forced, self.vehicle_detected)
 
-    def at_least(self, oldest: str) -> bool:
-        return at_least(self.px4, oldest)
+    @property
+    def release(self) -> Release:
+        """The release record of ``px4`` (look it up once, where a model or check is built)."""
+        return releases.get(self.px4)
 
     @property
     def is_rover(self) -> bool:

@@ -11,6 +11,7 @@ from typing import Any
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from fuzzoff import releases
 from fuzzoff.config import Settings
 from fuzzoff.engine import run_events
 from fuzzoff.events import (
@@ -26,7 +27,7 @@ from fuzzoff.events import (
     TrajectorySetpoint,
     VehicleStatus,
 )
-from fuzzoff.profiles import PX4_PROFILES, Profile
+from fuzzoff.profiles import Profile
 from fuzzoff.sources.base import RecordingInfo
 from tests.helpers import fresh
 
@@ -161,7 +162,7 @@ def findings_by_code(
     events=streams(),
     freeze=st.sampled_from([0.0, 0.1, 0.5, 3.0]),
     max_gap=st.sampled_from([0.3, 1.0]),
-    px4=st.sampled_from(PX4_PROFILES),
+    px4=st.sampled_from(releases.names()),
     vehicle=st.sampled_from(["mc", "mc", "fw", "rover-ackermann"]),
 )
 def test_runs_report_what_single_messages_report(

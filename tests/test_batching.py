@@ -10,13 +10,13 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from fuzzoff import releases
 from fuzzoff.cli import build_parser
 from fuzzoff.commands._common import settings_from_args
 from fuzzoff.engine import VehicleRun, lint_file
 from fuzzoff.fuzz.properties import FuzzContext, runs_match_single_messages
 from fuzzoff.fuzz.scenario import Scenario
 from fuzzoff.fuzz.streams import scenarios
-from fuzzoff.profiles import PX4_PROFILES
 
 CORPORA = Path(__file__).resolve().parent.parent / "corpora"
 EXPECTED = sorted(CORPORA.rglob("*.expected.json"))
@@ -48,7 +48,7 @@ def test_runs_are_used_on_the_hot_path() -> None:
         assert run.batched, kinds
 
 
-@pytest.mark.parametrize("px4", PX4_PROFILES)
+@pytest.mark.parametrize("px4", releases.names())
 @settings(max_examples=40, deadline=None, suppress_health_check=list(HealthCheck), derandomize=True)
 @given(data=st.data())
 def test_generated_streams_give_the_same_findings_as_runs(px4: str, data: st.DataObject) -> None:

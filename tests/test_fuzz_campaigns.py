@@ -13,6 +13,7 @@ from urllib.parse import unquote, urlparse
 
 import pytest
 
+from fuzzoff import releases
 from fuzzoff.config import Settings
 from fuzzoff.engine import Timeline
 from fuzzoff.events import (
@@ -34,7 +35,6 @@ from fuzzoff.fuzz.properties import (
 )
 from fuzzoff.fuzz.reproducers import save
 from fuzzoff.fuzz.scenario import Scenario, run
-from fuzzoff.profiles import PX4_PROFILES
 from fuzzoff.writers.mcap import write_mcap
 from tests.helpers import CORPORA, run_cli
 
@@ -52,7 +52,7 @@ def _explain(result: object) -> str:
     return "\n".join(lines)
 
 
-@pytest.mark.parametrize("px4", PX4_PROFILES)
+@pytest.mark.parametrize("px4", releases.names())
 def test_campaign_finds_no_new_hazard_or_invariant_break(px4: str) -> None:
     config = CampaignConfig(
         px4=px4,

@@ -217,7 +217,7 @@ class TrajectoryContent(Check):
 
 def _invalid_effect(ctx: CheckContext) -> str:
     """What mc_pos_control does with invalid input (gate spec section 8)."""
-    if ctx.profile.at_least("1.16"):
+    if ctx.profile.release.reuses_last_valid_setpoint:
         return (
             f"PX4 {ctx.profile.px4} reuses the last valid setpoint for 200 ms, then flies a "
             "failsafe setpoint (hold, or descend without a velocity estimate)"

@@ -18,7 +18,6 @@ from fuzzoff.findings import Severity, clip
 from fuzzoff.gate import GateTransition
 from fuzzoff.gate.failsafe import LossAction
 from fuzzoff.gate.params import RC_PRESENT
-from fuzzoff.profiles import at_least
 
 
 class GateDisagrees(Check):
@@ -57,7 +56,7 @@ def _param_source(ctx: CheckContext, name: str) -> str:
 
 def _rc_text(ctx: CheckContext) -> str:
     est = ctx.gate.est
-    if ctx.profile.px4 in ("1.14", "1.15", "1.16"):
+    if not ctx.profile.release.consults_manual_control_on_loss:
         return "manual control not consulted (1.14-1.16)"
     if est.rc_recorded:
         return "manual control present" if est.rc_present else "no manual control (recorded)"
@@ -68,19 +67,20 @@ def _rc_text(ctx: CheckContext) -> str:
 def loss_summary(ctx: CheckContext) -> str:
     """The OFB701 text: timeout, action parameter, what happens, and the return."""
     gate = ctx.gate
-    px4 = ctx.profile.px4
+    release = ctx.profile.release
     action = gate.current_loss_action()
     p = gate.params
     loss_t = float(p.get("COM_OF_LOSS_T", 0.0))
     src_t = _param_source(ctx, "COM_OF_LOSS_T")
     act = p.get("COM_OBL_RC_ACT", 0.0)
     src_a = _param_source(ctx, "COM_OBL_RC_ACT")
-    if px4 == "legacy":
+    if release.fixed_loss_s is not None:
         head = (
-            f"offboard loss after 500 ms without a setpoint (fixed), then after COM_OF_LOSS_T "
+            f"offboard loss after {release.fixed_loss_s * 1000:g} ms without a setpoint (fixed), "
+            "then after COM_OF_LOSS_T "
             f"{loss_t:g} s ({src_t}) more the loss action"
         )
-    elif at_least(px4, "1.14"):
+    elif release.tick_based:
         head = (
             f"offboard loss when the newest keep-alive is COM_OF_LOSS_T {loss_t:g} s ({src_t}) "
             f"old, checked at 10 Hz"
@@ -88,7 +88,7 @@ def loss_summary(ctx: CheckContext) -> str:
     else:
         head = f"offboard loss after COM_OF_LOSS_T {loss_t:g} s ({src_t}) without a keep-alive"
     head += f"; COM_OBL_RC_ACT {act:g} ({src_a})"
-    if not at_least(px4, "1.14"):
+    if "COM_OBL_ACT" in release.param_defaults:
         head += f", COM_OBL_ACT {p.get('COM_OBL_ACT', 0.0):g} ({_param_source(ctx, 'COM_OBL_ACT')})"
     what = _action_text(action)
     back = (
@@ -104,7 +104,8 @@ def loss_short(ctx: CheckContext) -> str:
     gate = ctx.gate
     action = gate.current_loss_action()
     loss_t = float(gate.params.get("COM_OF_LOSS_T", 0.0))
-    after = f"0.5 s + {loss_t:g} s" if ctx.profile.px4 == "legacy" else f"{loss_t:g} s"
+    fixed = ctx.profile.release.fixed_loss_s
+    after = f"{fixed:g} s + {loss_t:g} s" if fixed is not None else f"{loss_t:g} s"
     if action.disarm:
         what = "disarm"
     elif action.none:

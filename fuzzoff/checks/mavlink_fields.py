@@ -31,7 +31,6 @@ from fuzzoff.events import (
 from fuzzoff.findings import Severity, clip
 from fuzzoff.gate.estimates import Estimates
 from fuzzoff.gate.receiver import DROPPED, FLOAT_FIELDS, ReceiverContext, receive
-from fuzzoff.profiles import at_least
 from fuzzoff.tables import mavlink as tm
 
 VEHICLE_LABELS = {"copter": "multicopter/VTOL", "fixedwing": "fixed-wing", "rover": "rover"}
@@ -113,7 +112,7 @@ class PositionTargetFields(Check):
         """PX4's receiver, to see the axes a copter setpoint leaves (1.13+: a docs page)."""
         if self.group == "copter" and tm.page_for(ctx.profile) is not None:
             self.rx = ReceiverContext(
-                px4=ctx.profile.px4,
+                release=ctx.profile.release,
                 own_system=None,
                 own_component=int(ctx.gate.params.get("MAV_COMP_ID", 1.0)),
                 fwdextsp=True,
@@ -355,7 +354,7 @@ class PositionTargetFields(Check):
             return {}
         fallback = (
             "reuses the last valid setpoint for up to 200 ms, then flies a failsafe hold"
-            if self.ctx.profile.at_least("1.16")
+            if self.ctx.profile.release.reuses_last_valid_setpoint
             else "flies a failsafe hold"
         )
         return {
@@ -384,7 +383,7 @@ class PositionTargetFields(Check):
             "flower-like pattern"
         )
         short = f"fixed-wing position with type_mask {event.type_mask}: no setpoint type"
-        if at_least(self.ctx.profile.px4, "1.13"):
+        if not self.ctx.profile.release.legacy_receiver:
             message += (
                 f"; PX4 {self.ctx.profile.px4}'s receiver does not read these bits at all "
                 "(v1.12+), so the value changes nothing there"
@@ -452,6 +451,7 @@ class LegacySetpointDropped(Check):
         super().__init__(ctx)
         self.episodes = Episodes(ctx)
         self.px4 = ctx.profile.px4
+        self.global_int_handled = ctx.profile.release.handles_global_int
         self.stream_types = self.wants
 
     def on_event(self, event: Event) -> None:
@@ -527,7 +527,7 @@ class LegacySetpointDropped(Check):
 
     def _global(self, event: SetPositionTargetGlobal) -> dict[str, Offence]:
         name = tm.MESSAGE_NAMES[tm.GLOBAL]
-        if self.px4 == "legacy":
+        if not self.global_int_handled:
             return {
                 "global": Offence(
                     f"{name} is not handled by PX4's receiver before v1.10 (v1.5-v1.8 have no "

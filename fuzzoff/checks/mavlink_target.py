@@ -78,8 +78,11 @@ class AttitudeTargetMask(Check):
                 "PX4 publishes nothing for it (no setpoint, no keep-alive)"
             )
         if not tm.thrust_used(mask):
-            if self.ctx.profile.at_least("main"):
-                effect = "PX4 main ignores such a message entirely (no setpoint, no keep-alive)"
+            if self.ctx.profile.release.attitude_target_needs_thrust:
+                effect = (
+                    f"PX4 {self.ctx.profile.px4} ignores such a message entirely (no setpoint, "
+                    "no keep-alive)"
+                )
             else:
                 effect = (
                     f"PX4 {self.ctx.profile.px4} accepts it and flies a thrust of 0 with an "

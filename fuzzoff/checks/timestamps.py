@@ -41,7 +41,7 @@ class KeepaliveTimestamp(Check):
     def __init__(self, ctx: CheckContext) -> None:
         super().__init__(ctx)
         self.lag_option = float(ctx.option("OFB106", "lag_s"))
-        self.judged_by_timestamp = ctx.profile.at_least("1.14")
+        self.judged_by_timestamp = ctx.profile.release.ros2_timestamp_rewrite
         self.best_offset: float | None = None
         self.previous: int | None = None
         self.seen: dict[str, _Seen] = {}

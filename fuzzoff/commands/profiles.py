@@ -11,7 +11,7 @@ from rich.table import Table
 
 from fuzzoff.commands import add_command
 from fuzzoff.commands._common import render_rich, write_output
-from fuzzoff.profiles import PX4_PROFILE_NOTES, PX4_PROFILES, VEHICLE_NOTES, VEHICLE_TYPES
+from fuzzoff.profiles import VEHICLE_NOTES, VEHICLE_TYPES, px4_notes
 
 
 def add_parser(sub: Any) -> None:
@@ -23,7 +23,7 @@ def add_parser(sub: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     if args.format == "json":
         data = {
-            "px4": [{"profile": p, "covers": PX4_PROFILE_NOTES[p]} for p in PX4_PROFILES],
+            "px4": [{"profile": p, "covers": covers} for p, covers in px4_notes().items()],
             "vehicles": [{"type": v, "name": VEHICLE_NOTES[v]} for v in VEHICLE_TYPES],
         }
         write_output(json.dumps(data, indent=2) + "\n", None)
@@ -38,8 +38,8 @@ def _draw(console: Console) -> None:
     table = Table(title="PX4 profiles", show_edge=False, box=table_box(console))
     table.add_column("profile")
     table.add_column("covers")
-    for p in PX4_PROFILES:
-        table.add_row(p, PX4_PROFILE_NOTES[p])
+    for p, covers in px4_notes().items():
+        table.add_row(p, covers)
     console.print(table)
     vehicles = Table(title="vehicle types", show_edge=False, box=table_box(console))
     vehicles.add_column("type")

@@ -33,6 +33,7 @@ from fuzzoff.fuzz.properties import PROPERTIES, FuzzContext, PropertySpec
 from fuzzoff.fuzz.scenario import Scenario, TransportName
 from fuzzoff.fuzz.streams import scenarios
 from fuzzoff.gate.params import default_params, loss_timeout
+from fuzzoff.releases import PX4Profile
 
 PROFILE_CI = "fuzzoff-ci"
 settings.register_profile(
@@ -103,7 +104,7 @@ class PropertyResult:
 
 @dataclass(slots=True)
 class CampaignConfig:
-    px4: str | None = None
+    px4: PX4Profile | None = None
     vehicle: str | None = None
     transport: TransportName | None = None
     examples: int | None = 200

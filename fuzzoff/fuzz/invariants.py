@@ -32,7 +32,6 @@ from fuzzoff.events import (
 from fuzzoff.fuzz.scenario import Scenario
 from fuzzoff.gate import GateModel, GateTransition
 from fuzzoff.gate.signal import LOOP_PERIOD, px4_stamp
-from fuzzoff.profiles import at_least
 
 EPS = 1e-6
 TERMINATION = 13
@@ -42,13 +41,13 @@ def invariant_violations(scenario: Scenario) -> list[str]:
     # The scenario's vehicle boots disarmed (its stream starts from there).
     model = GateModel(scenario.profile, dict(scenario.params), _vehicle(scenario), armed=False)
     sent = [e for e in scenario.events if e.origin == "sent"]
-    new_gate = at_least(scenario.px4, "1.14")
+    release = scenario.profile.release
     problems: list[str] = []
     transitions: list[GateTransition] = []
     last_keepalive: float | None = None
     all_count = True
     lost_since: float | None = None
-    dating = _Dating(new_gate)
+    dating = _Dating(release.ros2_timestamp_rewrite)
     for event in sent:
         before_armed, before_nav = model.armed, model.nav_state
         out = model.feed(event)
@@ -66,7 +65,7 @@ def invariant_violations(scenario: Scenario) -> list[str]:
         elif isinstance(event, ControlMode):
             all_count = False  # an empty control mode is a keep-alive that does not count
         if (
-            new_gate
+            release.loss_failsafe == "framework"
             and model.armed
             and model.in_offboard
             and lost_since is not None
@@ -77,7 +76,11 @@ def invariant_violations(scenario: Scenario) -> list[str]:
                 f"invariant 1 (5.1): OFFBOARD at {event.t:.3f} s while armed with the signal "
                 f"lost since {lost_since:.3f} s"
             )
-        if isinstance(event, Command) and event.is_offboard_switch and new_gate:
+        if (
+            isinstance(event, Command)
+            and event.is_offboard_switch
+            and release.accepts_disarmed_switch
+        ):
             problems += _disarmed_switch(scenario, event, out, before_armed, before_nav)
     end = sent[-1].t if sent else 0.0
     transitions += model.finish(end)
@@ -149,7 +152,8 @@ def _disarmed_switch(
 ) -> list[str]:
     if was_armed or nav == TERMINATION:
         return []
-    if cmd.command == VEHICLE_CMD_SET_NAV_STATE and not at_least(scenario.px4, "1.15"):
+    release = scenario.profile.release
+    if cmd.command == VEHICLE_CMD_SET_NAV_STATE and not release.handles_set_nav_state:
         return []
     if any(tr.what == "request_accepted" and tr.cause is cmd for tr in out):
         return []

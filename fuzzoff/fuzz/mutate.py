@@ -29,6 +29,7 @@ from fuzzoff.fuzz.recordings import read_with_info
 from fuzzoff.fuzz.scenario import Scenario, TransportName, run
 from fuzzoff.fuzz.streams import settle
 from fuzzoff.profiles import DEFAULT_PX4, DEFAULT_VEHICLE, ProfileError, px4_profile_for
+from fuzzoff.releases import PX4Profile
 
 FAMILIES = ("stall", "drop", "jitter", "skew")
 MAX_SIZE = {"stall": 5.0, "drop": 50.0, "jitter": 1.0, "skew": 5.0}
@@ -36,14 +37,14 @@ UNIT = {"stall": "s", "drop": "messages", "jitter": "s", "skew": "s"}
 
 
 def scenario_from_recording(
-    path: Path, px4: str | None, vehicle: str | None, params: dict[str, float]
+    path: Path, px4: PX4Profile | None, vehicle: str | None, params: dict[str, float]
 ) -> Scenario:
     """The recording's events as a scenario (see ``read_base``)."""
     return read_base(path, px4, vehicle, params)[0]
 
 
 def read_base(
-    path: Path, px4: str | None, vehicle: str | None, params: dict[str, float]
+    path: Path, px4: PX4Profile | None, vehicle: str | None, params: dict[str, float]
 ) -> tuple[Scenario, list[str]]:
     """The recording's events as a scenario (transport from its events; profile as given, else
     as the recording says, else PX4 1.15 multicopter like ``fuzzoff lint``), and the parts of

@@ -19,6 +19,7 @@ from fuzzoff.engine import Timeline
 from fuzzoff.fuzz.hazards import Hazard, hazards
 from fuzzoff.fuzz.scenario import Scenario, run
 from fuzzoff.modes import nav_state_name
+from fuzzoff.releases import PX4Profile
 
 _TIMING = re.compile(r" (?:between [\d.]+ and [\d.]+ s|at [\d.]+ s \([^)]*\))")
 """The time words of a gate failsafe message (its window, or where the recording dated it)."""
@@ -33,7 +34,7 @@ def hazards_of(scenario: Scenario) -> list[Hazard]:
 
 
 def changes(
-    px4: str, before: Sequence[Hazard], after: Sequence[Hazard], moved_s: float
+    px4: PX4Profile, before: Sequence[Hazard], after: Sequence[Hazard], moved_s: float
 ) -> list[str]:
     """What PX4 does after the perturbation and did not before, then what it no longer does."""
     unmatched = list(before)
@@ -60,7 +61,7 @@ def changes(
     return out + [f"no longer: {describe(px4, h)}" for h in unmatched]
 
 
-def describe(px4: str, h: Hazard) -> str:
+def describe(px4: PX4Profile, h: Hazard) -> str:
     """One hazard as what PX4 does: "PX4 1.15 runs POSCTL at 7.2 s (offboard loss)"."""
     # "offboard loss between 5.81 and 5.91 s: POSCTL": the cause, not the gate's timing words
     cause = _TIMING.sub("", h.message.split(":", 1)[0])

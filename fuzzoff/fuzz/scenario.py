@@ -16,7 +16,8 @@ from fuzzoff.config import Settings
 from fuzzoff.engine import Timeline, run_events
 from fuzzoff.events import Event, VehicleStatus, Where, event_from_dict, event_to_dict
 from fuzzoff.findings import Finding
-from fuzzoff.profiles import Profile
+from fuzzoff.profiles import Profile, px4_profile_for
+from fuzzoff.releases import PX4Profile
 from fuzzoff.sources.base import RecordingInfo
 
 TransportName = Literal["ros2", "mavlink", "mavros"]
@@ -37,7 +38,7 @@ MAVLink; a MAVROS stream is a ROS 1 bag, since a tlog cannot say it came through
 
 @dataclass(frozen=True, slots=True)
 class Scenario:
-    px4: str
+    px4: PX4Profile
     vehicle: str
     transport: TransportName
     events: tuple[Event, ...]
@@ -88,7 +89,7 @@ class Scenario:
     def from_json(cls, data: Mapping[str, Any]) -> Scenario:
         events = tuple(event_from_dict(dict(e)) for e in data["events"])
         return cls(
-            px4=str(data["px4"]),
+            px4=px4_profile_for(str(data["px4"])),
             vehicle=str(data["vehicle"]),
             transport=data["transport"],
             events=events,

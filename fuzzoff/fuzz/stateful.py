@@ -17,12 +17,13 @@ from hypothesis import strategies as st
 from hypothesis.stateful import RuleBasedStateMachine, initialize, invariant, precondition, rule
 
 from fuzzoff import events as ev
+from fuzzoff import releases
 from fuzzoff.fuzz.invariants import invariant_violations
 from fuzzoff.fuzz.known import KNOWN
 from fuzzoff.fuzz.scenario import Scenario
 from fuzzoff.fuzz.strategies import LOSS_TIMEOUTS, CommandPlan
 from fuzzoff.fuzz.streams import commands, settle
-from fuzzoff.profiles import PX4_PROFILES, at_least
+from fuzzoff.releases import PX4Profile
 
 
 class OffboardSession(RuleBasedStateMachine):
@@ -30,16 +31,16 @@ class OffboardSession(RuleBasedStateMachine):
 
     def __init__(self) -> None:
         super().__init__()
-        self.px4 = "1.15"
+        self.px4: PX4Profile = "1.15"
         self.params: dict[str, float] = {}
         self.events: list[ev.Event] = []
         self.now = 0.0
 
     @initialize(
-        px4=st.sampled_from([p for p in PX4_PROFILES if at_least(p, "1.13")]),
+        px4=st.sampled_from([r.name for r in releases.RELEASES if r.control_mode_flags]),
         timeout=st.sampled_from(LOSS_TIMEOUTS),
     )
-    def start(self, px4: str, timeout: float) -> None:
+    def start(self, px4: PX4Profile, timeout: float) -> None:
         self.px4 = px4
         self.params = {"COM_OF_LOSS_T": timeout}
 
@@ -48,7 +49,9 @@ class OffboardSession(RuleBasedStateMachine):
         """Keep-alive (position) and a trajectory setpoint at ``rate`` for ``seconds``."""
         n = max(1, int(seconds * rate))
         layout: Literal["actuator", "thrust_and_torque"] = (
-            "thrust_and_torque" if at_least(self.px4, "1.15") else "actuator"
+            "thrust_and_torque"
+            if releases.get(self.px4).control_mode == "thrust_and_torque"
+            else "actuator"
         )
         for i in range(n):
             t = round(self.now + i / rate, 4)

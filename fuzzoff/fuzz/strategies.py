@@ -19,7 +19,9 @@ from typing import Any
 
 from hypothesis import strategies as st
 
-from fuzzoff.profiles import PX4_PROFILES, VEHICLE_TYPES, at_least
+from fuzzoff import releases
+from fuzzoff.profiles import VEHICLE_TYPES
+from fuzzoff.releases import PX4Profile
 
 NAN = math.nan
 f32 = st.floats(min_value=-200.0, max_value=200.0, width=32, allow_nan=False)
@@ -28,11 +30,12 @@ f32 = st.floats(min_value=-200.0, max_value=200.0, width=32, allow_nan=False)
 # --------------------------------------------------------------------------- profile, params
 
 
-def px4_versions(transport: str | None = None) -> st.SearchStrategy[str]:
+def px4_versions(transport: str | None = None) -> st.SearchStrategy[PX4Profile]:
     """Modelled PX4 profiles; ROS 2 direct needs the boolean control mode of 1.13+."""
     if transport == "ros2":
-        return st.sampled_from([p for p in PX4_PROFILES if at_least(p, "1.13")])
-    return st.sampled_from(PX4_PROFILES)
+        flags = [r.control_mode_flags for r in releases.RELEASES]
+        return st.sampled_from([n for n, f in zip(releases.names(), flags, strict=True) if f])
+    return st.sampled_from(releases.names())
 
 
 def vehicle_types() -> st.SearchStrategy[str]:
@@ -43,7 +46,7 @@ LOSS_TIMEOUTS = (0.2, 0.5, 1.0, 1.5, 2.0)
 
 
 @st.composite
-def gate_params(draw: st.DrawFn, px4: str) -> dict[str, float]:
+def gate_params(draw: st.DrawFn, px4: PX4Profile) -> dict[str, float]:
     """``COM_OF_LOSS_T``, the loss action (``COM_OBL_RC_ACT``) and whether an RC is present."""
     params: dict[str, float] = {}
     if draw(st.booleans()):
@@ -156,11 +159,11 @@ OCM_FLAGS_115 = (
 
 
 @st.composite
-def control_modes(draw: st.DrawFn, px4: str) -> dict[str, Any]:
+def control_modes(draw: st.DrawFn, px4: PX4Profile) -> dict[str, Any]:
     """``OffboardControlMode`` flags of the release's layout: usually one flag, sometimes a
     mix, sometimes none (OFB301)."""
-    names = OCM_FLAGS_115 if at_least(px4, "1.15") else OCM_FLAGS_BEFORE_115
-    layout = "thrust_and_torque" if at_least(px4, "1.15") else "actuator"
+    layout = releases.get(px4).control_mode
+    names = OCM_FLAGS_115 if layout == "thrust_and_torque" else OCM_FLAGS_BEFORE_115
     chosen = draw(
         st.one_of(
             st.sampled_from(names).map(lambda n: {n}),

@@ -22,14 +22,15 @@ from typing import Any
 from hypothesis import strategies as st
 
 from fuzzoff import events as ev
+from fuzzoff import releases
 from fuzzoff.fuzz import strategies as fs
 from fuzzoff.fuzz.scenario import AUTOPILOT, COMPANION, TRANSPORTS, Scenario, TransportName
 from fuzzoff.gate import GateModel
 from fuzzoff.gate.params import default_params, loss_timeout
 from fuzzoff.modes import mavros_mode_to_nav_state, nav_state_to_mavros_mode
-from fuzzoff.profiles import Profile, at_least, is_rover
+from fuzzoff.profiles import Profile, is_rover
+from fuzzoff.releases import PX4Profile
 from fuzzoff.sources import px4_msgs
-from fuzzoff.sources.px4_msgs import release_for
 
 MIN_STEP = 0.0001
 """Distinct receive times: events never share a timestamp (the readers' order for equal
@@ -124,7 +125,7 @@ REJECT = {"request_rejected", "arm_rejected", "disarm_rejected"}
 
 def echo(
     sent: Sequence[ev.Event],
-    px4: str,
+    px4: PX4Profile,
     vehicle: str,
     params: dict[str, float],
     *,
@@ -162,7 +163,7 @@ def echo(
         transitions = model.feed(event)
         clock = max(clock, event.t)
         if isinstance(event, ev.Command) and acks:
-            out += _acks(event, transitions, px4, transport, vid)
+            out += _acks(event, transitions, profile.release.acks_switch_twice, transport, vid)
         if status:
             note(event.t)
     return out
@@ -181,7 +182,7 @@ def _status(t: float, model: GateModel, vid: str) -> ev.VehicleStatus:
 def _acks(
     cmd: ev.Command,
     transitions: Sequence[Any],
-    px4: str,
+    twice: bool,
     transport: TransportName,
     vid: str,
 ) -> list[ev.Event]:
@@ -202,7 +203,7 @@ def _acks(
             sender_time_us=round(t * 1e6) if stamp else None,
         )
 
-    if transport == "mavlink" and cmd.is_mode_switch and px4 in ("1.16", "1.17"):
+    if transport == "mavlink" and cmd.is_mode_switch and twice:
         out.append(ack(cmd.t + 0.002, 0))
     out.append(ack(cmd.t + 0.008, result))
     return out
@@ -224,32 +225,37 @@ _MESSAGE = {
 }
 
 
-def _published(kind: str, px4: str) -> bool:
+def _published(kind: str, px4: PX4Profile) -> bool:
     """Does the release's px4_msgs have this setpoint's message (rover topics vary)?"""
-    return px4_msgs.definition(release_for(px4) or "main", _MESSAGE[kind]) is not None
+    return px4_msgs.definition(_msg_folder(px4), _MESSAGE[kind]) is not None
+
+
+def _msg_folder(px4: PX4Profile) -> str:
+    """The px4_msgs folder of the release (main's for a release before ROS 2)."""
+    return releases.get(px4).msg_folder or "main"
 
 
 _WIRE_NAME = {"normalized_steering_angle": "normalized_steering_setpoint"}
 """Event fields whose message field was renamed in a release (1.17's RoverSteeringSetpoint)."""
 
 
-def _carried(kind: str, px4: str, values: dict[str, Any]) -> dict[str, Any]:
+def _carried(kind: str, px4: PX4Profile, values: dict[str, Any]) -> dict[str, Any]:
     """``values`` with NaN for the fields the release's message does not have (1.17 dropped
     RoverSteeringSetpoint's ``normalized_speed_diff``): a recording of that release cannot
     hold them, and its reader gives NaN, as PX4 would never see them."""
     if kind not in _MESSAGE:
         return values
     name = _MESSAGE[kind]
-    text = px4_msgs.definition(release_for(px4) or "main", name)
+    text = px4_msgs.definition(_msg_folder(px4), name)
     if text is None:
         return values
     wire = px4_msgs.field_names(px4_msgs.type_name(name), text)
     return {k: v if k in wire or _WIRE_NAME.get(k) in wire else fs.NAN for k, v in values.items()}
 
 
-def _ros2_setpoint_kinds(vehicle: str, px4: str) -> list[str]:
+def _ros2_setpoint_kinds(vehicle: str, px4: PX4Profile) -> list[str]:
     kinds = ["trajectory", "trajectory", "attitude", "rates", "none"]
-    if is_rover(vehicle) and at_least(px4, "1.16"):
+    if is_rover(vehicle) and releases.get(px4).rover_setpoints:
         kinds += [k for k in fs.ROVER_KINDS if _published(k, px4)] * 2
     return kinds
 
@@ -268,7 +274,7 @@ _ROS2_BUILD: dict[str, Callable[..., ev.Event]] = {
 
 
 @st.composite
-def ros2_sent(draw: st.DrawFn, px4: str, vehicle: str, times: list[float]) -> list[ev.Event]:
+def ros2_sent(draw: st.DrawFn, px4: PX4Profile, vehicle: str, times: list[float]) -> list[ev.Event]:
     """Keep-alive and setpoints of a ROS 2 companion (``/fmu/in``)."""
     flags = draw(fs.control_modes(px4))
     skew = draw(fs.clock_skews())
@@ -280,7 +286,7 @@ def ros2_sent(draw: st.DrawFn, px4: str, vehicle: str, times: list[float]) -> li
     # A rover program publishes a combination of rover setpoints (OFB502, OFB504).
     most = 3 if is_rover(vehicle) else 1
     any_kinds = st.lists(st.sampled_from(choices), min_size=1, max_size=most, unique=True)
-    if is_rover(vehicle) and at_least(px4, "1.16"):
+    if is_rover(vehicle) and releases.get(px4).rover_setpoints:
         combos = [c for c in fs.ROVER_COMBINATIONS if all(_published(k, px4) for k in c)]
         kinds = draw(
             st.one_of(any_kinds, st.sampled_from(combos).map(list)) if combos else any_kinds
@@ -296,7 +302,7 @@ def ros2_sent(draw: st.DrawFn, px4: str, vehicle: str, times: list[float]) -> li
 
 @st.composite
 def _setpoint_series(
-    draw: st.DrawFn, kind: str, times: list[float], lag: float, px4: str
+    draw: st.DrawFn, kind: str, times: list[float], lag: float, px4: PX4Profile
 ) -> list[ev.Event]:
     """One setpoint topic following the keep-alive by ``lag``, maybe starting late or stopping
     early (stale setpoints under a live keep-alive: OFB104), frozen or moving."""
@@ -356,7 +362,7 @@ def mavlink_sent(draw: st.DrawFn, times: list[float], transport: TransportName) 
 @st.composite
 def scenarios(
     draw: st.DrawFn,
-    px4: str | None = None,
+    px4: PX4Profile | None = None,
     vehicle: str | None = None,
     transport: TransportName | None = None,
 ) -> Scenario:
@@ -364,25 +370,26 @@ def scenarios(
     chosen: TransportName = (
         transport if transport is not None else draw(st.sampled_from(TRANSPORTS))
     )
-    px4 = px4 or draw(fs.px4_versions(chosen))
-    if chosen == "ros2" and not at_least(px4, "1.13"):
+    profile: PX4Profile = px4 if px4 is not None else draw(fs.px4_versions(chosen))
+    release = releases.get(profile)
+    if chosen == "ros2" and not release.control_mode_flags:
         chosen = "mavlink"  # the ROS 2 control mode does not exist before 1.13
     vehicle = vehicle or draw(fs.vehicle_types())
-    params = draw(fs.gate_params(px4))
-    timeout = loss_timeout(px4, default_params(px4) | params)
+    params = draw(fs.gate_params(profile))
+    timeout = loss_timeout(profile, default_params(profile) | params)
     times = draw(fs.keepalive_times(timeout))
     duration = times[-1] if times else 0.0
     if chosen == "ros2":
-        sent = draw(ros2_sent(px4, vehicle, times))
+        sent = draw(ros2_sent(profile, vehicle, times))
     else:
         sent = draw(mavlink_sent(times, chosen))
-    plan = draw(fs.command_plans(duration, chosen == "ros2" and at_least(px4, "1.15")))
+    plan = draw(fs.command_plans(duration, chosen == "ros2" and release.handles_set_nav_state))
     if chosen == "mavros":
         plan = replace(plan, acks=False)
     sent = settle([*sent, *commands(plan, chosen)])
     answers = echo(
         sent,
-        px4,
+        profile,
         vehicle,
         params,
         acks=plan.acks,
@@ -393,4 +400,6 @@ def scenarios(
     if chosen == "mavros":
         stream = [e for e in stream if not isinstance(e, ev.Command)]
         stream = settle(stream)
-    return Scenario(px4=px4, vehicle=vehicle, transport=chosen, events=tuple(stream), params=params)
+    return Scenario(
+        px4=profile, vehicle=vehicle, transport=chosen, events=tuple(stream), params=params
+    )

@@ -27,7 +27,7 @@ from fuzzoff.gate.ocm import (
     VELOCITY,
     first_flag,
 )
-from fuzzoff.profiles import at_least
+from fuzzoff.releases import Release
 
 LAST_VALID_S = 0.2
 """1.16+: an invalid setpoint reuses the last valid one if it is younger than this (8)."""
@@ -67,16 +67,16 @@ _BASE: dict[int, tuple[str, ...]] = {
 }
 
 
-def control_flags(px4: str, mask: int) -> tuple[str, ...]:
+def control_flags(release: Release, mask: int) -> tuple[str, ...]:
     """The ``flag_control_*`` names enabled in OFFBOARD for this flag mask (section 7)."""
     first = first_flag(mask)
-    if px4 in ("legacy", "1.11"):
+    if not release.control_mode_flags:
         return _legacy_flags(mask)
     if first in (ACTUATOR, THRUST_AND_TORQUE):
-        return ("allocation",) if at_least(px4, "1.15") and first == THRUST_AND_TORQUE else ()
+        return ("allocation",) if release.allocation_flag and first == THRUST_AND_TORQUE else ()
     if first in (DIRECT_ACTUATOR, 0):
         return ()
-    if px4 == "main":
+    if release.setpoint_types_control_mode:
         if first == POSITION:
             return (
                 "allocation",
@@ -93,7 +93,7 @@ def control_flags(px4: str, mask: int) -> tuple[str, ...]:
             return ("allocation", "rates", "attitude", "velocity")
         return ("allocation", *_BASE[first])
     flags = _BASE[first]
-    if at_least(px4, "1.15"):
+    if release.allocation_flag:
         flags = (*flags, "allocation")
     return flags
 
@@ -118,9 +118,9 @@ def _legacy_flags(mask: int) -> tuple[str, ...]:
 _POSITION_LOOPS = ("position", "velocity", "acceleration", "altitude", "climb_rate")
 
 
-def position_control(px4: str, mask: int) -> bool:
+def position_control(release: Release, mask: int) -> bool:
     """Does this OCM switch the (multicopter) position controller on?"""
-    flags = control_flags(px4, mask)
+    flags = control_flags(release, mask)
     return any(
         f in flags for f in ("position", "velocity", "acceleration", "altitude", "climb_rate")
     )
@@ -187,14 +187,14 @@ _ROVER_TABLE: dict[str, dict[int, str]] = {
 }
 
 
-def describe(px4: str, vehicle: str, mask: int) -> tuple[str, str, bool]:
+def describe(release: Release, vehicle: str, mask: int) -> tuple[str, str, bool]:
     """(text, spec section, unverified) naming what runs in OFFBOARD for this OCM."""
     first = first_flag(mask)
-    flags = control_flags(px4, mask)
+    flags = control_flags(release, mask)
     chain = ", ".join(flags) if flags else "no controller"
     name = FLAG_NAMES.get(first, "no flag")
     if vehicle.startswith("rover"):
-        if px4 == "main":
+        if release.rover_drive_modes:
             what = _ROVER_TABLE[vehicle].get(first, "no rover setpoint generated")
             return f"rover offboard ({name}): {what}; controllers {chain}", "10", False
         return (
@@ -213,5 +213,5 @@ def describe(px4: str, vehicle: str, mask: int) -> tuple[str, str, bool]:
                 True,
             )
         return f"fixed-wing offboard {name}: {chain}", "9", False
-    unverified = vehicle == "vtol" or px4 in ("legacy", "1.11")
+    unverified = vehicle == "vtol" or release.old_code_unverified
     return f"offboard {name}: {chain}", "7", unverified

@@ -1,6 +1,6 @@
 """What the vehicle does when the offboard signal is lost, per profile (gate spec section 5).
 
-``loss_action(px4, vehicle, params, est, stage)`` gives the action the failsafe selects at that
+``loss_action(release, vehicle, params, est, stage)`` gives the action the failsafe selects at that
 moment. Mode requirements used for the degradation chains are fuzzoff's approximation of PX4's
 mode requirements (the spec gives the chains, not every requirement): results that depend on
 them are marked ``unverified``.
@@ -13,7 +13,7 @@ from dataclasses import dataclass, replace
 from fuzzoff.gate.estimates import Estimates
 from fuzzoff.gate.params import RC_PRESENT
 from fuzzoff.modes import nav_state_name
-from fuzzoff.profiles import at_least
+from fuzzoff.releases import Release
 
 MANUAL, ALTCTL, POSCTL, LOITER, RTL, LANDGPSFAIL, DESCEND, TERMINATION = 0, 1, 2, 4, 5, 9, 12, 13
 OFFBOARD, STAB, LAND = 14, 15, 18
@@ -111,13 +111,13 @@ def _finish(
     )
 
 
-def _nav_rcl_action(value: int, px4: str) -> tuple[int | None, bool, str]:
+def _nav_rcl_action(value: int, release: Release) -> tuple[int | None, bool, str]:
     """NAV_RCL_ACT as the replacement action of 1.17+ (5.1): (nav, unverified, label)."""
     if value == 0:
         return None, True, "NAV_RCL_ACT 0 (Disabled): no failsafe"
     if value == 6:
         return None, False, "NAV_RCL_ACT 6 (Disarm)"
-    if value == 7 and px4 == "main":
+    if value == 7 and release.nav_rcl_hold_no_failsafe:
         return LOITER, True, "NAV_RCL_ACT 7 (Hold, no failsafe)"
     nav = _NAV_RCL.get(value)
     if nav is None:
@@ -125,7 +125,9 @@ def _nav_rcl_action(value: int, px4: str) -> tuple[int | None, bool, str]:
     return nav, False, f"NAV_RCL_ACT {value}"
 
 
-def _framework(px4: str, vehicle: str, params: dict[str, float], est: Estimates) -> LossAction:
+def _framework(
+    release: Release, vehicle: str, params: dict[str, float], est: Estimates
+) -> LossAction:
     """1.14 - main (5.1)."""
     raw = params.get("COM_OBL_RC_ACT", 0.0)
     value = int(raw) if raw == int(raw) else -99
@@ -136,27 +138,27 @@ def _framework(px4: str, vehicle: str, params: dict[str, float], est: Estimates)
     chosen = _OBL_RC_14.get(value, POSCTL)
     if value not in _OBL_RC_14:
         note += " (out of range: treated as 0, Position)"
-    if value == 2 and not at_least(px4, "1.16"):
+    if value == 2 and release.obl_rc_manual_is_stabilized:
         note += " (labelled Manual, selects Stabilized)"
-    if px4 in ("1.14", "1.15", "1.16"):
+    if release.nav_rcl_fallback == "none":
         if chosen == POSCTL and params.get("COM_POSCTL_NAVL", 0.0) == 1.0:
             final = _degrade(POSCTL, est, vehicle, (POSCTL, LAND, DESCEND, TERMINATION))
         else:
             final = _degrade(chosen, est, vehicle, _CHAIN_14)
         return _finish(chosen, final, "5.1", False, note, rc)
-    # 1.17: replace a stick mode by NAV_RCL_ACT first; main: after the stick chain.
+    # 1.17: replace a stick mode by NAV_RCL_ACT first; 1.18 and main: after the stick chain.
     if not est.rc_recorded:
         note += f"; manual control assumed {'present' if rc else 'absent'} ({RC_PRESENT})"
-    if px4 == "1.17" and chosen in _STICK and not rc:
-        return _replace(px4, vehicle, params, est, chosen, note, rc)
+    if release.nav_rcl_fallback == "before_degrade" and chosen in _STICK and not rc:
+        return _replace(release, vehicle, params, est, chosen, note, rc)
     final = _degrade(chosen, est, vehicle, _CHAIN_14)
-    if px4 == "main" and final in _STICK and not rc:
-        return _replace(px4, vehicle, params, est, final, note, rc)
+    if release.nav_rcl_fallback == "after_degrade" and final in _STICK and not rc:
+        return _replace(release, vehicle, params, est, final, note, rc)
     return _finish(chosen, final, "5.1", False, note, rc)
 
 
 def _replace(
-    px4: str,
+    release: Release,
     vehicle: str,
     params: dict[str, float],
     est: Estimates,
@@ -164,7 +166,7 @@ def _replace(
     note: str,
     rc: bool,
 ) -> LossAction:
-    nav, unverified, label = _nav_rcl_action(int(params.get("NAV_RCL_ACT", 2.0)), px4)
+    nav, unverified, label = _nav_rcl_action(int(params.get("NAV_RCL_ACT", 2.0)), release)
     stick = _name(chosen)
     note += f"; no manual control: {stick} replaced by {label}"
     if nav is None:
@@ -216,10 +218,10 @@ def _chain_13(nav: int, est: Estimates, vehicle: str) -> int:
     return nav
 
 
-def _v113(px4: str, vehicle: str, params: dict[str, float], est: Estimates) -> LossAction:
+def _v113(release: Release, vehicle: str, params: dict[str, float], est: Estimates) -> LossAction:
     rc = _rc_present(params, est)
     exception = int(params.get("COM_RCL_EXCEPT", 0.0)) & 4 != 0
-    unverified = px4 == "1.11"
+    unverified = release.old_code_unverified
     spec = "5.2"
     if rc and not exception:
         name, table = "COM_OBL_RC_ACT", _OBL_RC_13
@@ -293,11 +295,11 @@ def _legacy(vehicle: str, params: dict[str, float], est: Estimates, stage: int) 
 
 
 def loss_action(
-    px4: str, vehicle: str, params: dict[str, float], est: Estimates, stage: int = 2
+    release: Release, vehicle: str, params: dict[str, float], est: Estimates, stage: int = 2
 ) -> LossAction:
     """The action on offboard loss now. ``stage`` is legacy's: 1 = lost, 2 = loss timeout."""
-    if px4 == "legacy":
+    if release.loss_failsafe == "state_machine_legacy":
         return _legacy(vehicle, params, est, stage)
-    if px4 in ("1.11", "1.13"):
-        return _v113(px4, vehicle, params, est)
-    return _framework(px4, vehicle, params, est)
+    if release.loss_failsafe == "state_machine":
+        return _v113(release, vehicle, params, est)
+    return _framework(release, vehicle, params, est)

@@ -72,7 +72,8 @@ from fuzzoff.gate.signal import (
 from fuzzoff.gate.tracker import ControllerTracker
 from fuzzoff.gate.transitions import GateTransition, TransitionKind
 from fuzzoff.modes import nav_state_name
-from fuzzoff.profiles import Profile, at_least
+from fuzzoff.profiles import Profile
+from fuzzoff.releases import LossFailsafe
 
 EMPTY: list[GateTransition] = []
 """Returned when an event changes nothing (shared: never mutate a returned list)."""
@@ -82,6 +83,12 @@ NOT_OFFBOARD = "no OFFBOARD on either side: other modes' own rules are not model
 FAILSAFE_TEXT_WINDOW_S = 3.0
 """A failsafe STATUSTEXT this long before a recorded change out of OFFBOARD explains it (PX4
 sends the text at once; the 1 Hz HEARTBEAT shows the new mode up to a second later)."""
+_RESUME_SPEC: dict[LossFailsafe, str] = {
+    "framework": "5.1",
+    "state_machine": "5.2",
+    "state_machine_legacy": "5.3",
+}
+"""The spec section of the return to OFFBOARD when the signal comes back, by loss failsafe."""
 NO_STREAM_SWITCH = "1.14+: no stream needed while disarmed, checked at arming"
 RECORDED_FAILSAFE = "PX4's failsafe recorded then"
 NOT_FLAGGED = "the model's alone: PX4's failsafe_flags shows no loss"
@@ -119,6 +126,7 @@ class GateModel:
     ) -> None:
         self.profile = profile
         self.px4 = profile.px4
+        self.release = profile.release
         self.vehicle_type = profile.vehicle
         self.vehicle = vehicle
         self.overrides = dict(params or {})
@@ -133,13 +141,13 @@ class GateModel:
         self.follows_flag = False
         """Without the stream: PX4's ``offboard_control_signal_lost`` has been seen, and the
         signal follows it from then on (the mode history no longer decides it)."""
-        self.signal = make_signal(self.px4, self.params)
+        self.signal = make_signal(self.release, self.params)
         if not stream_recorded:
             self.signal = UnseenSignal(self.signal.timeout)
         self._failsafe_text_at = -INF
         """When PX4 last said a failsafe began (STATUSTEXT), for a recording without stream."""
-        self.tick_based = at_least(self.px4, "1.14")
-        self._flags_ignored = self.px4 in ("legacy", "1.11")
+        self.tick_based = self.release.tick_based
+        self._flags_ignored = not self.release.control_mode_flags
         """Before 1.13 any keep-alive counts, whatever its flags (2.2)."""
         self.armed: bool | None = armed
         """None until the recording shows the arming state (or a request settles it):
@@ -163,7 +171,7 @@ class GateModel:
         self._drop_reason: str | None = None
         self._good = False
         self._sampled = False
-        self.ctl = ControllerTracker(self.px4, self.vehicle_type, self.est)
+        self.ctl = ControllerTracker(self.release, self.vehicle_type, self.est)
         self._deadline = INF
         self._clock = -INF
         """The newest event time fed: nothing is emitted earlier (the timeline never goes back)."""
@@ -197,13 +205,13 @@ class GateModel:
         not known yet, and PX4's flag stands for them."""
         self._dirty = False
         self._stamp_offset: float | None = None
-        self.compare = Comparator(slack(self.px4) + LOOP_PERIOD)
+        self.compare = Comparator(slack(self.release) + LOOP_PERIOD)
         try:
             own: int | None = int(vehicle)
         except ValueError:
             own = None
         self._rx = ReceiverContext(
-            px4=self.px4,
+            release=self.release,
             own_system=own,
             own_component=int(self.params.get("MAV_COMP_ID", 1.0)),
             fwdextsp=bool(self.params.get("MAV_FWDEXTSP", 1.0)),
@@ -255,7 +263,7 @@ class GateModel:
 
     def current_loss_action(self) -> LossAction:
         """What the vehicle would do if the signal were lost now (OFB701/OFB702)."""
-        return loss_action(self.px4, self.vehicle_type, self.params, self.est)
+        return loss_action(self.release, self.vehicle_type, self.params, self.est)
 
     # ------------------------------------------------------------------ driving
 
@@ -404,7 +412,7 @@ class GateModel:
         self.signal.mark_lost()
         self._signal_changed(t)
         last = self.signal.last
-        why = estimate_failure(self.px4, self.ocm_mask, self.est) if self.tick_based else None
+        why = estimate_failure(self.release, self.ocm_mask, self.est) if self.tick_based else None
         if why is None and self.ocm_mask == 0 and last is not None and not self._flags_ignored:
             why = "no flag set in the newest keep-alive"
         if why is None and self.tick_based and self.signal.stamps_lag:
@@ -525,7 +533,7 @@ class GateModel:
         if self._flags_ignored:
             self._good = True
         else:
-            self._good = mask != 0 and estimate_failure(self.px4, mask, self.est) is None
+            self._good = mask != 0 and estimate_failure(self.release, mask, self.est) is None
         self.ctl.set_mask(mask)
 
     def _on_control_mode(self, event: ControlMode) -> None:
@@ -752,7 +760,7 @@ class GateModel:
         if self.est.update(event):
             self._verdicts.clear()
             self._mask_changed()
-            if self.tick_based and estimate_failure(self.px4, self.ocm_mask, self.est):
+            if self.tick_based and estimate_failure(self.release, self.ocm_mask, self.est):
                 self.signal.turned_bad(event.t)
             self._update_controller(event.t)
 
@@ -766,7 +774,7 @@ class GateModel:
         self.params[name] = event.value
         self._verdicts.clear()
         if name == "COM_OF_LOSS_T" and self.stream_recorded:
-            if self.px4 == "legacy":
+            if self.release.fixed_loss_s is not None:
                 self.signal.loss_extra = max(0.0, event.value)  # type: ignore[attr-defined]
             else:
                 self.signal.timeout = max(0.0, event.value)
@@ -796,7 +804,7 @@ class GateModel:
         elif self._needs_failsafe():
             stage = 2 if getattr(self.signal, "timed_out", True) else 1
             if self._fallback is None or self._fallback_stage != stage:
-                action = loss_action(self.px4, self.vehicle_type, self.params, self.est, stage)
+                action = loss_action(self.release, self.vehicle_type, self.params, self.est, stage)
                 self._fallback = action
                 self._fallback_stage = stage
                 self._failsafe(t, action, kwargs)
@@ -815,7 +823,7 @@ class GateModel:
                         t,
                         "offboard_resumed",
                         "offboard signal back: OFFBOARD again (the user intention never changed)",
-                        "5.1" if self.tick_based else "5.2" if self.px4 != "legacy" else "5.3",
+                        _RESUME_SPEC[self.release.loss_failsafe],
                         nav_state=NAV_STATE_OFFBOARD,
                         **kwargs,
                     )
@@ -912,16 +920,18 @@ class GateModel:
         attitude_ok = self.est.attitude and self.est.angular_velocity
         if cmd.is_mode_switch:
             return switch_decision(
-                self.px4, cmd, target, armed, self.signal.available, self._nav, attitude_ok
+                self.release, cmd, target, armed, self.signal.available, self._nav, attitude_ok
             )
         if cmd.is_arm:
-            why = estimate_failure(self.px4, self.ocm_mask, self.est) or "no offboard signal"
+            why = estimate_failure(self.release, self.ocm_mask, self.est) or "no offboard signal"
             flags_known = self.ocm_mask != 0 or self._flags_unlogged
             now_ok = self.signal.ok_now(cmd.t, flags_known and why == "no offboard signal")
-            return arm_decision(self.px4, cmd, self.user_intention, now_ok, why, attitude_ok, armed)
+            return arm_decision(
+                self.release, cmd, self.user_intention, now_ok, why, attitude_ok, armed
+            )
         landed, why = self.landed.landed(cmd.t)
         ground = self.vehicle_type.startswith("rover")
-        return disarm_decision(self.px4, cmd, armed, landed, why, ground)
+        return disarm_decision(self.release, cmd, armed, landed, why, ground)
 
     # -- requests while the arming state is unknown
 

@@ -10,7 +10,9 @@ transmitter or joystick is connected, used only where the recording has no
 
 from __future__ import annotations
 
-from fuzzoff.profiles import Profile, at_least
+from fuzzoff import releases
+from fuzzoff.profiles import Profile
+from fuzzoff.releases import PX4Profile
 
 RC_PRESENT = "FUZZOFF_RC_PRESENT"
 
@@ -30,11 +32,12 @@ GATE_PARAMS: tuple[str, ...] = (
 )
 
 
-def default_params(px4: str) -> dict[str, float]:
-    """The defaults of ``px4`` (a profile name) for every parameter in ``GATE_PARAMS``."""
-    legacy = px4 == "legacy"
+def default_params(px4: PX4Profile) -> dict[str, float]:
+    """The defaults of ``px4`` (a profile name) for every parameter in ``GATE_PARAMS``: those
+    every release shares, then the release's own (``Release.param_defaults``)."""
+    own = releases.get(px4).param_defaults
     params: dict[str, float] = {
-        "COM_OF_LOSS_T": 0.0 if legacy else 0.5 if px4 == "1.11" else 1.0,
+        "COM_OF_LOSS_T": own["COM_OF_LOSS_T"],
         "COM_OBL_RC_ACT": 0.0,
         "MAV_FWDEXTSP": 1.0,
         "MAV_SYS_ID": 1.0,
@@ -45,11 +48,10 @@ def default_params(px4: str) -> dict[str, float]:
         "COM_POSCTL_NAVL": 0.0,
         # Auto-disarm of a vehicle that does not take off; fuzzoff reads it as take-off
         # evidence (gate/landed.py). Not read for legacy (0: no such inference).
-        "COM_DISARM_PRFLT": 0.0 if legacy else 10.0,
+        "COM_DISARM_PRFLT": own["COM_DISARM_PRFLT"],
         RC_PRESENT: 1.0,
     }
-    if not at_least(px4, "1.14"):
-        params["COM_OBL_ACT"] = 0.0  # removed in 1.14 (section 13)
+    params.update(own)  # and the parameters a release alone has (COM_OBL_ACT before 1.14)
     return params
 
 
@@ -60,8 +62,9 @@ def effective_params(
     return default_params(profile.px4) | recorded | overrides
 
 
-def loss_timeout(px4: str, params: dict[str, float]) -> float:
+def loss_timeout(px4: PX4Profile, params: dict[str, float]) -> float:
     """The time without keep-alive after which the signal counts as lost (sections 2.1-2.3)."""
-    if px4 == "legacy":
-        return 0.5
+    fixed = releases.get(px4).fixed_loss_s
+    if fixed is not None:
+        return fixed
     return max(0.0, float(params.get("COM_OF_LOSS_T", 1.0)))

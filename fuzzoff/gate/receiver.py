@@ -23,7 +23,7 @@ from fuzzoff.events import (
 )
 from fuzzoff.gate.estimates import Estimates
 from fuzzoff.gate.ocm import ACCELERATION, ATTITUDE, BODY_RATE, POSITION, VELOCITY
-from fuzzoff.profiles import at_least
+from fuzzoff.releases import Release
 
 DROPPED = -1
 
@@ -41,16 +41,19 @@ Result = tuple[int, int, "str | None", str]
 class ReceiverContext:
     """What the receiver reads besides the message (6.1)."""
 
-    px4: str
+    release: Release
     own_system: int | None
     own_component: int
     fwdextsp: bool
     est: Estimates
     old_rule: bool = False
     """v1.13's "any component finite" flag rule instead of 1.14's "not all NaN" (6.2)."""
+    legacy: bool = False
+    """The legacy / 1.11 receiver (6.4 legacy, 6.5)."""
 
     def __post_init__(self) -> None:
-        self.old_rule = not at_least(self.px4, "1.14")
+        self.old_rule = self.release.setpoint_valid_if_any_finite
+        self.legacy = self.release.legacy_receiver
 
 
 def _target_ok(msg: MavlinkTarget, ctx: ReceiverContext) -> str | None:
@@ -156,7 +159,7 @@ def shape(msg: MavlinkTarget) -> Shape | None:
 
 
 def receive(msg: MavlinkTarget, ctx: ReceiverContext) -> Result:
-    if ctx.px4 in ("legacy", "1.11"):
+    if ctx.legacy:
         return _legacy(msg, ctx)
     if not ctx.fwdextsp:
         return DROPPED, 0, "MAV_FWDEXTSP is 0: setpoint handling is off", "6.1"
@@ -234,7 +237,7 @@ def _position(msg: MavlinkTarget, ctx: ReceiverContext) -> Result:
             what += " (yaw-only message)"
         return DROPPED, 0, what, spec
     ocm = (POSITION if pos_p else 0) | (VELOCITY if vel_p else 0) | (ACCELERATION if acc_p else 0)
-    if ctx.px4 == "main":
+    if ctx.release.yaw_sets_attitude_flags:
         yaw: float = getattr(msg, "yaw", math.nan)
         yaw_rate: float = getattr(msg, "yaw_rate", math.nan)
         if not mask & YAW_IGNORE and math.isfinite(yaw):
@@ -248,7 +251,7 @@ def _attitude(msg: SetAttitudeTarget, ctx: ReceiverContext) -> Result:
     mask = msg.type_mask
     attitude = not mask & 128
     rates = not mask & 1 and not mask & 2
-    if ctx.px4 == "main" and not (not mask & 64 or mask & 32):
+    if ctx.release.attitude_target_needs_thrust and not (not mask & 64 or mask & 32):
         return DROPPED, 0, "no thrust (main requires thrust in SET_ATTITUDE_TARGET)", "6.4"
     if not (attitude or rates):
         return DROPPED, 0, "attitude and body rates both ignored", "6.4"
@@ -274,7 +277,7 @@ def _legacy(msg: MavlinkTarget, ctx: ReceiverContext) -> Result:
         ocm = (0 if mask & 7 else BODY_RATE) | (0 if mask & 128 else ATTITUDE)
         return ocm, 0, None, "6.4"
     if isinstance(msg, SetPositionTargetGlobal):
-        if ctx.px4 == "legacy":
+        if not ctx.release.handles_global_int:
             return DROPPED, 0, "SET_POSITION_TARGET_GLOBAL_INT not handled (legacy)", "6.3"
         return VELOCITY, 0, "legacy-style GLOBAL_INT handler (unverified)", "6.3"
     position: tuple[float, float, float] = getattr(msg, "position", (0.0, 0.0, 0.0))

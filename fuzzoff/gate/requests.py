@@ -18,7 +18,7 @@ from fuzzoff.events import (
     whole,
 )
 from fuzzoff.modes import custom_mode_to_nav_state
-from fuzzoff.profiles import at_least
+from fuzzoff.releases import Release
 
 TERMINATION = 13
 FORCE_ARM_MAGIC = 21196
@@ -53,7 +53,7 @@ def decode_mode(cmd: Command) -> int | None:
 
 
 def switch_decision(
-    px4: str,
+    release: Release,
     cmd: Command,
     target: int | None,
     armed: bool,
@@ -63,24 +63,24 @@ def switch_decision(
 ) -> Decision:
     """A mode switch (4.1). ``signal_ok`` is the last check pass's verdict (1.14+) or the
     current flag (older)."""
-    if cmd.command == VEHICLE_CMD_SET_NAV_STATE and not at_least(px4, "1.15"):
+    if cmd.command == VEHICLE_CMD_SET_NAV_STATE and not release.handles_set_nav_state:
         return Decision(False, "4.1", "SET_NAV_STATE is not handled before 1.15", UNSUPPORTED)
     if target is None:
-        if px4 == "main":
+        if release.unsupported_main_mode == "rejected":
             return Decision(False, "4.1", "unsupported main mode", TEMPORARILY_REJECTED)
-        if at_least(px4, "1.14"):
+        if release.unsupported_main_mode == "acked_no_change":
             return Decision(
                 True, "4.1", "unsupported main mode: acked, no mode change", changes=False
             )
         return Decision(
             False, "4.1", "unsupported main mode", TEMPORARILY_REJECTED, unverified=True
         )
-    if at_least(px4, "1.16") and nav_state == TERMINATION:  # armed or not
+    if release.never_leaves_termination and nav_state == TERMINATION:  # armed or not
         return Decision(False, "4.1", "never out of TERMINATION", TEMPORARILY_REJECTED)
     if target != NAV_STATE_OFFBOARD:
         # Other modes' requirements are not modelled: assumed accepted.
         return Decision(True, "4.1", None, unverified=False)
-    if at_least(px4, "1.14"):
+    if release.accepts_disarmed_switch:
         if not armed:
             return Decision(True, "4.1", None)
         if not attitude_ok:
@@ -94,7 +94,7 @@ def switch_decision(
 
 
 def arm_decision(
-    px4: str,
+    release: Release,
     cmd: Command,
     intention: int | None,
     signal_now: bool,
@@ -112,12 +112,12 @@ def arm_decision(
             "4.2",
             "already armed: acked ACCEPTED, no change",
             changes=False,
-            unverified=px4 in ("legacy", "1.11"),
+            unverified=release.old_code_unverified,
         )
     if intention != NAV_STATE_OFFBOARD:
         return Decision(True, "4.2", None)
-    if not at_least(px4, "1.14"):
-        return Decision(True, "4.2", None, unverified=px4 == "legacy")
+    if not release.checks_signal_at_arming:
+        return Decision(True, "4.2", None, unverified=release.arming_unverified)
     forced = nearest(cmd.params[1]) == FORCE_ARM_MAGIC
     if forced and cmd.from_external is False:
         return Decision(True, "4.2", "forced arming from an internal source: checks skipped")
@@ -129,7 +129,7 @@ def arm_decision(
 
 
 def disarm_decision(
-    px4: str, cmd: Command, armed: bool, landed: bool, why: str, ground_vehicle: bool
+    release: Release, cmd: Command, armed: bool, landed: bool, why: str, ground_vehicle: bool
 ) -> Decision:
     """Disarming (13a): refused unless forced (param2 21196, from any source), landed
     (``landed``/``maybe_landed``) or a ground vehicle. Seen on 1.15.4 and 1.18.0-alpha1 SITL:
@@ -144,7 +144,7 @@ def disarm_decision(
         return Decision(True, "13a", "a ground vehicle disarms anywhere")
     if landed:
         return Decision(True, "13a", why)
-    old = px4 in ("legacy", "1.11")
+    old = release.old_code_unverified
     return Decision(
         False,
         "13a",

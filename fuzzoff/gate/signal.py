@@ -25,7 +25,7 @@ import math
 
 from fuzzoff.gate.estimates import Estimates
 from fuzzoff.gate.ocm import ACCELERATION, ATTITUDE, POSITION, VELOCITY
-from fuzzoff.profiles import at_least
+from fuzzoff.releases import Release
 
 INF = math.inf
 CHECK_PERIOD = 0.1
@@ -43,28 +43,28 @@ def grid_ceil(x: float, period: float) -> float:
     return math.ceil(x / period - _EPS) * period
 
 
-def slack(px4: str) -> float:
+def slack(release: Release) -> float:
     """How late PX4 may see a loss compared with a continuous model (2.1.3: >= 110 ms on 1.14+;
     one Commander iteration plus one on older profiles)."""
-    return 0.11 if at_least(px4, "1.14") else 2 * LOOP_PERIOD
+    return 0.11 if release.tick_based else 2 * LOOP_PERIOD
 
 
-def estimate_failure(px4: str, mask: int, est: Estimates) -> str | None:
+def estimate_failure(release: Release, mask: int, est: Estimates) -> str | None:
     """Why the newest keep-alive's flags fail their estimate requirements (2.1 table, 2.2), or
     None. Every set flag is checked, not only the first (D10)."""
-    if px4 in ("legacy", "1.11"):
+    if not release.control_mode_flags:
         return None
     if mask & POSITION and not est.local_position:
         return "no local position estimate (position flag)"
     if mask & VELOCITY and not est.local_velocity:
         return "no local velocity estimate (velocity flag)"
     if mask & ACCELERATION:
-        if at_least(px4, "1.16"):
+        if release.acceleration_needs_attitude:
             if not est.attitude:
                 return "no attitude estimate (acceleration flag)"
         elif not est.local_velocity:
             return "no local velocity estimate (acceleration flag)"
-    if px4 == "main" and mask & ATTITUDE and not est.attitude:
+    if release.attitude_flag_needs_attitude and mask & ATTITUDE and not est.attitude:
         return "no attitude estimate (attitude flag)"
     return None
 
@@ -256,13 +256,13 @@ class LegacySignal(Signal):
     def lost_at(self) -> float:
         if not self.available or self.last is None:
             return INF
-        return self.last + LEGACY_TIMEOUT
+        return self.last + self.timeout
 
     def timeout_at(self) -> float:
         if self.timed_out or self.last is None:
             return INF
         extra = self.loss_extra if self.loss_extra >= 1.19e-7 else 0.0
-        return self.last + LEGACY_TIMEOUT + extra
+        return self.last + self.timeout + extra
 
 
 class UnseenSignal(Signal):
@@ -290,12 +290,13 @@ class UnseenSignal(Signal):
         return self.available
 
 
-def make_signal(px4: str, params: dict[str, float]) -> Signal:
+def make_signal(release: Release, params: dict[str, float]) -> Signal:
     timeout = max(0.0, float(params.get("COM_OF_LOSS_T", 1.0)))
-    if px4 == "legacy":
-        return LegacySignal(LEGACY_TIMEOUT, timeout)
-    if px4 == "1.11":
+    if release.loss_signal == "fixed":
+        fixed = LEGACY_TIMEOUT if release.fixed_loss_s is None else release.fixed_loss_s
+        return LegacySignal(fixed, timeout)
+    if release.loss_signal == "age":
         return AgeSignal(timeout)
-    if px4 == "1.13":
+    if release.loss_signal == "hysteresis":
         return HysteresisSignal(timeout)
     return TickSignal(timeout)

@@ -14,7 +14,7 @@ from typing import Any
 from fuzzoff.gate import controllers, ocm
 from fuzzoff.gate.estimates import Estimates
 from fuzzoff.modes import nav_state_name
-from fuzzoff.profiles import at_least
+from fuzzoff.releases import Release
 
 OFFBOARD = 14
 INF = float("inf")
@@ -31,8 +31,8 @@ class Change:
 
 
 class ControllerTracker:
-    def __init__(self, px4: str, vehicle_type: str, est: Estimates) -> None:
-        self.px4 = px4
+    def __init__(self, release: Release, vehicle_type: str, est: Estimates) -> None:
+        self.release = release
         self.vehicle_type = vehicle_type
         self.est = est
         self.mask = 0
@@ -46,9 +46,10 @@ class ControllerTracker:
         self.reuse_due = INF
         """1.16+: when a reused last valid setpoint expires (section 8)."""
         self.kind = "none"
-        self.legacy = px4 in ("legacy", "1.11")
+        self.legacy = not release.control_mode_flags
         """legacy/1.11: the offboard setpoint reaches mc_pos_control as
         ``position_setpoint_triplet`` (section 8 legacy note: details not modelled)."""
+        self.reuses_last_valid = release.reuses_last_valid_setpoint
         self.setpoint_t = -INF
         """legacy/1.11: the newest offboard setpoint (triplet, MAVLink or trajectory setpoint)."""
         self._memo: dict[int, str | None] = {}
@@ -57,7 +58,7 @@ class ControllerTracker:
     def set_mask(self, mask: int) -> None:
         self.mask = mask
         self.position_control = self.vehicle_type in ("mc", "vtol") and (
-            controllers.position_control(self.px4, mask)
+            controllers.position_control(self.release, mask)
         )
 
     def entered_offboard(self, t: float) -> None:
@@ -117,7 +118,9 @@ class ControllerTracker:
             if key == self.key:
                 return None
             self.key = key
-            text, spec, unverified = controllers.describe(self.px4, self.vehicle_type, self.mask)
+            text, spec, unverified = controllers.describe(
+                self.release, self.vehicle_type, self.mask
+            )
             return Change(f"{text}; {fw}" if fw else text, spec, None, unverified)
         return self._multicopter(t)
 
@@ -134,7 +137,7 @@ class ControllerTracker:
             if invalid is None:
                 kind = "ok"
                 key = (mask, kind, axes)
-            elif at_least(self.px4, "1.16") and t < self.last_valid_t + controllers.LAST_VALID_S:
+            elif self.reuses_last_valid and t < self.last_valid_t + controllers.LAST_VALID_S:
                 kind = "reuse"
                 self.reuse_due = self.last_valid_t + controllers.LAST_VALID_S
                 key = (mask, kind, self.last_valid_t)
@@ -145,9 +148,9 @@ class ControllerTracker:
         if key == self.key:
             return None
         self.key = key
-        flags = ", ".join(controllers.control_flags(self.px4, mask))
+        flags = ", ".join(controllers.control_flags(self.release, mask))
         head = f"multicopter offboard {ocm.names(ocm.first_flag(mask))} ({flags})"
-        unverified = self.vehicle_type == "vtol" or self.px4 in ("legacy", "1.11")
+        unverified = self.vehicle_type == "vtol" or self.release.old_code_unverified
         if kind == "ok":
             return Change(f"{head}: {controllers.mc_axes_text(axes)}", "8", None, unverified)
         if kind == "reuse":
@@ -168,7 +171,7 @@ class ControllerTracker:
         if key == self.key:
             return None
         self.key = key
-        flags = ", ".join(controllers.control_flags(self.px4, self.mask))
+        flags = ", ".join(controllers.control_flags(self.release, self.mask))
         head = f"multicopter offboard {ocm.names(ocm.first_flag(self.mask))} ({flags})"
         if seen:
             text = f"{head}: setpoint from position_setpoint_triplet (not modelled per axis)"

@@ -114,7 +114,7 @@ def loss_line(seconds: float, source: str, profile: Profile, recorded: float | N
     counts as lost at once: nothing to draw on a log axis, and in a recording that names no
     release (the profile assumed) it usually means an older firmware, where 0 was the default.
     """
-    if profile.px4 == "legacy":
+    if profile.release.fixed_loss_s is not None:
         extra = f"; COM_OF_LOSS_T {recorded:g} s more before the loss action" if recorded else ""
         return LossLine(
             LEGACY_LOSS_S,

@@ -28,7 +28,7 @@ def loss_timeout(timeline: Timeline, profile: Profile, settings: Settings) -> tu
     value = getattr(timeline, "loss_timeout", None)
     if not isinstance(value, int | float):
         value = GateModel(profile, settings.params).loss_timeout
-    if profile.px4 == "legacy":
+    if profile.release.fixed_loss_s is not None:
         return float(value), "fixed in PX4 before 1.11"  # COM_OF_LOSS_T is not the timeout
     if "COM_OF_LOSS_T" in settings.params:
         return float(value), settings.param_origin("COM_OF_LOSS_T")

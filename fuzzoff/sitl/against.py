@@ -38,6 +38,7 @@ from fuzzoff.fuzz import recordings
 from fuzzoff.fuzz.reproducers import save, setup_for
 from fuzzoff.fuzz.scenario import Scenario
 from fuzzoff.profiles import px4_profile_for
+from fuzzoff.releases import PX4Profile
 from fuzzoff.sitl import bundle, delivery
 from fuzzoff.sitl.bench import Bench
 from fuzzoff.sitl.classify import edge_note, health_refusals, own_changes, shape, signature
@@ -77,7 +78,7 @@ class AgainstConfig:
     """None: no reproducer saved (``--no-save``)."""
 
     @property
-    def profile(self) -> str:
+    def profile(self) -> PX4Profile:
         return px4_profile_for(self.build.profile_release)
 
 

@@ -405,7 +405,7 @@ class Ros2Decoding:
         it to several: the release is then not known, but it is one of these."""
         if not self.evidence or len(self.evidence) == 1:
             return []
-        return [r for r in px4_msgs.RELEASES if r in self.evidence]
+        return [r for r in px4_msgs.folders() if r in self.evidence]
 
     def vehicle_from(self, decoder: Decoder | None, raw: bytes | memoryview) -> str | None:
         """The vehicle type one ``VehicleStatus`` payload names (None for anything else)."""

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from fuzzoff import events as ev
+from fuzzoff import releases
 from fuzzoff.profiles import MAV_TYPE_VEHICLE, PX4_VEHICLE_TYPE, ProfileError, px4_profile_for
 from fuzzoff.sources.base import (
     POSITION_PERIOD_S,
@@ -308,15 +309,16 @@ class UlogSource(Source):
 
     def _context(self, info: RecordingInfo) -> Context:
         context = Context()
-        profile = None
+        release = None
         if info.px4_version:
             try:
-                profile = px4_profile_for(info.px4_version)
+                release = releases.get(px4_profile_for(info.px4_version))
             except ProfileError:
-                profile = None
-        context.legacy_arming = profile == "legacy" or (
-            profile is None and ev.LegacyControlMode.kind in info.kinds
-        )
+                release = None
+        if release is not None:
+            context.legacy_arming = release.armed_error_state
+        else:
+            context.legacy_arming = ev.LegacyControlMode.kind in info.kinds
         commander = next((d for d in self._datasets() if d.name == "commander_state"), None)
         if commander is not None and "main_state" in commander.data:
             ts = commander.data["timestamp"]

@@ -158,13 +158,14 @@ SETPOINT_KINDS = frozenset(SETPOINT_NAMES)
 @functools.cache
 def table_for(profile: Profile) -> dict[str, FlagRow]:
     """The docs' table that applies to this profile (empty before 1.13: no boolean fields)."""
-    if not profile.at_least("1.13"):
+    release = profile.release
+    if release.docs_page is None:
         return {}
-    if profile.is_rover and profile.at_least("1.16"):
+    if profile.is_rover and release.rover_setpoints:
         return ROVER_TABLE
-    if not profile.at_least("1.15"):
+    if release.docs_page == "002":
         return TABLE_002
-    if profile.px4 == "1.15":
+    if release.docs_acceleration_needs_velocity:
         return TABLE_115
     return TABLE_000
 

@@ -228,14 +228,8 @@ PAGE_002 = MavlinkPage(
     },
 )
 
-PAGE_BY_PROFILE: dict[str, MavlinkPage] = {
-    "1.13": PAGE_002,
-    "1.14": PAGE_002,
-    "1.15": PAGE_000,
-    "1.16": PAGE_000,
-    "1.17": PAGE_000,
-    "main": PAGE_000,
-}
+PAGES: dict[str, MavlinkPage] = {"002": PAGE_002, "000": PAGE_000}
+"""The pages by seed; a release names its own (``Release.docs_page``)."""
 
 ROVER_YAW_IGNORED = frozenset({"rover-ackermann", "rover-differential"})
 """Seed 000 "Ровер" (MAVLink): yaw and yaw rate are ignored; mecanum uses them."""
@@ -252,7 +246,8 @@ def vehicle_group(vehicle: str) -> str:
 
 def page_for(profile: Profile) -> MavlinkPage | None:
     """The docs page that judges this profile's MAVLink fields (None: no page covers it)."""
-    return PAGE_BY_PROFILE.get(profile.px4)
+    page = profile.release.docs_page
+    return None if page is None else PAGES[page]
 
 
 def position_rules(profile: Profile, kind: str) -> PositionTargetRules | None:

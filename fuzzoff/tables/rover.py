@@ -93,15 +93,10 @@ TABLES_000 = RoverTables(
     yaw_unsupported=frozenset({"rover-ackermann"}),
 )
 
-TABLES_BY_PROFILE: dict[str, RoverTables] = {
-    "1.16": TABLES_000,
-    "1.17": TABLES_000,
-    "main": TABLES_000,
-}
-
 
 def rover_tables(profile: Profile) -> RoverTables | None:
-    return TABLES_BY_PROFILE.get(profile.px4)
+    """Seed 000's tables where the rover setpoints exist (1.16+, ``Release.rover_setpoints``)."""
+    return TABLES_000 if profile.release.rover_setpoints else None
 
 
 def has_value(event: Event) -> bool:

@@ -8,20 +8,21 @@ like PX4's; a field list starts at the era named and holds until the next entry.
 
 from __future__ import annotations
 
+from typing import get_args
+
+from fuzzoff import releases
 from fuzzoff.profiles import px4_profile_for
 
-ERAS: tuple[str, ...] = ("legacy", "1.13", "1.14", "1.15", "1.16", "1.17")
-"""``legacy`` = v1.5-v1.11 (ignore_* control mode), ``1.13`` = v1.12-v1.13, ``1.17`` = 1.17+."""
-
-_PROFILE_ERA = {"legacy": "legacy", "1.11": "legacy", "main": "1.17"}
+ERAS: tuple[str, ...] = get_args(releases.UlogEra)
+"""``legacy`` = v1.5-v1.11 (ignore_* control mode), ``1.13`` = v1.12-v1.13, ``1.17`` = 1.17+;
+a release names its era in ``fuzzoff/releases.py`` (``Release.ulog_era``)."""
 
 
 def era_for(px4_version: str | None) -> str:
     """The format era of a release (``1.15.4``) or profile name; 1.15 when unknown."""
     if px4_version is None:
         return "1.15"
-    profile = px4_profile_for(px4_version)
-    return _PROFILE_ERA.get(profile, profile)
+    return releases.get(px4_profile_for(px4_version)).ulog_era
 
 
 # Nested type used by position_setpoint_triplet (legacy and 1.13).

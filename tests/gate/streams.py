@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 from typing import Any
 
+from fuzzoff import releases
 from fuzzoff.events import (
     Command,
     ControlMode,
@@ -14,10 +15,10 @@ from fuzzoff.events import (
     VehicleStatus,
 )
 from fuzzoff.gate import GateModel, GateTransition
-from fuzzoff.profiles import PX4_PROFILES, Profile
+from fuzzoff.profiles import Profile
 
-ALL = list(PX4_PROFILES)
-TICK = ["1.14", "1.15", "1.16", "1.17", "main"]
+ALL = list(releases.names())
+TICK = [r.name for r in releases.RELEASES if r.tick_based]
 """Profiles with OffboardChecks at 10 Hz (gate spec 2.1)."""
 OLD = ["legacy", "1.11", "1.13"]
 RECEIVER_NEW = ["1.13", *TICK]

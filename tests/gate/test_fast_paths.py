@@ -14,6 +14,7 @@ from typing import Any
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from fuzzoff import releases
 from fuzzoff.events import (
     ControlMode,
     Event,
@@ -69,7 +70,11 @@ def messages(draw: st.DrawFn) -> MavlinkTarget:
 
 def _context(px4: str, fwdextsp: bool, component: int, est: Estimates) -> ReceiverContext:
     return ReceiverContext(
-        px4=px4, own_system=1, own_component=component, fwdextsp=fwdextsp, est=est
+        release=releases.get(px4),
+        own_system=1,
+        own_component=component,
+        fwdextsp=fwdextsp,
+        est=est,
     )
 
 

@@ -38,9 +38,20 @@ def test_4_1_set_nav_state_from_115(px4: str, handled: bool) -> None:
     assert bool(of("request_accepted", trs)) is handled
 
 
-@pytest.mark.parametrize(("px4", "rejected"), [*[(p, False) for p in TICK[:-1]], ("main", True)])
+@pytest.mark.parametrize(
+    ("px4", "rejected"),
+    [
+        ("1.14", False),
+        ("1.15", False),
+        ("1.16", False),
+        ("1.17", False),
+        ("1.18", True),
+        ("main", True),
+    ],
+)
 def test_4_1_unsupported_main_mode(px4: str, rejected: bool) -> None:
-    """4.1: an unknown custom main mode: main rejects it; 1.14-1.17 ack it with no change."""
+    """4.1: an unknown custom main mode: 1.18 and main reject it; 1.14-1.17 ack it with no
+    change."""
     trs = run(px4, [status(0.0, POSCTL, True, POSCTL), switch_mode(1.0, 42)])
     assert any("unsupported main mode" in (t.message or "") for t in trs)
     assert any("rejected" in t.message for t in trs) is rejected

@@ -1,6 +1,7 @@
 """Bundled px4_msgs definitions, one ``.msg`` file per message per release (formats.md 2.2, 3).
 
-Each folder (``1.13`` ... ``1.17``, ``main`` = release/1.18) holds the wire fields of the messages
+Each folder (``1.13`` ... ``1.17``, ``main`` = release/1.18; a release names its folder in
+``fuzzoff/releases.py``, ``Release.msg_folder``) holds the wire fields of the messages
 fuzzoff decodes, in the order of that release's ``px4_msgs`` branch, with comments and constants
 dropped except ``MESSAGE_VERSION`` (which names the ``_vN`` topic suffix; it is not on the wire).
 They are used for recordings without embedded definitions (Humble-and-older ``.db3`` bags) and by
@@ -16,11 +17,9 @@ from importlib import resources
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.store import Typestore
 
+from fuzzoff import releases
 from fuzzoff.profiles import ProfileError, px4_profile_for
 from fuzzoff.sources.typedefs import bounded
-
-RELEASES: tuple[str, ...] = ("1.13", "1.14", "1.15", "1.16", "1.17", "main")
-"""Oldest to newest; ``main`` is release/1.18 (identical to main for these messages)."""
 
 PACKAGE = "px4_msgs"
 _VERSION = re.compile(r"^\s*uint32\s+MESSAGE_VERSION\s*=\s*(\d+)", re.MULTILINE)
@@ -32,14 +31,23 @@ def type_name(message: str) -> str:
 
 
 def release_for(px4: str | None) -> str | None:
-    """The bundled release for a ``--px4`` value (``1.15.4``, ``main``); None if none applies."""
+    """The bundled folder for a ``--px4`` value (``1.15.4``, ``main``); None if none applies."""
     if not px4:
         return None
     try:
         profile = px4_profile_for(px4)
     except ProfileError:
         return None
-    return profile if profile in RELEASES else None
+    return releases.get(profile).msg_folder
+
+
+def folders() -> tuple[str, ...]:
+    """The bundled folders, oldest first (the release records' ``msg_folder``, once each)."""
+    out: list[str] = []
+    for release in releases.RELEASES:
+        if release.msg_folder is not None and release.msg_folder not in out:
+            out.append(release.msg_folder)
+    return tuple(out)
 
 
 @cache
@@ -53,7 +61,7 @@ def definition(release: str, message: str) -> str | None:
 
 def releases_with(message: str) -> list[str]:
     """The releases (oldest first) that define ``message``."""
-    return [r for r in RELEASES if definition(r, message) is not None]
+    return [r for r in folders() if definition(r, message) is not None]
 
 
 def message_version(text: str) -> int:

@@ -1,0 +1,236 @@
+"""The release records are the one place a release's behaviour is written: for every record, the
+gate does on a tiny stream what the record says, and a record added to the table (here, in a
+test only) is a profile ``fuzzoff profiles`` lists and a lint judges with, nothing else edited."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+from fuzzoff import releases
+from fuzzoff.events import Command, SetAttitudeTarget
+from fuzzoff.fuzz.streams import echo
+from fuzzoff.gate import GateModel
+from fuzzoff.profiles import Profile, px4_profile_for
+from fuzzoff.releases import Release
+from tests.gate.streams import (
+    LOITER,
+    OFFBOARD,
+    POSCTL,
+    TERMINATION,
+    arm,
+    flags,
+    in_offboard,
+    loss_times,
+    ocm,
+    of,
+    run,
+    status,
+    stream,
+    switch_mode,
+    switch_offboard,
+)
+from tests.helpers import CORPORA, ROOT, run_cli
+
+RELEASES = list(releases.RELEASES)
+NAMES = [r.name for r in RELEASES]
+FRAMEWORK = [r for r in RELEASES if r.loss_failsafe == "framework"]
+
+
+def by_name(release: Release) -> str:
+    return release.name
+
+
+@pytest.mark.parametrize("release", RELEASES, ids=by_name)
+def test_a_disarmed_switch_without_a_stream_is_accepted_as_the_record_says(
+    release: Release,
+) -> None:
+    events = [status(0.0, POSCTL, False, POSCTL), switch_offboard(1.0)]
+    trs = run(release.name, events)
+    assert bool(of("request_accepted", trs)) is release.accepts_disarmed_switch
+    assert bool(of("request_rejected", trs)) is not release.accepts_disarmed_switch
+
+
+@pytest.mark.parametrize("release", [r for r in RELEASES if r.accepts_disarmed_switch], ids=by_name)
+def test_arming_in_offboard_without_a_stream_is_checked_as_the_record_says(
+    release: Release,
+) -> None:
+    events = [status(0.0, POSCTL, False, POSCTL), switch_offboard(1.0), arm(2.0)]
+    trs = run(release.name, events)
+    assert bool(of("arm_rejected", trs)) is release.checks_signal_at_arming
+
+
+@pytest.mark.parametrize("release", RELEASES, ids=by_name)
+def test_a_mavlink_mode_switch_is_acked_as_often_as_the_record_says(release: Release) -> None:
+    switch = Command(t=1.0, command=176, params=(1.0, 6.0, 0.0, 0.0, 0.0, 0.0, 0.0))
+    answers = echo([switch], release.name, "mc", {}, acks=True, status=False, transport="mavlink")
+    assert len(answers) == (2 if release.acks_switch_twice else 1)
+
+
+@pytest.mark.parametrize("release", FRAMEWORK, ids=by_name)
+def test_the_loss_action_without_manual_control_follows_nav_rcl_act_as_the_record_says(
+    release: Release,
+) -> None:
+    """COM_OBL_RC_ACT 0 (Position) with no manual control: NAV_RCL_ACT's Return where the
+    record falls back to it, else Position as configured."""
+    events = [flags(0.0, manual_control_signal_lost=True), in_offboard(), *stream(0.0, 1.0)]
+    trs = run(release.name, events, t_end=3.0)
+    expected = "POSCTL" if release.nav_rcl_fallback == "none" else "AUTO_RTL"
+    assert [t.action for t in of("failsafe", trs)] == [expected]
+
+
+@pytest.mark.parametrize("release", RELEASES, ids=by_name)
+def test_set_nav_state_is_handled_as_the_record_says(release: Release) -> None:
+    set_nav_state = Command(t=1.0, command=100001, params=(float(OFFBOARD), 0, 0, 0, 0, 0, 0))
+    trs = run(release.name, [status(0.0, POSCTL, False, POSCTL), set_nav_state])
+    assert bool(of("request_accepted", trs)) is (
+        release.handles_set_nav_state and release.accepts_disarmed_switch
+    )
+
+
+@pytest.mark.parametrize("release", RELEASES, ids=by_name)
+def test_an_attitude_target_without_thrust_keeps_the_stream_as_the_record_says(
+    release: Release,
+) -> None:
+    """SET_ATTITUDE_TARGET with the thrust ignored (type_mask 71): a keep-alive unless the
+    record's receiver needs the thrust."""
+    target = SetAttitudeTarget(t=1.0, type_mask=71, target_system=1, target_component=1)
+    trs = run(release.name, [status(0.0, LOITER, True, LOITER), target], t_end=1.05)
+    assert bool(of("signal_available", trs)) is not release.attitude_target_needs_thrust
+
+
+@pytest.mark.parametrize("release", FRAMEWORK, ids=by_name)
+def test_an_unknown_main_mode_is_answered_as_the_record_says(release: Release) -> None:
+    trs = run(release.name, [status(0.0, POSCTL, True, POSCTL), switch_mode(1.0, 42)])
+    rejected = release.unsupported_main_mode == "rejected"
+    assert any("unsupported main mode" in (t.message or "") for t in trs)
+    assert any("rejected" in t.message for t in trs) is rejected
+
+
+@pytest.mark.parametrize("release", FRAMEWORK, ids=by_name)
+def test_termination_is_left_or_not_as_the_record_says(release: Release) -> None:
+    events = [status(0.0, TERMINATION, True, TERMINATION), *stream(0.0, 1.0), switch_offboard(0.5)]
+    rejected = bool(of("request_rejected", run(release.name, events)))
+    assert rejected is release.never_leaves_termination
+
+
+@pytest.mark.parametrize("release", FRAMEWORK, ids=by_name)
+def test_the_acceleration_flag_needs_the_estimate_the_record_names(release: Release) -> None:
+    """Without a velocity estimate the acceleration flag keeps the signal only where it needs
+    the attitude instead; without an attitude estimate, only where it needs the velocity."""
+    no_velocity = [flags(0.0, local_velocity_valid=False), ocm(1.0, acceleration=True)]
+    no_attitude = [flags(0.0, attitude_valid=False), ocm(1.0, acceleration=True)]
+    needs_attitude = release.acceleration_needs_attitude
+    assert bool(of("signal_available", run(release.name, no_velocity))) is needs_attitude
+    assert bool(of("signal_available", run(release.name, no_attitude))) is not needs_attitude
+
+
+@pytest.mark.parametrize("release", FRAMEWORK, ids=by_name)
+def test_the_attitude_flag_needs_an_attitude_estimate_as_the_record_says(
+    release: Release,
+) -> None:
+    events = [flags(0.0, attitude_valid=False), ocm(1.0, attitude=True)]
+    available = bool(of("signal_available", run(release.name, events)))
+    assert available is not release.attitude_flag_needs_attitude
+
+
+@pytest.mark.parametrize("release", RELEASES, ids=by_name)
+def test_the_signal_is_lost_after_the_records_timeout(release: Release) -> None:
+    """The last keep-alive at 1 s: the signal is lost after the fixed time where the record has
+    one, else after its default COM_OF_LOSS_T (up to one check pass and loop later)."""
+    timeout = release.fixed_loss_s
+    if timeout is None:
+        timeout = release.param_defaults["COM_OF_LOSS_T"]
+    model = GateModel(Profile(px4=px4_profile_for(release.name)), {}, "1")
+    assert model.loss_timeout == timeout
+    (lost,) = loss_times(run(release.name, [in_offboard(), *stream(0.0, 1.0)], t_end=4.0))
+    assert 1.0 + timeout <= lost + 1e-9 <= 1.0 + timeout + 0.25
+
+
+@pytest.mark.parametrize("release", RELEASES, ids=by_name)
+def test_a_release_names_its_own_profile(release: Release) -> None:
+    assert px4_profile_for(release.name) == release.name
+    for minor in release.minors:
+        assert px4_profile_for(f"1.{minor}.2") == release.name
+
+
+def test_versions_past_the_newest_release_are_main_and_before_the_oldest_legacy() -> None:
+    assert px4_profile_for("1.19.0") == px4_profile_for("2.0") == "main"
+    assert px4_profile_for("1.4.1") == px4_profile_for("0.9") == "legacy"
+
+
+# A made-up release, added to the table in a fresh interpreter only -----------------------------
+
+_WITH_EXTRA = textwrap.dedent(
+    """
+    import dataclasses, sys
+    from fuzzoff import releases
+    newest = releases.RELEASES[-2]
+    extra = dataclasses.replace(
+        newest, name="1.19", covers="v1.19: made up by a test", minors=(19,), acks_switch_twice=True
+    )
+    releases.RELEASES = (*releases.RELEASES[:-1], extra, releases.RELEASES[-1])
+    from fuzzoff.cli import main
+    sys.exit(main(sys.argv[1:]))
+    """
+)
+
+
+def _with_extra(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-c", _WITH_EXTRA, *args],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+
+
+def test_a_new_record_is_a_profile_fuzzoff_profiles_lists() -> None:
+    done = _with_extra("profiles", "--format", "json")
+    assert done.returncode == 0, done.stderr
+    listed = [p["profile"] for p in json.loads(done.stdout)["px4"]]
+    assert listed == [*NAMES[:-1], "1.19", NAMES[-1]]
+    assert {"profile": "1.19", "covers": "v1.19: made up by a test"} in json.loads(done.stdout)[
+        "px4"
+    ]
+
+
+def test_a_new_record_judges_a_lint_with_the_rules_of_its_range() -> None:
+    """``--px4 1.19.1`` selects the new record with no note; the rules the catalog gives to
+    ``1.13+`` judge it, and its findings are those of the release it copies."""
+    gap = str(CORPORA / "tlog" / "keepalive_gap_0_7s.tlog")
+    done = _with_extra("lint", gap, "--px4", "1.19.1", "--format", "json")
+    assert done.returncode in (0, 1), done.stderr
+    assert "judged with profile" not in done.stderr
+    (file,) = json.loads(done.stdout)["files"]
+    assert file["profile"]["px4"] == "1.19"
+    copied = _with_extra("lint", gap, "--px4", NAMES[-2], "--format", "json")
+    (same,) = json.loads(copied.stdout)["files"]
+    codes = [f["code"] for f in file["findings"]]
+    assert codes and codes == [f["code"] for f in same["findings"]]
+
+
+# 1.18 beside main ----------------------------------------------------------------------------
+
+
+def test_px4_1_18_is_its_own_profile_with_no_note() -> None:
+    gap = str(CORPORA / "tlog" / "keepalive_gap_0_7s.tlog")
+    result = run_cli(["lint", gap, "--px4", "1.18.0", "--format", "json"])
+    assert json.loads(result.stdout)["files"][0]["profile"]["px4"] == "1.18"
+    assert "judged with profile" not in result.stderr
+    listed = json.loads(run_cli(["profiles", "--format", "json"]).stdout)["px4"]
+    assert [p["profile"] for p in listed][-2:] == ["1.18", "main"]
+
+
+@pytest.mark.parametrize(
+    "name", ["disarmed_switch_no_stream-1.18.0-alpha1.ulg", "acceleration_only-1.18.0-alpha1.tlog"]
+)
+def test_a_recording_of_px4_1_18_is_judged_with_profile_1_18(name: str) -> None:
+    result = run_cli(["lint", str(CORPORA / "sitl" / name), "--format", "json"])
+    (file,) = json.loads(result.stdout)["files"]
+    assert file["profile"]["px4"] == "1.18" and file["profile"]["px4_source"] == "recording"
