@@ -627,3 +627,47 @@ def lint_paths(
             if on_file is not None:
                 on_file(file_report)
     return report
+
+
+def timeline_loss_timeout(
+    timeline: Timeline, profile: Profile, settings: Settings
+) -> tuple[float, str]:
+    """COM_OF_LOSS_T as the gate used it, and where the value came from.
+
+    An engine that copies the gate's final ``loss_timeout`` and ``recorded_params`` onto the
+    timeline gives the recording's own value; without them the value is ``--param`` /
+    configuration, else the profile's default (what the gate model starts from). Before 1.11
+    the timeout is a fixed 500 ms whatever COM_OF_LOSS_T says (gate spec 2.3).
+    """
+    recorded = timeline.recorded_params
+    value = timeline.loss_timeout
+    if value is None:
+        value = GateModel(profile, settings.params).loss_timeout
+    if profile.px4 == "legacy":
+        return float(value), "fixed in PX4 before 1.11"  # COM_OF_LOSS_T is not the timeout
+    if "COM_OF_LOSS_T" in settings.params:
+        return float(value), settings.param_origin("COM_OF_LOSS_T")
+    if "COM_OF_LOSS_T" in recorded:
+        return float(value), "from the recording"
+    return float(value), f"PX4 {profile.px4} default"
+
+
+def lint_file_with_timelines(path: str | Path, settings: Settings) -> FileReport:
+    """``lint_file`` with what the HTML report plots: every vehicle's timeline (every recorded
+    position, not one per ``POSITION_PERIOD_S``) and the loss timeout the gate used."""
+    settings = settings.for_recording(path)
+    timelines: dict[str, Timeline] = {}
+    report = lint_file(path, settings, timelines=timelines, plot_data=True)
+    report.timelines = timelines
+    report.loss_timeouts = {
+        vehicle: timeline_loss_timeout(tl, report.profile, settings)
+        for vehicle, tl in timelines.items()
+    }
+    return report
+
+
+def lint_with_timelines(
+    paths: Sequence[str | Path], settings: Settings, *, jobs: int = 1
+) -> Report:
+    """Like ``lint_paths`` but every file report carries its timelines."""
+    return lint_paths(paths, settings, jobs=jobs, lint=lint_file_with_timelines)

@@ -5,10 +5,13 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 from enum import IntEnum
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from fuzzoff.events import Where
 from fuzzoff.profiles import Profile
+
+if TYPE_CHECKING:
+    from fuzzoff.engine import Timeline
 
 
 class Severity(IntEnum):
@@ -145,8 +148,11 @@ class FileReport:
     malformed: list[str] = field(default_factory=list)
     """One line per malformed part that was read around with nothing lost (OFB004 messages)."""
     stats: dict[str, Any] = field(default_factory=dict)
-    extras: dict[str, Any] = field(default_factory=dict)
-    """Optional data for rich reports (gate timeline, keep-alive series)."""
+    timelines: dict[str, Timeline] = field(default_factory=dict)
+    """Per vehicle, the series the HTML report plots (``engine.lint_file_with_timelines`` fills
+    it; empty in a plain lint)."""
+    loss_timeouts: dict[str, tuple[float, str]] = field(default_factory=dict)
+    """Per vehicle of ``timelines``, the loss timeout the gate used and where it came from."""
 
     def to_json(self) -> dict[str, Any]:
         return {
