@@ -9,7 +9,7 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import cast
 
 from fuzzoff.catalog import get_rule
 from fuzzoff.checks import CheckContext, load_all
@@ -26,7 +26,16 @@ from fuzzoff.events import (
     VehicleStatus,
     is_keepalive,
 )
-from fuzzoff.findings import FileReport, Finding, Report, Severity, clip, first_clause
+from fuzzoff.findings import (
+    FileReport,
+    FileStats,
+    Finding,
+    Report,
+    RunStats,
+    Severity,
+    clip,
+    first_clause,
+)
 from fuzzoff.gate import GateModel, GateTransition
 from fuzzoff.profiles import (
     DEFAULT_PX4,
@@ -296,7 +305,7 @@ def run_events(
     timelines: dict[str, Timeline] | None = None,
     on_event: Callable[[int], None] | None = None,
     batching: bool = True,
-) -> tuple[list[Finding], dict[str, Any]]:
+) -> tuple[list[Finding], RunStats]:
     """Run the gate and every enabled check over ``events`` (one recording, any vehicles).
 
     ``batching=False`` hands every stream message to every check one at a time, as the
@@ -326,7 +335,7 @@ def _run_events(
     timelines: dict[str, Timeline] | None,
     on_event: Callable[[int], None] | None,
     batching: bool,
-) -> tuple[list[Finding], dict[str, Any]]:
+) -> tuple[list[Finding], RunStats]:
     runs: dict[str, VehicleRun] = {}
     kinds: Counter[str] = Counter()
     count = 0
@@ -374,7 +383,7 @@ def _run_events(
                     summary=clip(f"{code} not checkable: {first_clause(needs)}"),
                 )
             )
-    stats = {
+    stats: RunStats = {
         "events": count,
         "duration_s": round(t_end, 6),
         "vehicles": sorted(runs),
@@ -528,7 +537,8 @@ def lint_file(
     findings = [f for f in findings if settings.enabled(f.code)]
     findings.sort(key=_sort_key)
     report.findings = findings
-    report.stats = {**stats, **source.stats}
+    # the run's keys and the reader's are disjoint (mypy cannot merge TypedDicts by **)
+    report.stats = cast(FileStats, {**stats, **source.stats})
     if source.start_time_s is not None:
         report.stats["start_unix_s"] = round(source.start_time_s, 6)
     if info.notes:
