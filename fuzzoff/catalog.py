@@ -4,8 +4,13 @@ A rule file holds ``code``, ``name``, ``severity``, ``profiles``, ``summary`` (w
 ``why`` (why it is bad), ``docs_vs_code`` (where PX4's code behaves differently), ``options``
 (thresholds with defaults), ``example`` (the client code that breaks the rule and its fix, in the
 client that fits: rclpy or rclcpp with px4_msgs, MAVSDK, MAVROS, pymavlink), ``test_stream.bad`` /
-``test_stream.good`` (tiny event streams the tests replay through the rule) and ``references``
-(PX4's docs by page and section, PX4's source by file and release tag).
+``test_stream.good`` (tiny event streams the tests replay through the rule), ``references``
+(PX4's docs by page and section, PX4's source by file and release tag), ``severities`` (for a
+rule whose findings take several severities: when each is given; ``severity`` is the highest),
+and what fuzz campaigns need to know: ``explains`` (the outcomes of the gate model,
+``HAZARD_KINDS``, that a finding of the rule explains) and ``reports`` (those of them the rule
+reports itself: when the recording cannot show them, OFB002 says so and a warning of an
+explaining rule is enough).
 
 Each page is also a Markdown file in the repository, ``docs/rules/CODE.md``, written from the
 catalog by ``docs/rules/build.py`` (a test keeps the two equal): that is where a rule links to.
@@ -23,7 +28,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal, get_args
 
 from fuzzoff import releases
 from fuzzoff._version import __version__
@@ -44,6 +49,12 @@ REFERENCE_PREFIXES = (
 definitions, or this repository's own docs (for the rules about reading a recording)."""
 
 EXAMPLE_LANGUAGES = ("python", "cpp", "sh", "toml")
+
+HazardKind = Literal[
+    "request_rejected", "arm_rejected", "failsafe", "disarmed", "setpoint_dropped", "controller"
+]
+"""An outcome the gate model predicts that a stream did not intend (``fuzz.hazards``)."""
+HAZARD_KINDS: tuple[HazardKind, ...] = get_args(HazardKind)
 
 
 class CatalogError(ValueError):
@@ -107,6 +118,13 @@ class Rule:
     stream_profile: dict[str, str] = field(default_factory=dict)
     formats: tuple[str, ...] = ()
     """Recording formats whose data can show this rule (empty = all)."""
+    severities: tuple[tuple[Severity, str], ...] = ()
+    """When a finding takes each severity, highest first, for a rule whose findings take several
+    (or whose one severity needs saying when); empty: always ``severity``."""
+    explains: tuple[HazardKind, ...] = ()
+    """The gate outcomes a finding of this rule explains (fuzz campaigns' ``explained``)."""
+    reports: tuple[HazardKind, ...] = ()
+    """The outcomes among ``explains`` this rule reports itself, not only a cause of."""
 
     @property
     def page(self) -> str:
@@ -236,6 +254,9 @@ def _load_rule(path: Path, data: dict[str, Any]) -> Rule:
             stream_good=tuple(stream.get("good", ())),
             stream_profile=dict(stream.get("profile", {})),
             formats=tuple(data.get("formats", ())),
+            severities=_severities(data.get("severities", {}), path),
+            explains=_kinds(data.get("explains", ()), "explains", path),
+            reports=_kinds(data.get("reports", ()), "reports", path),
         )
     except KeyError as exc:
         raise CatalogError(f"{path.name}: missing key {exc}") from None
@@ -248,7 +269,28 @@ def _load_rule(path: Path, data: dict[str, Any]) -> Rule:
             raise CatalogError(f"{path.name}: reference {ref.url!r} is not PX4's docs or source")
     if rule.example is not None and rule.example.language not in EXAMPLE_LANGUAGES:
         raise CatalogError(f"{path.name}: example language {rule.example.language!r}")
+    if rule.severities and rule.severities[0][0] is not rule.severity:
+        raise CatalogError(f"{path.name}: severity is not the highest of its severities")
+    if not set(rule.reports) <= set(rule.explains):
+        raise CatalogError(f"{path.name}: reports outcomes it does not explain")
     return rule
+
+
+def _severities(data: dict[str, str], path: Path) -> tuple[tuple[Severity, str], ...]:
+    try:
+        levels = [(Severity.parse(level), str(when).strip()) for level, when in data.items()]
+    except ValueError as exc:
+        raise CatalogError(f"{path.name}: severities: {exc}") from None
+    return tuple(sorted(levels, key=lambda item: item[0], reverse=True))
+
+
+def _kinds(values: Iterable[str], key: str, path: Path) -> tuple[HazardKind, ...]:
+    """``values`` as hazard kinds, in ``HAZARD_KINDS`` order."""
+    chosen = set(values)
+    unknown = chosen - set(HAZARD_KINDS)
+    if unknown:
+        raise CatalogError(f"{path.name}: {key}: unknown outcome {sorted(unknown)[0]!r}")
+    return tuple(kind for kind in HAZARD_KINDS if kind in chosen)
 
 
 def _client_example(data: dict[str, Any]) -> ClientExample:

@@ -9,7 +9,7 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import cast
 
 from fuzzoff.catalog import get_rule
 from fuzzoff.checks import CheckContext, load_all
@@ -26,7 +26,16 @@ from fuzzoff.events import (
     VehicleStatus,
     is_keepalive,
 )
-from fuzzoff.findings import FileReport, Finding, Report, Severity, clip, first_clause
+from fuzzoff.findings import (
+    FileReport,
+    FileStats,
+    Finding,
+    Report,
+    RunStats,
+    Severity,
+    clip,
+    first_clause,
+)
 from fuzzoff.gate import GateModel, GateTransition
 from fuzzoff.profiles import (
     DEFAULT_PX4,
@@ -297,7 +306,7 @@ def run_events(
     timelines: dict[str, Timeline] | None = None,
     on_event: Callable[[int], None] | None = None,
     batching: bool = True,
-) -> tuple[list[Finding], dict[str, Any]]:
+) -> tuple[list[Finding], RunStats]:
     """Run the gate and every enabled check over ``events`` (one recording, any vehicles).
 
     ``batching=False`` hands every stream message to every check one at a time, as the
@@ -327,7 +336,7 @@ def _run_events(
     timelines: dict[str, Timeline] | None,
     on_event: Callable[[int], None] | None,
     batching: bool,
-) -> tuple[list[Finding], dict[str, Any]]:
+) -> tuple[list[Finding], RunStats]:
     runs: dict[str, VehicleRun] = {}
     kinds: Counter[str] = Counter()
     count = 0
@@ -375,7 +384,7 @@ def _run_events(
                     summary=clip(f"{code} not checkable: {first_clause(needs)}"),
                 )
             )
-    stats = {
+    stats: RunStats = {
         "events": count,
         "duration_s": round(t_end, 6),
         "vehicles": sorted(runs),
@@ -527,7 +536,8 @@ def lint_file(
     findings = [f for f in findings if settings.enabled(f.code)]
     findings.sort(key=_sort_key)
     report.findings = findings
-    report.stats = {**stats, **source.stats}
+    # the run's keys and the reader's are disjoint (mypy cannot merge TypedDicts by **)
+    report.stats = cast(FileStats, {**stats, **source.stats})
     if source.start_time_s is not None:
         report.stats["start_unix_s"] = round(source.start_time_s, 6)
     if info.notes:
@@ -626,3 +636,47 @@ def lint_paths(
             if on_file is not None:
                 on_file(file_report)
     return report
+
+
+def timeline_loss_timeout(
+    timeline: Timeline, profile: Profile, settings: Settings
+) -> tuple[float, str]:
+    """COM_OF_LOSS_T as the gate used it, and where the value came from.
+
+    An engine that copies the gate's final ``loss_timeout`` and ``recorded_params`` onto the
+    timeline gives the recording's own value; without them the value is ``--param`` /
+    configuration, else the profile's default (what the gate model starts from). Before 1.11
+    the timeout is a fixed 500 ms whatever COM_OF_LOSS_T says (gate spec 2.3).
+    """
+    recorded = timeline.recorded_params
+    value = timeline.loss_timeout
+    if value is None:
+        value = GateModel(profile, settings.params).loss_timeout
+    if profile.release.fixed_loss_s is not None:
+        return float(value), "fixed in PX4 before 1.11"  # COM_OF_LOSS_T is not the timeout
+    if "COM_OF_LOSS_T" in settings.params:
+        return float(value), settings.param_origin("COM_OF_LOSS_T")
+    if "COM_OF_LOSS_T" in recorded:
+        return float(value), "from the recording"
+    return float(value), f"PX4 {profile.px4} default"
+
+
+def lint_file_with_timelines(path: str | Path, settings: Settings) -> FileReport:
+    """``lint_file`` with what the HTML report plots: every vehicle's timeline (every recorded
+    position, not one per ``POSITION_PERIOD_S``) and the loss timeout the gate used."""
+    settings = settings.for_recording(path)
+    timelines: dict[str, Timeline] = {}
+    report = lint_file(path, settings, timelines=timelines, plot_data=True)
+    report.timelines = timelines
+    report.loss_timeouts = {
+        vehicle: timeline_loss_timeout(tl, report.profile, settings)
+        for vehicle, tl in timelines.items()
+    }
+    return report
+
+
+def lint_with_timelines(
+    paths: Sequence[str | Path], settings: Settings, *, jobs: int = 1
+) -> Report:
+    """Like ``lint_paths`` but every file report carries its timelines."""
+    return lint_paths(paths, settings, jobs=jobs, lint=lint_file_with_timelines)

@@ -5,10 +5,13 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 from enum import IntEnum
-from typing import Any
+from typing import TYPE_CHECKING, Any, TypedDict
 
 from fuzzoff.events import Where
 from fuzzoff.profiles import Profile
+
+if TYPE_CHECKING:
+    from fuzzoff.engine import Timeline
 
 
 class Severity(IntEnum):
@@ -131,6 +134,50 @@ class Finding:
         }
 
 
+class RecordingStats(TypedDict, total=False):
+    """What a reader counted while it read (``Source.stats``); each format fills its own keys."""
+
+    packets: int
+    """tlog: MAVLink packets read."""
+    bad_data: int
+    """tlog: stretches of bytes that were no packet."""
+    bad_data_bytes: int
+    unknown: dict[str, int]
+    """tlog: packets of message ids the dialect does not know (``UNKNOWN_<id>``, ``other``)."""
+    truncated: bool
+    messages: int | dict[str, int]
+    """MCAP and ROS 2 bags: messages read; tlog: packets per message type."""
+    ignored: dict[str, int]
+    """tlog: messages read and not used, by reason."""
+    messages_decoded: int
+    """ROS 1 bags: messages decoded."""
+    pyulog_messages: list[str]
+    """ULog: what pyulog said about a damaged file (its first lines)."""
+
+
+class RunStats(TypedDict):
+    """What ``engine.run_events`` counted."""
+
+    events: int
+    duration_s: float
+    vehicles: list[str]
+    kinds: dict[str, int]
+    """Events per kind."""
+
+
+class FileStats(RecordingStats, total=False):
+    """``FileReport.stats``: the run's counts (``RunStats``), the reader's, and what dates the
+    recording (the ``stats`` of the JSON report, spec/interface.md); empty for a file that
+    could not be opened."""
+
+    events: int
+    duration_s: float
+    vehicles: list[str]
+    kinds: dict[str, int]
+    start_unix_s: float
+    notes: list[str]
+
+
 @dataclass(slots=True)
 class FileReport:
     """What linting one recording produced."""
@@ -144,9 +191,12 @@ class FileReport:
     """One line per part of the input that could not be read (OFB001 messages)."""
     malformed: list[str] = field(default_factory=list)
     """One line per malformed part that was read around with nothing lost (OFB004 messages)."""
-    stats: dict[str, Any] = field(default_factory=dict)
-    extras: dict[str, Any] = field(default_factory=dict)
-    """Optional data for rich reports (gate timeline, keep-alive series)."""
+    stats: FileStats = field(default_factory=lambda: FileStats())
+    timelines: dict[str, Timeline] = field(default_factory=dict)
+    """Per vehicle, the series the HTML report plots (``engine.lint_file_with_timelines`` fills
+    it; empty in a plain lint)."""
+    loss_timeouts: dict[str, tuple[float, str]] = field(default_factory=dict)
+    """Per vehicle of ``timelines``, the loss timeout the gate used and where it came from."""
 
     def to_json(self) -> dict[str, Any]:
         return {

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from fuzzoff.engine import Timeline
+from fuzzoff.config import Settings
+from fuzzoff.engine import Timeline, timeline_loss_timeout
 from fuzzoff.events import Event, SetPositionTargetLocal, StatusText, VehicleStatus, Where
 from fuzzoff.findings import FileReport, Finding, Report, Severity
 from fuzzoff.gate import GateTransition
@@ -69,6 +70,15 @@ def hostile_findings() -> list[Finding]:
     ]
 
 
+def with_plots(file: FileReport, timelines: dict[str, Timeline]) -> None:
+    """Give ``file`` these timelines to plot, with the loss timeout a lint would give them."""
+    file.timelines = timelines
+    file.loss_timeouts = {
+        vehicle: timeline_loss_timeout(tl, file.profile, Settings())
+        for vehicle, tl in timelines.items()
+    }
+
+
 def hostile_report() -> Report:
     """Two recordings: one with a timeline and three findings, one unreadable."""
     good = FileReport(
@@ -78,7 +88,7 @@ def hostile_report() -> Report:
         findings=hostile_findings(),
         stats={"events": 1234, "duration_s": 20.0, "vehicles": [VEHICLE]},
     )
-    good.extras["timelines"] = {VEHICLE: hostile_timeline()}
+    with_plots(good, {VEHICLE: hostile_timeline()})
     bad = FileReport(
         path=f"broken{IMG}.ulg",
         format="unknown",

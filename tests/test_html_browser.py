@@ -17,16 +17,15 @@ from typing import Any
 import pytest
 
 from fuzzoff.config import Settings
-from fuzzoff.engine import Timeline
+from fuzzoff.engine import Timeline, lint_file_with_timelines
 from fuzzoff.findings import FileReport, Finding, Report, Severity
 from fuzzoff.profiles import Profile
 from fuzzoff.report.html import render
 from fuzzoff.report.html_assets import report_csp
-from fuzzoff.report.timelines import lint_one
 from fuzzoff.sources import find_recordings
 from tests.cdp import Browser, find_chromium
 from tests.helpers import CORPORA, ROOT, run_cli
-from tests.report_fixtures import SCRIPT, gap_recording, hostile_report
+from tests.report_fixtures import SCRIPT, gap_recording, hostile_report, with_plots
 
 ARTIFACTS = ROOT / "build" / "test-artifacts"
 WIDTHS = (1280, 760)
@@ -116,7 +115,7 @@ def test_plot_and_every_finding_are_shown(browser: Browser, tmp_path: Path) -> N
         for j, finding in enumerate(file.findings):
             row = browser.evaluate(f"document.getElementById('finding-{i}-{j}').innerText")
             assert finding.code in row and finding.message.split("\x1b")[0] in row
-            if finding.time_s is not None and file.extras.get("timelines"):
+            if finding.time_s is not None and file.timelines:
                 shown = browser.evaluate(
                     f"(() => {{ const m = document.getElementById('mark-{i}-{j}');"
                     " return m !== null && (!m.hidden || [...document.querySelectorAll("
@@ -171,7 +170,7 @@ def test_cli_html_of_real_recordings(browser: Browser, tmp_path: Path) -> None:
 def crowded_file() -> FileReport:
     """A minute of stream with 120 findings in two bursts: too many to draw one by one."""
     file = FileReport("crowded.tlog", "tlog", Profile("1.15", "mc"), stats={"duration_s": 60.0})
-    file.extras["timelines"] = {"1": Timeline(keepalive=[i * 0.05 for i in range(1200)])}
+    with_plots(file, {"1": Timeline(keepalive=[i * 0.05 for i in range(1200)])})
     file.findings = [
         Finding("OFB101", "x", Severity.WARNING, f"gap {k}", time_s=10.0 + k * 0.05, vehicle="1")
         for k in range(60)
@@ -194,7 +193,7 @@ def user_report(tmp_path_factory: pytest.TempPathFactory) -> Path:
         CORPORA / "mcap" / "stream_lost.mcap",
         CORPORA / "tlog" / "px4_1_17_0_loss.gcs.tlog",  # PX4 1.17 SITL's own failsafe message
     ]
-    files = [lint_one(p, Settings()) for p in paths if p.exists()]
+    files = [lint_file_with_timelines(p, Settings()) for p in paths if p.exists()]
     page = folder / "report.html"
     page.write_text(render(Report(files=[*files, crowded_file()]), Settings()), "utf-8")
     return page

@@ -15,7 +15,7 @@ from typing import Any
 
 from fuzzoff.catalog import REFERENCE_PREFIXES
 from fuzzoff.config import Settings
-from fuzzoff.engine import Timeline, lint_file
+from fuzzoff.engine import Timeline, lint_file, lint_file_with_timelines, timeline_loss_timeout
 from fuzzoff.events import (
     Command,
     CommandAck,
@@ -29,10 +29,9 @@ from fuzzoff.findings import FileReport, Finding, Report, Severity
 from fuzzoff.profiles import Profile
 from fuzzoff.report.html import render
 from fuzzoff.report.html_plot import BUCKETS, as_script_data, min_max_buckets, with_ramps
-from fuzzoff.report.timelines import lint_one, loss_timeout
 from fuzzoff.writers.tlog import write_tlog
 from tests.helpers import CORPORA, ROOT, run_cli
-from tests.report_fixtures import SCRIPT, gap_recording, hostile_report
+from tests.report_fixtures import SCRIPT, gap_recording, hostile_report, with_plots
 
 
 class Markup(HTMLParser):
@@ -128,7 +127,7 @@ def test_every_finding_has_a_row_and_every_timed_one_a_marker() -> None:
     for i, file in enumerate(report.files):
         for j, finding in enumerate(file.findings):
             assert f'id="finding-{i}-{j}"' in page
-            timed = finding.time_s is not None and bool(file.extras.get("timelines"))
+            timed = finding.time_s is not None and bool(file.timelines)
             assert (f"{i}-{j}" in marks) == timed
             assert (f'href="#mark-{i}-{j}"' in page) == timed
             assert f'href="#rule-{finding.code}"' in page and f'id="rule-{finding.code}"' in page
@@ -143,7 +142,7 @@ def test_long_series_are_downsampled_but_keep_their_spikes() -> None:
     assert len(points) <= 2 * BUCKETS
     assert max(v for _, v in points) == max(values)
     file = FileReport("long.tlog", "tlog", Profile(), stats={"duration_s": times[-1]})
-    file.extras["timelines"] = {"1": Timeline(keepalive=times)}
+    with_plots(file, {"1": Timeline(keepalive=times)})
     file.findings = [Finding("OFB001", "x", Severity.ERROR, "gap", time_s=1800.0)]
     page = render(Report(files=[file]), Settings())
     (plot,) = Markup(page).plot_data()
@@ -155,10 +154,10 @@ def test_long_series_are_downsampled_but_keep_their_spikes() -> None:
 def test_loss_timeout_line_follows_the_profile_and_param(tmp_path: Path) -> None:
     recording = gap_recording(tmp_path / "gap.tlog")
     settings = replace(Settings(), px4="1.15")
-    page = render(Report(files=[lint_one(recording, settings)]), settings)
+    page = render(Report(files=[lint_file_with_timelines(recording, settings)]), settings)
     assert "COM_OF_LOSS_T = 1 s (PX4 1.15 default)" in page
     settings = replace(settings, params={"COM_OF_LOSS_T": 0.3})
-    page = render(Report(files=[lint_one(recording, settings)]), settings)
+    page = render(Report(files=[lint_file_with_timelines(recording, settings)]), settings)
     assert "COM_OF_LOSS_T = 0.3 s (set by the user)" in page
     (plot,) = Markup(page).plot_data()
     assert [0.3, "loss timeout (COM_OF_LOSS_T) 0.3 s", "loss"] in plot["keepalive"]["lines"]
@@ -197,20 +196,20 @@ def test_loss_timeout_from_the_recording_when_the_engine_records_it() -> None:
     timeline.loss_timeout = 0.7  # type: ignore[attr-defined]
     timeline.recorded_params = {"COM_OF_LOSS_T": 0.7}  # type: ignore[attr-defined]
     profile = Profile("1.15", "mc")
-    assert loss_timeout(timeline, profile, Settings()) == (0.7, "from the recording")
+    assert timeline_loss_timeout(timeline, profile, Settings()) == (0.7, "from the recording")
     forced = replace(Settings(), params={"COM_OF_LOSS_T": 0.7})
-    assert loss_timeout(timeline, profile, forced) == (0.7, "set by the user")
+    assert timeline_loss_timeout(timeline, profile, forced) == (0.7, "set by the user")
     from_file = replace(forced, param_origins={"COM_OF_LOSS_T": "/flights/pyproject.toml"})
-    assert loss_timeout(timeline, profile, from_file) == (0.7, "set in pyproject.toml")
-    assert loss_timeout(Timeline(), profile, Settings()) == (1.0, "PX4 1.15 default")
+    assert timeline_loss_timeout(timeline, profile, from_file) == (0.7, "set in pyproject.toml")
+    assert timeline_loss_timeout(Timeline(), profile, Settings()) == (1.0, "PX4 1.15 default")
 
 
 def test_each_vehicle_has_its_plot_and_its_own_markers() -> None:
     file = FileReport("fleet.mcap", "mcap", Profile(), stats={"duration_s": 10.0})
-    file.extras["timelines"] = {
+    with_plots(file, {
         "/px4_1": Timeline(keepalive=[0.1 * i for i in range(100)]),
         "/px4_2": Timeline(keepalive=[0.1 * i for i in range(50)]),
-    }
+    })
     file.findings = [
         Finding("OFB001", "x", Severity.ERROR, "one", time_s=2.0, vehicle="/px4_1"),
         Finding("OFB001", "x", Severity.ERROR, "two", time_s=6.0, vehicle="/px4_2"),
@@ -225,7 +224,7 @@ def test_each_vehicle_has_its_plot_and_its_own_markers() -> None:
 
 def test_vehicle_names_are_shown_as_they_are_not_as_python_reprs(tmp_path: Path) -> None:
     recording = gap_recording(tmp_path / "gap.tlog")
-    page = render(Report(files=[lint_one(recording, Settings())]), Settings())
+    page = render(Report(files=[lint_file_with_timelines(recording, Settings())]), Settings())
     assert "<b>vehicle 1</b>" in page and "'1'" not in page
     assert "<dt>vehicles</dt><dd>1</dd>" in page
 
@@ -252,7 +251,7 @@ def _flight(path: Path) -> Path:
 
 def test_the_timeline_has_the_position_messages_and_labelled_commands(tmp_path: Path) -> None:
     recording = _flight(tmp_path / "flight.tlog")
-    page = render(Report(files=[lint_one(recording, Settings())]), Settings())
+    page = render(Report(files=[lint_file_with_timelines(recording, Settings())]), Settings())
     (plot,) = Markup(page).plot_data()
     t, altitude, x, _ = plot["position"]
     assert t[0] == 0.01 and altitude[-1] == 1.98 and x[-1] == 9.9  # NED: altitude is -z
@@ -270,12 +269,12 @@ def test_a_plain_lint_reads_the_position_once_a_second_and_the_report_every_one(
     # OFB404 needs the vehicle's height on the ground; a lint decodes one position a second
     recording = _flight(tmp_path / "flight.tlog")  # 20 Hz for 5 s
     assert lint_file(recording).stats["kinds"]["vehicle_position"] == 5
-    assert lint_one(recording, Settings()).stats["kinds"]["vehicle_position"] == 100
+    assert lint_file_with_timelines(recording, Settings()).stats["kinds"]["vehicle_position"] == 100
 
 
 def test_the_recordings_start_on_the_wall_clock() -> None:
     def start(path: Path) -> str:
-        page = render(Report(files=[lint_one(path, Settings())]), Settings())
+        page = render(Report(files=[lint_file_with_timelines(path, Settings())]), Settings())
         found = re.search(r"<dt>start</dt><dd>([^<]*)</dd>", page)
         assert found is not None
         return found.group(1)
@@ -290,13 +289,13 @@ def test_a_recorded_loss_timeout_of_zero_says_what_it_means() -> None:
     """sample.ulg (PX4 v1.6) names no release, so 1.15 is assumed, and records COM_OF_LOSS_T = 0:
     before 1.11 an extra wait after a fixed 500 ms, from 1.11 a signal lost at once."""
     log = CORPORA / "real" / "sample.ulg"
-    page = render(Report(files=[lint_one(log, Settings())]), Settings())
+    page = render(Report(files=[lint_file_with_timelines(log, Settings())]), Settings())
     assert "COM_OF_LOSS_T = 0 s (from the recording): PX4 1.15 would count" in page
     assert "judge it with --px4 legacy" in page
     (plot,) = Markup(page).plot_data()
     assert plot["keepalive"] is None  # no stream: nothing to draw a line across
     legacy = replace(Settings(), px4="legacy")
-    page = render(Report(files=[lint_one(log, legacy)]), legacy)
+    page = render(Report(files=[lint_file_with_timelines(log, legacy)]), legacy)
     assert "lost 500 ms after the newest keep-alive (fixed in PX4 before 1.11)" in page
     assert "COM_OF_LOSS_T = 0" not in page
 

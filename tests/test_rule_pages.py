@@ -10,9 +10,11 @@ them.
 from __future__ import annotations
 
 import ast
+import importlib.util
 import re
 import tomllib
 from pathlib import Path
+from types import ModuleType
 
 import pytest
 
@@ -175,3 +177,43 @@ def test_rule_verbose_shows_the_test_stream() -> None:
     assert plain.returncode == verbose.returncode == 0
     assert "## Use instead" in plain.stdout and "Test stream" not in plain.stdout
     assert "## Test stream" in verbose.stdout and 'kind = "control_mode"' in verbose.stdout
+
+
+def _build() -> ModuleType:
+    spec = importlib.util.spec_from_file_location(
+        "rules_build", ROOT / "docs" / "rules" / "build.py"
+    )
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_overview_pages_list_the_rules_as_the_catalog_has_them() -> None:
+    """docs/rules.md and docs/rules-rover-mavlink.md repeat no rule fact by hand: their tables
+    (names, severities and when each is given, profiles, option defaults) are the build's."""
+    for path, text in _build().overview_pages().items():
+        assert path.read_text(encoding="utf-8") == text, (
+            f"{path.name} is stale: run .venv/bin/python docs/rules/build.py"
+        )
+    rules_md = (ROOT / "docs" / "rules.md").read_text(encoding="utf-8")
+    for rule in RULES:
+        for option in rule.options:
+            assert f"| `{rule.code}.{option.name}` | `{option.default}` |" in rules_md
+        for level, when in rule.severities:
+            assert when in rules_md, (rule.code, level)
+    mavlink_md = (ROOT / "docs" / "rules-rover-mavlink.md").read_text(encoding="utf-8")
+    ofb507 = (
+        "| [OFB507](rules/OFB507.md) | rover-attitude-target-unsupported | error (or warning) |"
+    )
+    assert ofb507 in mavlink_md
+
+
+def test_an_overview_page_without_its_table_s_place_is_refused() -> None:
+    build = _build()
+    with pytest.raises(SystemExit, match="catalog:options"):
+        build.fill(
+            "# rules\n<!-- catalog:severities -->\n<!-- catalog:end -->\n",
+            build.TABLES["rules.md"],
+            RULES,
+        )

@@ -69,10 +69,10 @@ def run(args: argparse.Namespace) -> int:
 
 def _own_report(target: str, where: Path, settings: Settings) -> None:
     """The recording's HTML report, as ``fuzzoff lint TARGET --format html`` writes it."""
+    from fuzzoff.engine import lint_file_with_timelines
     from fuzzoff.fleet.task import lint_target
     from fuzzoff.report import renderer
-    from fuzzoff.report.timelines import lint_one
 
-    outcome = lint_target(target, settings, lint=lint_one)
+    outcome = lint_target(target, settings, lint=lint_file_with_timelines)
     assert outcome.report is not None
     write_output(renderer("html")(Report([outcome.report]), settings), str(where))

@@ -30,6 +30,7 @@ from fuzzoff.fuzz.properties import PROPERTIES
 from fuzzoff.fuzz.reproducers import DEFAULT_DIR, save
 from fuzzoff.fuzz.scenario import TRANSPORTS
 from fuzzoff.profiles import ProfileError, vehicle_type_for
+from fuzzoff.report import CampaignReport, campaign_renderer
 from fuzzoff.report.sanitize import printable
 from fuzzoff.sources import SourceError, is_bag_folder
 
@@ -237,7 +238,8 @@ def run(args: argparse.Namespace) -> int:
         from fuzzoff.fuzz.mutate import margins as find_margins
 
         margins = find_margins(config.base)
-    write_output(_render(args.format, result, saved, margins), args.output)
+    report = CampaignReport(result, saved, margins)
+    write_output(campaign_renderer(args.format)(report), args.output)
     if save_error is not None:
         print(f"error: {save_error}", file=sys.stderr)
         return 2
@@ -312,15 +314,3 @@ def _save_all(result: CampaignResult, directory: Path) -> tuple[dict[str, Path],
                     f"{reason}{where}; it is in the report"
                 )
     return saved, None
-
-
-def _render(fmt: str, result: CampaignResult, saved: dict[str, Path], margins: list[Any]) -> str:
-    from fuzzoff.fuzz import report
-
-    if fmt == "json":
-        return report.to_json(result, saved, margins)
-    if fmt == "junit":
-        return report.to_junit(result, saved)
-    if fmt == "sarif":
-        return report.to_sarif(result, saved)
-    return report.to_terminal(result, saved, margins)

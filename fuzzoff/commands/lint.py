@@ -22,13 +22,12 @@ from fuzzoff.commands._common import (
     write_output,
 )
 from fuzzoff.config import ConfigError, Settings
-from fuzzoff.engine import lint_paths
+from fuzzoff.engine import lint_file, lint_paths, lint_with_timelines
 from fuzzoff.findings import Report
 from fuzzoff.fleet import fleet_wanted
 from fuzzoff.report import FORMATS, renderer
 from fuzzoff.report.sanitize import printable
-from fuzzoff.report.timelines import lint_with_timelines
-from fuzzoff.sources import RECORDING_SUFFIXES, find_recordings
+from fuzzoff.sources import RECORDING_SUFFIXES, find_recordings, recordings_in
 
 
 def add_parser(sub: Any) -> None:
@@ -68,12 +67,28 @@ def _lint(
     if "html" in formats:
         return lint_with_timelines(paths, settings, jobs=args.jobs)
     if sys.stderr.isatty() and not args.no_progress and args.jobs == 1:
-        from rich.console import Console
-
-        from fuzzoff.report.terminal import lint_with_progress
-
-        return lint_with_progress(paths, settings, Console(stderr=True, highlight=False))
+        return _lint_with_progress(paths, settings)
     return lint_paths(paths, settings, jobs=args.jobs)
+
+
+def _lint_with_progress(paths: list[str], settings: Settings) -> Report:
+    """One file at a time with a progress bar on stderr's terminal (long files take seconds)."""
+    from rich.console import Console
+    from rich.progress import BarColumn, Progress, TaskID, TextColumn, TimeRemainingColumn
+
+    report = Report()
+    columns = (TextColumn("{task.description}"), BarColumn(), TimeRemainingColumn())
+    console = Console(stderr=True, highlight=False)
+    with Progress(*columns, console=console, transient=True) as progress:
+        for f in recordings_in(paths):
+            task = progress.add_task(printable(f.name, 60), total=1.0)
+
+            def advance(fraction: float, task: TaskID = task) -> None:
+                progress.update(task, completed=fraction)
+
+            report.files.append(lint_file(f, settings, progress=advance))
+            progress.remove_task(task)
+    return report
 
 
 def _terminal(

@@ -93,9 +93,9 @@ def run_fleet(
     settings_per_recording(settings, local)
     lint: Lint = lint_file
     if any(fmt == "html" for fmt, _ in reports):
-        from fuzzoff.report.timelines import lint_one
+        from fuzzoff.engine import lint_file_with_timelines
 
-        lint = lint_one
+        lint = lint_file_with_timelines
     dataset = dataset_dir(reports)
     known: frozenset[str] = frozenset()
     writer = None

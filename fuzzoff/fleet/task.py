@@ -1,9 +1,10 @@
 """Lint one recording, local or at a URL: the unit of work a Dask task (or a process) runs.
 
-The lint itself is ``fuzzoff.lint_file`` (or the HTML report's ``lint_one``), so a fleet run
-gives exactly the findings, problems and exit status of a plain lint. Around it: fetching a
-URL into a temporary folder, the content hash the Parquet dataset is keyed by, the skip of a
-recording the dataset already holds, and the wall-clock start time.
+The lint itself is ``fuzzoff.lint_file`` (or, for the HTML report,
+``engine.lint_file_with_timelines``), so a fleet run gives exactly the findings, problems and
+exit status of a plain lint. Around it: fetching a URL into a temporary folder, the content hash
+the Parquet dataset is keyed by, the skip of a recording the dataset already holds, and the
+wall-clock start time.
 """
 
 from __future__ import annotations

@@ -13,14 +13,16 @@ A *hazard* is a ``GateTransition`` of one of these kinds (gate spec section in b
 
 ``EXPLAINED_BY`` names the rules whose findings explain each kind: rules about the very outcome
 (OFB201, OFB103, OFB6xx...) and about its causes (a gap, an empty control mode, a dropped
-keep-alive...).
+keep-alive...). Each rule says which kinds it explains in its page (``rules/CODE.toml``,
+``explains`` and ``reports``): a new rule that explains an outcome needs no change here.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
+from fuzzoff.catalog import HAZARD_KINDS, CatalogError, Rule, load_catalog
 from fuzzoff.events import Command
 from fuzzoff.gate import GateTransition
 
@@ -31,67 +33,28 @@ WAIT_S = 0.55
 slowest stream the docs allow (2 Hz, plus 10 % jitter): a stream's own rate is intended."""
 NO_SETPOINT_YET = "no TrajectorySetpoint since"
 
-_DROPPED = frozenset(
-    {
-        "OFB601",
-        "OFB602",
-        "OFB603",
-        "OFB604",
-        "OFB605",
-        "OFB606",
-        "OFB607",
-        "OFB609",
-        "OFB507",
-        "OFB508",
-        "OFB509",
-        "OFB803",
-        "OFB801",
-    }
-)
-_NO_SIGNAL = frozenset({"OFB101", "OFB102", "OFB103", "OFB106", "OFB301", "OFB305"}) | _DROPPED
 
-EXPLAINED_BY: dict[str, frozenset[str]] = {
-    "request_rejected": _NO_SIGNAL | {"OFB201"},
-    "arm_rejected": _NO_SIGNAL | {"OFB201"},
-    "failsafe": _NO_SIGNAL,
-    "disarmed": _NO_SIGNAL,
-    "setpoint_dropped": _DROPPED,
-    "controller": frozenset(
-        {
-            "OFB104",
-            "OFB203",
-            "OFB301",
-            "OFB302",
-            "OFB303",
-            "OFB305",
-            "OFB401",
-            "OFB402",
-            "OFB403",
-            "OFB408",
-            "OFB501",
-            "OFB502",
-            "OFB503",
-            "OFB504",
-            "OFB505",
-            "OFB506",
-            "OFB603",
-            "OFB604",
-            "OFB605",
-            "OFB803",
-        }
-    )
-    | _NO_SIGNAL,
-}
+def explained_by(
+    catalog: Mapping[str, Rule],
+) -> tuple[dict[str, frozenset[str]], dict[str, str]]:
+    """Each kind's explaining rules and the rule that reports it, from the rules' pages."""
+    explained: dict[str, set[str]] = {kind: set() for kind in HAZARD_KINDS}
+    outcome: dict[str, str] = {}
+    for rule in catalog.values():
+        for kind in rule.explains:
+            explained[kind].add(rule.code)
+        for kind in rule.reports:
+            if kind in outcome:
+                raise CatalogError(f"{rule.code}: {kind} is reported by {outcome[kind]} already")
+            outcome[kind] = rule.code
+    return {kind: frozenset(codes) for kind, codes in explained.items()}, outcome
 
-OUTCOME_RULE: dict[str, str] = {
-    "request_rejected": "OFB201",
-    "arm_rejected": "OFB201",
-    "failsafe": "OFB103",
-    "disarmed": "OFB103",
-}
-"""The rule that reports the outcome itself: when the recording cannot show it (OFB002 says
-so), a warning of an explaining rule is enough (e.g. OFB102 before a rejected switch in a
-recording without acks)."""
+
+EXPLAINED_BY, OUTCOME_RULE = explained_by(load_catalog())
+"""``EXPLAINED_BY``: the rules whose findings explain each kind (``explains`` in their pages).
+``OUTCOME_RULE``: the rule that reports the outcome itself (``reports``): when the recording
+cannot show it (OFB002 says so), a warning of an explaining rule is enough (e.g. OFB102 before
+a rejected switch in a recording without acks)."""
 
 
 WHILE_ARMED = frozenset({"failsafe", "disarmed", "controller"})
@@ -163,9 +126,7 @@ def hazards(transitions: Sequence[GateTransition], t_end: float) -> list[Hazard]
             if armed_at is None:
                 continue
             # ...and only while it stays armed: a disarm ends what the controller flies
-            end = next(
-                (x.t for x in transitions if armed_at < x.t < end and x.armed is False), end
-            )
+            end = next((x.t for x in transitions if armed_at < x.t < end and x.armed is False), end)
             hold = WAIT_S if tr.reason.startswith(NO_SETPOINT_YET) else HOLD_S
             if end - armed_at < hold:
                 continue

@@ -13,13 +13,14 @@ float32, so a stream survives the round trip through the writers unchanged.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Literal, TypedDict
 
 from hypothesis import strategies as st
 
 from fuzzoff import releases
+from fuzzoff.events import Quat, Vec3
 from fuzzoff.profiles import VEHICLE_TYPES
 from fuzzoff.releases import PX4Profile
 
@@ -158,20 +159,36 @@ OCM_FLAGS_115 = (
 )
 
 
+class ControlModeFlags(TypedDict, total=False):
+    """The ``ControlMode`` fields a generated ``OffboardControlMode`` sets."""
+
+    position: bool
+    velocity: bool
+    acceleration: bool
+    attitude: bool
+    body_rate: bool
+    thrust_and_torque: bool
+    direct_actuator: bool
+    actuator: bool
+    layout: Literal["actuator", "thrust_and_torque"]
+
+
 @st.composite
-def control_modes(draw: st.DrawFn, px4: PX4Profile) -> dict[str, Any]:
+def control_modes(draw: st.DrawFn, px4: PX4Profile) -> ControlModeFlags:
     """``OffboardControlMode`` flags of the release's layout: usually one flag, sometimes a
     mix, sometimes none (OFB301)."""
-    layout = releases.get(px4).control_mode
-    names = OCM_FLAGS_115 if layout == "thrust_and_torque" else OCM_FLAGS_BEFORE_115
+    newer = releases.get(px4).control_mode == "thrust_and_torque"
+    names = OCM_FLAGS_115 if newer else OCM_FLAGS_BEFORE_115
+    layout: Literal["actuator", "thrust_and_torque"] = "thrust_and_torque" if newer else "actuator"
     chosen = draw(
         st.one_of(
             st.sampled_from(names).map(lambda n: {n}),
             st.sets(st.sampled_from(names), max_size=3),
         )
     )
-    flags: dict[str, Any] = {name: True for name in chosen}
-    flags["layout"] = layout
+    flags = ControlModeFlags(layout=layout)
+    for name in chosen:
+        flags[name] = True  # type: ignore[literal-required]  # a name of OCM_FLAGS_*
     return flags
 
 
@@ -217,8 +234,34 @@ def _vec(draw: st.DrawFn, mask: tuple[bool, bool, bool]) -> tuple[float, float, 
     return (x, y, z)
 
 
+class TrajectoryValues(TypedDict):
+    position: Vec3
+    velocity: Vec3
+    acceleration: Vec3
+    yaw: float
+
+
+class AttitudeValues(TypedDict):
+    q_d: Quat
+    thrust_body: Vec3
+
+
+class RatesValues(TypedDict):
+    roll: float
+    pitch: float
+    yaw: float
+    thrust_body: Vec3
+
+
+RoverValues = dict[str, float | tuple[float, float]]
+"""A rover setpoint's fields (each rover message has its own few)."""
+
+SetpointValues = TrajectoryValues | AttitudeValues | RatesValues | RoverValues
+"""The fields of one generated ROS 2 setpoint message, by message."""
+
+
 @st.composite
-def trajectory_values(draw: st.DrawFn, pattern: NanPattern) -> dict[str, Any]:
+def trajectory_values(draw: st.DrawFn, pattern: NanPattern) -> TrajectoryValues:
     """Field values of a ``TrajectorySetpoint`` following ``pattern``."""
     return {
         "position": _vec(draw, pattern.position),
@@ -228,7 +271,7 @@ def trajectory_values(draw: st.DrawFn, pattern: NanPattern) -> dict[str, Any]:
     }
 
 
-def trajectory_setpoints() -> st.SearchStrategy[dict[str, Any]]:
+def trajectory_setpoints() -> st.SearchStrategy[TrajectoryValues]:
     return nan_patterns().flatmap(trajectory_values)
 
 
@@ -264,12 +307,12 @@ def thrusts() -> st.SearchStrategy[float]:
 
 
 @st.composite
-def attitude_setpoints(draw: st.DrawFn) -> dict[str, Any]:
+def attitude_setpoints(draw: st.DrawFn) -> AttitudeValues:
     return {"q_d": draw(quaternions()), "thrust_body": (0.0, 0.0, draw(thrusts()))}
 
 
 @st.composite
-def rates_setpoints(draw: st.DrawFn) -> dict[str, Any]:
+def rates_setpoints(draw: st.DrawFn) -> RatesValues:
     rate = st.one_of(st.floats(-5.0, 5.0, width=32), st.just(NAN))
     return {
         "roll": draw(rate),
@@ -300,7 +343,7 @@ ROVER_COMBINATIONS: tuple[tuple[str, ...], ...] = (
 
 
 @st.composite
-def rover_setpoints(draw: st.DrawFn, kind: str | None = None) -> tuple[str, dict[str, Any]]:
+def rover_setpoints(draw: st.DrawFn, kind: str | None = None) -> tuple[str, RoverValues]:
     """(kind, values) of one rover setpoint topic; NaN where the docs require it, or not."""
     kind = kind or draw(st.sampled_from(ROVER_KINDS))
     value = st.one_of(st.floats(-2.0, 2.0, width=32), st.just(NAN))
@@ -423,10 +466,10 @@ def command_plans(draw: st.DrawFn, duration: float, ros2_nav_state: bool) -> Com
 # --------------------------------------------------------------------------- helpers
 
 
-def frozen_or_moving(values: dict[str, Any]) -> Callable[[int], dict[str, Any]]:
+def frozen_or_moving(values: Mapping[str, object]) -> Callable[[int], Mapping[str, object]]:
     """The i-th message's values: a frozen setpoint repeats them, a moving one shifts x."""
 
-    def nth(i: int) -> dict[str, Any]:
+    def nth(i: int) -> Mapping[str, object]:
         pos = values.get("position")
         if isinstance(pos, tuple) and math.isfinite(pos[0]):
             return {**values, "position": (_f32(pos[0] + 0.01 * i), pos[1], pos[2])}

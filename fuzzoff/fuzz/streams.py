@@ -239,7 +239,7 @@ _WIRE_NAME = {"normalized_steering_angle": "normalized_steering_setpoint"}
 """Event fields whose message field was renamed in a release (1.17's RoverSteeringSetpoint)."""
 
 
-def _carried(kind: str, px4: PX4Profile, values: dict[str, Any]) -> dict[str, Any]:
+def _carried(kind: str, px4: PX4Profile, values: fs.RoverValues) -> fs.RoverValues:
     """``values`` with NaN for the fields the release's message does not have (1.17 dropped
     RoverSteeringSetpoint's ``normalized_speed_diff``): a recording of that release cannot
     hold them, and its reader gives NaN, as PX4 would never see them."""
@@ -306,6 +306,7 @@ def _setpoint_series(
 ) -> list[ev.Event]:
     """One setpoint topic following the keep-alive by ``lag``, maybe starting late or stopping
     early (stale setpoints under a live keep-alive: OFB104), frozen or moving."""
+    values: fs.SetpointValues
     if kind == "trajectory":
         values = draw(fs.trajectory_setpoints())
     elif kind == "attitude":
@@ -313,8 +314,8 @@ def _setpoint_series(
     elif kind == "rates":
         values = draw(fs.rates_setpoints())
     else:
-        _, values = draw(fs.rover_setpoints(kind))
-        values = _carried(kind, px4, values)
+        _, rover = draw(fs.rover_setpoints(kind))
+        values = _carried(kind, px4, rover)
     nth = fs.frozen_or_moving(values) if draw(st.booleans()) else (lambda i: values)
     whole = draw(st.sampled_from(["whole", "whole", "late", "early"]))
     start = draw(st.integers(0, len(times) - 1)) if whole == "late" else 0

@@ -28,7 +28,6 @@ from fuzzoff.report.html_assets import CSP, report_csp, scripts, uplot_css
 from fuzzoff.report.html_plot import Marker, as_script_data, loss_line, vehicle_plot
 from fuzzoff.report.html_style import CSS
 from fuzzoff.report.sanitize import printable
-from fuzzoff.report.timelines import loss_timeout
 
 __all__ = ["CSP", "e", "render", "rule_article"]
 
@@ -113,11 +112,9 @@ def _plots(
     file: FileReport,
     markers: list[Marker],
     timelines: dict[str, Timeline],
-    settings: Settings,
 ) -> str:
     if not timelines:
         return '<p class="none">No timeline: the recording has no events fuzzoff could read.</p>'
-    stored = file.extras.get("loss_timeouts", {})
     t_end = float(file.stats.get("duration_s") or 0.0)
     start = file.stats.get("start_unix_s")
     vehicles = list(timelines)
@@ -130,7 +127,7 @@ def _plots(
             or (m.finding.vehicle not in timelines and vehicle == vehicles[0])
         ]
         tl = timelines[vehicle]
-        seconds, source = stored.get(vehicle) or loss_timeout(tl, file.profile, settings)
+        seconds, source = file.loss_timeouts[vehicle]
         recorded = tl.recorded_params.get("COM_OF_LOSS_T")
         loss = loss_line(seconds, source, file.profile, recorded)
         name = vehicle_name(vehicle)
@@ -178,14 +175,14 @@ def _findings_table(markers: list[Marker], timed: set[str]) -> str:
     )
 
 
-def _file_section(index: int, file: FileReport, settings: Settings) -> str:
-    timelines: dict[str, Timeline] = file.extras.get("timelines", {})
+def _file_section(index: int, file: FileReport) -> str:
+    timelines = file.timelines
     markers = [Marker(f"{index}-{i}", f) for i, f in enumerate(file.findings)]
     timed = {m.ident for m in markers if m.finding.time_s is not None and timelines}
     return (
         f'<section class="file" id="file-{index}"><h2>{e(file.path)}</h2>'
         f"{_summary(file, timelines)}<h3>Timeline</h3>"
-        f"{_plots(index, file, markers, timelines, settings)}"
+        f"{_plots(index, file, markers, timelines)}"
         f"<h3>Findings</h3>{_findings_table(markers, timed)}</section>"
     )
 
@@ -299,7 +296,7 @@ HELP = (
 
 
 def render(report: Report, settings: Settings) -> str:
-    sections = "".join(_file_section(i, f, settings) for i, f in enumerate(report.files))
+    sections = "".join(_file_section(i, f) for i, f in enumerate(report.files))
     codes = sorted({f.code for f in report.findings})
     rules = [r for r in (_rule(c) for c in codes) if r is not None]
     articles = "".join(rule_article(r) for r in rules)

@@ -1,4 +1,5 @@
-"""``--format json``: the stable machine-readable shape of spec/interface.md."""
+"""``--format json``: the stable machine-readable shape of spec/interface.md, for a lint and for
+a fuzz campaign."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ from typing import Any
 from fuzzoff import __version__
 from fuzzoff.config import Settings
 from fuzzoff.findings import Report
+from fuzzoff.report import CampaignReport
 from fuzzoff.report.sanitize import escape_bidi
 
 
@@ -33,3 +35,37 @@ def report_dict(report: Report) -> dict[str, Any]:
 
 def render(report: Report, settings: Settings) -> str:
     return escape_bidi(json.dumps(report_dict(report), indent=2, ensure_ascii=False)) + "\n"
+
+
+def render_campaign(campaign: CampaignReport) -> str:
+    """``fuzzoff fuzz --format json``: the campaign and each property's result."""
+    result, saved = campaign.result, campaign.saved
+    margins = campaign.margins
+    cfg = result.config
+    data: dict[str, Any] = {
+        "tool": "fuzzoff",
+        "version": __version__,
+        "campaign": {
+            "px4": cfg.px4,
+            "vehicle": cfg.vehicle,
+            "transport": cfg.transport,
+            "seed": cfg.seed,
+            "seeds": list(cfg.seeds) or [cfg.seed],
+            "examples": cfg.examples,
+            "budget_s": cfg.budget_s,
+            "from": None if cfg.base is None else cfg.base.describe(),
+            "from_problems": cfg.base_problems,
+        },
+        "failed": result.failed,
+        "unchecked": result.unchecked,
+        "examples": result.examples,
+        "seconds": round(result.seconds, 3),
+        "properties": [],
+    }
+    for r in result.results:
+        entry = r.to_json()
+        entry["reproducer"] = str(saved[r.name]) if r.name in saved else None
+        data["properties"].append(entry)
+    if margins:
+        data["margins"] = [m.to_json() for m in margins]
+    return json.dumps(data, indent=2) + "\n"

@@ -4,6 +4,8 @@ One ``testsuite`` per recording, one ``testcase`` per enabled rule: failed when 
 findings at or above the fail level (listed in the failure), skipped when the rule does not apply
 to the recording's profile or cannot be checked on it (its OFB002 finding says why), else passed
 (findings below the fail level go to ``system-out``). Text from recordings is made valid XML.
+
+A fuzz campaign: one ``testcase`` per property, failed with its first counterexample.
 """
 
 from __future__ import annotations
@@ -14,6 +16,8 @@ import xml.etree.ElementTree as ET
 from fuzzoff.catalog import Rule, load_catalog
 from fuzzoff.config import Settings
 from fuzzoff.findings import FileReport, Finding, Report
+from fuzzoff.fuzz.known import KNOWN
+from fuzzoff.report import CampaignReport, campaign_seeds
 from fuzzoff.report.sanitize import CI_TEXT_LIMIT, escape_bidi, printable
 
 _NOT_XML = re.compile("[^\t\n\r\x20-\x7e\xa0-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
@@ -127,5 +131,44 @@ def render(report: Report, settings: Settings) -> str:
     for key in ("tests", "failures", "errors", "skipped"):
         root.set(key, str(sum(int(s.get(key, "0")) for s in suites)))
     root.extend(suites)
+    ET.indent(root)
+    return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+
+
+def render_campaign(campaign: CampaignReport) -> str:
+    """``fuzzoff fuzz --format junit``: one test case per property."""
+    result, saved = campaign.result, campaign.saved
+    failures = sum(1 for r in result.results if r.failed)
+    suite = ET.Element(
+        "testsuite",
+        name=f"fuzzoff fuzz ({campaign_seeds(result)})",
+        tests=str(len(result.results)),
+        failures=str(failures),
+        errors="0",
+        skipped=str(len(result.unchecked)),
+        time=f"{result.seconds:.3f}",
+    )
+    for r in result.results:
+        case = ET.SubElement(
+            suite, "testcase", classname="fuzzoff.fuzz", name=r.name, time=f"{r.seconds:.3f}"
+        )
+        if r.failed:
+            text = f"{r.failed_examples} of {r.examples} examples failed; the first:\n"
+            text += "\n".join(r.problems)
+            if r.counterexample is not None:
+                text += f"\ncounterexample: {r.counterexample.describe()}"
+            if r.name in saved:
+                text += f"\nreproducer: {saved[r.name]}"
+            failure = ET.SubElement(case, "failure", message=printable(r.problems[0], 300))
+            failure.text = text
+        elif r.examples == 0:
+            ET.SubElement(case, "skipped", message="no example ran within the time budget")
+        out = ET.SubElement(case, "system-out")
+        out.text = f"{r.claim}: {r.examples} examples in {r.seconds:.2f} s"
+        for pattern, count in r.known.items():
+            out.text += f"\nleft out, a known problem of fuzzoff in {count} examples: "
+            out.text += KNOWN.get(pattern, pattern)
+    root = ET.Element("testsuites")
+    root.append(suite)
     ET.indent(root)
     return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"

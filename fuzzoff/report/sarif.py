@@ -24,6 +24,7 @@ from fuzzoff import __version__
 from fuzzoff.catalog import Rule, load_catalog, render_page
 from fuzzoff.config import Settings
 from fuzzoff.findings import Finding, Report, Severity
+from fuzzoff.report import CampaignReport
 from fuzzoff.report.sanitize import CI_TEXT_LIMIT, escape_bidi, printable
 
 SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
@@ -182,3 +183,57 @@ def sarif_log(report: Report, settings: Settings, root: Path | None = None) -> d
 
 def render(report: Report, settings: Settings) -> str:
     return escape_bidi(json.dumps(sarif_log(report, settings), indent=2, ensure_ascii=False)) + "\n"
+
+
+def render_campaign(campaign: CampaignReport) -> str:
+    """``fuzzoff fuzz --format sarif``: one rule per property (``fuzz/<name>``), one result per
+    counterexample, located at the saved reproducer (an artifact, so code scanning shows it
+    where it was committed)."""
+    result, saved = campaign.result, campaign.saved
+    root = Path.cwd().resolve()
+    rules = [
+        {
+            "id": f"fuzz/{r.name}",
+            "name": "".join(p.capitalize() for p in r.name.split("-")),
+            "shortDescription": {"text": r.claim},
+            "defaultConfiguration": {"level": "error"},
+        }
+        for r in result.results
+    ]
+    results = []
+    for r in result.results:
+        if not r.failed:
+            continue
+        item: dict[str, Any] = {
+            "ruleId": f"fuzz/{r.name}",
+            "level": "error",
+            "message": {"text": "; ".join(r.problems)[:2000]},
+            "properties": {
+                "counterexample": None if r.counterexample is None else r.counterexample.describe(),
+                "seed": result.config.seed,
+            },
+        }
+        if r.name in saved:
+            # As lint writes it: relative to the working folder (SRCROOT), percent-encoded.
+            uri, base = artifact_uri(str(saved[r.name]), root)
+            location = {"uri": uri, **({"uriBaseId": base} if base else {})}
+            item["locations"] = [{"physicalLocation": {"artifactLocation": location}}]
+        results.append(item)
+    doc = {
+        "$schema": SCHEMA,
+        "version": "2.1.0",
+        "runs": [
+            {
+                "tool": {
+                    "driver": {
+                        "name": "fuzzoff",
+                        "version": __version__,
+                        "rules": rules,
+                    }
+                },
+                "originalUriBaseIds": {BASE_ID: {"uri": root.as_uri() + "/"}},
+                "results": results,
+            }
+        ],
+    }
+    return json.dumps(doc, indent=2) + "\n"

@@ -9,24 +9,28 @@ Colour only on a terminal and without ``NO_COLOR`` (rich decides; ``FORCE_COLOR`
 tables fall back to ASCII when the output is not a terminal. Every string that comes from a
 recording goes through ``printable`` and into ``Text`` objects, never into markup, so escape
 sequences in a recording are shown as ``\\x1b`` and never reach the terminal.
+
+A fuzz campaign's report is plain text (``render_campaign``), one line per property.
 """
 
 from __future__ import annotations
 
 from collections import Counter
+from typing import TYPE_CHECKING
 
 from rich import box
 from rich.console import Console
-from rich.progress import BarColumn, Progress, TaskID, TextColumn, TimeRemainingColumn
 from rich.table import Table
 from rich.text import Text
 
 from fuzzoff.catalog import get_rule
-from fuzzoff.config import Settings
-from fuzzoff.engine import lint_file
 from fuzzoff.findings import FileReport, Finding, Report, Severity
+from fuzzoff.fuzz.known import KNOWN
+from fuzzoff.report import CampaignReport, campaign_seeds
 from fuzzoff.report.sanitize import printable
-from fuzzoff.sources import recordings_in
+
+if TYPE_CHECKING:
+    from fuzzoff.fuzz.campaign import CampaignResult, PropertyResult
 
 STYLE = {Severity.ERROR: "bold red", Severity.WARNING: "yellow", Severity.INFO: "cyan"}
 VERDICT = {0: "passed", 1: "failed", 2: "incomplete input"}
@@ -227,18 +231,55 @@ def print_report(
         print_summary(console, report, fail_on, verbose)
 
 
-def lint_with_progress(paths: list[str], settings: Settings, console: Console) -> Report:
-    """One file at a time with a progress bar on the terminal (long files take seconds)."""
-    report = Report()
-    files = recordings_in(paths)
-    columns = (TextColumn("{task.description}"), BarColumn(), TimeRemainingColumn())
-    with Progress(*columns, console=console, transient=True) as progress:
-        for f in files:
-            task = progress.add_task(printable(f.name, 60), total=1.0)
+def _property_line(r: PropertyResult) -> str:
+    rate = f"{r.examples / r.seconds:.0f}/s" if r.seconds else "-"
+    verdict = "FAILED" if r.failed else ("counted" if r.name == "docs-stricter" else "held")
+    if not r.examples:
+        verdict = "not run"
+    return f"  {r.name:<14} {verdict:<8} {r.examples:>6} examples {r.seconds:7.2f} s {rate:>7}"
 
-            def advance(fraction: float, task: TaskID = task) -> None:
-                progress.update(task, completed=fraction)
 
-            report.files.append(lint_file(f, settings, progress=advance))
-            progress.remove_task(task)
-    return report
+def render_campaign(campaign: CampaignReport) -> str:
+    """``fuzzoff fuzz``'s text: a line per property, its counterexample and what was left out."""
+    result, saved = campaign.result, campaign.saved
+    margins = campaign.margins
+    lines = [f"fuzzoff fuzz, {campaign_seeds(result)}"]
+    for problem in result.config.base_problems:
+        lines.append(f"  --from incomplete, the part before this was fuzzed: {printable(problem)}")
+    for r in result.results:
+        lines.append(_property_line(r))
+        if r.failed:
+            shrunk = f", shrunk in {r.shrinks} steps" if r.shrinks else ""
+            lines.append(
+                f"      {r.failed_examples} of {r.examples} examples failed; the first "
+                f"(example {r.found_after}){shrunk}:"
+            )
+        for p in r.problems:
+            lines.append(f"      {printable(p, 300)}")
+        if r.counterexample is not None:
+            lines.append(f"      counterexample: {r.counterexample.describe()}")
+        if r.name in saved:
+            lines.append(f"      reproducer: {saved[r.name]}  (fuzzoff replay {saved[r.name]})")
+        for pattern, count in r.known.items():
+            what = KNOWN.get(pattern, pattern)
+            lines.append(
+                f"      left out: a known problem of fuzzoff in {count} examples "
+                f"(--include-known to fail on it): {printable(what, 200)}"
+            )
+        for code, c in r.counts.items():
+            lines.append(
+                f"      {code}: fired {c['fired']}, gate accepted {c['gate_accepted']} "
+                "(docs stricter than code)"
+            )
+    for m in margins:
+        lines.append(f"  margin {m.family:<7} {m.describe()}")
+    lines.append(f"{result.examples} examples in {result.seconds:.1f} s; {_verdict(result)}")
+    return "\n".join(lines) + "\n"
+
+
+def _verdict(result: CampaignResult) -> str:
+    failed = sum(1 for r in result.results if r.failed)
+    verdicts = [f"{failed} propert{'y' if failed == 1 else 'ies'} failed"] if failed else []
+    if result.unchecked:
+        verdicts.append(f"no example of {', '.join(result.unchecked)} ran")
+    return "; ".join(verdicts) or "all held"

@@ -14,9 +14,9 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import TracebackType
-from typing import Any
 
 from fuzzoff.events import Event
+from fuzzoff.findings import RecordingStats
 
 
 def path_text(path: Path | str) -> str:
@@ -117,7 +117,7 @@ class Source(abc.ABC):
     def __init__(self, path: Path) -> None:
         self.path = path
         self.problems: list[SourceProblem] = []
-        self.stats: dict[str, Any] = {}
+        self.stats = RecordingStats()
         self.on_progress: Callable[[], None] | None = None
         """Set by the caller that shows progress: a reader that reads a long stretch without
         an event (a tlog's garbage) calls it now and then."""

@@ -31,6 +31,7 @@ from fuzzoff.events import (
     VehicleStatus,
     Where,
 )
+from fuzzoff.findings import RecordingStats
 from fuzzoff.modes import custom_mode_to_nav_state, nav_state_name, split_custom_mode
 from fuzzoff.profiles import MAV_TYPE_VEHICLE
 from fuzzoff.sources.base import (
@@ -321,7 +322,7 @@ class TlogSource(Source):
             )
         self.problems.extend(lines)
 
-    def _stats(self, stats: FrameStats, decoder: _Decoder) -> dict[str, Any]:
+    def _stats(self, stats: FrameStats, decoder: _Decoder) -> RecordingStats:
         return {
             "packets": stats.packets,
             "bad_data": len(stats.regions),
