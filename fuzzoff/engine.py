@@ -27,6 +27,7 @@ from fuzzoff.events import (
     is_keepalive,
 )
 from fuzzoff.findings import FileReport, Finding, Report, Severity, clip, first_clause
+from fuzzoff.formats import SourceError, open_source, recordings_in
 from fuzzoff.gate import GateModel, GateTransition
 from fuzzoff.profiles import (
     DEFAULT_PX4,
@@ -35,8 +36,7 @@ from fuzzoff.profiles import (
     ProfileError,
     px4_profile_for,
 )
-from fuzzoff.sources import SourceError, open_source, recordings_in
-from fuzzoff.sources.base import RecordingInfo, SourceProblem, path_text
+from fuzzoff.recording import RecordingInfo, SourceProblem, path_text
 from fuzzoff.state import VehicleState
 
 Progress = Callable[[float], None]

@@ -41,11 +41,11 @@ os.environ.setdefault("MAVLINK20", "1")
 from pymavlink import mavutil
 
 from fuzzoff import events as ev
-from fuzzoff.sources.mavros_msgs import mavros_typedefs
-from fuzzoff.writers.mcap import write_mcap
-from fuzzoff.writers.ros2_messages import RawMessage
-from fuzzoff.writers.rosbag1 import Ros1Message, mavros_typestore, write_rosbag1
-from fuzzoff.writers.rosbag2 import write_rosbag2
+from fuzzoff.formats.mavros.mavros_msgs import mavros_typedefs
+from fuzzoff.formats.mcap.writer import write_mcap
+from fuzzoff.formats.ros2msgs.messages import RawMessage
+from fuzzoff.formats.rosbag1.writer import Ros1Message, mavros_typestore, write_rosbag1
+from fuzzoff.formats.rosbag2.writer import write_rosbag2
 
 HERE = Path(__file__).resolve().parent
 RUNS = HERE / "runs"

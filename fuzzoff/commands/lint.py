@@ -25,10 +25,10 @@ from fuzzoff.config import ConfigError, Settings
 from fuzzoff.engine import lint_paths
 from fuzzoff.findings import Report
 from fuzzoff.fleet import fleet_wanted
+from fuzzoff.formats import RECORDING_SUFFIXES, find_recordings
 from fuzzoff.report import FORMATS, renderer
 from fuzzoff.report.sanitize import printable
 from fuzzoff.report.timelines import lint_with_timelines
-from fuzzoff.sources import RECORDING_SUFFIXES, find_recordings
 
 
 def add_parser(sub: Any) -> None:

@@ -9,15 +9,15 @@ import stat
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 
-from fuzzoff.sources.base import RecordingInfo, Source, SourceError, SourceProblem
+from fuzzoff.recording import RecordingInfo, Source, SourceError, SourceProblem
 
 READERS: dict[str, str] = {
-    "tlog": "fuzzoff.sources.tlog:TlogSource",
-    "ulog": "fuzzoff.sources.ulog:UlogSource",
-    "mcap": "fuzzoff.sources.mcap:McapSource",
-    "rosbag2-sqlite3": "fuzzoff.sources.rosbag2:Rosbag2Source",
-    "rosbag2-mcap": "fuzzoff.sources.rosbag2:Rosbag2Source",
-    "rosbag1": "fuzzoff.sources.rosbag1:Rosbag1Source",
+    "tlog": "fuzzoff.formats.tlog.reader:TlogSource",
+    "ulog": "fuzzoff.formats.ulog.reader:UlogSource",
+    "mcap": "fuzzoff.formats.mcap.reader:McapSource",
+    "rosbag2-sqlite3": "fuzzoff.formats.rosbag2.reader:Rosbag2Source",
+    "rosbag2-mcap": "fuzzoff.formats.rosbag2.reader:Rosbag2Source",
+    "rosbag1": "fuzzoff.formats.rosbag1.reader:Rosbag1Source",
 }
 """Format name -> reader class; imported lazily so a run loads only the libraries it needs."""
 

@@ -1,4 +1,4 @@
-"""Scenarios to recordings through the real writers (``fuzzoff/writers``), and back.
+"""Scenarios to recordings through the real writers (``formats/<name>/writer.py``), and back.
 
 ``FORMATS_FOR`` lists the formats each transport's stream can be written to: ROS 2 direct ->
 MCAP and a rosbag2 (sqlite3) bag; MAVLink -> tlog; MAVROS -> ROS 1 bag. ULog is left out: it is
@@ -11,10 +11,10 @@ from __future__ import annotations
 from pathlib import Path
 
 from fuzzoff.events import Event
+from fuzzoff.formats import open_source
+from fuzzoff.formats.ros2msgs.px4_msgs import release_for
 from fuzzoff.fuzz.scenario import Scenario
-from fuzzoff.sources import open_source
-from fuzzoff.sources.base import RecordingInfo, path_text
-from fuzzoff.sources.px4_msgs import release_for
+from fuzzoff.recording import RecordingInfo, path_text
 
 FORMATS_FOR: dict[str, tuple[str, ...]] = {
     "ros2": ("mcap", "rosbag2"),
@@ -34,19 +34,19 @@ def write(scenario: Scenario, path: Path, fmt: str) -> Path:
     """Write the scenario's events as ``fmt`` at ``path`` (a folder for rosbag2)."""
     events = list(scenario.events)
     if fmt == "mcap":
-        from fuzzoff.writers.mcap import write_mcap
+        from fuzzoff.formats.mcap.writer import write_mcap
 
         return write_mcap(path, events, release=release(scenario))
     if fmt == "rosbag2":
-        from fuzzoff.writers.rosbag2 import write_rosbag2
+        from fuzzoff.formats.rosbag2.writer import write_rosbag2
 
         return write_rosbag2(path, events, release=release(scenario))
     if fmt == "tlog":
-        from fuzzoff.writers.tlog import write_tlog
+        from fuzzoff.formats.tlog.writer import write_tlog
 
         return write_tlog(path, events)
     if fmt == "rosbag1":
-        from fuzzoff.writers.rosbag1 import write_rosbag1
+        from fuzzoff.formats.rosbag1.writer import write_rosbag1
 
         return write_rosbag1(path, events)
     raise ValueError(f"no writer for {fmt!r}")

@@ -17,7 +17,7 @@ from fuzzoff.engine import Timeline, run_events
 from fuzzoff.events import Event, VehicleStatus, Where, event_from_dict, event_to_dict
 from fuzzoff.findings import Finding
 from fuzzoff.profiles import Profile
-from fuzzoff.sources.base import RecordingInfo
+from fuzzoff.recording import RecordingInfo
 
 TransportName = Literal["ros2", "mavlink", "mavros"]
 TRANSPORTS: tuple[TransportName, ...] = ("ros2", "mavlink", "mavros")

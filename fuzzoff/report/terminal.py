@@ -25,8 +25,8 @@ from fuzzoff.catalog import get_rule
 from fuzzoff.config import Settings
 from fuzzoff.engine import lint_file
 from fuzzoff.findings import FileReport, Finding, Report, Severity
+from fuzzoff.formats import recordings_in
 from fuzzoff.report.sanitize import printable
-from fuzzoff.sources import recordings_in
 
 STYLE = {Severity.ERROR: "bold red", Severity.WARNING: "yellow", Severity.INFO: "cyan"}
 VERDICT = {0: "passed", 1: "failed", 2: "incomplete input"}

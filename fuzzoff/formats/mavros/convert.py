@@ -33,9 +33,7 @@ from fuzzoff.events import (
     VehicleStatus,
     Where,
 )
-from fuzzoff.modes import mavros_mode_to_nav_state
-from fuzzoff.sources.base import POSITION_PERIOD_S
-from fuzzoff.sources.mavros_frames import (
+from fuzzoff.formats.mavros.frames import (
     AIRCRAFT_BASELINK_Q,
     enu_to_ned,
     flu_to_frd,
@@ -46,6 +44,8 @@ from fuzzoff.sources.mavros_frames import (
     yaw_enu_to_ned,
     yaw_flu_to_frd,
 )
+from fuzzoff.modes import mavros_mode_to_nav_state
+from fuzzoff.recording import POSITION_PERIOD_S
 
 # MAV_FRAME values MAVROS compares against (PositionTarget constants).
 FRAME_LOCAL_NED = 1

@@ -1,4 +1,4 @@
-"""MAVROS topics in ROS 2 recordings: decode, then ``fuzzoff.sources.mavros`` turns each message
+"""MAVROS topics in ROS 2 recordings: decode, then ``mavros.convert`` turns each message
 into the MAVLink event MAVROS sends PX4 (formats.md 6.1).
 
 Definitions: the recording's own (MCAP schema, rosbag2 schema 4), else the shipped
@@ -16,9 +16,9 @@ from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.store import Typestore
 
 from fuzzoff.events import Event
-from fuzzoff.sources.mavros import TOPIC_KINDS, Handler, MavrosTopic
-from fuzzoff.sources.mavros_msgs import mavros_typedefs
-from fuzzoff.sources.typedefs import bounded
+from fuzzoff.formats.mavros.convert import TOPIC_KINDS, Handler, MavrosTopic
+from fuzzoff.formats.mavros.mavros_msgs import mavros_typedefs
+from fuzzoff.formats.typedefs import bounded
 
 
 @cache

@@ -6,7 +6,7 @@ base, salvage and problems are the same for both formats.
 
 from __future__ import annotations
 
-from fuzzoff.sources.rosbag2 import Rosbag2Source
+from fuzzoff.formats.rosbag2.reader import Rosbag2Source
 
 
 class McapSource(Rosbag2Source):

@@ -26,9 +26,9 @@ from mcap.stream_reader import (
 )
 
 from fuzzoff.events import Event
-from fuzzoff.sources.base import SourceProblem
-from fuzzoff.sources.ros2_decode import Decoder, Ros2Decoding
-from fuzzoff.sources.ros2_order import ChunkOrder
+from fuzzoff.formats.mcap.order import ChunkOrder
+from fuzzoff.formats.ros2msgs.decode import Decoder, Ros2Decoding
+from fuzzoff.recording import SourceProblem
 
 Connect = Callable[[str, str, str | None, str], Decoder | None]
 """(topic, message type, embedded definition, its format) -> decoder or None."""

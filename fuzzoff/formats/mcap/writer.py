@@ -16,8 +16,8 @@ from mcap.writer import CompressionType
 from mcap_ros2.writer import Writer
 
 from fuzzoff.events import Event
-from fuzzoff.sources import px4_msgs
-from fuzzoff.writers.ros2_messages import (
+from fuzzoff.formats.ros2msgs import px4_msgs
+from fuzzoff.formats.ros2msgs.messages import (
     START_NS,
     Px4Message,
     RawMessage,

@@ -20,14 +20,14 @@ from rosbags.typesys import get_types_from_idl, get_types_from_msg
 from rosbags.typesys.store import Typestore
 
 from fuzzoff.events import NOWHERE, Event, Origin, VehicleStatus, Where
+from fuzzoff.formats.mavros.convert import MavrosConverter, mavros_topic
+from fuzzoff.formats.mavros.ros2 import MavrosTopicDecoder
+from fuzzoff.formats.ros2msgs import px4_msgs
+from fuzzoff.formats.ros2msgs.convert import BUILDERS, KIND_OF, Builder
+from fuzzoff.formats.ros2msgs.topics import MESSAGE_FOR_NAME, OUTPUT_MESSAGES, TopicRef, parse_topic
+from fuzzoff.formats.typedefs import bounded
 from fuzzoff.profiles import PX4_VEHICLE_TYPE
-from fuzzoff.sources import px4_msgs
-from fuzzoff.sources.base import SourceProblem
-from fuzzoff.sources.mavros import MavrosConverter, mavros_topic
-from fuzzoff.sources.ros2_convert import BUILDERS, KIND_OF, Builder
-from fuzzoff.sources.ros2_mavros import MavrosTopicDecoder
-from fuzzoff.sources.ros2_topics import MESSAGE_FOR_NAME, OUTPUT_MESSAGES, TopicRef, parse_topic
-from fuzzoff.sources.typedefs import bounded
+from fuzzoff.recording import SourceProblem
 
 _DECODE_ERRORS = (struct.error, IndexError, ValueError, TypeError, UnicodeDecodeError, SerdeError)
 """What rosbags' CDR decoders raise on a payload that does not fit its definition (a length

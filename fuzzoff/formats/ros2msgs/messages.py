@@ -1,4 +1,4 @@
-"""Events -> px4_msgs messages of a chosen release (the inverse of ``sources/ros2_convert``).
+"""Events -> px4_msgs messages of a chosen release (the inverse of ``ros2msgs.convert``).
 
 Shared by the MCAP and rosbag2 writers. A message is a plain dict holding every wire field of
 the release's bundled definition (fields the event does not carry get zero / NaN defaults), the
@@ -16,9 +16,9 @@ from typing import Any
 import numpy as np
 
 from fuzzoff import events as ev
-from fuzzoff.sources import px4_msgs
-from fuzzoff.sources.ros2_convert import ARMING_STATE_ARMED, ESTIMATES
-from fuzzoff.sources.ros2_topics import topic_for
+from fuzzoff.formats.ros2msgs import px4_msgs
+from fuzzoff.formats.ros2msgs.convert import ARMING_STATE_ARMED, ESTIMATES
+from fuzzoff.formats.ros2msgs.topics import topic_for
 
 START_NS = 1_700_000_000_000_000_000
 """Recording start (log time of t = 0) used by the writers unless told otherwise."""

@@ -1,6 +1,6 @@
 """ROS 1 bags (``#ROSBAG V2.0``) with MAVROS topics, read by ``rosbags.rosbag1`` (formats.md 6).
 
-Only the connections that matter are decoded: the MAVROS topics ``fuzzoff.sources.mavros``
+Only the connections that matter are decoded: the MAVROS topics ``fuzzoff.formats.mavros.convert``
 converts (setpoints and ``state``). Every other connection (images, IMU, ...) is filtered out
 before its messages are read, using the bag's index, one chunk at a time
 (``rosbag1_chunkwise``: memory does not grow with the bag). Message definitions come from the bag
@@ -26,19 +26,19 @@ from rosbags.rosbag1 import ReaderError
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 from fuzzoff.events import Event
-from fuzzoff.sources.base import (
+from fuzzoff.formats.mavros.convert import TOPIC_KINDS, Handler, MavrosConverter, mavros_topic
+from fuzzoff.formats.mavros.mavros_msgs import mavros_typedefs
+from fuzzoff.formats.rosbag1.check import chunk_infos_disagree, walk
+from fuzzoff.formats.rosbag1.chunkwise import ChunkwiseReader
+from fuzzoff.formats.rosbag1.salvage import SalvageReader, bag_header_index_pos
+from fuzzoff.formats.typedefs import bounded
+from fuzzoff.recording import (
     POSITION_PERIOD_S,
     RecordingInfo,
     Source,
     SourceError,
     SourceProblem,
 )
-from fuzzoff.sources.mavros import TOPIC_KINDS, Handler, MavrosConverter, mavros_topic
-from fuzzoff.sources.mavros_msgs import mavros_typedefs
-from fuzzoff.sources.rosbag1_check import chunk_infos_disagree, walk
-from fuzzoff.sources.rosbag1_chunkwise import ChunkwiseReader
-from fuzzoff.sources.rosbag1_salvage import SalvageReader, bag_header_index_pos
-from fuzzoff.sources.typedefs import bounded
 
 REINDEX_HINT = "run `rosbag reindex` on it for a complete read"
 

@@ -1,6 +1,6 @@
 """Normalised events -> a ROS 1 bag of MAVROS topics, written by ``rosbags.rosbag1.Writer``.
 
-The inverse of ``fuzzoff.sources.mavros``: each MAVLink setpoint event becomes the MAVROS
+The inverse of ``fuzzoff.formats.mavros.convert``: each MAVLink setpoint event becomes the MAVROS
 message that makes MAVROS send exactly that setpoint, on the ``setpoint_raw/*`` topics (the only
 ones that carry every field and the ``type_mask`` through unchanged):
 
@@ -40,15 +40,15 @@ from fuzzoff.events import (
     SetPositionTargetLocal,
     VehicleStatus,
 )
-from fuzzoff.modes import mavros_mode_to_nav_state, nav_state_to_mavros_mode
-from fuzzoff.sources.mavros import BODY_FRAMES
-from fuzzoff.sources.mavros_frames import (
+from fuzzoff.formats.mavros.convert import BODY_FRAMES
+from fuzzoff.formats.mavros.frames import (
     enu_to_ned,
     flu_to_frd,
     orientation_ned_to_enu,
     wrap_pi,
 )
-from fuzzoff.sources.mavros_msgs import mavros_typedefs
+from fuzzoff.formats.mavros.mavros_msgs import mavros_typedefs
+from fuzzoff.modes import mavros_mode_to_nav_state, nav_state_to_mavros_mode
 
 DEFAULT_START_NS = 1_735_689_600 * 1_000_000_000
 """2025-01-01 00:00:00 UTC: the bag time of ``t = 0``."""

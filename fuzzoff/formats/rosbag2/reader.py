@@ -22,21 +22,24 @@ from rosbags.rosbag2 import Reader
 from ruamel.yaml import YAML
 
 from fuzzoff.events import Event
+from fuzzoff.formats.mavros.convert import mavros_topic
+from fuzzoff.formats.mcap import check as mcap_check
+from fuzzoff.formats.mcap import indexed as mcap_indexed
+from fuzzoff.formats.mcap.order import ChunkOrder
+from fuzzoff.formats.mcap.stream import McapStream
+from fuzzoff.formats.ros2msgs import px4_msgs
+from fuzzoff.formats.ros2msgs.decode import Decoder, Ros2Decoding, TopicDecoder, message_of
+from fuzzoff.formats.rosbag2 import metadata as ros2_metadata
+from fuzzoff.formats.rosbag2.sqlite import SQLITE_ERRORS, SalvageCopies
+from fuzzoff.formats.rosbag2.sqlite import topics as sqlite_topics
 from fuzzoff.profiles import ROVER_ASSUMED
-from fuzzoff.sources import mcap_check, mcap_indexed, px4_msgs, ros2_metadata
-from fuzzoff.sources.base import (
+from fuzzoff.recording import (
     POSITION_PERIOD_S,
     RecordingInfo,
     Source,
     SourceError,
     SourceProblem,
 )
-from fuzzoff.sources.mavros import mavros_topic
-from fuzzoff.sources.mcap_stream import McapStream
-from fuzzoff.sources.ros2_decode import Decoder, Ros2Decoding, TopicDecoder, message_of
-from fuzzoff.sources.ros2_order import ChunkOrder
-from fuzzoff.sources.rosbag2_sqlite import SQLITE_ERRORS, SalvageCopies
-from fuzzoff.sources.rosbag2_sqlite import topics as sqlite_topics
 
 DATA_SUFFIXES = (".db3", ".mcap")
 STATUS_WINDOW_NS = 10_000_000_000

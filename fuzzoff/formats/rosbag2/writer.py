@@ -19,8 +19,8 @@ from rosbags.rosbag2 import StoragePlugin, Writer
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 from fuzzoff.events import Event
-from fuzzoff.sources import px4_msgs
-from fuzzoff.writers.ros2_messages import (
+from fuzzoff.formats.ros2msgs import px4_msgs
+from fuzzoff.formats.ros2msgs.messages import (
     START_NS,
     RawMessage,
     encode,

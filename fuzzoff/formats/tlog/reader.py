@@ -31,16 +31,16 @@ from fuzzoff.events import (
     VehicleStatus,
     Where,
 )
+from fuzzoff.formats.tlog.frames import RESYNC_LIMIT, Framer, FrameStats, message_name
 from fuzzoff.modes import custom_mode_to_nav_state, nav_state_name, split_custom_mode
 from fuzzoff.profiles import MAV_TYPE_VEHICLE
-from fuzzoff.sources.base import (
+from fuzzoff.recording import (
     POSITION_PERIOD_S,
     RecordingInfo,
     Source,
     SourceError,
     SourceProblem,
 )
-from fuzzoff.sources.tlog_frames import RESYNC_LIMIT, Framer, FrameStats, message_name
 
 HEARTBEAT = 0
 SYS_STATUS = 1

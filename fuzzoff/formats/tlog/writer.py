@@ -4,7 +4,7 @@ One pymavlink ``MAVLink`` encoder per sender (autopilot, companion, GCS) so each
 its own sequence numbers; every record is the 8-byte big-endian microsecond timestamp followed
 by the packet, as QGroundControl and MAVProxy write them.
 
-What becomes what (the inverse of ``fuzzoff.sources.tlog``):
+What becomes what (the inverse of ``fuzzoff.formats.tlog.reader``):
 
 * setpoints -> SET_POSITION_TARGET_LOCAL_NED / _GLOBAL_INT / SET_ATTITUDE_TARGET from the
   event's ``source_system``/``source_component`` (default: the companion); ``thrust_body``
@@ -82,7 +82,7 @@ SUPPORTED: tuple[type[Event], ...] = (
     VehiclePosition,
     LandDetected,
 )
-"""The event kinds a tlog carries (what ``fuzzoff.sources.tlog`` emits)."""
+"""The event kinds a tlog carries (what ``fuzzoff.formats.tlog.reader`` emits)."""
 
 _RELEASE = re.compile(r"^v?(\d+)\.(\d+)(?:\.(\d+))?")
 

@@ -35,7 +35,7 @@ from typing import Any, BinaryIO
 from pyulog import ULog
 from pyulog.core import ULogException
 
-from fuzzoff.sources.base import SourceError, SourceProblem
+from fuzzoff.recording import SourceError, SourceProblem
 
 _unpack_header = struct.Struct("<HB").unpack
 

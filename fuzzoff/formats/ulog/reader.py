@@ -21,16 +21,8 @@ from typing import Any
 import numpy as np
 
 from fuzzoff import events as ev
-from fuzzoff.profiles import MAV_TYPE_VEHICLE, PX4_VEHICLE_TYPE, ProfileError, px4_profile_for
-from fuzzoff.sources.base import (
-    POSITION_PERIOD_S,
-    RecordingInfo,
-    Source,
-    SourceError,
-    SourceProblem,
-)
-from fuzzoff.sources.ulog_load import Loaded, load, quoted
-from fuzzoff.sources.ulog_topics import (
+from fuzzoff.formats.ulog.load import Loaded, load, quoted
+from fuzzoff.formats.ulog.topics import (
     EXTRA_FIELDS,
     EXTRA_TOPICS,
     GPS_TOPICS,
@@ -40,6 +32,14 @@ from fuzzoff.sources.ulog_topics import (
     Context,
     failsafe_flags,
     renamed_fields,
+)
+from fuzzoff.profiles import MAV_TYPE_VEHICLE, PX4_VEHICLE_TYPE, ProfileError, px4_profile_for
+from fuzzoff.recording import (
+    POSITION_PERIOD_S,
+    RecordingInfo,
+    Source,
+    SourceError,
+    SourceProblem,
 )
 
 LOADED_TOPICS: tuple[str, ...] = (*TOPICS, *EXTRA_TOPICS)

@@ -23,8 +23,8 @@ import numpy as np
 from pyulog import ULog
 
 from fuzzoff import events as ev
-from fuzzoff.sources.ulog_topics import NAV_TO_MAIN_STATE
-from fuzzoff.writers.ulog_formats import FORMATS, NESTED, era_for, fields_for
+from fuzzoff.formats.ulog.layouts import FORMATS, NESTED, era_for, fields_for
+from fuzzoff.formats.ulog.topics import NAV_TO_MAIN_STATE
 
 DEFAULT_START_US = 20_000_000
 """PX4's logger starts some seconds after boot; the header timestamp is that moment."""
@@ -136,7 +136,7 @@ class _Topics:
         return self.era != "legacy"
 
     def _at_least(self, era: str) -> bool:
-        from fuzzoff.writers.ulog_formats import ERAS
+        from fuzzoff.formats.ulog.layouts import ERAS
 
         return ERAS.index(self.era) >= ERAS.index(era)
 

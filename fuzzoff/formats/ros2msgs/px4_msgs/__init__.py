@@ -16,8 +16,8 @@ from importlib import resources
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.store import Typestore
 
+from fuzzoff.formats.typedefs import bounded
 from fuzzoff.profiles import ProfileError, px4_profile_for
-from fuzzoff.sources.typedefs import bounded
 
 RELEASES: tuple[str, ...] = ("1.13", "1.14", "1.15", "1.16", "1.17", "main")
 """Oldest to newest; ``main`` is release/1.18 (identical to main for these messages)."""

@@ -1,0 +1,1 @@
+"""ROS 2 bag folders (sqlite3 or MCAP storage): reader, metadata.yaml checks, salvage, writer."""
