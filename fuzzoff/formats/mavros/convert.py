@@ -35,6 +35,8 @@ from fuzzoff.events import (
 )
 from fuzzoff.formats.mavros.frames import (
     AIRCRAFT_BASELINK_Q,
+    BODY_FRAMES,
+    FRAME_LOCAL_NED,
     enu_to_ned,
     flu_to_frd,
     orientation_enu_to_ned,
@@ -46,13 +48,6 @@ from fuzzoff.formats.mavros.frames import (
 )
 from fuzzoff.modes import mavros_mode_to_nav_state
 from fuzzoff.recording import POSITION_PERIOD_S
-
-# MAV_FRAME values MAVROS compares against (PositionTarget constants).
-FRAME_LOCAL_NED = 1
-FRAME_GLOBAL_INT = 5
-FRAME_BODY_NED = 8
-FRAME_BODY_OFFSET_NED = 9
-BODY_FRAMES = frozenset({FRAME_BODY_NED, FRAME_BODY_OFFSET_NED})
 
 # type_mask values MAVROS's plugins hard-code (bit numbers as in POSITION_TARGET_TYPEMASK).
 MASK_POSITION_YAW = (1 << 11) | (7 << 6) | (7 << 3)  # 0x9F8: setpoint_position/local

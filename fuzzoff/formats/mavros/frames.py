@@ -18,6 +18,14 @@ import math
 
 from fuzzoff.events import Quat, Vec3
 
+# MAV_FRAME values MAVROS compares against (PositionTarget constants).
+FRAME_LOCAL_NED = 1
+FRAME_GLOBAL_INT = 5
+FRAME_BODY_NED = 8
+FRAME_BODY_OFFSET_NED = 9
+BODY_FRAMES = frozenset({FRAME_BODY_NED, FRAME_BODY_OFFSET_NED})
+"""Frames whose setpoint MAVROS turns from FLU to FRD, not from ENU to NED."""
+
 
 def quat_mul(a: Quat, b: Quat) -> Quat:
     aw, ax, ay, az = a

@@ -12,14 +12,11 @@ from typing import Any
 
 from fuzzoff import events as ev
 from fuzzoff.events import Event, Origin, Where
+from fuzzoff.formats.uorb import ARMING_STATE_ARMED, ESTIMATES
 from fuzzoff.modes import nav_state_name
 
 Builder = Callable[[Any, float, Where, int], Event]
 """(decoded message, t, where, sender_time_us) -> event."""
-
-ARMING_STATE_ARMED = 2
-"""``arming_state`` value for armed in every release (1.13/1.14 and 1.15+ numberings agree)."""
-
 
 def _vec(value: Any) -> tuple[float, ...]:
     """A fixed array (rosbags: a numpy array) as a tuple of Python floats."""
@@ -334,18 +331,6 @@ def _control_mode_status(fields: frozenset[str], vehicle: str, origin: Origin) -
         )
 
     return build
-
-
-ESTIMATES = (
-    "local_position",
-    "local_velocity",
-    "local_altitude",
-    "global_position",
-    "attitude",
-    "angular_velocity",
-    "home_position",
-)
-"""``FailsafeFlags`` ``<estimate>_invalid`` fields, negated into ``FailsafeFlags`` events."""
 
 
 def _failsafe_flags(fields: frozenset[str], vehicle: str, origin: Origin) -> Builder:

@@ -17,14 +17,11 @@ import numpy as np
 
 from fuzzoff import events as ev
 from fuzzoff.formats.ros2msgs import px4_msgs
-from fuzzoff.formats.ros2msgs.convert import ARMING_STATE_ARMED, ESTIMATES
 from fuzzoff.formats.ros2msgs.topics import topic_for
+from fuzzoff.formats.uorb import ARMING_STATE_ARMED, ARMING_STATE_DISARMED, ESTIMATES
 
 START_NS = 1_700_000_000_000_000_000
 """Recording start (log time of t = 0) used by the writers unless told otherwise."""
-
-ARMING_STATE_DISARMED = 1
-"""STANDBY in 1.13/1.14, DISARMED from 1.15: 1 in both numberings."""
 
 _MESSAGE_OF: dict[type[ev.Event], str] = {
     ev.ControlMode: "OffboardControlMode",

@@ -40,8 +40,8 @@ from fuzzoff.events import (
     SetPositionTargetLocal,
     VehicleStatus,
 )
-from fuzzoff.formats.mavros.convert import BODY_FRAMES
 from fuzzoff.formats.mavros.frames import (
+    BODY_FRAMES,
     enu_to_ned,
     flu_to_frd,
     orientation_ned_to_enu,

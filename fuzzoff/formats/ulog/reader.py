@@ -26,13 +26,13 @@ from fuzzoff.formats.ulog.topics import (
     EXTRA_FIELDS,
     EXTRA_TOPICS,
     GPS_TOPICS,
-    MAIN_STATE_TO_NAV,
     TOPICS,
     Chunk,
     Context,
     failsafe_flags,
     renamed_fields,
 )
+from fuzzoff.formats.uorb import MAIN_STATE_TO_NAV
 from fuzzoff.profiles import MAV_TYPE_VEHICLE, PX4_VEHICLE_TYPE, ProfileError, px4_profile_for
 from fuzzoff.recording import (
     POSITION_PERIOD_S,

@@ -19,35 +19,13 @@ from typing import Any, Literal
 import numpy as np
 
 from fuzzoff import events as ev
+from fuzzoff.formats.uorb import ESTIMATES
 from fuzzoff.modes import nav_state_name
 
 VEHICLE: Literal["vehicle"] = "vehicle"
 
 Columns = Mapping[str, Any]
 """Field name -> numpy array (one topic instance, as in ``ULog.Data.data``)."""
-
-MAIN_STATE_TO_NAV: dict[int, int] = {
-    0: 0,
-    1: 1,
-    2: 2,
-    3: 3,
-    4: 4,
-    5: 5,
-    6: 10,
-    7: 14,
-    8: 15,
-    9: 16,
-    10: 17,
-    11: 18,
-    12: 19,
-    13: 20,
-    14: 21,
-    15: 22,
-}
-"""``commander_state.main_state`` (legacy - v1.13) -> the nav_state of the same mode (gate 11)."""
-
-NAV_TO_MAIN_STATE: dict[int, int] = {nav: main for main, nav in MAIN_STATE_TO_NAV.items()}
-
 
 @dataclass(slots=True)
 class Context:
@@ -459,17 +437,6 @@ def control_mode_status(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
         )
 
 
-_ESTIMATES = (
-    "local_position",
-    "local_velocity",
-    "local_altitude",
-    "global_position",
-    "attitude",
-    "angular_velocity",
-    "home_position",
-)
-
-
 def _valid(c: Chunk, estimate: str) -> list[bool | None]:
     """``*_valid`` from whichever spelling the release logs (``*_invalid`` from v1.14)."""
     if c.has(f"{estimate}_invalid"):
@@ -498,7 +465,7 @@ def failsafe_flags(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
     manual = (
         "manual_control_signal_lost" if c.has("manual_control_signal_lost") else "rc_signal_lost"
     )
-    valid = [_valid(c, name) for name in _ESTIMATES]
+    valid = [_valid(c, name) for name in ESTIMATES]
     for t, w, ts, lost, manual_lost, *flags in zip(
         c.t, c.where, c.ts, c.ob("offboard_control_signal_lost"), c.ob(manual), *valid, strict=True
     ):
@@ -509,7 +476,7 @@ def failsafe_flags(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
             origin=VEHICLE,
             offboard_control_signal_lost=lost,
             manual_control_signal_lost=manual_lost,
-            **{f"{name}_valid": v for name, v in zip(_ESTIMATES, flags, strict=True)},
+            **{f"{name}_valid": v for name, v in zip(ESTIMATES, flags, strict=True)},
         )
 
 

@@ -24,7 +24,7 @@ from pyulog import ULog
 
 from fuzzoff import events as ev
 from fuzzoff.formats.ulog.layouts import FORMATS, NESTED, era_for, fields_for
-from fuzzoff.formats.ulog.topics import NAV_TO_MAIN_STATE
+from fuzzoff.formats.uorb import NAV_TO_MAIN_STATE
 
 DEFAULT_START_US = 20_000_000
 """PX4's logger starts some seconds after boot; the header timestamp is that moment."""
