@@ -1,35 +1,16 @@
-"""Readers, one per format, behind one ``open_source`` that detects the format from content."""
+"""Recording formats, one package each (``fuzzoff/formats/<name>/``: reader, writer, damage
+checks, detection), registered in ``registry``; ``open_source`` detects a file's format from
+its content and the search finds the recordings under a folder."""
 
 from __future__ import annotations
 
-import importlib
-import os
-import re
 import stat
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 
+from fuzzoff.formats import rosbag2
+from fuzzoff.formats.registry import BY_REPORTED_NAME, FORMATS, RECORDING_SUFFIXES
 from fuzzoff.recording import RecordingInfo, Source, SourceError, SourceProblem
-
-READERS: dict[str, str] = {
-    "tlog": "fuzzoff.formats.tlog.reader:TlogSource",
-    "ulog": "fuzzoff.formats.ulog.reader:UlogSource",
-    "mcap": "fuzzoff.formats.mcap.reader:McapSource",
-    "rosbag2-sqlite3": "fuzzoff.formats.rosbag2.reader:Rosbag2Source",
-    "rosbag2-mcap": "fuzzoff.formats.rosbag2.reader:Rosbag2Source",
-    "rosbag1": "fuzzoff.formats.rosbag1.reader:Rosbag1Source",
-}
-"""Format name -> reader class; imported lazily so a run loads only the libraries it needs."""
-
-RECORDING_SUFFIXES = (".tlog", ".ulg", ".mcap", ".bag", ".db3", ".active")
-"""``.active``: a ROS 1 bag whose recorder was killed (``flight.bag.active``)."""
-
-_MAGIC: tuple[tuple[bytes, str], ...] = (
-    (b"ULog\x01\x12\x35", "ulog"),
-    (b"\x89MCAP", "mcap"),
-    (b"#ROSBAG V2.0", "rosbag1"),
-    (b"SQLite format 3\x00", "rosbag2-sqlite3"),
-)
 
 
 def detect_format(path: Path) -> str:
@@ -37,7 +18,7 @@ def detect_format(path: Path) -> str:
     try:
         mode = path.stat().st_mode
         if stat.S_ISDIR(mode):
-            return _detect_bag_folder(path)
+            return rosbag2.detect_folder(path)
         if not stat.S_ISREG(mode):
             raise SourceError(path, f"{_special(mode)}, not a file: {_NEEDS_A_FILE}")
         with path.open("rb") as fh:
@@ -46,13 +27,10 @@ def detect_format(path: Path) -> str:
         raise SourceError(path, f"cannot open: {exc.strerror or exc}") from None
     if not head:
         raise SourceError(path, "empty file")
-    for magic, name in _MAGIC:
-        if head.startswith(magic):
-            if name == "mcap" and path.parent.joinpath("metadata.yaml").is_file():
-                return "rosbag2-mcap"
+    for fmt in FORMATS:
+        name = fmt.detect_file(path, head)
+        if name is not None:
             return name
-    if len(head) >= 9 and head[8] in (0xFD, 0xFE):
-        return "tlog"
     raise SourceError(path, "not a recording fuzzoff can read (no tlog, ULog, MCAP, rosbag header)")
 
 
@@ -67,60 +45,20 @@ def _special(mode: int) -> str:
     return "a device"
 
 
-def _detect_bag_folder(path: Path) -> str:
-    """The storage of a bag folder: its data files say it (metadata.yaml may be missing, cut
-    short or another bag's); metadata.yaml only where they do not (file-compressed data)."""
-    suffixes = {p.suffix for p in path.iterdir() if p.suffix in (".db3", ".mcap")}
-    if suffixes == {".mcap"}:
-        return "rosbag2-mcap"
-    if suffixes == {".db3"}:
-        return "rosbag2-sqlite3"
-    meta = path / "metadata.yaml"
-    if meta.is_file():
-        text = meta.read_text(errors="replace")
-        return "rosbag2-mcap" if "storage_identifier: mcap" in text else "rosbag2-sqlite3"
-    if suffixes:
-        return "rosbag2-sqlite3"
-    raise SourceError(path, "a folder without metadata.yaml or .db3/.mcap files is not a ROS 2 bag")
-
-
-_BAG_PART = re.compile(r"^(?P<stem>.+)_(?P<n>\d+)\.(?:db3|mcap)$")
-
-
 def is_bag_folder(path: Path) -> bool:
-    """A folder that is one ROS 2 bag (with its metadata.yaml, whatever state that is in, or a
-    bag whose recorder crashed before writing it), not a folder of recordings to search."""
-    return os.path.lexists(path / "metadata.yaml") or _is_bag_without_metadata(path)
-
-
-def _is_bag_without_metadata(path: Path) -> bool:
-    """A rosbag2 folder whose metadata.yaml was never written (the recorder crashed): rosbag2
-    names its data files ``<folder>_<n>.db3|mcap``. Such a folder is one bag, not one
-    recording per file; a folder of independent recordings does not follow that naming."""
-    parts = [p for p in path.iterdir() if p.suffix in RECORDING_SUFFIXES]
-    if not parts:
-        return False
-    for part in parts:
-        match = _BAG_PART.match(part.name)
-        if match is None or match.group("stem") != path.name:
-            return False
-    return True
+    """A folder that is one ROS 2 bag, not a folder of recordings to search."""
+    return rosbag2.is_bag_folder(path, RECORDING_SUFFIXES)
 
 
 def open_source(path: Path, fmt: str | None = None) -> Source:
     """A reader for ``path`` (not yet opened)."""
     fmt = fmt or detect_format(path)
-    module_name, _, class_name = READERS[fmt].partition(":")
     try:
-        module = importlib.import_module(module_name)
+        return BY_REPORTED_NAME[fmt].open(path, fmt)
     except ModuleNotFoundError as exc:  # a reader not written yet is a clear error, not a crash
         raise SourceError(
             path, f"format {fmt} is recognised but not supported yet ({exc})"
         ) from None
-    cls: type[Source] = getattr(module, class_name)
-    source = cls(path)
-    source.format = fmt
-    return source
 
 
 def find_recordings(path: Path) -> list[Path]:
@@ -204,7 +142,7 @@ def _children_to_search(folder: Path, found: list[Path]) -> list[Path] | None:
 
 
 __all__ = [
-    "READERS",
+    "RECORDING_SUFFIXES",
     "RecordingInfo",
     "Source",
     "SourceError",
