@@ -38,6 +38,7 @@ from fuzzoff.profiles import (
 )
 from fuzzoff.recording import RecordingInfo, SourceProblem, path_text
 from fuzzoff.state import VehicleState
+from fuzzoff.type_mask import POSITION_BITS
 
 Progress = Callable[[float], None]
 
@@ -264,8 +265,6 @@ class VehicleRun:
 
 
 NOTED = (StatusText, Command, CommandAck)
-POSITION_IGNORED = 0b111
-"""``type_mask`` bits of SET_POSITION_TARGET_LOCAL_NED that ignore x, y, z."""
 
 
 def _plotted_position(event: Event) -> bool:
@@ -276,7 +275,7 @@ def _plotted_position(event: Event) -> bool:
     return (
         isinstance(event, SetPositionTargetLocal)
         and event.coordinate_frame == 1
-        and not event.type_mask & POSITION_IGNORED
+        and not event.type_mask & POSITION_BITS
     )
 
 

@@ -48,14 +48,26 @@ from fuzzoff.formats.mavros.frames import (
 )
 from fuzzoff.modes import mavros_mode_to_nav_state
 from fuzzoff.recording import POSITION_PERIOD_S
+from fuzzoff.type_mask import (
+    ACCELERATION_BITS,
+    ATTITUDE_IGNORE,
+    BODY_YAW_RATE_IGNORE,
+    FORCE_SET,
+    PITCH_RATE_IGNORE,
+    POSITION_BITS,
+    ROLL_RATE_IGNORE,
+    VELOCITY_BITS,
+    YAW_IGNORE,
+    YAW_RATE_IGNORE,
+)
 
-# type_mask values MAVROS's plugins hard-code (bit numbers as in POSITION_TARGET_TYPEMASK).
-MASK_POSITION_YAW = (1 << 11) | (7 << 6) | (7 << 3)  # 0x9F8: setpoint_position/local
-MASK_VELOCITY_YAW_RATE = (1 << 10) | (7 << 6) | 7  # 0x5C7: setpoint_velocity/*
-MASK_ACCEL = (3 << 10) | (7 << 3) | 7  # 0xC3F: setpoint_accel/accel
-MASK_FORCE = 1 << 9
-MASK_ATTITUDE_THRUST = 7  # setpoint_attitude/attitude: ignore the three body rates
-MASK_RATES_THRUST = 1 << 7  # setpoint_attitude/cmd_vel: ignore the attitude
+# type_mask values MAVROS's plugins hard-code.
+MASK_POSITION_YAW = YAW_RATE_IGNORE | ACCELERATION_BITS | VELOCITY_BITS  # 0x9F8: setpoint_position
+MASK_VELOCITY_YAW_RATE = YAW_IGNORE | ACCELERATION_BITS | POSITION_BITS  # 0x5C7: setpoint_velocity
+MASK_ACCEL = YAW_IGNORE | YAW_RATE_IGNORE | VELOCITY_BITS | POSITION_BITS  # 0xC3F: setpoint_accel
+MASK_FORCE = FORCE_SET
+MASK_ATTITUDE_THRUST = ROLL_RATE_IGNORE | PITCH_RATE_IGNORE | BODY_YAW_RATE_IGNORE  # attitude
+MASK_RATES_THRUST = ATTITUDE_IGNORE  # setpoint_attitude/cmd_vel: ignore the attitude
 
 MAVROS_TARGET_SYSTEM = 1
 MAVROS_TARGET_COMPONENT = 1
