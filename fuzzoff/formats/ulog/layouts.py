@@ -8,6 +8,8 @@ like PX4's; a field list starts at the era named and holds until the next entry.
 
 from __future__ import annotations
 
+from fuzzoff.formats.ros2msgs import px4_msgs
+from fuzzoff.formats.ros2msgs.topics import MESSAGE_FOR_NAME
 from fuzzoff.profiles import px4_profile_for
 
 ERAS: tuple[str, ...] = ("legacy", "1.13", "1.14", "1.15", "1.16", "1.17")
@@ -55,31 +57,6 @@ POSITION_SETPOINT = [
     "uint8_t[7] _padding0",
 ]
 
-_VEHICLE_STATUS_1_13 = [
-    "uint64_t timestamp",
-    "uint64_t armed_time",
-    "uint64_t takeoff_time",
-    "uint64_t nav_state_timestamp",
-    "uint32_t onboard_control_sensors_present",
-    "uint16_t failure_detector_status",
-    "uint8_t arming_state",
-    "uint8_t latest_arming_reason",
-    "uint8_t latest_disarming_reason",
-    "uint8_t nav_state",
-    "uint8_t hil_state",
-    "uint8_t vehicle_type",
-    "bool failsafe",
-    "bool failsafe_and_user_took_over",
-    "uint8_t system_type",
-    "uint8_t system_id",
-    "uint8_t component_id",
-    "bool is_vtol",
-    "bool is_vtol_tailsitter",
-    "bool in_transition_mode",
-    "bool rc_signal_found_once",
-    "uint8_t[5] _padding0",
-]
-
 FORMATS: dict[str, list[tuple[str, list[str]]]] = {
     "offboard_control_mode": [
         (
@@ -96,33 +73,6 @@ FORMATS: dict[str, list[tuple[str, list[str]]]] = {
                 "bool ignore_acceleration_force",
                 "bool ignore_alt_hold",
                 "uint8_t[7] _padding0",
-            ],
-        ),
-        (
-            "1.13",
-            [
-                "uint64_t timestamp",
-                "bool position",
-                "bool velocity",
-                "bool acceleration",
-                "bool attitude",
-                "bool body_rate",
-                "bool actuator",
-                "uint8_t[2] _padding0",
-            ],
-        ),
-        (
-            "1.15",
-            [
-                "uint64_t timestamp",
-                "bool position",
-                "bool velocity",
-                "bool acceleration",
-                "bool attitude",
-                "bool body_rate",
-                "bool thrust_and_torque",
-                "bool direct_actuator",
-                "uint8_t[1] _padding0",
             ],
         ),
     ],
@@ -166,62 +116,6 @@ FORMATS: dict[str, list[tuple[str, list[str]]]] = {
                 "uint8_t[5] _padding0",
             ],
         ),
-        # as logged by PX4 1.15 (pyulog's sample_px4_events.ulg)
-        (
-            "1.14",
-            [
-                "uint64_t timestamp",
-                "uint64_t timestamp_sample",
-                "uint64_t ref_timestamp",
-                "double ref_lat",
-                "double ref_lon",
-                "float x",
-                "float y",
-                "float z",
-                "float[2] delta_xy",
-                "float delta_z",
-                "float vx",
-                "float vy",
-                "float vz",
-                "float z_deriv",
-                "float[2] delta_vxy",
-                "float delta_vz",
-                "float ax",
-                "float ay",
-                "float az",
-                "float heading",
-                "float heading_var",
-                "float unaided_heading",
-                "float delta_heading",
-                "float tilt_var",
-                "float ref_alt",
-                "float dist_bottom",
-                "float eph",
-                "float epv",
-                "float evh",
-                "float evv",
-                "float vxy_max",
-                "float vz_max",
-                "float hagl_min",
-                "float hagl_max",
-                "bool xy_valid",
-                "bool z_valid",
-                "bool v_xy_valid",
-                "bool v_z_valid",
-                "uint8_t xy_reset_counter",
-                "uint8_t z_reset_counter",
-                "uint8_t vxy_reset_counter",
-                "uint8_t vz_reset_counter",
-                "uint8_t heading_reset_counter",
-                "bool heading_good_for_control",
-                "bool xy_global",
-                "bool z_global",
-                "bool dist_bottom_valid",
-                "uint8_t dist_bottom_sensor_bitfield",
-                "bool dead_reckoning",
-                "uint8_t[5] _padding0",
-            ],
-        ),
     ],
     "trajectory_setpoint": [
         (
@@ -240,18 +134,6 @@ FORMATS: dict[str, list[tuple[str, list[str]]]] = {
                 "float[3] jerk",
                 "float[3] thrust",
                 "uint8_t[4] _padding0",
-            ],
-        ),
-        (
-            "1.14",
-            [
-                "uint64_t timestamp",
-                "float[3] position",
-                "float[3] velocity",
-                "float[3] acceleration",
-                "float[3] jerk",
-                "float yaw",
-                "float yawspeed",
             ],
         ),
     ],
@@ -274,42 +156,6 @@ FORMATS: dict[str, list[tuple[str, list[str]]]] = {
                 "uint8_t[7] _padding0",
             ],
         ),
-        (
-            "1.14",
-            [
-                "uint64_t timestamp",
-                "float roll_body",
-                "float pitch_body",
-                "float yaw_body",
-                "float yaw_sp_move_rate",
-                "float[4] q_d",
-                "float[3] thrust_body",
-                "bool reset_integral",
-                "bool fw_control_yaw_wheel",
-                "uint8_t[2] _padding0",
-            ],
-        ),
-        (
-            "1.16",
-            [
-                "uint64_t timestamp",
-                "float yaw_sp_move_rate",
-                "float[4] q_d",
-                "float[3] thrust_body",
-                "bool reset_integral",
-                "bool fw_control_yaw_wheel",
-                "uint8_t[2] _padding0",
-            ],
-        ),
-        (
-            "1.17",
-            [
-                "uint64_t timestamp",
-                "float yaw_sp_move_rate",
-                "float[4] q_d",
-                "float[3] thrust_body",
-            ],
-        ),
     ],
     "vehicle_rates_setpoint": [
         (
@@ -320,18 +166,6 @@ FORMATS: dict[str, list[tuple[str, list[str]]]] = {
                 "float pitch",
                 "float yaw",
                 "float[3] thrust_body",
-            ],
-        ),
-        (
-            "1.14",
-            [
-                "uint64_t timestamp",
-                "float roll",
-                "float pitch",
-                "float yaw",
-                "float[3] thrust_body",
-                "bool reset_integral",
-                "uint8_t[3] _padding0",
             ],
         ),
     ],
@@ -368,68 +202,9 @@ FORMATS: dict[str, list[tuple[str, list[str]]]] = {
                 "uint8_t[6] _padding0",
             ],
         ),
-        (
-            "1.14",
-            [
-                "uint64_t timestamp",
-                "uint64_t timestamp_sample",
-                "float[12] control",
-                "uint16_t reversible_flags",
-                "uint8_t[6] _padding0",
-            ],
-        ),
     ],
     "actuator_servos": [
         ("legacy", ["uint64_t timestamp", "uint64_t timestamp_sample", "float[8] control"]),
-    ],
-    "rover_position_setpoint": [
-        (
-            "1.16",
-            [
-                "uint64_t timestamp",
-                "float[2] position_ned",
-                "float cruising_speed",
-                "float yaw",
-            ],
-        ),
-        (
-            "1.17",
-            [
-                "uint64_t timestamp",
-                "float[2] position_ned",
-                "float[2] start_ned",
-                "float cruising_speed",
-                "float arrival_speed",
-                "float yaw",
-                "uint8_t[4] _padding0",
-            ],
-        ),
-    ],
-    "rover_speed_setpoint": [
-        ("1.17", ["uint64_t timestamp", "float speed_body_x", "float speed_body_y"]),
-    ],
-    "rover_attitude_setpoint": [
-        ("1.16", ["uint64_t timestamp", "float yaw_setpoint", "uint8_t[4] _padding0"]),
-    ],
-    "rover_rate_setpoint": [
-        ("1.16", ["uint64_t timestamp", "float yaw_rate_setpoint", "uint8_t[4] _padding0"]),
-    ],
-    "rover_throttle_setpoint": [
-        ("1.16", ["uint64_t timestamp", "float throttle_body_x", "float throttle_body_y"]),
-    ],
-    "rover_steering_setpoint": [
-        (
-            "1.16",
-            [
-                "uint64_t timestamp",
-                "float normalized_steering_angle",
-                "float normalized_speed_diff",
-            ],
-        ),
-        (
-            "1.17",
-            ["uint64_t timestamp", "float normalized_steering_setpoint", "uint8_t[4] _padding0"],
-        ),
     ],
     "position_setpoint_triplet": [
         (
@@ -460,29 +235,6 @@ FORMATS: dict[str, list[tuple[str, list[str]]]] = {
                 "bool in_transition_mode",
                 "bool data_link_lost",
                 "uint8_t[4] _padding0",
-            ],
-        ),
-        ("1.13", _VEHICLE_STATUS_1_13),
-        (
-            "1.14",
-            [
-                *_VEHICLE_STATUS_1_13[:10],
-                "uint8_t nav_state_user_intention",
-                *_VEHICLE_STATUS_1_13[10:-1],
-                "uint8_t[4] _padding0",
-            ],
-        ),
-        (
-            "1.15",
-            [
-                *_VEHICLE_STATUS_1_13[:10],
-                "uint8_t nav_state_user_intention",
-                "uint8_t executor_in_charge",
-                "uint32_t valid_nav_states_mask",
-                "uint32_t can_set_nav_states_mask",
-                *_VEHICLE_STATUS_1_13[10:-1],
-                "uint8_t failsafe_defer_state",
-                "uint8_t[7] _padding0",
             ],
         ),
     ],
@@ -518,28 +270,6 @@ FORMATS: dict[str, list[tuple[str, list[str]]]] = {
                 "uint8_t[3] _padding0",
             ],
         ),
-        (
-            "1.14",
-            [
-                "uint64_t timestamp",
-                "bool flag_armed",
-                "bool flag_multicopter_position_control_enabled",
-                "bool flag_control_manual_enabled",
-                "bool flag_control_auto_enabled",
-                "bool flag_control_offboard_enabled",
-                "bool flag_control_position_enabled",
-                "bool flag_control_velocity_enabled",
-                "bool flag_control_altitude_enabled",
-                "bool flag_control_climb_rate_enabled",
-                "bool flag_control_acceleration_enabled",
-                "bool flag_control_attitude_enabled",
-                "bool flag_control_rates_enabled",
-                "bool flag_control_allocation_enabled",
-                "bool flag_control_termination_enabled",
-                "uint8_t source_id",
-                "uint8_t[1] _padding0",
-            ],
-        ),
     ],
     "vehicle_status_flags": [
         (
@@ -556,31 +286,6 @@ FORMATS: dict[str, list[tuple[str, list[str]]]] = {
                 "bool rc_signal_lost",
                 "bool offboard_control_signal_lost",
                 "uint8_t[7] _padding0",
-            ],
-        ),
-    ],
-    "failsafe_flags": [
-        (
-            "1.14",
-            [
-                "uint64_t timestamp",
-                "uint32_t mode_req_angular_velocity",
-                "uint32_t mode_req_attitude",
-                "uint32_t mode_req_local_alt",
-                "uint32_t mode_req_local_position",
-                "uint32_t mode_req_global_position",
-                "uint32_t mode_req_offboard_signal",
-                "bool angular_velocity_invalid",
-                "bool attitude_invalid",
-                "bool local_altitude_invalid",
-                "bool local_position_invalid",
-                "bool local_position_invalid_relaxed",
-                "bool local_velocity_invalid",
-                "bool global_position_invalid",
-                "bool home_position_invalid",
-                "bool offboard_control_signal_lost",
-                "bool manual_control_signal_lost",
-                "uint8_t[6] _padding0",
             ],
         ),
     ],
@@ -627,27 +332,6 @@ FORMATS: dict[str, list[tuple[str, list[str]]]] = {
                 "uint8_t[2] _padding0",
             ],
         ),
-        (
-            "1.15",
-            [
-                "uint64_t timestamp",
-                "double param5",
-                "double param6",
-                "float param1",
-                "float param2",
-                "float param3",
-                "float param4",
-                "float param7",
-                "uint32_t command",
-                "uint8_t target_system",
-                "uint8_t target_component",
-                "uint8_t source_system",
-                "uint16_t source_component",
-                "uint8_t confirmation",
-                "bool from_external",
-                "uint8_t[1] _padding0",
-            ],
-        ),
     ],
     "vehicle_command_ack": [
         (
@@ -662,20 +346,6 @@ FORMATS: dict[str, list[tuple[str, list[str]]]] = {
                 "uint8_t target_component",
                 "bool from_external",
                 "uint8_t[3] _padding0",
-            ],
-        ),
-        (
-            "1.15",
-            [
-                "uint64_t timestamp",
-                "uint32_t command",
-                "int32_t result_param2",
-                "uint16_t target_component",
-                "uint8_t result",
-                "uint8_t result_param1",
-                "uint8_t target_system",
-                "bool from_external",
-                "uint8_t[2] _padding0",
             ],
         ),
     ],
@@ -720,9 +390,25 @@ NESTED: dict[str, list[str]] = {"position_setpoint": POSITION_SETPOINT}
 
 
 def fields_for(topic: str, era: str) -> list[str] | None:
-    """The field list of ``topic`` in ``era``, or None when that era has no such topic."""
+    """The field list of ``topic`` in ``era``, or None when that era has no such topic: from
+    the release's px4_msgs ``.msg`` file where it has one, else from ``FORMATS``."""
+    message = MESSAGE_FOR_NAME.get(topic)
+    if message is not None and era in px4_msgs.RELEASES:
+        derived = px4_msgs.ulog_fields(era, message)
+        if derived is not None:
+            return list(derived)
     chosen: list[str] | None = None
-    for first, fields in FORMATS[topic]:
+    for first, fields in FORMATS.get(topic, ()):
         if ERAS.index(first) <= ERAS.index(era):
             chosen = fields
     return chosen
+
+
+def earliest_fields(topic: str) -> list[str]:
+    """The field list of ``topic`` in the first era that has it: what the writer declares for a
+    topic written into a log of a release from before it existed."""
+    for era in ERAS:
+        fields = fields_for(topic, era)
+        if fields is not None:
+            return fields
+    raise KeyError(topic)

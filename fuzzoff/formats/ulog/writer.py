@@ -23,7 +23,7 @@ import numpy as np
 from pyulog import ULog
 
 from fuzzoff import events as ev
-from fuzzoff.formats.ulog.layouts import FORMATS, NESTED, era_for, fields_for
+from fuzzoff.formats.ulog.layouts import NESTED, earliest_fields, era_for, fields_for
 from fuzzoff.formats.uorb import NAV_TO_MAIN_STATE
 
 DEFAULT_START_US = 20_000_000
@@ -487,7 +487,7 @@ def _add_topics(
 ) -> None:
     formats: dict[str, Any] = {name: _format(name, fields) for name, fields in NESTED.items()}
     for msg_id, topic in enumerate(sorted(topics)):
-        fields = fields_for(topic, era) or FORMATS[topic][0][1]  # before it existed: its first
+        fields = fields_for(topic, era) or earliest_fields(topic)
         formats[topic] = _format(topic, fields)
         columns, rows = topics[topic]
         ulog._data_list.append(_dataset(topic, msg_id, columns, rows, formats))

@@ -12,7 +12,9 @@ from __future__ import annotations
 import re
 from functools import cache
 from importlib import resources
+from typing import Any
 
+from rosbags.interfaces import Nodetype
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.store import Typestore
 
@@ -78,3 +80,53 @@ def field_names(typename: str, text: str) -> frozenset[str]:
     """The wire field names of ``typename`` under ``text``."""
     store = typestore_for(typename, text)
     return frozenset(name for name, _ in store.fielddefs[typename][1])
+
+
+_C_TYPES: dict[str, tuple[str, int]] = {
+    "uint64": ("uint64_t", 8),
+    "int64": ("int64_t", 8),
+    "float64": ("double", 8),
+    "uint32": ("uint32_t", 4),
+    "int32": ("int32_t", 4),
+    "float32": ("float", 4),
+    "uint16": ("uint16_t", 2),
+    "int16": ("int16_t", 2),
+    "uint8": ("uint8_t", 1),
+    "int8": ("int8_t", 1),
+    "byte": ("uint8_t", 1),
+    "char": ("char", 1),
+    "bool": ("bool", 1),
+}
+"""ROS 2 base type -> (uORB C type, size in bytes)."""
+
+
+@cache
+def ulog_fields(release: str, message: str) -> tuple[str, ...] | None:
+    """``message``'s fields as PX4 ``release`` logs them in a ULog format record, or None where
+    the release lacks it or a field is not a number (nested types are not derived).
+
+    PX4's uORB generator orders the ``.msg`` fields by type size, largest first (in file
+    order among equals), and pads the struct to 8 bytes with ``uint8_t[N] _padding0``; the
+    ULogs PX4 SITL 1.14 to 1.18 writes declare exactly that."""
+    text = definition(release, message)
+    if text is None:
+        return None
+    typename = type_name(message)
+    fields: list[tuple[int, str]] = []
+    total = 0
+    field_defs: list[tuple[str, Any]] = typestore_for(typename, text).fielddefs[typename][1]
+    for name, (nodetype, details) in field_defs:
+        count: int | None = None
+        if nodetype == Nodetype.ARRAY:
+            (nodetype, details), count = details
+        base = details[0]
+        if nodetype != Nodetype.BASE or base not in _C_TYPES:
+            return None
+        c_type, size = _C_TYPES[base]
+        fields.append((size, f"{c_type} {name}" if count is None else f"{c_type}[{count}] {name}"))
+        total += size * (count or 1)
+    fields.sort(key=lambda field: -field[0])  # stable: file order among equal sizes
+    padding = -total % 8
+    return tuple(text for _, text in fields) + (
+        (f"uint8_t[{padding}] _padding0",) if padding else ()
+    )
