@@ -12,11 +12,12 @@ from typing import Any
 
 from fuzzoff import events as ev
 from fuzzoff.events import Event, Origin, Where
-from fuzzoff.formats.uorb import ARMING_STATE_ARMED, ESTIMATES
+from fuzzoff.formats.uorb import ARMING_STATE_ARMED, ESTIMATES, TOPICS
 from fuzzoff.modes import nav_state_name
 
 Builder = Callable[[Any, float, Where, int], Event]
 """(decoded message, t, where, sender_time_us) -> event."""
+
 
 def _vec(value: Any) -> tuple[float, ...]:
     """A fixed array (rosbags: a numpy array) as a tuple of Python floats."""
@@ -399,24 +400,5 @@ BUILDERS: dict[str, Callable[[frozenset[str], str, Origin], Builder]] = {
 """px4_msgs message name -> builder factory (fields of the definition, vehicle, origin)."""
 
 KIND_OF: dict[str, str] = {
-    "OffboardControlMode": ev.ControlMode.kind,
-    "TrajectorySetpoint": ev.TrajectorySetpoint.kind,
-    "VehicleAttitudeSetpoint": ev.AttitudeSetpoint.kind,
-    "VehicleRatesSetpoint": ev.RatesSetpoint.kind,
-    "VehicleThrustSetpoint": ev.ThrustSetpoint.kind,
-    "VehicleTorqueSetpoint": ev.TorqueSetpoint.kind,
-    "ActuatorMotors": ev.ActuatorMotors.kind,
-    "ActuatorServos": ev.ActuatorServos.kind,
-    "RoverPositionSetpoint": ev.RoverPositionSetpoint.kind,
-    "RoverSpeedSetpoint": ev.RoverSpeedSetpoint.kind,
-    "RoverAttitudeSetpoint": ev.RoverAttitudeSetpoint.kind,
-    "RoverRateSetpoint": ev.RoverRateSetpoint.kind,
-    "RoverThrottleSetpoint": ev.RoverThrottleSetpoint.kind,
-    "RoverSteeringSetpoint": ev.RoverSteeringSetpoint.kind,
-    "VehicleCommand": ev.Command.kind,
-    "VehicleCommandAck": ev.CommandAck.kind,
-    "VehicleStatus": ev.VehicleStatus.kind,
-    "VehicleControlMode": ev.VehicleControlModeStatus.kind,
-    "FailsafeFlags": ev.FailsafeFlags.kind,
-    "VehicleLocalPosition": ev.VehiclePosition.kind,
+    topic.message: topic.kind for topic in TOPICS.values() if topic.message is not None
 }

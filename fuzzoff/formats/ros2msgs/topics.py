@@ -10,31 +10,13 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
+from fuzzoff.formats.uorb import TOPICS
+
 _UXRCE = re.compile(r"^(?P<ns>/.+?)?/fmu/(?P<dir>in|out)/(?P<name>[a-z0-9_]+?)(?:_v(?P<ver>\d+))?$")
 _RTPS = re.compile(r"^(?P<ns>/.+?)?/fmu/(?P<name>[a-z0-9_]+?)/(?P<dir>in|out)$")
 
 MESSAGE_FOR_NAME: dict[str, str] = {
-    "offboard_control_mode": "OffboardControlMode",
-    "trajectory_setpoint": "TrajectorySetpoint",
-    "vehicle_attitude_setpoint": "VehicleAttitudeSetpoint",
-    "vehicle_rates_setpoint": "VehicleRatesSetpoint",
-    "vehicle_thrust_setpoint": "VehicleThrustSetpoint",
-    "vehicle_torque_setpoint": "VehicleTorqueSetpoint",
-    "actuator_motors": "ActuatorMotors",
-    "actuator_servos": "ActuatorServos",
-    "rover_position_setpoint": "RoverPositionSetpoint",
-    "rover_speed_setpoint": "RoverSpeedSetpoint",
-    "rover_attitude_setpoint": "RoverAttitudeSetpoint",
-    "rover_rate_setpoint": "RoverRateSetpoint",
-    "rover_throttle_setpoint": "RoverThrottleSetpoint",
-    "rover_steering_setpoint": "RoverSteeringSetpoint",
-    "vehicle_command": "VehicleCommand",
-    "vehicle_command_mode_executor": "VehicleCommand",
-    "vehicle_command_ack": "VehicleCommandAck",
-    "vehicle_status": "VehicleStatus",
-    "vehicle_control_mode": "VehicleControlMode",
-    "failsafe_flags": "FailsafeFlags",
-    "vehicle_local_position": "VehicleLocalPosition",
+    name: topic.message for name, topic in TOPICS.items() if topic.message is not None
 }
 """Topic base name -> px4_msgs message: the topics fuzzoff decodes."""
 
@@ -43,13 +25,7 @@ for _name, _msg in MESSAGE_FOR_NAME.items():
     NAME_FOR_MESSAGE.setdefault(_msg, _name)
 
 OUTPUT_MESSAGES = frozenset(
-    {
-        "VehicleCommandAck",
-        "VehicleStatus",
-        "VehicleControlMode",
-        "FailsafeFlags",
-        "VehicleLocalPosition",
-    }
+    topic.message for topic in TOPICS.values() if topic.message is not None and topic.published
 )
 """Messages PX4 publishes (``/fmu/out``); the rest are inputs to PX4."""
 

@@ -9,7 +9,7 @@ like PX4's; a field list starts at the era named and holds until the next entry.
 from __future__ import annotations
 
 from fuzzoff.formats.ros2msgs import px4_msgs
-from fuzzoff.formats.ros2msgs.topics import MESSAGE_FOR_NAME
+from fuzzoff.formats.uorb import TOPICS
 from fuzzoff.profiles import px4_profile_for
 
 ERAS: tuple[str, ...] = ("legacy", "1.13", "1.14", "1.15", "1.16", "1.17")
@@ -392,7 +392,7 @@ NESTED: dict[str, list[str]] = {"position_setpoint": POSITION_SETPOINT}
 def fields_for(topic: str, era: str) -> list[str] | None:
     """The field list of ``topic`` in ``era``, or None when that era has no such topic: from
     the release's px4_msgs ``.msg`` file where it has one, else from ``FORMATS``."""
-    message = MESSAGE_FOR_NAME.get(topic)
+    message = TOPICS[topic].message if topic in TOPICS else None
     if message is not None and era in px4_msgs.RELEASES:
         derived = px4_msgs.ulog_fields(era, message)
         if derived is not None:

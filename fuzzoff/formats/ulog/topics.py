@@ -20,12 +20,14 @@ import numpy as np
 
 from fuzzoff import events as ev
 from fuzzoff.formats.uorb import ESTIMATES
+from fuzzoff.formats.uorb import TOPICS as UORB_TOPICS
 from fuzzoff.modes import nav_state_name
 
 VEHICLE: Literal["vehicle"] = "vehicle"
 
 Columns = Mapping[str, Any]
 """Field name -> numpy array (one topic instance, as in ``ULog.Data.data``)."""
+
 
 @dataclass(slots=True)
 class Context:
@@ -554,50 +556,43 @@ class TopicSpec:
     """An offboard keep-alive or setpoint topic: subsampled by the logger."""
 
 
+DECODERS: dict[str, Decoder] = {
+    "vehicle_command": command,
+    "offboard_control_mode": control_mode,
+    "trajectory_setpoint": trajectory,
+    "vehicle_attitude_setpoint": attitude,
+    "vehicle_rates_setpoint": rates,
+    "vehicle_thrust_setpoint": thrust,
+    "vehicle_torque_setpoint": torque,
+    "actuator_motors": motors,
+    "actuator_servos": servos,
+    "rover_position_setpoint": rover_position,
+    "rover_speed_setpoint": _plain(ev.RoverSpeedSetpoint, ("speed_body_x", "speed_body_y")),
+    "rover_attitude_setpoint": _plain(ev.RoverAttitudeSetpoint, ("yaw_setpoint",)),
+    "rover_rate_setpoint": _plain(ev.RoverRateSetpoint, ("yaw_rate_setpoint",)),
+    "rover_throttle_setpoint": _plain(
+        ev.RoverThrottleSetpoint, ("throttle_body_x", "throttle_body_y")
+    ),
+    "rover_steering_setpoint": steering,
+    "position_setpoint_triplet": triplet,
+    "vehicle_command_ack": ack,
+    "vehicle_status": vehicle_status,
+    "vehicle_control_mode": control_mode_status,
+    "failsafe_flags": failsafe_flags,
+    "vehicle_status_flags": failsafe_flags,
+    "vehicle_land_detected": land_detected,
+    "vehicle_local_position": local_position,
+}
+"""uORB topic -> its decoder (what each topic is: ``uorb.TOPICS``)."""
+
 TOPICS: dict[str, TopicSpec] = {
-    "vehicle_command": TopicSpec(ev.Command.kind, command),
-    "offboard_control_mode": TopicSpec(ev.ControlMode.kind, control_mode, 0.1, True),
-    "trajectory_setpoint": TopicSpec(ev.TrajectorySetpoint.kind, trajectory, 0.2, True),
-    "vehicle_attitude_setpoint": TopicSpec(ev.AttitudeSetpoint.kind, attitude, 0.1, True),
-    "vehicle_rates_setpoint": TopicSpec(ev.RatesSetpoint.kind, rates, None, True),
-    "vehicle_thrust_setpoint": TopicSpec(ev.ThrustSetpoint.kind, thrust, None, True),
-    "vehicle_torque_setpoint": TopicSpec(ev.TorqueSetpoint.kind, torque, None, True),
-    "actuator_motors": TopicSpec(ev.ActuatorMotors.kind, motors, None, True),
-    "actuator_servos": TopicSpec(ev.ActuatorServos.kind, servos, None, True),
-    "rover_position_setpoint": TopicSpec(ev.RoverPositionSetpoint.kind, rover_position, None, True),
-    "rover_speed_setpoint": TopicSpec(
-        ev.RoverSpeedSetpoint.kind,
-        _plain(ev.RoverSpeedSetpoint, ("speed_body_x", "speed_body_y")),
-        None,
-        True,
-    ),
-    "rover_attitude_setpoint": TopicSpec(
-        ev.RoverAttitudeSetpoint.kind,
-        _plain(ev.RoverAttitudeSetpoint, ("yaw_setpoint",)),
-        None,
-        True,
-    ),
-    "rover_rate_setpoint": TopicSpec(
-        ev.RoverRateSetpoint.kind,
-        _plain(ev.RoverRateSetpoint, ("yaw_rate_setpoint",)),
-        None,
-        True,
-    ),
-    "rover_throttle_setpoint": TopicSpec(
-        ev.RoverThrottleSetpoint.kind,
-        _plain(ev.RoverThrottleSetpoint, ("throttle_body_x", "throttle_body_y")),
-        None,
-        True,
-    ),
-    "rover_steering_setpoint": TopicSpec(ev.RoverSteeringSetpoint.kind, steering, None, True),
-    "position_setpoint_triplet": TopicSpec(ev.PositionSetpointTriplet.kind, triplet, 0.2, True),
-    "vehicle_command_ack": TopicSpec(ev.CommandAck.kind, ack),
-    "vehicle_status": TopicSpec(ev.VehicleStatus.kind, vehicle_status),
-    "vehicle_control_mode": TopicSpec(ev.VehicleControlModeStatus.kind, control_mode_status),
-    "failsafe_flags": TopicSpec(ev.FailsafeFlags.kind, failsafe_flags),
-    "vehicle_status_flags": TopicSpec(ev.FailsafeFlags.kind, failsafe_flags),
-    "vehicle_land_detected": TopicSpec(ev.LandDetected.kind, land_detected),
-    "vehicle_local_position": TopicSpec(ev.VehiclePosition.kind, local_position),
+    name: TopicSpec(
+        UORB_TOPICS[name].kind,
+        decode,
+        UORB_TOPICS[name].log_interval_s,
+        UORB_TOPICS[name].setpoint,
+    )
+    for name, decode in DECODERS.items()
 }
 """uORB topic -> what it becomes. Dict order = the order of events at the same microsecond."""
 
