@@ -9,7 +9,7 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 from fuzzoff.formats import rosbag2
-from fuzzoff.formats.registry import BY_REPORTED_NAME, FORMATS, RECORDING_SUFFIXES
+from fuzzoff.formats.registry import BY_REPORTED_NAME, DETECTION_ORDER, RECORDING_SUFFIXES
 from fuzzoff.recording import RecordingInfo, Source, SourceError, SourceProblem
 
 
@@ -27,7 +27,7 @@ def detect_format(path: Path) -> str:
         raise SourceError(path, f"cannot open: {exc.strerror or exc}") from None
     if not head:
         raise SourceError(path, "empty file")
-    for fmt in FORMATS:
+    for fmt in DETECTION_ORDER:
         name = fmt.detect_file(path, head)
         if name is not None:
             return name

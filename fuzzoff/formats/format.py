@@ -43,6 +43,9 @@ class Format:
     """File names a folder search takes (lower case); the first is the usual one."""
     written_suffix: str
     """What ``writer`` is given as a file name's suffix (``""``: the writer makes a folder)."""
+    fallback: bool = False
+    """Detected only where no other format claims the file (a tlog has no header: its likely
+    first packet could be any file's bytes)."""
     transports: tuple[Transport, ...] = ()
     """The streams whose messages this format records as sent (empty for a vehicle's log)."""
     detect_folder: Callable[[Path], str] | None = None

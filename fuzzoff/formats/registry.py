@@ -1,8 +1,7 @@
 """The formats fuzzoff reads and writes, each registered once (add a format here).
 
-The order is detection's: a file goes to the first format whose ``detect_file`` names it, so
-a ROS 2 bag's MCAP data file is claimed by ``rosbag2`` before ``mcap``, and a tlog (which has
-no header, only a likely first packet) comes last.
+In the order the folder search lists their file names. Detection asks every format but the
+fallback ones (a tlog, which has no header) first; no two of the others claim the same file.
 """
 
 from __future__ import annotations
@@ -11,11 +10,15 @@ from fuzzoff.formats import mcap, rosbag1, rosbag2, tlog, ulog
 from fuzzoff.formats.format import Format, Transport
 
 FORMATS: tuple[Format, ...] = (
+    tlog.FORMAT,
     ulog.FORMAT,
-    rosbag2.FORMAT,
     mcap.FORMAT,
     rosbag1.FORMAT,
-    tlog.FORMAT,
+    rosbag2.FORMAT,
+)
+
+DETECTION_ORDER: tuple[Format, ...] = tuple(
+    sorted(FORMATS, key=lambda f: f.fallback)  # stable: the fallback ones last
 )
 
 BY_NAME: dict[str, Format] = {f.name: f for f in FORMATS}
@@ -24,17 +27,15 @@ BY_NAME: dict[str, Format] = {f.name: f for f in FORMATS}
 BY_REPORTED_NAME: dict[str, Format] = {name: f for f in FORMATS for name in f.names}
 """Every name a recording is reported under (``rosbag2-sqlite3``) -> its format."""
 
-_SEARCH_ORDER = (tlog.FORMAT, ulog.FORMAT, mcap.FORMAT, rosbag1.FORMAT, rosbag2.FORMAT)
-
-RECORDING_SUFFIXES: tuple[str, ...] = tuple(f.suffixes[0] for f in _SEARCH_ORDER) + tuple(
-    s for f in _SEARCH_ORDER for s in f.suffixes[1:]
+RECORDING_SUFFIXES: tuple[str, ...] = tuple(f.suffixes[0] for f in FORMATS) + tuple(
+    s for f in FORMATS for s in f.suffixes[1:]
 )
 """The file names a folder search takes, the usual one of each format first."""
 
 
 def written_for(transport: Transport) -> tuple[Format, ...]:
     """The formats a stream of ``transport`` is written to, the one a reproducer keeps first."""
-    return tuple(f for f in _SEARCH_ORDER if transport in f.transports)
+    return tuple(f for f in FORMATS if transport in f.transports)
 
 
 def reported_names(transport: Transport) -> frozenset[str]:

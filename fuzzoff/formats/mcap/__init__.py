@@ -12,8 +12,10 @@ MAGIC = b"\x89MCAP"
 
 
 def _detect(path: Path, head: bytes) -> str | None:
-    """An MCAP beside a metadata.yaml is a ROS 2 bag's data file (the rosbag2 entry's)."""
-    return "mcap" if head.startswith(MAGIC) else None
+    """An MCAP beside a metadata.yaml is a ROS 2 bag's data file: the rosbag2 entry's."""
+    if head.startswith(MAGIC) and not path.parent.joinpath("metadata.yaml").is_file():
+        return "mcap"
+    return None
 
 
 def release_options(px4: str | None) -> Mapping[str, Any]:

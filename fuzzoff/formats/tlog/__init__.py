@@ -20,5 +20,6 @@ FORMAT = Format(
     names=("tlog",),
     suffixes=(".tlog",),
     written_suffix=".tlog",
+    fallback=True,
     transports=("mavlink",),
 )
