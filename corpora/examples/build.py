@@ -43,6 +43,7 @@ from pymavlink import mavutil
 from fuzzoff import events as ev
 from fuzzoff.formats.mavros.mavros_msgs import mavros_typedefs
 from fuzzoff.formats.mcap.writer import write_mcap
+from fuzzoff.formats.registry import BY_NAME
 from fuzzoff.formats.ros2msgs.messages import RawMessage
 from fuzzoff.formats.rosbag1.writer import Ros1Message, mavros_typestore, write_rosbag1
 from fuzzoff.formats.rosbag2.writer import write_rosbag2
@@ -93,8 +94,7 @@ class Recording:
 
     @property
     def path(self) -> Path:
-        suffix = {"mcap": ".mcap", "rosbag1": ".bag", "rosbag2": ""}[self.fmt]
-        return HERE / f"{self.name}{suffix}"
+        return HERE / f"{self.name}{BY_NAME[self.fmt].written_suffix}"
 
 
 RECORDINGS = [
