@@ -61,7 +61,7 @@ def _px4(duration: float, rate: float) -> tuple[list[RawMessage], list[object]]:
 
 
 def _definition(message: str) -> str:
-    from fuzzoff.formats.ros2msgs import px4_msgs
+    from fuzzoff.formats import px4_msgs
 
     text = px4_msgs.definition("main", message)
     assert text is not None

@@ -16,7 +16,7 @@ from typing import Any
 import pytest
 
 from fuzzoff.events import Event, event_to_dict
-from fuzzoff.formats.ros2msgs import px4_msgs
+from fuzzoff.formats import px4_msgs
 from fuzzoff.formats.ros2msgs.convert import BUILDERS
 from fuzzoff.formats.ros2msgs.decode import Ros2Decoding, TopicDecoder, bundled, bundled_layout
 from fuzzoff.formats.ulog import reader as ulog_module

@@ -189,7 +189,7 @@ def test_embedded_definition_without_a_needed_field_falls_back_to_bundled(
 ) -> None:
     # A fork's px4_msgs (or a damaged schema) that renamed a field fuzzoff reads: the payload
     # still has the release's layout, so the bundled definition decodes it.
-    from fuzzoff.formats.ros2msgs import px4_msgs
+    from fuzzoff.formats import px4_msgs
     from fuzzoff.formats.ros2msgs.messages import encode, to_message
 
     message = to_message(event, "1.15")

@@ -17,7 +17,7 @@ from pathlib import Path
 import pytest
 
 from fuzzoff.catalog import Rule, load_catalog, render_page
-from fuzzoff.formats.ros2msgs import px4_msgs
+from fuzzoff.formats import px4_msgs
 from tests.helpers import ROOT, run_cli
 
 RULES = list(load_catalog().values())

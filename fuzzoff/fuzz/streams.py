@@ -22,8 +22,8 @@ from typing import Any
 from hypothesis import strategies as st
 
 from fuzzoff import events as ev
-from fuzzoff.formats.ros2msgs import px4_msgs
-from fuzzoff.formats.ros2msgs.px4_msgs import release_for
+from fuzzoff.formats import px4_msgs
+from fuzzoff.formats.px4_msgs import release_for
 from fuzzoff.fuzz import strategies as fs
 from fuzzoff.fuzz.scenario import AUTOPILOT, COMPANION, TRANSPORTS, Scenario, TransportName
 from fuzzoff.gate import GateModel

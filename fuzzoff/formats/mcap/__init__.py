@@ -20,7 +20,7 @@ def _detect(path: Path, head: bytes) -> str | None:
 
 def release_options(px4: str | None) -> Mapping[str, Any]:
     """The px4_msgs definitions a ROS 2 recording of ``px4`` embeds (``main`` when unknown)."""
-    from fuzzoff.formats.ros2msgs.px4_msgs import release_for
+    from fuzzoff.formats.px4_msgs import release_for
 
     return {"release": release_for(px4) or "main"}
 

@@ -16,7 +16,7 @@ from mcap.writer import CompressionType
 from mcap_ros2.writer import Writer
 
 from fuzzoff.events import Event
-from fuzzoff.formats.ros2msgs import px4_msgs
+from fuzzoff.formats import px4_msgs
 from fuzzoff.formats.ros2msgs.messages import (
     START_NS,
     Px4Message,

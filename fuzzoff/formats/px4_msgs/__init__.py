@@ -3,8 +3,9 @@
 Each folder (``1.13`` ... ``1.17``, ``main`` = release/1.18) holds the wire fields of the messages
 fuzzoff decodes, in the order of that release's ``px4_msgs`` branch, with comments and constants
 dropped except ``MESSAGE_VERSION`` (which names the ``_vN`` topic suffix; it is not on the wire).
-They are used for recordings without embedded definitions (Humble-and-older ``.db3`` bags) and by
-the writers. See ``docs/ros2.md`` for what is exact and what is not.
+They are used for recordings without embedded definitions (Humble-and-older ``.db3`` bags), by
+the ROS 2 writers, and for the layouts the ULog writer declares (``ulog_fields``).
+See ``docs/ros2.md`` for what is exact and what is not.
 """
 
 from __future__ import annotations

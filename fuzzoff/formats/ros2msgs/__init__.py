@@ -1,2 +1,2 @@
-"""The px4_msgs vocabulary shared by the MCAP and ROS 2 bag formats: definitions per release,
-topic names, messages to events (readers) and events to messages (writers)."""
+"""The px4_msgs vocabulary shared by the MCAP and ROS 2 bag formats: topic names, messages to
+events (readers) and events to messages (writers); the definitions are in ``formats.px4_msgs``."""

@@ -20,9 +20,9 @@ from rosbags.typesys import get_types_from_idl, get_types_from_msg
 from rosbags.typesys.store import Typestore
 
 from fuzzoff.events import NOWHERE, Event, Origin, VehicleStatus, Where
+from fuzzoff.formats import px4_msgs
 from fuzzoff.formats.mavros.convert import MavrosConverter, mavros_topic
 from fuzzoff.formats.mavros.ros2 import MavrosTopicDecoder
-from fuzzoff.formats.ros2msgs import px4_msgs
 from fuzzoff.formats.ros2msgs.convert import BUILDERS, KIND_OF, Builder
 from fuzzoff.formats.ros2msgs.topics import MESSAGE_FOR_NAME, OUTPUT_MESSAGES, TopicRef, parse_topic
 from fuzzoff.formats.typedefs import bounded

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from fuzzoff import events as ev
-from fuzzoff.formats.ros2msgs import px4_msgs
+from fuzzoff.formats import px4_msgs
 from fuzzoff.formats.ros2msgs.topics import topic_for
 from fuzzoff.formats.uorb import ARMING_STATE_ARMED, ARMING_STATE_DISARMED, ESTIMATES
 

@@ -22,12 +22,12 @@ from rosbags.rosbag2 import Reader
 from ruamel.yaml import YAML
 
 from fuzzoff.events import Event
+from fuzzoff.formats import px4_msgs
 from fuzzoff.formats.mavros.convert import mavros_topic
 from fuzzoff.formats.mcap import check as mcap_check
 from fuzzoff.formats.mcap import indexed as mcap_indexed
 from fuzzoff.formats.mcap.order import ChunkOrder
 from fuzzoff.formats.mcap.stream import McapStream
-from fuzzoff.formats.ros2msgs import px4_msgs
 from fuzzoff.formats.ros2msgs.decode import Decoder, Ros2Decoding, TopicDecoder, message_of
 from fuzzoff.formats.rosbag2 import metadata as ros2_metadata
 from fuzzoff.formats.rosbag2.sqlite import SQLITE_ERRORS, SalvageCopies

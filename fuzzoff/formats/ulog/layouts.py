@@ -8,7 +8,7 @@ like PX4's; a field list starts at the era named and holds until the next entry.
 
 from __future__ import annotations
 
-from fuzzoff.formats.ros2msgs import px4_msgs
+from fuzzoff.formats import px4_msgs
 from fuzzoff.formats.uorb import TOPICS
 from fuzzoff.profiles import px4_profile_for
 
