@@ -63,3 +63,26 @@ def test_the_python_api_import_of_recording_info_still_works() -> None:
     from fuzzoff.sources.base import RecordingInfo as OldName
 
     assert OldName is RecordingInfo
+
+
+@pytest.mark.parametrize("fmt", FORMATS, ids=lambda f: f.name)
+def test_the_fleet_table_dates_a_recording_by_its_own_clock(tmp_path: Path, fmt: Format) -> None:
+    """A ULog's clock counts from boot (no GPS fix here: no date); the others log Unix time."""
+    from fuzzoff.fleet.wallclock import start_time
+    from fuzzoff.formats.ros2msgs.messages import START_NS
+    from fuzzoff.formats.rosbag1.writer import DEFAULT_START_NS
+    from fuzzoff.formats.tlog.writer import DEFAULT_START_US
+
+    path = fmt.write(tmp_path / f"flight{fmt.written_suffix}", _stream(fmt), "1.15")
+    when = start_time(path, detect_format(path))
+    expected = {
+        "tlog": DEFAULT_START_US / 1e6,
+        "mcap": START_NS / 1e9,
+        "rosbag2": START_NS / 1e9,
+        "rosbag1": DEFAULT_START_NS / 1e9,
+    }.get(fmt.name)
+    if expected is None:
+        assert when is None
+    else:
+        assert when is not None
+        assert when.timestamp() == pytest.approx(expected, abs=1e-3)

@@ -34,6 +34,9 @@ class Format:
     """``module:class`` of the reader (a ``Source``)."""
     writer: str
     """``module:function`` of the writer: ``write(path, events, **options) -> Path``."""
+    clock: str
+    """``module:function`` giving when the recording started on the wall clock (UNIX seconds),
+    or None where it does not say (the fleet table's weeks)."""
     detect_file: Callable[[Path, bytes], str | None]
     """The format name a file's first 32 bytes (and its place) say, or None: the name a
     recording is reported under (``rosbag2-sqlite3``), which may differ from ``name``."""
@@ -66,6 +69,12 @@ class Format:
         """``events`` written at ``path`` as PX4 ``px4`` would have them recorded."""
         function: Callable[..., Path] = _load(self.writer)
         return function(path, events, **self.writer_options(px4))
+
+
+    def start_s(self, path: Path) -> float | None:
+        """When the recording at ``path`` started on the wall clock, where it says."""
+        function: Callable[[Path], float | None] = _load(self.clock)
+        return function(path)
 
 
 def _load(target: str) -> Any:

@@ -29,6 +29,7 @@ FORMAT = Format(
     name="mcap",
     reader="fuzzoff.formats.mcap.reader:McapSource",
     writer="fuzzoff.formats.mcap.writer:write_mcap",
+    clock="fuzzoff.formats.mcap.clock:start_s",
     detect_file=_detect,
     names=("mcap",),
     suffixes=(".mcap",),

@@ -17,6 +17,7 @@ FORMAT = Format(
     name="rosbag1",
     reader="fuzzoff.formats.rosbag1.reader:Rosbag1Source",
     writer="fuzzoff.formats.rosbag1.writer:write_rosbag1",
+    clock="fuzzoff.formats.rosbag1.clock:start_s",
     detect_file=_detect,
     names=("rosbag1",),
     suffixes=(".bag", ".active"),

@@ -69,6 +69,7 @@ FORMAT = Format(
     name="rosbag2",
     reader="fuzzoff.formats.rosbag2.reader:Rosbag2Source",
     writer="fuzzoff.formats.rosbag2.writer:write_rosbag2",
+    clock="fuzzoff.formats.rosbag2.clock:start_s",
     detect_file=_detect,
     names=("rosbag2-sqlite3", "rosbag2-mcap"),
     suffixes=(".db3",),

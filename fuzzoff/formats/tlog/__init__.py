@@ -16,6 +16,7 @@ FORMAT = Format(
     name="tlog",
     reader="fuzzoff.formats.tlog.reader:TlogSource",
     writer="fuzzoff.formats.tlog.writer:write_tlog",
+    clock="fuzzoff.formats.tlog.clock:start_s",
     detect_file=_detect,
     names=("tlog",),
     suffixes=(".tlog",),

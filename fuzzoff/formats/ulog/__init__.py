@@ -23,6 +23,7 @@ FORMAT = Format(
     name="ulog",
     reader="fuzzoff.formats.ulog.reader:UlogSource",
     writer="fuzzoff.formats.ulog.writer:write_ulog",
+    clock="fuzzoff.formats.ulog.clock:start_s",
     detect_file=_detect,
     names=("ulog",),
     suffixes=(".ulg",),
