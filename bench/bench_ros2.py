@@ -60,8 +60,8 @@ print(n, time.process_time() - start)
 READER = """
 import sys, time
 from pathlib import Path
-from fuzzoff.sources import open_source
-import fuzzoff.sources.mcap, fuzzoff.sources.rosbag2  # imports are start-up, not work
+from fuzzoff.formats import open_source
+import fuzzoff.formats.mcap.reader, fuzzoff.formats.rosbag2.reader  # imports are start-up, not work
 start = time.process_time()
 source = open_source(Path(sys.argv[1]))
 with source:
@@ -74,7 +74,7 @@ LINT = """
 import sys, time
 from fuzzoff import lint_file
 from fuzzoff.checks import load_all
-import fuzzoff.sources.mcap, fuzzoff.sources.rosbag2  # imports are start-up, not work
+import fuzzoff.formats.mcap.reader, fuzzoff.formats.rosbag2.reader  # imports are start-up, not work
 load_all()
 start = time.process_time()
 report = lint_file(sys.argv[1])

@@ -40,7 +40,7 @@ print(n)
 READER = """
 import sys
 from pathlib import Path
-from fuzzoff.sources.rosbag1 import Rosbag1Source
+from fuzzoff.formats.rosbag1.reader import Rosbag1Source
 source = Rosbag1Source(Path(sys.argv[1]))
 with source:
     source.probe()

@@ -48,7 +48,7 @@ print(n)
 READER = """
 import sys
 from pathlib import Path
-from fuzzoff.sources.tlog import TlogSource
+from fuzzoff.formats.tlog.reader import TlogSource
 source = TlogSource(Path(sys.argv[1]))
 with source:
     source.probe()

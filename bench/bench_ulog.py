@@ -19,7 +19,7 @@ from pathlib import Path
 from bench.measure import Run, per_message_split
 from bench.measure import measure as run_measured
 from bench.ulog_data import generate
-from fuzzoff.sources.ulog import LOADED_TOPICS
+from fuzzoff.formats.ulog.reader import LOADED_TOPICS
 
 DATA = Path(__file__).resolve().parent / "data"
 ROOT = DATA.parent.parent
@@ -35,7 +35,7 @@ print(sum(len(d.data["timestamp"]) for d in ulog.data_list))
 READER = """
 import sys
 from pathlib import Path
-from fuzzoff.sources.ulog import UlogSource
+from fuzzoff.formats.ulog.reader import UlogSource
 source = UlogSource(Path(sys.argv[1]))
 with source:
     source.probe()

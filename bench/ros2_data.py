@@ -18,9 +18,9 @@ from pathlib import Path
 from rosbags.typesys import Stores, get_typestore
 
 from fuzzoff.events import Command, CommandAck, ControlMode, TrajectorySetpoint, VehicleStatus
-from fuzzoff.writers.mcap import write_mcap
-from fuzzoff.writers.ros2_messages import RawMessage, encode, to_message
-from fuzzoff.writers.rosbag2 import write_rosbag2
+from fuzzoff.formats.mcap.writer import write_mcap
+from fuzzoff.formats.ros2msgs.messages import RawMessage, encode, to_message
+from fuzzoff.formats.rosbag2.writer import write_rosbag2
 
 PX4_RATE = 50.0
 MIXED_PX4_RATE = 20.0
@@ -61,7 +61,7 @@ def _px4(duration: float, rate: float) -> tuple[list[RawMessage], list[object]]:
 
 
 def _definition(message: str) -> str:
-    from fuzzoff.sources import px4_msgs
+    from fuzzoff.formats import px4_msgs
 
     text = px4_msgs.definition("main", message)
     assert text is not None

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 from rosbags.rosbag1 import Writer
 
-from fuzzoff.writers.rosbag1 import DEFAULT_START_NS, mavros_typestore
+from fuzzoff.formats.rosbag1.writer import DEFAULT_START_NS, mavros_typestore
 
 VARIANTS = 256
 SETPOINT_PERIOD_NS = 20_000_000

@@ -20,8 +20,8 @@ os.environ.setdefault("MAVLINK20", "1")
 
 from pymavlink.dialects.v20 import common as mavlink
 
+from fuzzoff.formats.tlog.writer import DEFAULT_START_US, encode_px4_version
 from fuzzoff.modes import nav_state_to_custom_mode
-from fuzzoff.writers.tlog import DEFAULT_START_US, encode_px4_version
 
 VARIANTS = 256
 SETPOINT_PERIOD_US = 20_000

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from fuzzoff.writers.ulog import DEFAULT_START_US, write_ulog_columns
+from fuzzoff.formats.ulog.writer import DEFAULT_START_US, write_ulog_columns
 
 Columns = dict[str, Any]
 

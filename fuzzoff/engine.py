@@ -36,6 +36,7 @@ from fuzzoff.findings import (
     clip,
     first_clause,
 )
+from fuzzoff.formats import SourceError, open_source, recordings_in
 from fuzzoff.gate import GateModel, GateTransition
 from fuzzoff.profiles import (
     DEFAULT_PX4,
@@ -44,10 +45,10 @@ from fuzzoff.profiles import (
     ProfileError,
     px4_profile_for,
 )
+from fuzzoff.recording import RecordingInfo, SourceProblem, path_text
 from fuzzoff.releases import PX4Profile
-from fuzzoff.sources import SourceError, open_source, recordings_in
-from fuzzoff.sources.base import RecordingInfo, SourceProblem, path_text
 from fuzzoff.state import VehicleState
+from fuzzoff.type_mask import POSITION_BITS
 
 Progress = Callable[[float], None]
 
@@ -274,8 +275,6 @@ class VehicleRun:
 
 
 NOTED = (StatusText, Command, CommandAck)
-POSITION_IGNORED = 0b111
-"""``type_mask`` bits of SET_POSITION_TARGET_LOCAL_NED that ignore x, y, z."""
 
 
 def _plotted_position(event: Event) -> bool:
@@ -286,7 +285,7 @@ def _plotted_position(event: Event) -> bool:
     return (
         isinstance(event, SetPositionTargetLocal)
         and event.coordinate_frame == 1
-        and not event.type_mask & POSITION_IGNORED
+        and not event.type_mask & POSITION_BITS
     )
 
 

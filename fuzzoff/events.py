@@ -587,7 +587,7 @@ class VehiclePosition(Event):
     """Where the vehicle estimates it is, local NED in metres (ULog and ROS 2
     ``vehicle_local_position``, MAVLink ``LOCAL_POSITION_NED``, MAVROS ``local_position/pose``
     turned back into NED); NaN where PX4 marks the coordinate invalid. OFB404 compares vertical
-    setpoints with its ``z``; a plain lint reads one per ``sources.base.POSITION_PERIOD_S``, the
+    setpoints with its ``z``; a plain lint reads one per ``recording.POSITION_PERIOD_S``, the
     HTML report's plots every one."""
 
     kind: ClassVar[str] = "vehicle_position"

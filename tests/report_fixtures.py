@@ -8,9 +8,9 @@ from fuzzoff.config import Settings
 from fuzzoff.engine import Timeline, timeline_loss_timeout
 from fuzzoff.events import Event, SetPositionTargetLocal, StatusText, VehicleStatus, Where
 from fuzzoff.findings import FileReport, Finding, Report, Severity
+from fuzzoff.formats.tlog.writer import write_tlog
 from fuzzoff.gate import GateTransition
 from fuzzoff.profiles import Profile
-from fuzzoff.writers.tlog import write_tlog
 
 SCRIPT = "<script>document.title='pwned';console.error('pwned')</script>"
 ONERROR = '" onerror="document.title=\'pwned\'" x="'

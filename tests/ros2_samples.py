@@ -8,8 +8,8 @@ from typing import Any
 
 from fuzzoff import events as ev
 from fuzzoff.events import Event, event_to_dict
-from fuzzoff.sources import open_source
-from fuzzoff.sources.base import Source
+from fuzzoff.formats import open_source
+from fuzzoff.recording import Source
 
 NAN = math.nan
 RELEASES = ("1.13", "1.14", "1.15", "1.16", "1.17", "main")

@@ -9,7 +9,7 @@ from fuzzoff.engine import run_events
 from fuzzoff.events import Command, CommandAck, ControlMode, Event, VehicleStatus
 from fuzzoff.findings import Finding
 from fuzzoff.profiles import Profile
-from fuzzoff.sources.base import RecordingInfo
+from fuzzoff.recording import RecordingInfo
 
 OFFBOARD = 14
 POSCTL = 2

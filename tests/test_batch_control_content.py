@@ -37,7 +37,7 @@ from fuzzoff.events import (
     VehicleStatus,
 )
 from fuzzoff.profiles import Profile
-from fuzzoff.sources.base import RecordingInfo
+from fuzzoff.recording import RecordingInfo
 from tests.helpers import fresh, in_lint_order
 
 NAN = math.nan

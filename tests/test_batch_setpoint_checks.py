@@ -28,7 +28,7 @@ from fuzzoff.events import (
     VehicleStatus,
 )
 from fuzzoff.profiles import Profile
-from fuzzoff.sources.base import RecordingInfo
+from fuzzoff.recording import RecordingInfo
 from tests.helpers import fresh
 
 CODES = ("OFB107", "OFB404", "OFB601", "OFB602", "OFB603", "OFB604", "OFB605", "OFB606")

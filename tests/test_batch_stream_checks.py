@@ -30,7 +30,7 @@ from fuzzoff.events import (
     VehicleStatus,
 )
 from fuzzoff.profiles import Profile
-from fuzzoff.sources.base import RecordingInfo
+from fuzzoff.recording import RecordingInfo
 from tests.helpers import in_lint_order
 
 MODULES = tuple(m.__name__ for m in (loss, outside_offboard, stale, stream, timestamps))

@@ -39,7 +39,7 @@ def test_runs_are_used_on_the_hot_path() -> None:
     """The equivalence above only means something if checks do take runs."""
     from fuzzoff.config import Settings
     from fuzzoff.profiles import Profile
-    from fuzzoff.sources.base import RecordingInfo
+    from fuzzoff.recording import RecordingInfo
 
     for kinds in ({"offboard_control_mode", "trajectory_setpoint"}, {"set_position_target_local"}):
         info = RecordingInfo("x", "mcap", kinds=set(kinds))

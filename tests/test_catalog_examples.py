@@ -18,7 +18,7 @@ from fuzzoff.engine import run_events
 from fuzzoff.events import Event, event_from_dict
 from fuzzoff.findings import Finding
 from fuzzoff.profiles import DEFAULT_PX4, DEFAULT_VEHICLE, Profile
-from fuzzoff.sources.base import RecordingInfo
+from fuzzoff.recording import RecordingInfo
 
 NOT_STREAM_RULES = {"OFB001", "OFB002", "OFB003", "OFB004"}
 """Rules about reading the file or choosing the profile: no event stream can show them."""

@@ -38,7 +38,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from fuzzoff.sources import SourceError, open_source
+from fuzzoff.formats import SourceError, open_source
 from tests.helpers import CORPORA, run_cli
 
 

@@ -12,7 +12,7 @@ from fuzzoff.engine import YOUNG_COLLECTION_EVERY, run_events
 from fuzzoff.events import Event
 from fuzzoff.findings import Finding
 from fuzzoff.profiles import Profile
-from fuzzoff.sources.base import RecordingInfo
+from fuzzoff.recording import RecordingInfo
 from tests.streams import OFFBOARD, codes, every, ocm, status
 
 Thresholds = tuple[int, int, int]

@@ -137,8 +137,8 @@ def test_rosbag1_writer_keeps_extra_messages_in_time_order(tmp_path: Path) -> No
     ``setpoint_position/local``): the extra messages are read back by fuzzoff's MAVROS reader,
     merged in time order with the events."""
     from fuzzoff.events import VehicleStatus
-    from fuzzoff.sources import open_source
-    from fuzzoff.writers.rosbag1 import Ros1Message, mavros_typestore, write_rosbag1
+    from fuzzoff.formats import open_source
+    from fuzzoff.formats.rosbag1.writer import Ros1Message, mavros_typestore, write_rosbag1
 
     types = mavros_typestore().types
     header = types["std_msgs/msg/Header"](

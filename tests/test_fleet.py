@@ -22,9 +22,9 @@ from fuzzoff.config import Settings
 from fuzzoff.events import ControlMode, VehicleStatus
 from fuzzoff.fleet.fuzz_run import merge, parse_seeds
 from fuzzoff.fleet.task import lint_target
+from fuzzoff.formats import find_recordings
 from fuzzoff.fuzz.campaign import CampaignConfig, CampaignResult, PropertyResult
 from fuzzoff.fuzz.scenario import Scenario
-from fuzzoff.sources import find_recordings
 from tests.helpers import CORPORA, ROOT, run_cli
 
 TLOGS = CORPORA / "tlog"

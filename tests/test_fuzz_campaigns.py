@@ -24,6 +24,7 @@ from fuzzoff.events import (
     TrajectorySetpoint,
     VehicleStatus,
 )
+from fuzzoff.formats.mcap.writer import write_mcap
 from fuzzoff.fuzz.campaign import CampaignConfig, run_campaign
 from fuzzoff.fuzz.invariants import invariant_violations
 from fuzzoff.fuzz.known import KNOWN
@@ -35,7 +36,6 @@ from fuzzoff.fuzz.properties import (
 )
 from fuzzoff.fuzz.reproducers import save
 from fuzzoff.fuzz.scenario import Scenario, run
-from fuzzoff.writers.mcap import write_mcap
 from tests.helpers import CORPORA, run_cli
 
 SEED = 20261122

@@ -100,7 +100,7 @@ def _without(codes: set[str]) -> Callable[..., list[Finding]]:
 
 def _lossy_mcap_writer(monkeypatch: pytest.MonkeyPatch) -> None:
     """A fault in a writer: the last message is not written."""
-    from fuzzoff.writers import mcap
+    from fuzzoff.formats.mcap import writer as mcap
 
     real = mcap.write_mcap
 

@@ -18,8 +18,8 @@ os.environ.setdefault("MAVLINK20", "1")
 from pymavlink.dialects.v20 import development as mavlink
 
 from fuzzoff.engine import Timeline, lint_file
+from fuzzoff.formats.tlog.writer import DEFAULT_START_US, encode_px4_version
 from fuzzoff.modes import nav_state_to_custom_mode
-from fuzzoff.writers.tlog import DEFAULT_START_US, encode_px4_version
 from tests.helpers import run_cli
 
 PX4 = (1, 1)

@@ -19,10 +19,10 @@ import pytest
 from fuzzoff.config import Settings
 from fuzzoff.engine import Timeline, lint_file_with_timelines
 from fuzzoff.findings import FileReport, Finding, Report, Severity
+from fuzzoff.formats import find_recordings
 from fuzzoff.profiles import Profile
 from fuzzoff.report.html import render
 from fuzzoff.report.html_assets import report_csp
-from fuzzoff.sources import find_recordings
 from tests.cdp import Browser, find_chromium
 from tests.helpers import CORPORA, ROOT, run_cli
 from tests.report_fixtures import SCRIPT, gap_recording, hostile_report, with_plots

@@ -26,10 +26,10 @@ from fuzzoff.events import (
     VehicleStatus,
 )
 from fuzzoff.findings import FileReport, Finding, Report, Severity
+from fuzzoff.formats.tlog.writer import write_tlog
 from fuzzoff.profiles import Profile
 from fuzzoff.report.html import render
 from fuzzoff.report.html_plot import BUCKETS, as_script_data, min_max_buckets, with_ramps
-from fuzzoff.writers.tlog import write_tlog
 from tests.helpers import CORPORA, ROOT, run_cli
 from tests.report_fixtures import SCRIPT, gap_recording, hostile_report, with_plots
 

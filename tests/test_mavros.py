@@ -15,14 +15,14 @@ from fuzzoff.events import (
     SetPositionTargetLocal,
     VehicleStatus,
 )
-from fuzzoff.sources import open_source
-from fuzzoff.sources.mavros import (
+from fuzzoff.formats import open_source
+from fuzzoff.formats.mavros.convert import (
     MavrosConverter,
     MavrosOptions,
     mavros_topic,
     split_topic,
 )
-from fuzzoff.sources.mavros_frames import (
+from fuzzoff.formats.mavros.frames import (
     AIRCRAFT_BASELINK_Q,
     orientation_enu_to_ned,
     quat_from_rpy,
@@ -31,8 +31,8 @@ from fuzzoff.sources.mavros_frames import (
     yaw_enu_to_ned,
     yaw_flu_to_frd,
 )
-from fuzzoff.sources.mavros_msgs import mavros_typedefs
-from fuzzoff.writers.rosbag1 import mavros_typestore
+from fuzzoff.formats.mavros.mavros_msgs import mavros_typedefs
+from fuzzoff.formats.rosbag1.writer import mavros_typestore
 from tests.helpers import CORPORA
 
 ROS1 = mavros_typestore()

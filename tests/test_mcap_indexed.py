@@ -1,4 +1,4 @@
-"""The indexed MCAP path (``sources/mcap_indexed``) reads what rosbags' own path reads.
+"""The indexed MCAP path (``formats/mcap/indexed``) reads what rosbags' own path reads.
 
 A recording whose PX4 topics are a small share of its messages (camera and IMU beside them) is
 read through the MCAP message indexes; everything else through rosbags. Both must give the same
@@ -17,9 +17,10 @@ from mcap.writer import CompressionType
 
 from bench.ros2_data import generate
 from fuzzoff.events import event_to_dict
-from fuzzoff.sources import mcap_indexed, open_source
-from fuzzoff.writers.mcap import write_mcap
-from fuzzoff.writers.ros2_messages import RawMessage
+from fuzzoff.formats import open_source
+from fuzzoff.formats.mcap import indexed as mcap_indexed
+from fuzzoff.formats.mcap.writer import write_mcap
+from fuzzoff.formats.ros2msgs.messages import RawMessage
 
 ROOT = Path(__file__).resolve().parent.parent
 CORPUS_MCAP = sorted(

@@ -16,11 +16,11 @@ from typing import Any
 import pytest
 
 from fuzzoff.events import Event, event_to_dict
-from fuzzoff.sources import px4_msgs
-from fuzzoff.sources import ulog as ulog_module
-from fuzzoff.sources.ros2_convert import BUILDERS
-from fuzzoff.sources.ros2_decode import Ros2Decoding, TopicDecoder, bundled, bundled_layout
-from fuzzoff.sources.ulog import UlogSource
+from fuzzoff.formats import px4_msgs
+from fuzzoff.formats.ros2msgs.convert import BUILDERS
+from fuzzoff.formats.ros2msgs.decode import Ros2Decoding, TopicDecoder, bundled, bundled_layout
+from fuzzoff.formats.ulog import reader as ulog_module
+from fuzzoff.formats.ulog.reader import UlogSource
 
 ROOT = Path(__file__).resolve().parent.parent
 ULOGS = sorted((ROOT / "corpora").rglob("*.ulg"))
@@ -151,8 +151,8 @@ def test_bundled_layout_is_the_type_store_layout() -> None:
 
 def test_rosbag1_decoder_is_the_library_call() -> None:
     """``_decoder`` gives rosbags' message, or raises rosbags' own error, for any payload."""
-    from fuzzoff.sources.rosbag1 import Rosbag1Source, _decoder
-    from fuzzoff.sources.rosbag1_chunkwise import ChunkwiseReader
+    from fuzzoff.formats.rosbag1.chunkwise import ChunkwiseReader
+    from fuzzoff.formats.rosbag1.reader import Rosbag1Source, _decoder
 
     bag = ROOT / "corpora" / "rosbag1" / "offboard_good.bag"
     source = Rosbag1Source(bag)

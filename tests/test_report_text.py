@@ -14,8 +14,8 @@ from pathlib import Path
 
 import pytest
 
+from fuzzoff.formats.mcap.writer import write_mcap
 from fuzzoff.report.sanitize import escape_bidi, printable
-from fuzzoff.writers.mcap import write_mcap
 from tests.helpers import CORPORA, run_cli
 
 NAMESPACE = "/px4_\u202e1\u2066x"

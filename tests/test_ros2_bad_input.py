@@ -12,9 +12,9 @@ import pytest
 from mcap.reader import make_reader
 
 from fuzzoff import events as ev
-from fuzzoff.writers.mcap import write_mcap
-from fuzzoff.writers.ros2_messages import RawMessage
-from fuzzoff.writers.rosbag2 import write_rosbag2
+from fuzzoff.formats.mcap.writer import write_mcap
+from fuzzoff.formats.ros2msgs.messages import RawMessage
+from fuzzoff.formats.rosbag2.writer import write_rosbag2
 from tests.helpers import run_cli
 from tests.ros2_samples import read_all
 

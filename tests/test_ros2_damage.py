@@ -18,8 +18,8 @@ import pytest
 from mcap.reader import SeekingReader
 
 from fuzzoff.events import ControlMode
-from fuzzoff.sources import open_source
-from fuzzoff.writers.mcap import write_mcap
+from fuzzoff.formats import open_source
+from fuzzoff.formats.mcap.writer import write_mcap
 from tests.helpers import CORPORA, run_cli
 from tests.test_ros2_bad_input import flight
 

@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from fuzzoff.writers.mcap import write_mcap
-from fuzzoff.writers.rosbag2 import write_rosbag2
+from fuzzoff.formats.mcap.writer import write_mcap
+from fuzzoff.formats.rosbag2.writer import write_rosbag2
 from tests.ros2_samples import RELEASES, comparable, every_kind, read_all
 
 KINDS = ("mcap", "rosbag2-sqlite3", "rosbag2-mcap", "rosbag2-humble")

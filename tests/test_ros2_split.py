@@ -9,7 +9,7 @@ import pytest
 from ruamel.yaml import YAML
 
 from fuzzoff.events import ControlMode, Event
-from fuzzoff.writers.rosbag2 import write_rosbag2
+from fuzzoff.formats.rosbag2.writer import write_rosbag2
 from tests.ros2_samples import read_all
 
 

@@ -10,11 +10,11 @@ import pytest
 from rosbags.typesys import Stores, get_typestore
 
 from fuzzoff import events as ev
-from fuzzoff.sources.mavros_msgs import mavros_typedefs, msg_text
-from fuzzoff.sources.ros2_topics import parse_topic
-from fuzzoff.writers.mcap import write_mcap
-from fuzzoff.writers.ros2_messages import RawMessage
-from fuzzoff.writers.rosbag2 import write_rosbag2
+from fuzzoff.formats.mavros.mavros_msgs import mavros_typedefs, msg_text
+from fuzzoff.formats.mcap.writer import write_mcap
+from fuzzoff.formats.ros2msgs.messages import RawMessage
+from fuzzoff.formats.ros2msgs.topics import parse_topic
+from fuzzoff.formats.rosbag2.writer import write_rosbag2
 from tests.ros2_samples import every_kind, read_all
 
 
@@ -159,7 +159,7 @@ def test_mavros_topics_become_what_mavros_sends(tmp_path: Path, definitions: boo
 
 
 def test_unparsable_embedded_definition_falls_back_to_bundled(tmp_path: Path) -> None:
-    from fuzzoff.writers.ros2_messages import encode, to_message
+    from fuzzoff.formats.ros2msgs.messages import encode, to_message
 
     raws = [
         RawMessage(
@@ -189,8 +189,8 @@ def test_embedded_definition_without_a_needed_field_falls_back_to_bundled(
 ) -> None:
     # A fork's px4_msgs (or a damaged schema) that renamed a field fuzzoff reads: the payload
     # still has the release's layout, so the bundled definition decodes it.
-    from fuzzoff.sources import px4_msgs
-    from fuzzoff.writers.ros2_messages import encode, to_message
+    from fuzzoff.formats import px4_msgs
+    from fuzzoff.formats.ros2msgs.messages import encode, to_message
 
     message = to_message(event, "1.15")
     text = px4_msgs.definition("1.15", message.message)

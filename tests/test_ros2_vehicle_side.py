@@ -20,8 +20,8 @@ from fuzzoff.events import (
     VehiclePosition,
     VehicleStatus,
 )
-from fuzzoff.sources import open_source
-from fuzzoff.writers.mcap import write_mcap
+from fuzzoff.formats import open_source
+from fuzzoff.formats.mcap.writer import write_mcap
 from tests.helpers import CORPORA, run_cli
 
 EXAMPLES = CORPORA / "examples"

@@ -21,9 +21,9 @@ from fuzzoff.events import (
     SetPositionTargetLocal,
     VehicleStatus,
 )
-from fuzzoff.sources import detect_format, open_source
-from fuzzoff.sources.rosbag1 import Rosbag1Source
-from fuzzoff.writers.rosbag1 import _Builder, mavros_typestore, write_rosbag1
+from fuzzoff.formats import detect_format, open_source
+from fuzzoff.formats.rosbag1.reader import Rosbag1Source
+from fuzzoff.formats.rosbag1.writer import _Builder, mavros_typestore, write_rosbag1
 from tests.helpers import run_cli, run_cli_process
 
 MAVROS: dict[str, Any] = {"target_system": 1, "target_component": 1, "transport": "mavros"}
@@ -337,7 +337,7 @@ def test_chunkwise_reader_gives_what_rosbags_gives(tmp_path: Path) -> None:
     """Same messages, same order as rosbags' whole-index reader, on a many-chunk mixed bag."""
     from rosbags.rosbag1 import Reader
 
-    from fuzzoff.sources.rosbag1_chunkwise import ChunkwiseReader
+    from fuzzoff.formats.rosbag1.chunkwise import ChunkwiseReader
 
     path = tmp_path / "mixed.bag"
     store = mavros_typestore()

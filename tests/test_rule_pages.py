@@ -19,7 +19,7 @@ from types import ModuleType
 import pytest
 
 from fuzzoff.catalog import Rule, load_catalog, render_page
-from fuzzoff.sources import px4_msgs
+from fuzzoff.formats import px4_msgs
 from tests.helpers import ROOT, run_cli
 
 RULES = list(load_catalog().values())

@@ -7,6 +7,7 @@ from typing import Any
 
 import pytest
 
+from fuzzoff import type_mask as tmask
 from fuzzoff.config import Settings
 from fuzzoff.events import (
     Event,
@@ -23,9 +24,9 @@ from tests.streams import codes, lint_events
 
 PAGE_PROFILES = ("1.13", "1.14", "1.15", "1.16", "1.17", "main")
 VEHICLES = ("mc", "fw", "vtol", "rover-ackermann", "rover-differential", "rover-mecanum")
-ALL_IGNORED = tm.POSITION_BITS | tm.VELOCITY_BITS | tm.ACCELERATION_BITS
-NO_YAW = tm.YAW_IGNORE | tm.YAW_RATE_IGNORE
-POSITION_ONLY_MASK = ALL_IGNORED & ~tm.POSITION_BITS | NO_YAW
+ALL_IGNORED = tmask.POSITION_BITS | tmask.VELOCITY_BITS | tmask.ACCELERATION_BITS
+NO_YAW = tmask.YAW_IGNORE | tmask.YAW_RATE_IGNORE
+POSITION_ONLY_MASK = ALL_IGNORED & ~tmask.POSITION_BITS | NO_YAW
 NAN_VALUE = float("nan")
 
 
@@ -128,7 +129,7 @@ def test_mask_selecting_nothing_is_an_error(mask: int) -> None:
 
 
 def test_force_setpoint_is_an_error() -> None:
-    mask = mask_for(frozenset({"acceleration"})) | tm.FORCE_BIT
+    mask = mask_for(frozenset({"acceleration"})) | tmask.FORCE_SET
     found = codes(lint([setpoint(tm.LOCAL, type_mask=mask, coordinate_frame=1)]), "OFB602")
     assert [f.severity for f in found] == [Severity.ERROR]
     assert "FORCE" in found[0].message
@@ -136,7 +137,7 @@ def test_force_setpoint_is_an_error() -> None:
 
 def test_partial_group_counts_as_that_group() -> None:
     # x, y used and z ignored is still a position setpoint (as the 292 gliding value is).
-    mask = mask_for(frozenset({"position"})) | tm.Z_IGNORE
+    mask = mask_for(frozenset({"position"})) | tmask.Z_IGNORE
     event = setpoint(tm.LOCAL, type_mask=mask, coordinate_frame=1)
     assert not codes(lint([event], vehicle="fw"), "OFB602")
     # A multicopter's position controller needs every axis (gate spec 8): that is the finding.
@@ -165,13 +166,13 @@ def test_copter_setpoint_the_position_controller_rejects(
     fallback = "for up to 200 ms" in found.message
     assert fallback is (px4 == "1.16")
     # The same message is a plain position setpoint for a fixed-wing.
-    if mask & tm.VELOCITY_BITS == tm.VELOCITY_BITS:
+    if mask & tmask.VELOCITY_BITS == tmask.VELOCITY_BITS:
         assert not codes(lint([event], px4, "fw"), "OFB602")
 
 
 def test_copter_setpoint_with_every_axis_is_clean() -> None:
     # z position with x, y velocity: mixed axes are legal (gate spec 8).
-    mask = ALL_IGNORED & ~(tm.Z_IGNORE | 8 | 16) | NO_YAW
+    mask = ALL_IGNORED & ~(tmask.Z_IGNORE | 8 | 16) | NO_YAW
     event = SetPositionTargetLocal(t=0.0, type_mask=mask, coordinate_frame=1)
     assert codes(lint([event]), "OFB602") == []  # position + velocity, a listed combination
 
@@ -397,9 +398,9 @@ POSITION_ONLY = mask_for(frozenset({"position"}))
     ("mask", "dropped"),
     [
         (POSITION_ONLY, True),
-        (POSITION_ONLY & ~tm.YAW_IGNORE, True),  # with a yaw: still nothing the receiver keeps
-        (mask_for(frozenset({"velocity"})) | tm.VZ_IGNORE, True),  # vx, vy only: no velocity
-        (mask_for(frozenset({"acceleration"})) | tm.AZ_IGNORE, True),
+        (POSITION_ONLY & ~tmask.YAW_IGNORE, True),  # with a yaw: still nothing the receiver keeps
+        (mask_for(frozenset({"velocity"})) | tmask.VZ_IGNORE, True),  # vx, vy only: no velocity
+        (mask_for(frozenset({"acceleration"})) | tmask.AZ_IGNORE, True),
         (mask_for(frozenset({"velocity"})), False),
         (mask_for(frozenset({"position", "velocity"})), False),
     ],
@@ -445,7 +446,7 @@ INF = float("inf")
             "non-finite vx, vy, vz",
         ),
         (
-            SetPositionTargetLocal(t=0.0, type_mask=POSITION_ONLY | tm.YAW_IGNORE, yaw=NAN),
+            SetPositionTargetLocal(t=0.0, type_mask=POSITION_ONLY | tmask.YAW_IGNORE, yaw=NAN),
             "non-finite yaw",
         ),
         (

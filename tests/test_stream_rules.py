@@ -20,7 +20,7 @@ from fuzzoff.events import (
 )
 from fuzzoff.findings import Severity
 from fuzzoff.profiles import Profile
-from fuzzoff.sources.base import RecordingInfo
+from fuzzoff.recording import RecordingInfo
 from tests.streams import OFFBOARD, POSCTL, ack, codes, every, lint_events, ocm, status, switch
 
 

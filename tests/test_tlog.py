@@ -33,10 +33,10 @@ from fuzzoff.events import (
     VehicleStatus,
     Where,
 )
+from fuzzoff.formats import SourceError, open_source
+from fuzzoff.formats.tlog.reader import TlogSource
+from fuzzoff.formats.tlog.writer import DEFAULT_START_US, write_tlog
 from fuzzoff.modes import custom_mode_to_nav_state, nav_state_name, nav_state_to_custom_mode
-from fuzzoff.sources import SourceError, open_source
-from fuzzoff.sources.tlog import TlogSource
-from fuzzoff.writers.tlog import DEFAULT_START_US, write_tlog
 from tests.helpers import run_cli, run_cli_process
 
 SENT: dict[str, Any] = {

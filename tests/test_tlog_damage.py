@@ -8,7 +8,7 @@ import json
 from pathlib import Path
 
 from fuzzoff.engine import lint_file
-from fuzzoff.sources.tlog_frames import RESYNC_LIMIT
+from fuzzoff.formats.tlog.frames import RESYNC_LIMIT
 from tests.helpers import CORPORA, run_cli
 
 GOOD = CORPORA / "tlog" / "good_offboard.tlog"

@@ -43,9 +43,9 @@ from fuzzoff.events import (
     VehicleStatus,
     event_to_dict,
 )
-from fuzzoff.sources import open_source
-from fuzzoff.sources.ulog import UlogSource, decode_release
-from fuzzoff.writers.ulog import DEFAULT_START_US, ver_sw_release, write_ulog
+from fuzzoff.formats import open_source
+from fuzzoff.formats.ulog.reader import UlogSource, decode_release
+from fuzzoff.formats.ulog.writer import DEFAULT_START_US, ver_sw_release, write_ulog
 from tests.helpers import run_cli, run_cli_process
 
 NAN = math.nan
@@ -213,7 +213,7 @@ def test_every_kind_round_trips_through_a_ulog(era: str, tmp_path: Path) -> None
 
 
 def test_round_trip_covers_every_kind_the_reader_emits() -> None:
-    from fuzzoff.sources.ulog_topics import TOPICS
+    from fuzzoff.formats.ulog.topics import TOPICS
 
     kinds = {e.kind for era in VERSIONS for e in flight(era)}
     assert {spec.kind for spec in TOPICS.values()} | {"legacy_control_mode"} <= kinds
@@ -536,7 +536,7 @@ def test_a_damaged_record_is_skipped_and_reported_with_the_last_good_time(tmp_pa
 def _chunk(columns: dict[str, list[Any]]) -> Any:
     import numpy as np
 
-    from fuzzoff.sources.ulog_topics import Chunk
+    from fuzzoff.formats.ulog.topics import Chunk
 
     cols = {name: np.asarray(values) for name, values in columns.items()}
     return Chunk(cols, slice(None), "vehicle_status", 0)
@@ -544,7 +544,7 @@ def _chunk(columns: dict[str, list[Any]]) -> Any:
 
 def test_older_layouts_the_writer_does_not_produce_are_read() -> None:
     """The seed's single ``ignore_bodyrate`` and the link-loss flags of a legacy status."""
-    from fuzzoff.sources.ulog_topics import Context, control_mode, failsafe_flags
+    from fuzzoff.formats.ulog.topics import Context, control_mode, failsafe_flags
 
     ocm = _chunk(
         {

@@ -12,8 +12,8 @@ import pytest
 from pyulog import ULog
 
 from fuzzoff.events import ControlMode, Event, TrajectorySetpoint, VehicleStatus
-from fuzzoff.sources import open_source
-from fuzzoff.writers.ulog import write_ulog
+from fuzzoff.formats import open_source
+from fuzzoff.formats.ulog.writer import write_ulog
 from tests.helpers import CORPORA, run_cli
 from tests.test_ulog import offboard_with_rejection
 

@@ -74,8 +74,8 @@ from flights import Flight  # noqa: E402  (corpora/mcap/flights.py)
 from mcap.reader import SeekingReader  # noqa: E402
 from rosbags.rosbag1.reader import Header, RecordType  # noqa: E402
 
-from fuzzoff.writers.mcap import write_mcap  # noqa: E402
-from fuzzoff.writers.rosbag1 import write_rosbag1  # noqa: E402
+from fuzzoff.formats.mcap.writer import write_mcap  # noqa: E402
+from fuzzoff.formats.rosbag1.writer import write_rosbag1  # noqa: E402
 
 _spec = importlib.util.spec_from_file_location("rosbag1_build", ROOT / "corpora/rosbag1/build.py")
 assert _spec is not None and _spec.loader is not None

@@ -41,11 +41,12 @@ os.environ.setdefault("MAVLINK20", "1")
 from pymavlink import mavutil
 
 from fuzzoff import events as ev
-from fuzzoff.sources.mavros_msgs import mavros_typedefs
-from fuzzoff.writers.mcap import write_mcap
-from fuzzoff.writers.ros2_messages import RawMessage
-from fuzzoff.writers.rosbag1 import Ros1Message, mavros_typestore, write_rosbag1
-from fuzzoff.writers.rosbag2 import write_rosbag2
+from fuzzoff.formats.mavros.mavros_msgs import mavros_typedefs
+from fuzzoff.formats.mcap.writer import write_mcap
+from fuzzoff.formats.registry import BY_NAME
+from fuzzoff.formats.ros2msgs.messages import RawMessage
+from fuzzoff.formats.rosbag1.writer import Ros1Message, mavros_typestore, write_rosbag1
+from fuzzoff.formats.rosbag2.writer import write_rosbag2
 
 HERE = Path(__file__).resolve().parent
 RUNS = HERE / "runs"
@@ -93,8 +94,7 @@ class Recording:
 
     @property
     def path(self) -> Path:
-        suffix = {"mcap": ".mcap", "rosbag1": ".bag", "rosbag2": ""}[self.fmt]
-        return HERE / f"{self.name}{suffix}"
+        return HERE / f"{self.name}{BY_NAME[self.fmt].written_suffix}"
 
 
 RECORDINGS = [

@@ -1,7 +1,7 @@
 """Build the gate corpus: PX4 ULogs (as the vehicle logs them) for the gate-model rules.
 
 Run ``.venv/bin/python corpora/gate/build.py``; deterministic. Every recording is written
-through ``fuzzoff.writers.ulog`` (pyulog) and gets ``NAME.expected.json`` with the findings
+through ``fuzzoff.formats.ulog.writer`` (pyulog) and gets ``NAME.expected.json`` with the findings
 planted here, judged against the rule texts (rules/OFB202.toml, OFB701.toml, OFB702.toml and the
 stream rules the flights also touch):
 
@@ -49,7 +49,7 @@ from fuzzoff.events import (
     TrajectorySetpoint,
     VehicleStatus,
 )
-from fuzzoff.writers.ulog import write_ulog
+from fuzzoff.formats.ulog.writer import write_ulog
 
 HERE = Path(__file__).resolve().parent
 POSCTL, RTL, OFFBOARD = 2, 5, 14

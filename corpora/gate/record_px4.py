@@ -36,7 +36,7 @@ sys.path.insert(0, str(HERE.parent / "tlog"))
 
 import record_px4 as flightlib  # noqa: E402  (corpora/tlog/record_px4.py, a script beside)
 
-from fuzzoff.sources.ulog import LOADED_TOPICS  # noqa: E402
+from fuzzoff.formats.ulog.reader import LOADED_TOPICS  # noqa: E402
 
 STOPS = 4
 STOP_S = 1.6

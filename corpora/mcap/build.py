@@ -2,7 +2,7 @@
 would record them (formats.md 2, 4).
 
 Run ``.venv/bin/python corpora/mcap/build.py``; it is deterministic. Every recording is written
-through ``fuzzoff.writers.mcap`` (mcap_ros2 encodes, px4_msgs definitions embedded) from the
+through ``fuzzoff.formats.mcap.writer`` (mcap_ros2 encodes, px4_msgs definitions embedded) from the
 flights in ``flights.py``, and gets ``NAME.expected.json`` with the findings planted here, judged
 against the rule texts (rules/OFB*.toml). Every flight is PX4 1.15 on a multicopter (the
 release is told by the embedded definitions, the type by ``VehicleStatus.vehicle_type``), so
@@ -41,7 +41,7 @@ from flights import Flight  # noqa: E402
 from mcap.reader import SeekingReader  # noqa: E402
 
 from fuzzoff.events import Event, VehicleControlModeStatus  # noqa: E402
-from fuzzoff.writers.mcap import write_mcap  # noqa: E402
+from fuzzoff.formats.mcap.writer import write_mcap  # noqa: E402
 
 RELEASE = "1.15"
 CONTEXT = [

@@ -14,7 +14,7 @@ from pathlib import Path
 
 from pyulog import ULog
 
-from fuzzoff.sources.ulog import PLOT_LOADED_TOPICS
+from fuzzoff.formats.ulog.reader import PLOT_LOADED_TOPICS
 
 HERE = Path(__file__).resolve().parent
 

@@ -2,7 +2,7 @@
 
     .venv/bin/python corpora/rosbag1/build.py
 
-Each recording is written by ``fuzzoff.writers.rosbag1`` (MAVROS ``setpoint_raw/local`` at
+Each recording is written by ``fuzzoff.formats.rosbag1.writer`` (MAVROS ``setpoint_raw/local`` at
 20 Hz and ``/mavros/state`` at 1 Hz, as MAVROS publishes it on every HEARTBEAT) and comes with
 ``NAME.expected.json``: the findings planted, checked against the rule texts. Deterministic.
 """
@@ -18,8 +18,8 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent.parent))
 
 from fuzzoff.events import Event, SetPositionTargetLocal, VehicleStatus  # noqa: E402
+from fuzzoff.formats.rosbag1.writer import write_rosbag1  # noqa: E402
 from fuzzoff.modes import mavros_mode_to_nav_state  # noqa: E402
-from fuzzoff.writers.rosbag1 import write_rosbag1  # noqa: E402
 
 RATE_S = 0.05
 """20 Hz setpoints."""

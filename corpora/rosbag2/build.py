@@ -1,10 +1,11 @@
 """Build the rosbag2 corpus: PX4 ROS 2 offboard flights in ROS 2 bag folders (formats.md 2, 5).
 
 Run ``.venv/bin/python corpora/rosbag2/build.py``; it is deterministic. Bags are written through
-``fuzzoff.writers.rosbag2`` (rosbags' writer) from the flights in ``corpora/mcap/flights.py``;
-each gets ``NAME.expected.json`` with the findings planted here, judged against the rule texts.
-Every flight is on a multicopter; each carries the context findings OFB002 (OFB305 needs
-estimator flags these topics lack) and OFB701 (loss parameters assumed) at the offboard request.
+``fuzzoff.formats.rosbag2.writer`` (rosbags' writer) from the flights in
+``corpora/mcap/flights.py``; each gets ``NAME.expected.json`` with the findings planted here, judged
+against the rule texts. Every flight is on a multicopter; each carries the context findings OFB002
+(OFB305 needs estimator flags these topics lack) and OFB701 (loss parameters assumed) at the
+offboard request.
 
 * ``good_flight_sqlite3``: PX4 1.18 (profile main; versioned topics ``vehicle_status_v4``,
   ``vehicle_command_ack_v1``), the good flight; nothing else.
@@ -34,7 +35,7 @@ sys.path.insert(0, str(HERE.parent / "mcap"))
 
 from flights import Flight  # noqa: E402
 
-from fuzzoff.writers.rosbag2 import write_rosbag2  # noqa: E402
+from fuzzoff.formats.rosbag2.writer import write_rosbag2  # noqa: E402
 
 
 def finding(code: str, severity: str, t: float | None, vehicle: str = "") -> dict[str, Any]:

@@ -1,12 +1,12 @@
 """Build the rule corpus: one bad and one good recording per content, control-mode, legacy rule.
 
 Run ``.venv/bin/python corpora/rules/build.py``; it is deterministic. ROS 2 rules are written as
-MCAP (``fuzzoff.writers.mcap``, px4_msgs of the case's release), the estimate rule OFB305 and
-the legacy rules OFB801-OFB803 as ULog (``fuzzoff.writers.ulog``, the 1.15 and the legacy
+MCAP (``fuzzoff.formats.mcap.writer``, px4_msgs of the case's release), the estimate rule OFB305 and
+the legacy rules OFB801-OFB803 as ULog (``fuzzoff.formats.ulog.writer``, the 1.15 and the legacy
 layouts), and the MAVLink side of OFB405/OFB406 (``SET_ATTITUDE_TARGET``) as a tlog
-(``fuzzoff.writers.tlog``). Each ``NAME.expected.json`` lists the findings planted here, judged
-against the rule texts (rules/OFB*.toml), and ``clean``: the rules the recording exercises that
-must stay silent.
+(``fuzzoff.formats.tlog.writer``). Each ``NAME.expected.json`` lists the findings planted here,
+judged against the rule texts (rules/OFB*.toml), and ``clean``: the rules the recording exercises
+that must stay silent.
 
 Every flight is built from one realistic pattern (``Flight``): a companion streams
 ``OffboardControlMode`` at 10 Hz with a PX4-synced ``timestamp``, the vehicle sits disarmed in
@@ -43,9 +43,9 @@ from fuzzoff.events import (
     VehicleInfo,
     VehicleStatus,
 )
-from fuzzoff.writers.mcap import write_mcap
-from fuzzoff.writers.tlog import write_tlog
-from fuzzoff.writers.ulog import write_ulog
+from fuzzoff.formats.mcap.writer import write_mcap
+from fuzzoff.formats.tlog.writer import write_tlog
+from fuzzoff.formats.ulog.writer import write_ulog
 
 HERE = Path(__file__).resolve().parent
 Fields = dict[str, Any]

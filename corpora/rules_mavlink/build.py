@@ -1,10 +1,10 @@
 """Build the MAVLink setpoint-field corpus (OFB601-OFB609, OFB507-OFB509): tlogs and MAVROS bags.
 
 Run ``.venv/bin/python corpora/rules_mavlink/build.py``; it is deterministic. Each case is
-written as a tlog (``fuzzoff.writers.tlog``: the MAVLink the companion sent, with the
+written as a tlog (``fuzzoff.formats.tlog.writer``: the MAVLink the companion sent, with the
 autopilot's HEARTBEAT, COMMAND_ACK, PARAM_VALUE and AUTOPILOT_VERSION) and, where a MAVROS bag
 can show the rule, as a ROS 1 bag of MAVROS ``setpoint_raw`` topics and ``state``
-(``fuzzoff.writers.rosbag1``). A bag cannot show OFB607 (MAVROS fills the target ids from its
+(``fuzzoff.formats.rosbag1.writer``). A bag cannot show OFB607 (MAVROS fills the target ids from its
 own parameters) or OFB509 (no parameters in a bag). Each ``NAME.expected.json`` lists the
 findings planted here, judged against the rule texts (rules/OFB5*.toml, rules/OFB6*.toml),
 and ``clean``: the rules the recording exercises that must stay silent.
@@ -40,8 +40,8 @@ from fuzzoff.events import (
     VehicleInfo,
     VehicleStatus,
 )
-from fuzzoff.writers.rosbag1 import write_rosbag1
-from fuzzoff.writers.tlog import write_tlog
+from fuzzoff.formats.rosbag1.writer import write_rosbag1
+from fuzzoff.formats.tlog.writer import write_tlog
 
 HERE = Path(__file__).resolve().parent
 POSCTL, OFFBOARD, AUTO_LOITER = 2, 14, 4

@@ -1,7 +1,7 @@
 """Build the rover rule corpus: ROS 2 offboard control of rovers (OFB501-OFB506) as MCAP.
 
 Run ``.venv/bin/python corpora/rules_rover/build.py``; it is deterministic. Every recording is
-written through ``fuzzoff.writers.mcap`` with the px4_msgs of PX4 1.17 (1.16 has no
+written through ``fuzzoff.formats.mcap.writer`` with the px4_msgs of PX4 1.17 (1.16 has no
 ``RoverSpeedSetpoint``) and linted with ``--px4 1.17 --vehicle <rover type>``. Each
 ``NAME.expected.json`` lists the findings planted here, judged against the rule texts
 (rules/OFB5*.toml), and ``clean``: the rules the recording exercises that must stay silent.
@@ -39,7 +39,7 @@ from fuzzoff.events import (
     VehicleStatus,
     event_from_dict,
 )
-from fuzzoff.writers.mcap import write_mcap
+from fuzzoff.formats.mcap.writer import write_mcap
 
 HERE = Path(__file__).resolve().parent
 POSCTL, OFFBOARD = 2, 14

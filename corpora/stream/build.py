@@ -1,8 +1,9 @@
 """Build the stream-rule corpus: OFB104 (stale setpoints) and OFB105 (marginal rate), bad and good.
 
 Run ``.venv/bin/python corpora/stream/build.py``; it is deterministic. OFB104 is a ROS 2 rule, so
-its cases are MCAP (``fuzzoff.writers.mcap``, PX4 1.15 definitions); OFB105 judges the keep-alive
-as sent, so its cases are tlogs (``fuzzoff.writers.tlog``: MAVLink setpoints are the keep-alive).
+its cases are MCAP (``fuzzoff.formats.mcap.writer``, PX4 1.15 definitions); OFB105 judges the
+keep-alive as sent, so its cases are tlogs (``fuzzoff.formats.tlog.writer``: MAVLink setpoints are
+the keep-alive).
 
 * ``ofb104_planner_stops``: OffboardControlMode at 10 Hz for the whole flight, TrajectorySetpoint
   at 20 Hz until 5.0 s, then nothing while the vehicle stays in OFFBOARD until 9.0 s: OFB104 from
@@ -34,8 +35,8 @@ from fuzzoff.events import (
     VehicleInfo,
     VehicleStatus,
 )
-from fuzzoff.writers.mcap import write_mcap
-from fuzzoff.writers.tlog import write_tlog
+from fuzzoff.formats.mcap.writer import write_mcap
+from fuzzoff.formats.tlog.writer import write_tlog
 
 HERE = Path(__file__).resolve().parent
 POSCTL, OFFBOARD = 2, 14

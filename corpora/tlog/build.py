@@ -1,8 +1,9 @@
 """Build the tlog corpus: offboard flights as a MAVLink link would log them (formats.md 7).
 
 Run ``.venv/bin/python corpora/tlog/build.py``; it is deterministic. Every recording is written
-through ``fuzzoff.writers.tlog`` (pymavlink packs the packets) and gets ``NAME.expected.json``
-with the findings planted here, judged against the rule texts (rules/OFB*.toml):
+through ``fuzzoff.formats.tlog.writer`` (pymavlink packs the packets) and gets
+``NAME.expected.json`` with the findings planted here, judged against the rule texts
+(rules/OFB*.toml):
 
 * ``good_offboard``: 20 Hz SET_POSITION_TARGET_LOCAL_NED from the companion (1/191) for 2 s
   before an accepted switch, arming in OFFBOARD, flight, AUTO_LAND; no finding but the OFB701
@@ -43,7 +44,7 @@ from fuzzoff.events import (
     VehicleInfo,
     VehicleStatus,
 )
-from fuzzoff.writers.tlog import write_tlog
+from fuzzoff.formats.tlog.writer import write_tlog
 
 HERE = Path(__file__).resolve().parent
 POSCTL, OFFBOARD, AUTO_LAND = 2, 14, 18

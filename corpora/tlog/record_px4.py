@@ -264,7 +264,7 @@ def cut_ulog(source: Path, target: Path) -> None:
     logged messages kept), ``vehicle_local_position`` thinned from ~125 Hz to 10 Hz."""
     from pyulog import ULog
 
-    from fuzzoff.sources.ulog import LOADED_TOPICS
+    from fuzzoff.formats.ulog.reader import LOADED_TOPICS
 
     log = ULog(str(source), message_name_filter_list=list(LOADED_TOPICS))
     for data in log.data_list:

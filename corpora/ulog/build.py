@@ -1,7 +1,7 @@
 """Build the ULog corpus: offboard flights as PX4's logger records them (formats.md 8).
 
 Run ``.venv/bin/python corpora/ulog/build.py``; it is deterministic. Every recording is written
-through ``fuzzoff.writers.ulog`` (pyulog's ``write_ulog``) the way PX4 logs a flight: topics
+through ``fuzzoff.formats.ulog.writer`` (pyulog's ``write_ulog``) the way PX4 logs a flight: topics
 subsampled by the default logger profile (``offboard_control_mode`` every 100 ms,
 ``trajectory_setpoint`` every 200 ms), ``vehicle_status`` on change and every second, PX4's own
 verdict in ``failsafe_flags``. Each gets ``NAME.expected.json`` with the findings planted here,
@@ -57,7 +57,7 @@ from fuzzoff.events import (
     VehicleControlModeStatus,
     VehicleStatus,
 )
-from fuzzoff.writers.ulog import write_ulog
+from fuzzoff.formats.ulog.writer import write_ulog
 
 HERE = Path(__file__).resolve().parent
 POSCTL, AUTO_MISSION, AUTO_TAKEOFF, OFFBOARD, AUTO_LAND, AUTO_LOITER = 2, 3, 17, 14, 18, 4

@@ -21,6 +21,7 @@ import math
 from dataclasses import dataclass
 from typing import Literal
 
+from fuzzoff import type_mask as tmask
 from fuzzoff.events import (
     AttitudeSetpoint,
     Event,
@@ -166,9 +167,9 @@ def _rates(
 
 def _local(event: SetPositionTargetLocal) -> Motion | None:
     mask = event.type_mask
-    if mask & tm.FORCE_BIT:
+    if mask & tmask.FORCE_SET:
         return None  # PX4 drops force setpoints (OFB602)
-    yaw_rate = event.yaw_rate if not mask & tm.YAW_RATE_IGNORE else math.nan
+    yaw_rate = event.yaw_rate if not mask & tmask.YAW_RATE_IGNORE else math.nan
     if event.coordinate_frame == MAV_FRAME_BODY_NED:
         kept = tm.body_ned_groups(mask)
         if "velocity" in kept and _nonzero(event.velocity[2]):
@@ -190,27 +191,27 @@ def _local(event: SetPositionTargetLocal) -> Motion | None:
 
 def _global(event: SetPositionTargetGlobal) -> Motion | None:
     mask = event.type_mask
-    if mask & tm.FORCE_BIT:
+    if mask & tmask.FORCE_SET:
         return None
     held = (0.0, 0.0, event.alt)  # lat/lon/alt as a position: finite whenever used
     motion = _axes(held, event.velocity, event.acceleration, _used(mask))
-    yaw_rate = event.yaw_rate if not mask & tm.YAW_RATE_IGNORE else math.nan
+    yaw_rate = event.yaw_rate if not mask & tmask.YAW_RATE_IGNORE else math.nan
     return motion or _turn(yaw_rate)
 
 
 def _attitude_target(event: SetAttitudeTarget, vehicle: str, hover: Hover) -> Motion | None:
     mask = event.type_mask
-    if mask & tm.THRUST_BODY_SET and event.thrust_body is not None:
+    if mask & tmask.THRUST_BODY_SET and event.thrust_body is not None:
         thrust = event.thrust_body[0] if vehicle == "fw" else event.thrust_body[2]
-    elif not mask & tm.THROTTLE_IGNORE:
+    elif not mask & tmask.THROTTLE_IGNORE:
         thrust = event.thrust
     else:
         thrust = math.nan
     if tm.attitude_used(mask):
         return _attitude(event.q, thrust, vehicle, hover)
-    roll = event.body_roll_rate if not mask & tm.ROLL_RATE_IGNORE else math.nan
-    pitch = event.body_pitch_rate if not mask & tm.PITCH_RATE_IGNORE else math.nan
-    yaw = event.body_yaw_rate if not mask & tm.BODY_YAW_RATE_IGNORE else math.nan
+    roll = event.body_roll_rate if not mask & tmask.ROLL_RATE_IGNORE else math.nan
+    pitch = event.body_pitch_rate if not mask & tmask.PITCH_RATE_IGNORE else math.nan
+    yaw = event.body_yaw_rate if not mask & tmask.BODY_YAW_RATE_IGNORE else math.nan
     return _rates(roll, pitch, yaw, thrust, vehicle, hover)
 
 

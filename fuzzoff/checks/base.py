@@ -36,7 +36,7 @@ from fuzzoff.events import (
 from fuzzoff.findings import Finding, Severity
 from fuzzoff.gate import GateModel
 from fuzzoff.profiles import Profile
-from fuzzoff.sources.base import RecordingInfo
+from fuzzoff.recording import RecordingInfo
 from fuzzoff.state import VehicleState
 from fuzzoff.tables.control_mode import FlagRow, row_for
 

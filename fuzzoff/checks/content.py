@@ -28,13 +28,9 @@ from fuzzoff.events import (
 )
 from fuzzoff.findings import clip
 from fuzzoff.tables.control_mode import SETPOINT_NAMES
+from fuzzoff.type_mask import ATTITUDE_IGNORE, THROTTLE_IGNORE, THRUST_BODY_SET
 
 TRAJECTORY_CONTROLS = ("position", "velocity", "acceleration")
-
-# SET_ATTITUDE_TARGET type_mask bits (gate spec 6.4).
-ATTITUDE_IGNORE = 128
-THROTTLE_IGNORE = 64
-THRUST_BODY_SET = 32
 
 MAVLINK_THRUST_RANGE: dict[str, tuple[float, float]] = {"mc": (0.0, 1.0), "vtol": (0.0, 1.0)}
 """SET_ATTITUDE_TARGET ``thrust``: 0..1, -1..1 where the vehicle can reverse (fw, rovers)."""

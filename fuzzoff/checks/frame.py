@@ -48,12 +48,10 @@ from fuzzoff.events import (
     VehicleStatus,
 )
 from fuzzoff.gate import GateTransition
+from fuzzoff.type_mask import VELOCITY_BITS, VZ_IGNORE, Z_IGNORE
 
 MAV_FRAME_LOCAL_NED = 1
 MAV_FRAME_BODY_NED = 8
-IGNORE_Z = 4
-IGNORE_V = 8 | 16 | 32
-IGNORE_VZ = 32
 
 MAV_CMD_NAV_TAKEOFF = 22
 MAV_CMD_NAV_VTOL_TAKEOFF = 84
@@ -94,9 +92,9 @@ def vertical_command(event: Event) -> tuple[float, float]:
         z = math.nan
         vz = math.nan
         if event.coordinate_frame == MAV_FRAME_LOCAL_NED:
-            z = math.nan if event.type_mask & IGNORE_Z else event.position[2]
-            vz = math.nan if event.type_mask & IGNORE_VZ else event.velocity[2]
-        elif event.coordinate_frame == MAV_FRAME_BODY_NED and not event.type_mask & IGNORE_V:
+            z = math.nan if event.type_mask & Z_IGNORE else event.position[2]
+            vz = math.nan if event.type_mask & VZ_IGNORE else event.velocity[2]
+        elif event.coordinate_frame == MAV_FRAME_BODY_NED and not event.type_mask & VELOCITY_BITS:
             vz = event.velocity[2]
         return z, vz
     return math.nan, math.nan

@@ -18,6 +18,7 @@ from itertools import chain
 from operator import attrgetter
 from typing import Any
 
+from fuzzoff import type_mask as tmask
 from fuzzoff.checks._episodes import Episodes, Offence
 from fuzzoff.checks._runs import Verdicts, commit_alike, first_of_each, sent_only
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
@@ -266,7 +267,7 @@ class PositionTargetFields(Check):
                     short=f"type_mask {mask} selects nothing: dropped, no keep-alive",
                 )
             }
-        if mask & tm.FORCE_BIT and "acceleration" in selected:
+        if mask & tmask.FORCE_SET and "acceleration" in selected:
             return {
                 "force": Offence(
                     f"{head} sets the FORCE bit: force setpoints are not supported and PX4 "
@@ -503,7 +504,7 @@ class LegacySetpointDropped(Check):
             return self._dropped(name, bad, "x/y/z, vx/vy/vz, afx/afy/afz and yaw")
         mask = event.type_mask
         head = f"{name} type_mask {mask}"
-        if mask & tm.FORCE_BIT and mask & tm.POSITION_BITS and mask & tm.VELOCITY_BITS:
+        if mask & tmask.FORCE_SET and mask & tmask.POSITION_BITS and mask & tmask.VELOCITY_BITS:
             return {
                 "force": Offence(
                     f"{head} sets the FORCE bit with position and velocity ignored: PX4 "
@@ -512,9 +513,9 @@ class LegacySetpointDropped(Check):
                     "offboard without a setpoint)"
                 )
             }
-        kind = LEGACY_SETPOINT_TYPES.get(mask & tm.SETPOINT_TYPE_BITS)
+        kind = LEGACY_SETPOINT_TYPES.get(mask & tmask.SETPOINT_TYPE_BITS)
         if kind is not None:
-            value = mask & tm.SETPOINT_TYPE_BITS
+            value = mask & tmask.SETPOINT_TYPE_BITS
             return {
                 f"type:{value}": Offence(
                     f"{head} carries the setpoint type {kind} ({value}): PX4 {self.px4}'s "

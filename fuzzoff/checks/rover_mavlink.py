@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from fuzzoff import type_mask as tmask
 from fuzzoff.checks._episodes import Episodes, Offence
 from fuzzoff.checks.base import Check, CheckContext
 from fuzzoff.checks.mavlink_fields import set_components
@@ -120,7 +121,7 @@ class RoverIgnoredFields(Check):
         vertical = [c for c in set_components(event, "velocity") if c == "vz"]
         if isinstance(event, SetPositionTargetLocal):
             z = event.position[2]
-            if not mask & tm.Z_IGNORE and z != 0 and not math.isnan(z):
+            if not mask & tmask.Z_IGNORE and z != 0 and not math.isnan(z):
                 vertical.insert(0, "z")
         if vertical:
             offences["z"] = Offence(
@@ -130,7 +131,7 @@ class RoverIgnoredFields(Check):
         if self.yaw_ignored:
             yaw = [
                 n
-                for n, bit in (("yaw", tm.YAW_IGNORE), ("yaw_rate", tm.YAW_RATE_IGNORE))
+                for n, bit in (("yaw", tmask.YAW_IGNORE), ("yaw_rate", tmask.YAW_RATE_IGNORE))
                 if not mask & bit
             ]
             if yaw:

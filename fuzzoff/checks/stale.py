@@ -12,9 +12,11 @@ from operator import attrgetter, le, sub
 from fuzzoff.checks._keepalive import control_modes, keepalive_run, mode_note
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import PX4_SETPOINTS, ControlMode, Event, Where
+from fuzzoff.formats.registry import reported_names
 from fuzzoff.tables.control_mode import SETPOINT_NAMES
 
-ROS2_FORMATS = ("mcap", "rosbag2-sqlite3", "rosbag2-mcap")
+ROS2_FORMATS = reported_names("ros2")
+"""The formats that hold the ROS 2 topics as sent (MCAP, ROS 2 bags)."""
 
 _SETPOINTS: frozenset[type[Event]] = frozenset(PX4_SETPOINTS)
 _TIME = attrgetter("t")

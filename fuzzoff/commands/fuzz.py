@@ -24,6 +24,7 @@ from fuzzoff.commands._common import (
     write_output,
 )
 from fuzzoff.config import ConfigError, user_px4_profile
+from fuzzoff.formats import SourceError, is_bag_folder
 from fuzzoff.fuzz.campaign import CampaignConfig, CampaignResult, PropertyResult, run_campaign
 from fuzzoff.fuzz.known import KNOWN
 from fuzzoff.fuzz.properties import PROPERTIES
@@ -32,7 +33,6 @@ from fuzzoff.fuzz.scenario import TRANSPORTS
 from fuzzoff.profiles import ProfileError, vehicle_type_for
 from fuzzoff.report import CampaignReport, campaign_renderer
 from fuzzoff.report.sanitize import printable
-from fuzzoff.sources import SourceError, is_bag_folder
 
 
 def add_parser(sub: Any) -> None:

@@ -25,9 +25,9 @@ from fuzzoff.config import ConfigError, Settings
 from fuzzoff.engine import lint_file, lint_paths, lint_with_timelines
 from fuzzoff.findings import Report
 from fuzzoff.fleet import fleet_wanted
+from fuzzoff.formats import RECORDING_SUFFIXES, find_recordings, recordings_in
 from fuzzoff.report import FORMATS, renderer
 from fuzzoff.report.sanitize import printable
-from fuzzoff.sources import RECORDING_SUFFIXES, find_recordings, recordings_in
 
 
 def add_parser(sub: Any) -> None:

@@ -28,8 +28,8 @@ from fuzzoff.commands import add_command
 from fuzzoff.commands._common import write_output
 from fuzzoff.config import ConfigError
 from fuzzoff.fuzz.reproducers import ReproducerError, load, recheck, recording_problem
+from fuzzoff.recording import SourceError
 from fuzzoff.report.sanitize import printable
-from fuzzoff.sources.base import SourceError
 
 TIME_TOLERANCE_S = 0.05
 MIN_SPEED, MAX_SPEED = 0.01, 100.0
@@ -239,10 +239,10 @@ def _stream(recording: Path, args: argparse.Namespace) -> int:
 
     from fuzzoff.commands._common import parse_params
     from fuzzoff.commands.sitl import report
+    from fuzzoff.recording import SourceError
     from fuzzoff.sitl.link import LinkError
     from fuzzoff.sitl.run import replay_live
     from fuzzoff.sitl.target import TargetError, target_for
-    from fuzzoff.sources.base import SourceError
 
     try:
         target = target_for(args.to)

@@ -74,10 +74,10 @@ def _list() -> int:
 def run_command(args: argparse.Namespace) -> int:
     if args.action == "list":
         return _list()
+    from fuzzoff.recording import SourceError
     from fuzzoff.sitl import bundle, run
     from fuzzoff.sitl.link import LinkError
     from fuzzoff.sitl.scenarios import SCENARIOS
-    from fuzzoff.sources.base import SourceError
 
     params = parse_params(args.param)
     env = {}

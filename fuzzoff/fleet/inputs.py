@@ -22,7 +22,7 @@ from typing import Any
 
 from fuzzoff.config import ConfigError
 from fuzzoff.fleet import is_url
-from fuzzoff.sources import RECORDING_SUFFIXES
+from fuzzoff.formats import RECORDING_SUFFIXES
 
 _GLOB = re.compile(r"[*?\[]")
 CHUNK = 1 << 20

@@ -30,9 +30,9 @@ from fuzzoff.findings import Report
 from fuzzoff.fleet import is_url, require
 from fuzzoff.fleet.inputs import expand
 from fuzzoff.fleet.task import LINTED, SKIPPED, Lint, Outcome, lint_target
+from fuzzoff.formats import RECORDING_SUFFIXES, find_recordings
 from fuzzoff.report import renderer
 from fuzzoff.report.sanitize import printable
-from fuzzoff.sources import RECORDING_SUFFIXES, find_recordings
 
 PARQUET = "parquet"
 

@@ -23,7 +23,7 @@ from fuzzoff.findings import FileReport, Finding, Severity
 from fuzzoff.fleet import is_url
 from fuzzoff.fleet.inputs import FetchError, content_hash, fetched
 from fuzzoff.fleet.wallclock import start_time
-from fuzzoff.sources.base import RecordingInfo, path_text
+from fuzzoff.recording import RecordingInfo, path_text
 
 Lint = Callable[[str, Settings], FileReport]
 

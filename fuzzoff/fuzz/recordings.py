@@ -1,4 +1,4 @@
-"""Scenarios to recordings through the real writers (``fuzzoff/writers``), and back.
+"""Scenarios to recordings through the real writers (``formats/<name>/writer.py``), and back.
 
 ``FORMATS_FOR`` lists the formats each transport's stream can be written to: ROS 2 direct ->
 MCAP and a rosbag2 (sqlite3) bag; MAVLink -> tlog; MAVROS -> ROS 1 bag. ULog is left out: it is
@@ -11,45 +11,23 @@ from __future__ import annotations
 from pathlib import Path
 
 from fuzzoff.events import Event
-from fuzzoff.fuzz.scenario import Scenario
-from fuzzoff.sources import open_source
-from fuzzoff.sources.base import RecordingInfo, path_text
-from fuzzoff.sources.px4_msgs import release_for
+from fuzzoff.formats import open_source
+from fuzzoff.formats.registry import BY_NAME, FORMATS, written_for
+from fuzzoff.fuzz.scenario import TRANSPORTS, Scenario
+from fuzzoff.recording import RecordingInfo, path_text
 
 FORMATS_FOR: dict[str, tuple[str, ...]] = {
-    "ros2": ("mcap", "rosbag2"),
-    "mavlink": ("tlog",),
-    "mavros": ("rosbag1",),
+    t: tuple(f.name for f in written_for(t)) for t in TRANSPORTS
 }
 
-SUFFIX = {"mcap": ".mcap", "rosbag2": "", "tlog": ".tlog", "rosbag1": ".bag"}
-
-
-def release(scenario: Scenario) -> str:
-    """The px4_msgs release whose definitions a ROS 2 recording of the scenario embeds."""
-    return release_for(scenario.px4) or "main"
+SUFFIX: dict[str, str] = {f.name: f.written_suffix for f in FORMATS}
 
 
 def write(scenario: Scenario, path: Path, fmt: str) -> Path:
     """Write the scenario's events as ``fmt`` at ``path`` (a folder for rosbag2)."""
-    events = list(scenario.events)
-    if fmt == "mcap":
-        from fuzzoff.writers.mcap import write_mcap
-
-        return write_mcap(path, events, release=release(scenario))
-    if fmt == "rosbag2":
-        from fuzzoff.writers.rosbag2 import write_rosbag2
-
-        return write_rosbag2(path, events, release=release(scenario))
-    if fmt == "tlog":
-        from fuzzoff.writers.tlog import write_tlog
-
-        return write_tlog(path, events)
-    if fmt == "rosbag1":
-        from fuzzoff.writers.rosbag1 import write_rosbag1
-
-        return write_rosbag1(path, events)
-    raise ValueError(f"no writer for {fmt!r}")
+    if fmt not in BY_NAME:
+        raise ValueError(f"no writer for {fmt!r}")
+    return BY_NAME[fmt].write(path, list(scenario.events), scenario.px4)
 
 
 def read(path: Path) -> list[Event]:

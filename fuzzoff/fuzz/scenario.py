@@ -16,9 +16,10 @@ from fuzzoff.config import Settings
 from fuzzoff.engine import Timeline, run_events
 from fuzzoff.events import Event, VehicleStatus, Where, event_from_dict, event_to_dict
 from fuzzoff.findings import Finding
+from fuzzoff.formats.registry import written_for
 from fuzzoff.profiles import Profile, px4_profile_for
+from fuzzoff.recording import RecordingInfo
 from fuzzoff.releases import PX4Profile
-from fuzzoff.sources.base import RecordingInfo
 
 TransportName = Literal["ros2", "mavlink", "mavros"]
 TRANSPORTS: tuple[TransportName, ...] = ("ros2", "mavlink", "mavros")
@@ -31,7 +32,7 @@ COMPANION = (245, 191)
 """The companion's own MAVLink (sysid, compid): not 1, the autopilot's, which PX4 takes for
 itself; 191 is ``MAV_COMP_ID_ONBOARD_COMPUTER``."""
 
-RECORDING_FORMAT: dict[str, str] = {"ros2": "mcap", "mavlink": "tlog", "mavros": "rosbag1"}
+RECORDING_FORMAT: dict[str, str] = {t: written_for(t)[0].name for t in TRANSPORTS}
 """The format a reproducer of each transport is saved in (task: MCAP for ROS 2, tlog for
 MAVLink; a MAVROS stream is a ROS 1 bag, since a tlog cannot say it came through MAVROS)."""
 

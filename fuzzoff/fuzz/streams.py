@@ -23,6 +23,7 @@ from hypothesis import strategies as st
 
 from fuzzoff import events as ev
 from fuzzoff import releases
+from fuzzoff.formats import px4_msgs
 from fuzzoff.fuzz import strategies as fs
 from fuzzoff.fuzz.scenario import AUTOPILOT, COMPANION, TRANSPORTS, Scenario, TransportName
 from fuzzoff.gate import GateModel
@@ -30,7 +31,6 @@ from fuzzoff.gate.params import default_params, loss_timeout
 from fuzzoff.modes import mavros_mode_to_nav_state, nav_state_to_mavros_mode
 from fuzzoff.profiles import Profile, is_rover
 from fuzzoff.releases import PX4Profile
-from fuzzoff.sources import px4_msgs
 
 MIN_STEP = 0.0001
 """Distinct receive times: events never share a timestamp (the readers' order for equal
@@ -340,7 +340,7 @@ def mavlink_sent(draw: st.DrawFn, times: list[float], transport: TransportName) 
     """MAVLink setpoints (each one a keep-alive) from the companion."""
     kind, values = draw(fs.mavlink_setpoints())
     if transport == "mavros" and "thrust" in values:
-        # MAVROS clamps thrust to [0, 1] before it is sent (writers/rosbag1.py): what PX4 gets.
+        # MAVROS clamps thrust to [0, 1] before it is sent (rosbag1/writer.py): what PX4 gets.
         thrust = float(values["thrust"])
         values["thrust"] = min(max(thrust, 0.0), 1.0) if thrust == thrust else 0.0
     skew = draw(fs.clock_skews()) if transport == "mavlink" else fs.ClockSkew(0.0, 0.0, ())

@@ -26,6 +26,7 @@ from fuzzoff.events import (
     SetPositionTargetLocal,
     TrajectorySetpoint,
 )
+from fuzzoff.type_mask import VZ_IGNORE, Z_IGNORE
 
 CLIMB_S = 2.0
 """How long a climb setpoint must be flown, armed in OFFBOARD, to count as a take-off."""
@@ -36,8 +37,6 @@ CLIMB_VZ_MS = -0.2
 TAKEOFF_NAV_STATES = frozenset({17, 22})
 """AUTO_TAKEOFF, AUTO_VTOL_TAKEOFF."""
 
-_POS_Z_IGNORED = 1 << 2
-_VEL_Z_IGNORED = 1 << 5
 _LOCAL_NED = 1
 _BODY_NED = 8
 
@@ -48,11 +47,11 @@ def climbs(event: SetPositionTargetLocal | TrajectorySetpoint) -> bool:
         z, vz = event.position[2], event.velocity[2]
         return (math.isfinite(z) and z <= CLIMB_Z_M) or (math.isfinite(vz) and vz <= CLIMB_VZ_MS)
     mask, frame = event.type_mask, event.coordinate_frame
-    if frame == _LOCAL_NED and not mask & _POS_Z_IGNORED and event.position[2] <= CLIMB_Z_M:
+    if frame == _LOCAL_NED and not mask & Z_IGNORE and event.position[2] <= CLIMB_Z_M:
         return True
     return (
         frame in (_LOCAL_NED, _BODY_NED)
-        and not mask & _VEL_Z_IGNORED
+        and not mask & VZ_IGNORE
         and event.velocity[2] <= CLIMB_VZ_MS
     )
 

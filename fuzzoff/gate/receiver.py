@@ -24,15 +24,23 @@ from fuzzoff.events import (
 from fuzzoff.gate.estimates import Estimates
 from fuzzoff.gate.ocm import ACCELERATION, ATTITUDE, BODY_RATE, POSITION, VELOCITY
 from fuzzoff.releases import Release
+from fuzzoff.type_mask import (
+    ACCELERATION_BITS,
+    FORCE_SET,
+    POSITION_BITS,
+    SETPOINT_IDLE,
+    SETPOINT_LAND,
+    SETPOINT_LOITER,
+    SETPOINT_TAKEOFF,
+    VECTOR_BITS,
+    VELOCITY_BITS,
+    YAW_IGNORE,
+    YAW_RATE_IGNORE,
+)
 
 DROPPED = -1
+_LEGACY_KINDS = {SETPOINT_TAKEOFF: "takeoff", SETPOINT_LAND: "land", SETPOINT_LOITER: "loiter"}
 
-FORCE_SET = 512
-YAW_IGNORE = 1024
-YAW_RATE_IGNORE = 2048
-_POS_BITS = 0b000000111
-_VEL_BITS = 0b000111000
-_ACC_BITS = 0b111000000
 
 Result = tuple[int, int, "str | None", str]
 
@@ -181,7 +189,7 @@ def _position(msg: MavlinkTarget, ctx: ReceiverContext) -> Result:
     pos_p = vel_p = acc_p = False
     if isinstance(msg, SetPositionTargetGlobal):
         spec = "6.3"
-        if not mask & _POS_BITS:
+        if not mask & POSITION_BITS:
             if frame not in (5, 6, 11):
                 return DROPPED, 0, f"invalid coordinate frame {frame}", spec
             if not ctx.est.global_position:
@@ -190,13 +198,13 @@ def _position(msg: MavlinkTarget, ctx: ReceiverContext) -> Result:
                 return DROPPED, 0, "no home altitude for GLOBAL_RELATIVE_ALT_INT", spec
             pos_f = 0b111 if math.isfinite(msg.alt) else 0b011
             pos_p = True
-        vel_f, vel_p = _present3(velocity, (mask & _VEL_BITS) >> 3, old_rule)
-        acc_f, acc_p = _present3(acceleration, (mask & _ACC_BITS) >> 6, old_rule)
+        vel_f, vel_p = _present3(velocity, (mask & VELOCITY_BITS) >> 3, old_rule)
+        acc_f, acc_p = _present3(acceleration, (mask & ACCELERATION_BITS) >> 6, old_rule)
     else:
         spec = "6.2"
         position: tuple[float, float, float] = getattr(msg, "position", (0.0, 0.0, 0.0))
         if frame == 1:
-            used = ~mask & 0x1FF
+            used = ~mask & VECTOR_BITS
             isf = math.isfinite
             finite = (
                 isf(position[0])
@@ -210,20 +218,20 @@ def _position(msg: MavlinkTarget, ctx: ReceiverContext) -> Result:
                 | isf(acceleration[2]) << 8
             )
             if used & ~finite:  # a used field is NaN or Inf: the exact per-version rule
-                pos_f, pos_p = _present3(position, mask & _POS_BITS, old_rule)
-                vel_f, vel_p = _present3(velocity, (mask & _VEL_BITS) >> 3, old_rule)
-                acc_f, acc_p = _present3(acceleration, (mask & _ACC_BITS) >> 6, old_rule)
+                pos_f, pos_p = _present3(position, mask & POSITION_BITS, old_rule)
+                vel_f, vel_p = _present3(velocity, (mask & VELOCITY_BITS) >> 3, old_rule)
+                acc_f, acc_p = _present3(acceleration, (mask & ACCELERATION_BITS) >> 6, old_rule)
             else:
                 axes = used & finite
                 pos_f, vel_f, acc_f = axes & 7, (axes >> 3) & 7, axes >> 6
                 pos_p, vel_p, acc_p = pos_f != 0, vel_f != 0, acc_f != 0
         elif frame == 8:
             # BODY_NED: position always ignored; any ignore bit drops the whole vector.
-            if not mask & _VEL_BITS:
+            if not mask & VELOCITY_BITS:
                 vel_f, vel_p = _present3(velocity, 0, old_rule)
                 if vel_f & 3 != 3:
                     vel_f &= 4  # rotated by yaw: a NaN in x or y spoils both
-            if not mask & _ACC_BITS:
+            if not mask & ACCELERATION_BITS:
                 acc_f, acc_p = _present3(acceleration, 0, old_rule)
                 if acc_f != 7:
                     acc_f = 0  # rotated by the full attitude
@@ -287,19 +295,20 @@ def _legacy(msg: MavlinkTarget, ctx: ReceiverContext) -> Result:
     if not _all_finite(*position, *velocity, *acceleration, yaw):
         return DROPPED, 0, "a non-finite field (legacy drops the whole message)", "6.5"
     ocm = (
-        (0 if mask & _POS_BITS else POSITION)
-        | (0 if mask & _VEL_BITS else VELOCITY)
-        | (0 if mask & _ACC_BITS else ACCELERATION)
+        (0 if mask & POSITION_BITS else POSITION)
+        | (0 if mask & VELOCITY_BITS else VELOCITY)
+        | (0 if mask & ACCELERATION_BITS else ACCELERATION)
         | (0 if mask & YAW_IGNORE else ATTITUDE)
         | (0 if mask & YAW_RATE_IGNORE else BODY_RATE)
     )
-    axes = (0 if mask & _POS_BITS else 7) | (0 if mask & _VEL_BITS else 56)
-    axes |= 0 if mask & _ACC_BITS else 448
+    axes = (0 if mask & POSITION_BITS else 7) | (0 if mask & VELOCITY_BITS else 56)
+    axes |= 0 if mask & ACCELERATION_BITS else 448
     reason = None
-    if mask & FORCE_SET and mask & _POS_BITS and mask & _VEL_BITS:
+    if mask & FORCE_SET and mask & POSITION_BITS and mask & VELOCITY_BITS:
         reason = "force setpoint not supported (keep-alive still sent, setpoint not forwarded)"
-    elif mask & 0x3000 and mask & 0x4000 == 0:
-        kind = {0x1000: "takeoff", 0x2000: "land", 0x3000: "loiter"}[mask & 0x3000]
+    elif mask & SETPOINT_LOITER and mask & SETPOINT_IDLE == 0:
+        value = mask & SETPOINT_LOITER
+        kind = _LEGACY_KINDS[value]
         if kind != "loiter":
-            reason = f"setpoint type {kind} ({mask & 0x3000}) is classified as LOITER in legacy"
+            reason = f"setpoint type {kind} ({value}) is classified as LOITER in legacy"
     return ocm, axes, reason, "6.5"

@@ -38,6 +38,7 @@ from fuzzoff.fuzz import recordings
 from fuzzoff.fuzz.reproducers import save, setup_for
 from fuzzoff.fuzz.scenario import Scenario
 from fuzzoff.profiles import px4_profile_for
+from fuzzoff.recording import SourceError
 from fuzzoff.releases import PX4Profile
 from fuzzoff.sitl import bundle, delivery
 from fuzzoff.sitl.bench import Bench
@@ -48,7 +49,6 @@ from fuzzoff.sitl.run import load_plan
 from fuzzoff.sitl.truth import read_truth
 from fuzzoff.sitl.variants import variants
 from fuzzoff.sitl.verdict import Item, Verdict, compare
-from fuzzoff.sources.base import SourceError
 
 Status = Literal["agree", "differ", "outside", "noise", "failed"]
 Log = Callable[[str], None]

@@ -20,8 +20,8 @@ from pathlib import Path
 from typing import Any
 
 from fuzzoff.modes import nav_state_name
+from fuzzoff.recording import SourceError
 from fuzzoff.sitl.link import Link, LinkError, open_tlog
-from fuzzoff.sources.base import SourceError
 
 MAV_AUTOPILOT_PX4 = 12
 NAV_OFFBOARD = 14

@@ -1,6 +1,6 @@
 """A PX4 ULog cut to the topics fuzzoff reads, so that a run's log stays under 1 MB.
 
-pyulog loads only ``fuzzoff.sources.ulog.LOADED_TOPICS`` and writes them back with
+pyulog loads only ``fuzzoff.formats.ulog.reader.LOADED_TOPICS`` and writes them back with
 ``ULog.write_ulog``: header, info, parameters and logged messages (PX4's own texts, such as
 "Disarming denied: not landed") are kept, as ``corpora/real/cut.py`` does for public logs.
 """
@@ -11,7 +11,7 @@ from pathlib import Path
 
 from pyulog import ULog
 
-from fuzzoff.sources.ulog import LOADED_TOPICS
+from fuzzoff.formats.ulog.reader import LOADED_TOPICS
 
 
 def trim(source: Path, target: Path) -> Path:

@@ -12,7 +12,7 @@ from struct import error as struct_error
 
 from pyulog import ULog
 
-from fuzzoff.sources.base import SourceError
+from fuzzoff.recording import SourceError
 
 TOPICS = [
     "vehicle_command",

@@ -14,6 +14,14 @@ from dataclasses import dataclass
 
 from fuzzoff.events import FailsafeFlags, LegacyControlMode, SetPositionTargetLocal
 from fuzzoff.profiles import Profile
+from fuzzoff.type_mask import (
+    ACCELERATION_BITS,
+    POSITION_BITS,
+    VELOCITY_BITS,
+    YAW_IGNORE,
+    YAW_RATE_IGNORE,
+    Z_IGNORE,
+)
 
 
 @dataclass(frozen=True, slots=True)
@@ -239,10 +247,10 @@ def legacy_mode_from_mask(sp: SetPositionTargetLocal) -> LegacyControlMode:
         vehicle=sp.vehicle,
         where=sp.where,
         origin="model",
-        ignore_position=bool(mask & 0b111),
-        ignore_alt_hold=bool(mask & 0b100),
-        ignore_velocity=bool(mask & 0b111000),
-        ignore_acceleration_force=bool(mask & 0b111000000),
-        ignore_attitude=bool(mask & 1024),
-        ignore_bodyrate=bool(mask & 2048),
+        ignore_position=bool(mask & POSITION_BITS),
+        ignore_alt_hold=bool(mask & Z_IGNORE),
+        ignore_velocity=bool(mask & VELOCITY_BITS),
+        ignore_acceleration_force=bool(mask & ACCELERATION_BITS),
+        ignore_attitude=bool(mask & YAW_IGNORE),
+        ignore_bodyrate=bool(mask & YAW_RATE_IGNORE),
     )

@@ -108,7 +108,7 @@ def test_a_loss_with_unknown_arming_says_what_each_does(px4: str) -> None:
 def test_lint_reports_both_outcomes(tmp_path: Path) -> None:
     """A companion's MCAP with only what it sent (no vehicle status, no acks): OFB102 and the
     predicted OFB201 name both outcomes; `fuzzoff gate` shows the undecided row."""
-    from fuzzoff.writers.mcap import write_mcap
+    from fuzzoff.formats.mcap.writer import write_mcap
     from tests.gate.streams import Command
 
     events: list[Event] = [

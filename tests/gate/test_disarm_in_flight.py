@@ -22,9 +22,9 @@ from fuzzoff.events import (
     SetPositionTargetLocal,
     TrajectorySetpoint,
 )
-from fuzzoff.sources import open_source
-from fuzzoff.writers.tlog import write_tlog
-from fuzzoff.writers.ulog import write_ulog
+from fuzzoff.formats import open_source
+from fuzzoff.formats.tlog.writer import write_tlog
+from fuzzoff.formats.ulog.writer import write_ulog
 from tests.gate.streams import OFFBOARD, TICK, arm, in_offboard, model, of, run, status, stream
 
 ALL_NEW = ["1.13", *TICK]

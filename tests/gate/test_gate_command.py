@@ -7,7 +7,7 @@ import json
 from pathlib import Path
 
 from fuzzoff.events import Event, SetPositionTargetLocal, VehicleInfo, VehicleStatus
-from fuzzoff.writers.tlog import write_tlog
+from fuzzoff.formats.tlog.writer import write_tlog
 from tests.helpers import CORPORA, run_cli
 
 OFFBOARD, POSCTL = 14, 2

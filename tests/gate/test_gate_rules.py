@@ -12,7 +12,7 @@ from fuzzoff.events import Command, CommandAck, Event, Parameter
 from fuzzoff.findings import Finding, Severity
 from fuzzoff.gate import GateModel, GateTransition
 from fuzzoff.profiles import Profile
-from fuzzoff.sources.base import RecordingInfo
+from fuzzoff.recording import RecordingInfo
 from tests.gate.streams import flags, in_offboard, status, stream
 
 POSCTL = 2
@@ -202,7 +202,7 @@ def test_ofb701_once_per_vehicle_and_recording_for_a_bag_split_in_two_files(
 
     from ruamel.yaml import YAML
 
-    from fuzzoff.writers.rosbag2 import write_rosbag2
+    from fuzzoff.formats.rosbag2.writer import write_rosbag2
     from tests.helpers import run_cli
 
     first = write_rosbag2(tmp_path / "a", [in_offboard(0.0), *stream(0.0, 4.9)])

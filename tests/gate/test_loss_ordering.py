@@ -19,9 +19,9 @@ from pathlib import Path
 import pytest
 
 from fuzzoff.events import ControlMode, Event, TrajectorySetpoint, VehicleStatus
+from fuzzoff.formats.mcap.writer import write_mcap
 from fuzzoff.gate import GateModel, GateTransition
 from fuzzoff.profiles import Profile
-from fuzzoff.writers.mcap import write_mcap
 from tests.gate.streams import (
     ALL,
     OFFBOARD,

@@ -18,9 +18,9 @@ from fuzzoff.config import Settings
 from fuzzoff.engine import lint_file, run_events
 from fuzzoff.events import CommandAck, ControlMode, Event, FailsafeFlags, SetPositionTargetLocal
 from fuzzoff.findings import Finding
+from fuzzoff.formats.tlog.writer import write_tlog
 from fuzzoff.profiles import Profile
-from fuzzoff.sources.base import RecordingInfo
-from fuzzoff.writers.tlog import write_tlog
+from fuzzoff.recording import RecordingInfo
 from tests.gate.streams import (
     OFFBOARD,
     POSCTL,

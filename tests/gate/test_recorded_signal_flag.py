@@ -11,7 +11,7 @@ from fuzzoff.engine import run_events
 from fuzzoff.events import Event, FailsafeFlags
 from fuzzoff.findings import Finding
 from fuzzoff.profiles import Profile
-from fuzzoff.sources.base import RecordingInfo
+from fuzzoff.recording import RecordingInfo
 from tests.gate.streams import POSCTL, TICK, in_offboard, status, stream
 
 

@@ -1,0 +1,88 @@
+"""Every registered format reads back what its own writer wrote, detected from content alone.
+
+The registry (``fuzzoff.formats.registry``) is the one place a format is declared: a new
+format's entry must agree with itself (detection, reader, writer, suffix) before lint or fuzz
+can rely on it.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from fuzzoff.events import (
+    ControlMode,
+    Event,
+    SetPositionTargetLocal,
+    TrajectorySetpoint,
+    VehicleStatus,
+)
+from fuzzoff.formats import detect_format, open_source
+from fuzzoff.formats.format import Format
+from fuzzoff.formats.registry import FORMATS, RECORDING_SUFFIXES
+from fuzzoff.fuzz.recordings import read
+
+UORB = [
+    VehicleStatus(t=0.0, nav_state=2, armed=True),
+    *(ControlMode(t=0.1 * i, position=True) for i in range(1, 11)),
+    *(TrajectorySetpoint(t=0.1 * i + 0.01, position=(0.0, 0.0, -2.0)) for i in range(1, 11)),
+]
+MAVLINK = [
+    VehicleStatus(t=0.0, nav_state=2, armed=True),
+    *(SetPositionTargetLocal(t=0.1 * i, type_mask=0xDF8) for i in range(1, 11)),
+]
+
+
+def _stream(fmt: Format) -> list[Event]:
+    return MAVLINK if set(fmt.transports) & {"mavlink", "mavros"} else UORB
+
+
+@pytest.mark.parametrize("fmt", FORMATS, ids=lambda f: f.name)
+def test_written_recording_is_detected_and_read(tmp_path: Path, fmt: Format) -> None:
+    path = fmt.write(tmp_path / f"flight{fmt.written_suffix}", _stream(fmt), "1.15")
+    name = detect_format(path)
+    assert name in fmt.names
+    with open_source(path) as source:
+        assert source.format == name
+        assert list(source.events())
+    if fmt.written_suffix:
+        assert fmt.written_suffix in RECORDING_SUFFIXES
+
+
+def test_a_renamed_recording_is_still_detected_by_content(tmp_path: Path) -> None:
+    by_name = {f.name: f for f in FORMATS}
+    path = by_name["tlog"].write(tmp_path / "flight.tlog", MAVLINK)
+    renamed = path.rename(tmp_path / "flight.bin")
+    assert detect_format(renamed) == "tlog"
+    assert read(renamed)
+
+
+def test_the_python_api_import_of_recording_info_still_works() -> None:
+    from fuzzoff.recording import RecordingInfo
+    from fuzzoff.sources.base import RecordingInfo as OldName
+
+    assert OldName is RecordingInfo
+
+
+@pytest.mark.parametrize("fmt", FORMATS, ids=lambda f: f.name)
+def test_the_fleet_table_dates_a_recording_by_its_own_clock(tmp_path: Path, fmt: Format) -> None:
+    """A ULog's clock counts from boot (no GPS fix here: no date); the others log Unix time."""
+    from fuzzoff.fleet.wallclock import start_time
+    from fuzzoff.formats.ros2msgs.messages import START_NS
+    from fuzzoff.formats.rosbag1.writer import DEFAULT_START_NS
+    from fuzzoff.formats.tlog.writer import DEFAULT_START_US
+
+    path = fmt.write(tmp_path / f"flight{fmt.written_suffix}", _stream(fmt), "1.15")
+    when = start_time(path, detect_format(path))
+    expected = {
+        "tlog": DEFAULT_START_US / 1e6,
+        "mcap": START_NS / 1e9,
+        "rosbag2": START_NS / 1e9,
+        "rosbag1": DEFAULT_START_NS / 1e9,
+    }.get(fmt.name)
+    if expected is None:
+        assert when is None
+    else:
+        assert when is not None
+        assert when.timestamp() == pytest.approx(expected, abs=1e-3)
