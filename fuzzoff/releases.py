@@ -98,6 +98,11 @@ class Release:
     an armed one needs the attitude estimate and the last check pass's signal (4.1, 1.14+)."""
     checks_signal_at_arming: bool
     """Arming in OFFBOARD re-runs the checks at the request (4.2, 1.14+)."""
+    arming_needs_manual_in_stick_modes: bool
+    """Arming in a mode flown with the sticks (Manual, Stabilized, Acro, Altitude, Position)
+    is refused without manual control: the mode's requirement, checked by ``canArm`` (4.2,
+    1.14+; seen on 1.18.0-alpha1 SITL: ack 1, "Arming denied: Resolve system health failures
+    first")."""
     arming_unverified: bool
     """The arming model follows old code, not checked on this release (4.2)."""
     handles_set_nav_state: bool
@@ -184,6 +189,7 @@ LEGACY = Release(
     attitude_target_needs_thrust=False,
     accepts_disarmed_switch=False,
     checks_signal_at_arming=False,
+    arming_needs_manual_in_stick_modes=False,
     arming_unverified=True,
     handles_set_nav_state=False,
     unsupported_main_mode="rejected_unverified",
@@ -247,6 +253,7 @@ V1_14 = replace(
     setpoint_valid_if_any_finite=False,
     accepts_disarmed_switch=True,
     checks_signal_at_arming=True,
+    arming_needs_manual_in_stick_modes=True,
     unsupported_main_mode="acked_no_change",
     loss_failsafe="framework",
     obl_rc_manual_is_stabilized=True,

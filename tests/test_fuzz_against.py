@@ -327,7 +327,7 @@ EXCHANGES = CORPORA / "against" / "exchanges"
 
 
 def _judge(stem: str, params: dict[str, float]) -> Verdict:
-    release = stem.rsplit("-", 1)[1]
+    release = stem.split("-", 1)[1]
     tlog, ulog = EXCHANGES / f"{stem}.tlog", EXCHANGES / f"{stem}.ulg"
     return compare(tlog, release, ulog, params, COMPANION_SYSID)
 
@@ -380,6 +380,18 @@ def test_an_arm_px4_refused_for_its_own_health_checks_is_outside_the_gate() -> N
     for release in ("1.15.4", "1.16.2", "1.17.0"):
         gate_refusal = read_truth(CORPORA / "sitl" / f"disarmed_switch_no_stream-{release}.ulg")
         assert health_refusals(gate_refusal, 0.0) == []
+
+
+def test_an_arm_in_position_without_manual_control_is_refused_as_px4_refused_it() -> None:
+    """A confirmed disagreement of a live 1.18.0-alpha1 campaign (seen in four streams): a
+    switch to Position with no joystick, then an arm, which PX4 refused (Position needs manual
+    control) and the model accepted. The model now refuses it too."""
+    params = {"COM_OF_LOSS_T": 0.19, "COM_OBL_RC_ACT": 4.0, "FUZZOFF_RC_PRESENT": 0.0}
+    verdict = _judge("arm_posctl_no_manual-1.18.0-alpha1", params)
+    (arm,) = [i for i in verdict.items if i.what == "arm"]
+    assert (arm.px4, arm.agree) == ("rejected (1)", True)
+    assert "no manual control, which POSCTL needs" in arm.model
+    assert verdict.agree
 
 
 def test_a_disagreement_confirmed_before_is_counted_not_followed_up_again(

@@ -65,6 +65,26 @@ def test_arming_in_offboard_without_a_stream_is_checked_as_the_record_says(
 
 
 @pytest.mark.parametrize("release", RELEASES, ids=by_name)
+def test_arming_in_position_mode_without_manual_control_as_the_record_says(
+    release: Release,
+) -> None:
+    """Disarmed in Position with the joystick lost, then an arm: refused where Position's
+    requirement (manual control) is checked at arming, accepted where it is not; with manual
+    control it is accepted everywhere."""
+    lost = flags(0.0, manual_control_signal_lost=True)
+    refused = of(
+        "arm_rejected", run(release.name, [lost, status(0.0, POSCTL, False, POSCTL), arm(1.0)])
+    )
+    assert bool(refused) is release.arming_needs_manual_in_stick_modes
+    if refused:
+        assert "no manual control, which POSCTL needs" in refused[0].message
+    kept = flags(0.0, manual_control_signal_lost=False)
+    assert not of(
+        "arm_rejected", run(release.name, [kept, status(0.0, POSCTL, False, POSCTL), arm(1.0)])
+    )
+
+
+@pytest.mark.parametrize("release", RELEASES, ids=by_name)
 def test_a_mavlink_mode_switch_is_acked_as_often_as_the_record_says(release: Release) -> None:
     switch = Command(t=1.0, command=176, params=(1.0, 6.0, 0.0, 0.0, 0.0, 0.0, 0.0))
     answers = echo([switch], release.name, "mc", {}, acks=True, status=False, transport="mavlink")

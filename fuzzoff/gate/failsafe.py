@@ -83,7 +83,8 @@ def _degrade(nav: int, est: Estimates, vehicle: str, chain: tuple[int, ...]) -> 
     return TERMINATION
 
 
-def _rc_present(params: dict[str, float], est: Estimates) -> bool:
+def rc_present(params: dict[str, float], est: Estimates) -> bool:
+    """Manual control as recorded, else the ``FUZZOFF_RC_PRESENT`` assumption."""
     if est.rc_recorded:
         return est.rc_present
     return bool(params.get(RC_PRESENT, 1.0))
@@ -131,7 +132,7 @@ def _framework(
     """1.14 - main (5.1)."""
     raw = params.get("COM_OBL_RC_ACT", 0.0)
     value = int(raw) if raw == int(raw) else -99
-    rc = _rc_present(params, est)
+    rc = rc_present(params, est)
     note = f"COM_OBL_RC_ACT {raw:g}"
     if value == 7:
         return LossAction("DISARM", None, "5.1", note, disarm=True)
@@ -219,7 +220,7 @@ def _chain_13(nav: int, est: Estimates, vehicle: str) -> int:
 
 
 def _v113(release: Release, vehicle: str, params: dict[str, float], est: Estimates) -> LossAction:
-    rc = _rc_present(params, est)
+    rc = rc_present(params, est)
     exception = int(params.get("COM_RCL_EXCEPT", 0.0)) & 4 != 0
     unverified = release.old_code_unverified
     spec = "5.2"
@@ -276,7 +277,7 @@ def _legacy_needs(nav: int, est: Estimates) -> bool:
 
 
 def _legacy(vehicle: str, params: dict[str, float], est: Estimates, stage: int) -> LossAction:
-    rc = _rc_present(params, est)
+    rc = rc_present(params, est)
     stage1 = _legacy_stage1(vehicle, est, rc)
     if stage == 1:
         where = "RC present" if rc else "no RC"

@@ -48,7 +48,7 @@ from fuzzoff.events import (
 from fuzzoff.gate import controllers, ocm
 from fuzzoff.gate.compare import SAMPLED_SLACK, Comparator, Decided
 from fuzzoff.gate.estimates import Estimates
-from fuzzoff.gate.failsafe import LossAction, loss_action
+from fuzzoff.gate.failsafe import LossAction, loss_action, rc_present
 from fuzzoff.gate.landed import LandedState, climbs
 from fuzzoff.gate.params import default_params
 from fuzzoff.gate.receiver import DROPPED, SHAPES, ReceiverContext, Result, Shape, receive
@@ -926,8 +926,9 @@ class GateModel:
             why = estimate_failure(self.release, self.ocm_mask, self.est) or "no offboard signal"
             flags_known = self.ocm_mask != 0 or self._flags_unlogged
             now_ok = self.signal.ok_now(cmd.t, flags_known and why == "no offboard signal")
+            manual = rc_present(self.params, self.est)
             return arm_decision(
-                self.release, cmd, self.user_intention, now_ok, why, attitude_ok, armed
+                self.release, cmd, self.user_intention, now_ok, why, attitude_ok, armed, manual
             )
         landed, why = self.landed.landed(cmd.t)
         ground = self.vehicle_type.startswith("rover")

@@ -17,7 +17,7 @@ from fuzzoff.events import (
     nearest,
     whole,
 )
-from fuzzoff.modes import custom_mode_to_nav_state
+from fuzzoff.modes import custom_mode_to_nav_state, nav_state_name
 from fuzzoff.releases import Release
 
 TERMINATION = 13
@@ -27,6 +27,8 @@ TEMPORARILY_REJECTED = 1
 DENIED = 2
 UNSUPPORTED = 3
 NO_ATTITUDE = "no attitude or angular-velocity estimate (OFFBOARD mode requirement, D11)"
+STICK_MODES = frozenset({0, 1, 2, 10, 15})
+"""Nav states flown with the sticks: Manual, Altitude, Position, Acro, Stabilized."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -101,11 +103,13 @@ def arm_decision(
     why: str | None,
     attitude_ok: bool = True,
     armed: bool = False,
+    manual_control: bool = True,
 ) -> Decision:
     """Arming (4.2). ``signal_now`` is the condition evaluated at the request (1.14+ re-runs the
     checks); ``why`` the reason it fails. Arming an armed vehicle changes nothing and is acked
     ACCEPTED (Commander's ``arm()`` returns "not changed"; seen on 1.15.4 and 1.18.0-alpha1 SITL
-    after a refused disarm in flight)."""
+    after a refused disarm in flight). Arming in a stick mode needs ``manual_control`` (1.14+):
+    a generated stream that switched to Position without a joystick was refused on 1.18 SITL."""
     if armed:
         return Decision(
             True,
@@ -115,6 +119,11 @@ def arm_decision(
             unverified=release.old_code_unverified,
         )
     if intention != NAV_STATE_OFFBOARD:
+        stick = intention in STICK_MODES and not manual_control
+        if stick and release.arming_needs_manual_in_stick_modes:
+            mode = nav_state_name(intention)
+            why = f"no manual control, which {mode} needs (mode requirement)"
+            return Decision(False, "4.2", why, TEMPORARILY_REJECTED)
         return Decision(True, "4.2", None)
     if not release.checks_signal_at_arming:
         return Decision(True, "4.2", None, unverified=release.arming_unverified)
