@@ -21,8 +21,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from fuzzoff.config import Settings
-from fuzzoff.findings import Severity
-from fuzzoff.fuzz.campaign import CampaignConfig, run_property
+from fuzzoff.fuzz.campaign import CampaignConfig, _Stop, run_property
 from fuzzoff.fuzz.hazards import EXPLAINED_BY
 from fuzzoff.fuzz.known import KNOWN
 from fuzzoff.fuzz.properties import (
@@ -146,15 +145,34 @@ def _target_check(code: str) -> Callable[[Scenario, FuzzContext], list[str]]:
         return [
             f"{f.code} fires: {f.message}"
             for f in run(scenario, ctx.settings)
-            if f.code == code and f.severity >= Severity.WARNING
+            if f.code == code  # at any severity: OFB603 is info where every release accepts
         ][:1]
 
     return check
 
 
+def _until_found(
+    check: Callable[[Scenario, FuzzContext], list[str]],
+) -> Callable[[Scenario, FuzzContext], list[str]]:
+    """``check``, ending the search at its first problem: a campaign goes on to the end of its
+    budget (every example is checked), but this benchmark asks only how soon a class is found,
+    and would otherwise spend the whole 60 s on every class and seed."""
+    found = False
+
+    def first(scenario: Scenario, ctx: FuzzContext) -> list[str]:
+        nonlocal found
+        if found:
+            raise _Stop
+        problems = check(scenario, ctx)
+        found = bool(problems)
+        return problems
+
+    return first
+
+
 def measure(cls: HazardClass, seed: int = SEED) -> tuple[bool, int, float]:
     check = _fault_check(cls.pattern) if cls.how == "fault" else _target_check(cls.rule)
-    spec = PropertySpec(cls.name, check, cls.name)
+    spec = PropertySpec(cls.name, _until_found(check), cls.name)
     config = CampaignConfig(
         px4=cls.px4,
         vehicle=cls.vehicle,
