@@ -446,6 +446,19 @@ class FailsafeFlags(Event):
     origin: Origin = "vehicle"
 
 
+ESTIMATES: tuple[str, ...] = (
+    "local_position",
+    "local_velocity",
+    "local_altitude",
+    "global_position",
+    "attitude",
+    "angular_velocity",
+    "home_position",
+)
+"""The estimates ``FailsafeFlags`` carries, each as ``<name>_valid`` (PX4's ``<name>_invalid``
+negated), in PX4's order."""
+
+
 @dataclass(frozen=True, slots=True, kw_only=True)
 class LandDetected(Event):
     """The land detector's verdict, which PX4 reads when it judges a disarm request (gate spec

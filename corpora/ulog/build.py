@@ -43,6 +43,7 @@ from pathlib import Path
 from typing import Any
 
 from fuzzoff.events import (
+    ESTIMATES,
     AttitudeSetpoint,
     Command,
     CommandAck,
@@ -65,15 +66,7 @@ OCM_INTERVAL, TRAJECTORY_INTERVAL = 0.1, 0.2  # PX4's default logger profile
 GCS = {"target_system": 1, "target_component": 1, "source_system": 255, "source_component": 190}
 ESTIMATES_OK = {
     f"{name}_valid": True
-    for name in (
-        "local_position",
-        "local_velocity",
-        "local_altitude",
-        "global_position",
-        "attitude",
-        "angular_velocity",
-        "home_position",
-    )
+    for name in ESTIMATES
 }
 
 Mode = tuple[float, int, bool, int, bool]

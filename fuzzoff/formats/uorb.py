@@ -16,15 +16,7 @@ ARMING_STATE_DISARMED = 1
 ARMING_STATE_ARMED = 2
 """``arming_state`` value for armed in every release (1.13/1.14 and 1.15+ numberings agree)."""
 
-ESTIMATES = (
-    "local_position",
-    "local_velocity",
-    "local_altitude",
-    "global_position",
-    "attitude",
-    "angular_velocity",
-    "home_position",
-)
+ESTIMATES = ev.ESTIMATES
 """The estimates ``failsafe_flags`` (``<estimate>_invalid``, v1.14+) and ``vehicle_status_flags``
 (``<estimate>_valid``, older) report on."""
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from fuzzoff.events import FailsafeFlags
+from fuzzoff.events import ESTIMATES, FailsafeFlags
 
 
 @dataclass(slots=True)
@@ -35,15 +35,7 @@ class Estimates:
     def update(self, flags: FailsafeFlags) -> bool:
         """Apply a ``FailsafeFlags`` event; True when anything the gate reads changed."""
         before = self.bits
-        for name in (
-            "local_position",
-            "local_velocity",
-            "local_altitude",
-            "global_position",
-            "attitude",
-            "angular_velocity",
-            "home_position",
-        ):
+        for name in ESTIMATES:
             value = getattr(flags, name + "_valid")
             if value is not None:
                 setattr(self, name, bool(value))
