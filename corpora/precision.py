@@ -144,20 +144,20 @@ def render(rows: Iterable[Row], gate: Counter[tuple[str, bool | None]]) -> str:
         " given as an error |",
         "| --- | --- | --- | --- | --- | --- |",
     ]
-    total = Row("all", "", 0, 0, 0, 0)
+    rows = list(rows)
     for r in rows:
         lines.append(
             f"| {r.recordings} | {r.what} | {r.clean} | {r.loud_on_clean} | {r.hazards} |"
             f" {r.caught} |"
         )
-        total = Row(
-            "all",
-            "",
-            total.clean + r.clean,
-            total.loud_on_clean + r.loud_on_clean,
-            total.hazards + r.hazards,
-            total.caught + r.caught,
-        )
+    total = Row(
+        "all",
+        "",
+        sum(r.clean for r in rows),
+        sum(r.loud_on_clean for r in rows),
+        sum(r.hazards for r in rows),
+        sum(r.caught for r in rows),
+    )
     lines.append(
         f"| **all** | | **{total.clean}** | **{total.loud_on_clean}** | **{total.hazards}** |"
         f" **{total.caught}** |"

@@ -49,17 +49,13 @@ class _Change:
     sampled: bool
     """The mode reached the recording over a link at 1 Hz: the change lies between the two."""
 
-    def text(self) -> str:
+    def text(self, brief: bool = False) -> str:
+        """The change as the finding says it; ``brief`` for the one-line view (a range)."""
         mode = nav_state_name(self.nav)
         if self.sampled and self.before is not None:
+            if brief:
+                return f"{mode} {self.before:.2f}-{self.t:.2f} s (1 Hz status)"
             return f"{mode} between {self.before:.2f} and {self.t:.2f} s (mode sampled at 1 Hz)"
-        return f"{mode} at {self.t:.2f} s"
-
-    def brief(self) -> str:
-        """``text`` for the one-line view: the sampled window as a range."""
-        mode = nav_state_name(self.nav)
-        if self.sampled and self.before is not None:
-            return f"{mode} {self.before:.2f}-{self.t:.2f} s (1 Hz status)"
         return f"{mode} at {self.t:.2f} s"
 
 
@@ -225,7 +221,7 @@ class OffboardLoss(Check):
         message, short = pending.message, pending.short
         if answer is not None:
             message += f"; recorded: {answer.text()}"
-            short += f"; recorded: {answer.brief()}"
+            short += f"; recorded: {answer.text(brief=True)}"
         elif self.ctx.state.mode_recorded:
             message += f"; recorded: still {nav_state_name(self.ctx.state.nav_state)}"
             short += f"; recorded: still {nav_state_name(self.ctx.state.nav_state)}"

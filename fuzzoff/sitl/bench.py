@@ -48,6 +48,17 @@ SILENT_S = 3.0
 Log = Callable[[str], None]
 
 
+def _wait_ready(link: Link, driver: Driver) -> str | None:
+    """Wait up to ``READY_AGAIN_S`` for PX4's pre-arm bit (SYS_STATUS); None once it is set,
+    else PX4's newest message, which says why not."""
+    deadline = time.monotonic() + READY_AGAIN_S
+    while not link.view.prearm_ok:
+        if time.monotonic() > deadline:
+            return link.view.statustexts[-1][1] if link.view.statustexts else "nothing"
+        driver.wait(0.1)
+    return None
+
+
 class NeedsRestart(LinkError):
     """PX4 cannot be brought back to the starting state: restart it (the message says why)."""
 
@@ -179,14 +190,11 @@ class Bench:
                 or not link.wait_for(lambda v: v.nav_state == NAV_LOITER, 3.0)
             ):
                 raise NeedsRestart("PX4 does not go to Hold (AUTO_LOITER)")
-        deadline = time.monotonic() + READY_AGAIN_S
-        while not link.view.prearm_ok:
-            if time.monotonic() > deadline:
-                said = link.view.statustexts[-1][1] if link.view.statustexts else "nothing"
-                raise NeedsRestart(
-                    f"not ready to arm again within {READY_AGAIN_S:g} s (PX4 said: {said})"
-                )
-            driver.wait(0.2)
+        said = _wait_ready(link, driver)
+        if said is not None:
+            raise NeedsRestart(
+                f"not ready to arm again within {READY_AGAIN_S:g} s (PX4 said: {said})"
+            )
 
     def _params(self, params: dict[str, float], notes: list[str]) -> None:
         link = self._link()
@@ -254,11 +262,8 @@ class Bench:
             # Ready to arm in that SYS_STATUS too: a health failure can come after the
             # reset found PX4 ready ("Preflight Fail: horizontal velocity unstable" 0.5 s
             # after a landing refused the stream's arm in a live 1.15 campaign).
-            deadline = time.monotonic() + READY_AGAIN_S
-            while not link.view.prearm_ok and time.monotonic() < deadline:
-                driver.wait(0.1)
-            if not link.view.prearm_ok:
-                said = link.view.statustexts[-1][1] if link.view.statustexts else "nothing"
+            said = _wait_ready(link, driver)
+            if said is not None:
                 notes.append(f"PX4 was not ready to arm when the stream began (it said: {said})")
             sent = replay.send(link, plan, 1.0, driver.tick)
             driver.wait(params.get("COM_OF_LOSS_T", 1.0) + TAIL_S)
