@@ -4,10 +4,14 @@ at the lowest versions allowed."""
 
 from __future__ import annotations
 
+import os
 import re
+import shutil
 import subprocess
 import sys
 import tomllib
+import zipfile
+from pathlib import Path
 
 import pytest
 
@@ -81,3 +85,31 @@ def test_license_and_type_marker_ship() -> None:
     assert "Apache License" in text and "Version 2.0, January 2004" in text
     assert (ROOT / "fuzzoff" / "py.typed").is_file()
     assert "Typing :: Typed" in PROJECT["classifiers"]
+
+
+def test_the_version_comes_from_the_tag(tmp_path: Path) -> None:
+    """A wheel built at a tag carries the tag's version, in its metadata and in what
+    ``fuzzoff --version`` prints (the generated ``fuzzoff/_version.py``): what the release
+    workflow publishes and the Action installs (it sets the version from its ref the same way).
+    The build is pip's, in isolation, from a copy of the source tree."""
+    source = tmp_path / "src"
+    shutil.copytree(
+        ROOT, source, ignore=shutil.ignore_patterns(".venv", "build", ".git", "*cache*", "corpora")
+    )
+    env = {**os.environ, "SETUPTOOLS_SCM_PRETEND_VERSION": "9.8.7"}
+    subprocess.run(
+        [sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "-w", str(tmp_path), str(source)],
+        check=True,
+        env=env,
+        capture_output=True,
+        timeout=600,
+    )
+    (wheel,) = tmp_path.glob("fuzzoff-*.whl")
+    assert wheel.name.startswith("fuzzoff-9.8.7-")
+    with zipfile.ZipFile(wheel) as archive:
+        metadata = archive.read("fuzzoff-9.8.7.dist-info/METADATA").decode()
+        generated = archive.read("fuzzoff/_version.py").decode()
+    assert "\nVersion: 9.8.7\n" in metadata
+    namespace: dict[str, object] = {}
+    exec(generated, namespace)
+    assert namespace["__version__"] == "9.8.7"

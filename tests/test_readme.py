@@ -6,17 +6,16 @@ colourless environment, and the lines shown under it must appear in its output, 
 block without a language is a line from an output shown above it. The ``toml`` configuration is
 used for a lint, the ``python`` API example runs against corpus recordings, the GitHub Actions
 workflow's lint step runs in a folder of recordings and writes the two reports its upload steps
-name, and the pre-commit configuration is the repository's own hook. A block marked
+name (the repository's action, run as a runner does, its inputs checked by actionlint), and the
+pre-commit configuration is the repository's own hook. A block marked
 ``<!-- readme-test: not run (why) -->`` is left out, and says why.
 """
 
 from __future__ import annotations
 
 import json
-import os
 import re
 import shutil
-import subprocess
 import sys
 import tomllib
 from dataclasses import dataclass
@@ -25,6 +24,7 @@ from pathlib import Path
 import pytest
 from ruamel.yaml import YAML
 
+from tests.action_runner import actionlint, run_step
 from tests.helpers import CORPORA, ROOT, run_cli
 
 README = (ROOT / "README.md").read_text(encoding="utf-8")
@@ -198,55 +198,37 @@ def _workflow() -> dict[str, object]:
     raise AssertionError("no GitHub Actions workflow in the README")
 
 
-def test_the_github_workflow_writes_the_reports_it_uploads_from_one_lint(tmp_path: Path) -> None:
+def test_the_github_workflow_uses_the_action_with_inputs_it_has(tmp_path: Path) -> None:
+    """The README's workflow names the repository's action; actionlint checks its inputs
+    against action.yml (with the action as ``./``), and its lint step, run with those inputs on
+    a folder of recordings, writes both reports and keeps the status for the job's last step."""
     workflow = _workflow()
     assert workflow["permissions"] == {"contents": "read", "security-events": "write"}
     jobs = workflow["jobs"]
     assert isinstance(jobs, dict)
     steps = next(iter(jobs.values()))["steps"]
-    lint = next(s for s in steps if "fuzzoff lint" in s.get("run", ""))
-    assert lint["run"].count("fuzzoff lint") == 1  # one lint, both reports
-    upload = next(s for s in steps if s.get("uses", "").startswith("github/codeql-action/upload"))
-    artifact = next(s for s in steps if s.get("uses", "").startswith("actions/upload-artifact"))
+    (action,) = (s for s in steps if str(s.get("uses", "")).startswith("fuzzoff/fuzzoff@"))
+    text = next(b.body for b in _of("yaml") if "jobs:" in b.body)
+    linted = actionlint(text.replace(action["uses"], "./"), tmp_path)
+    assert linted.returncode == 0, linted.stdout
     logs = tmp_path / "logs"
     logs.mkdir()
     for name in ("stream_lost_in_offboard.tlog", "good_offboard.tlog"):
         shutil.copy(CORPORA / "tlog" / name, logs / name)
-    output = tmp_path / "github_output"
-    env = {
-        **os.environ,
-        "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}",
-        "GITHUB_OUTPUT": str(output),
-        "NO_COLOR": "1",
-    }
-    proc = subprocess.run(
-        ["bash", "-e", "-c", lint["run"]],
-        cwd=tmp_path,
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
-    assert proc.returncode == 0, proc.stderr  # the step itself passes: the status is kept
-    assert output.read_text().strip() == "status=1"  # and the last step fails the job with it
-    sarif = json.loads((tmp_path / upload["with"]["sarif_file"]).read_text(encoding="utf-8"))
-    assert sarif["version"] == "2.1.0" and sarif["runs"][0]["results"]
-    html = (tmp_path / artifact["with"]["path"]).read_text(encoding="utf-8")
-    assert "stream_lost_in_offboard.tlog" in html and "<!DOCTYPE html>" in html[:200]
-    assert "OFB101" in proc.stdout  # the findings in the job's log too
-    last = steps[-1]
-    assert last["if"] == f"steps.{lint['id']}.outputs.status != '0'"
+    run = run_step("lint", action["with"], tmp_path, tmp_path)
+    assert run.returncode == 0, run.stderr
+    assert run.outputs["status"] == "1"  # the action's last step fails the job with it
+    assert json.loads(Path(run.outputs["sarif-file"]).read_text())["runs"][0]["results"]
+    assert "stream_lost_in_offboard.tlog" in Path(run.outputs["html-file"]).read_text()
 
 
 def test_the_pre_commit_example_is_the_repositorys_hook() -> None:
     (hook,) = YAML(typ="safe").load((ROOT / ".pre-commit-hooks.yaml").read_text())
     configs = [_yaml(b) for b in _of("yaml")]
     config = next(c for c in configs if isinstance(c, dict) and "repos" in c)
-    (local,) = config["repos"][0]["hooks"]
-    assert config["repos"][0]["repo"] == "local"
-    for key in ("id", "entry", "language", "files", "require_serial"):
-        assert local[key] == hook[key], key
-    assert local["additional_dependencies"] == ["fuzzoff"]
+    (repo,) = config["repos"]
+    assert repo["repo"].endswith("/fuzzoff") and repo["rev"].startswith("v")
+    assert repo["hooks"] == [{"id": hook["id"]}]
 
 
 def test_the_precision_table_is_what_the_corpus_gives() -> None:
