@@ -34,7 +34,7 @@ from fuzzoff.events import (
 )
 from fuzzoff.findings import Severity
 from fuzzoff.gate import GateTransition
-from fuzzoff.gate.model import SAME_ITERATION_S
+from fuzzoff.gate.commander import SAME_ITERATION_S
 from fuzzoff.state import DOUBLE_ACK_WINDOW_S
 
 NEAR_LOSS_FRACTION = 0.8
