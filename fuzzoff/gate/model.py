@@ -31,7 +31,6 @@ deadline when it comes. The parts share one ``state.GateState``:
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Mapping
 from typing import Any
 
@@ -264,27 +263,8 @@ class GateModel:
         return True
 
     def _on_parameter(self, event: Parameter) -> bool:
-        """A recorded parameter: applied unless the user overrides it, with what reads it."""
-        s = self.state
-        name = event.name.upper()
-        s.recorded_params[name] = event.value
-        if name in s.overrides or not math.isfinite(event.value):
-            # A NaN or infinite value (a damaged record) is shown as recorded but not applied:
-            # PX4 would cast it to a whole number, which C leaves undefined.
-            return True
-        s.params[name] = event.value
-        self.mavlink.forget()
-        if name == "COM_OF_LOSS_T" and s.stream_recorded:
-            if s.release.fixed_loss_s is not None:
-                s.signal.loss_extra = max(0.0, event.value)  # type: ignore[attr-defined]
-            else:
-                s.signal.timeout = max(0.0, event.value)
-        elif name == "MAV_FWDEXTSP":
-            s.rx.fwdextsp = bool(event.value)
-        elif name == "COM_DISARM_PRFLT":
-            s.landed.preflight_disarm_s = event.value
-        elif name == "MAV_COMP_ID":
-            s.rx.own_component = int(event.value)
+        if self.state.apply_parameter(event):
+            self.mavlink.forget()  # the receiver reads MAV_FWDEXTSP, MAV_COMP_ID
         return True
 
     def _on_land(self, event: LandDetected) -> bool:

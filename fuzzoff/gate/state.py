@@ -10,11 +10,12 @@ event being fed has caused so far (``emit``).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from fuzzoff.events import NAV_STATE_OFFBOARD, Event, FailsafeFlags
+from fuzzoff.events import NAV_STATE_OFFBOARD, Event, FailsafeFlags, Parameter
 from fuzzoff.gate.compare import Comparator
 from fuzzoff.gate.estimates import Estimates
 from fuzzoff.gate.failsafe import LossAction, loss_action
@@ -179,6 +180,29 @@ class GateState:
             self.out = [tr]
         else:
             self.out.append(tr)
+
+    def apply_parameter(self, event: Parameter) -> bool:
+        """A recorded parameter; True when applied (the user's overrides win, and a value that
+        is not a finite number is shown as recorded but not applied)."""
+        name = event.name.upper()
+        self.recorded_params[name] = event.value
+        if name in self.overrides or not math.isfinite(event.value):
+            # PX4 would cast a NaN or infinite value (a damaged record) to a whole number,
+            # which C leaves undefined.
+            return False
+        self.params[name] = event.value
+        if name == "COM_OF_LOSS_T" and self.stream_recorded:
+            if self.release.fixed_loss_s is not None:
+                self.signal.loss_extra = max(0.0, event.value)  # type: ignore[attr-defined]
+            else:
+                self.signal.timeout = max(0.0, event.value)
+        elif name == "MAV_FWDEXTSP":
+            self.rx.fwdextsp = bool(event.value)
+        elif name == "COM_DISARM_PRFLT":
+            self.landed.preflight_disarm_s = event.value
+        elif name == "MAV_COMP_ID":
+            self.rx.own_component = int(event.value)
+        return True
 
     def take_output(self) -> list[GateTransition] | None:
         out = self.out
