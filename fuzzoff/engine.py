@@ -192,7 +192,6 @@ class VehicleRun:
 
     def _transitions(self, transitions: list[GateTransition]) -> None:
         for tr in transitions:
-            self.state.set_predicted(self.gate.in_offboard, tr.t)
             if self.timeline is not None:
                 self.timeline.transitions.append(tr)
             self._dispatch(tr)
@@ -215,13 +214,13 @@ class VehicleRun:
         if transitions:
             self._flush()
             self._transitions(transitions)
-        if gate.in_offboard != state.predicted_offboard:  # set_predicted's own first test
-            self._flush()
-            state.set_predicted(gate.in_offboard, event.t)
+        batch = self._batch
+        if batch is not None and gate.in_offboard != batch.gate.in_offboard:
+            self._flush()  # the prediction moved without a transition: the run saw it before
         if self.timeline is not None:
             self._record(event)
         if self._watch_offboard and (
-            state.in_offboard or (isinstance(event, Command) and event.is_offboard_switch)
+            self.ctx.in_offboard or (isinstance(event, Command) and event.is_offboard_switch)
         ):
             self.offboard_seen = True
             self._watch_offboard = False

@@ -2,8 +2,10 @@
 
 The engine updates it with every event before the checks see that event. "In offboard" follows
 rules.md: the recorded mode, except that a mode switch accepted by a command ack takes effect at
-that ack (the last ack of a command wins: PX4 1.16/1.17 send two); where the recording has no
-mode at all, the gate model's prediction is used and ``mode_source`` says so.
+that ack (the last ack of a command wins: PX4 1.16/1.17 send two). Where the recording has no
+mode at all, the checks ask the gate model's prediction instead (``CheckContext.in_offboard``,
+``flying`` and ``offboard_since`` choose; ``mode_source`` says which): this state holds only
+what the recording says.
 """
 
 from __future__ import annotations
@@ -56,20 +58,16 @@ class VehicleState:
     """The nav_state of the newest recorded status, without the acks applied: what PX4 had
     switched to (its own flight tasks write the setpoint topics until that status)."""
     armed: bool | None = None
-    predicted_offboard: bool = False
-    """The gate model's verdict, used where the recording has no mode."""
-    offboard_since: float | None = None
     params: dict[str, float] = field(default_factory=dict)
     control_mode: ControlMode | LegacyControlMode | None = None
     failsafe_flags: FailsafeFlags | None = None
     declared_flag: str | None = None
     """The first true field of the latest boolean ``OffboardControlMode`` (None: none/empty)."""
-    in_offboard: bool = False
-    """Recorded mode (acks applied), or the gate's prediction when no mode is recorded; kept as
-    a plain attribute because every check asks on every message."""
-    flying: bool = False
-    """``in_offboard`` and not known to be disarmed (a disarmed vehicle parked in OFFBOARD is
-    idle): what most stream rules ask on every keep-alive, so it is kept up to date here."""
+    recorded_offboard: bool = False
+    """The recorded mode (acks applied) is OFFBOARD; False where no mode is recorded. Kept as
+    a plain attribute because the checks ask on every message."""
+    recorded_offboard_since: float | None = None
+    """When ``recorded_offboard`` last turned true (None while it is false)."""
     own_system: int | None = None
     """This vehicle's MAVLink system id (None where its name is not one: ROS namespaces)."""
     keepalive: Event | None = None
@@ -81,25 +79,9 @@ class VehicleState:
     _left: tuple[float, int | None] | None = None
     """(ack time, the mode before) of the newest accepted switch that changed ``nav_state``."""
 
-    def _now_in_offboard(self) -> bool:
-        if self.mode_recorded:
-            return self.nav_state == NAV_STATE_OFFBOARD
-        return self.predicted_offboard
-
     @property
     def mode_source(self) -> str:
         return "recorded" if self.mode_recorded else "predicted by the gate model"
-
-    def set_predicted(self, in_offboard: bool, t: float) -> None:
-        """The gate model's verdict after an event; it drives ``in_offboard`` when no mode is
-        recorded, so ``offboard_since`` follows it then."""
-        if self.predicted_offboard == in_offboard:
-            return
-        self.predicted_offboard = in_offboard
-        if not self.mode_recorded:
-            self.in_offboard = in_offboard
-            self.flying = in_offboard and self.armed is not False
-            self.offboard_since = t if in_offboard else None
 
     def update(self, event: Event) -> None:
         updater = _UPDATER_BY_TYPE.get(type(event))
@@ -109,14 +91,13 @@ class VehicleState:
         if updater not in _MODE_UPDATERS:  # nothing the mode depends on moves (every setpoint)
             updater(self, event)
             return
-        was = self.in_offboard
+        was = self.recorded_offboard
         updater(self, event)
-        now = self.in_offboard = self._now_in_offboard()
-        self.flying = now and self.armed is not False
+        now = self.recorded_offboard = self.mode_recorded and self.nav_state == NAV_STATE_OFFBOARD
         if now and not was:
-            self.offboard_since = event.t
+            self.recorded_offboard_since = event.t
         elif was and not now:
-            self.offboard_since = None
+            self.recorded_offboard_since = None
 
     def counts_as_keepalive(self, event: Event) -> bool:
         """What ``update`` puts in ``keepalive`` for this event (runs of messages use it)."""
@@ -216,8 +197,8 @@ instead of walking the chain on every message (about 0.3 µs a setpoint on a tlo
 
 
 _MODE_UPDATERS = frozenset((VehicleState._status, VehicleState._command_ack))
-"""The only updaters that move ``nav_state`` or ``armed``; after any other, ``in_offboard``,
-``flying`` and ``offboard_since`` stay as they were (``set_predicted`` moves them too)."""
+"""The only updaters that move ``nav_state`` or ``armed``; after any other,
+``recorded_offboard`` and ``recorded_offboard_since`` stay as they were."""
 
 
 _UPDATER_BY_TYPE: dict[type, Callable[[VehicleState, Event], None]] = {}

@@ -30,7 +30,7 @@ def from_external(ctx: CheckContext, event: Event) -> bool:
     if event.origin == "sent":
         return True
     state = ctx.state
-    if event.origin != "vehicle" or not state.in_offboard:
+    if event.origin != "vehicle" or not ctx.in_offboard:
         return False
     if state.mode_recorded and state.status_nav_state != NAV_STATE_OFFBOARD:
         return False  # accepted, but PX4 has not switched yet: its own flight task writes

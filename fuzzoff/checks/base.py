@@ -34,7 +34,7 @@ from fuzzoff.events import (
     Where,
 )
 from fuzzoff.findings import Finding, Severity
-from fuzzoff.gate import GateModel
+from fuzzoff.gate import GateView
 from fuzzoff.profiles import Profile
 from fuzzoff.recording import RecordingInfo
 from fuzzoff.state import VehicleState
@@ -67,7 +67,8 @@ class CheckContext:
     info: RecordingInfo
     vehicle: str
     state: VehicleState
-    gate: GateModel
+    gate: GateView
+    """The gate model's prediction, read-only (during ``on_batch``: as the run saw it)."""
     findings: list[Finding] = field(default_factory=list)
     not_checkable: dict[str, str] = field(default_factory=dict)
     """code -> what the recording would need (becomes one OFB002 finding per code)."""
@@ -135,6 +136,29 @@ class CheckContext:
         if self.enabled(code):
             self.not_checkable.setdefault(code, needs)
 
+    @property
+    def in_offboard(self) -> bool:
+        """In OFFBOARD: as recorded (acks applied), else as the gate model predicts
+        (``state.mode_source`` says which)."""
+        state = self.state
+        if state.mode_recorded:
+            return state.recorded_offboard
+        return self.gate.in_offboard
+
+    @property
+    def flying(self) -> bool:
+        """``in_offboard`` and not known to be disarmed (a disarmed vehicle parked in OFFBOARD
+        is idle): what most stream rules ask."""
+        return self.in_offboard and self.state.armed is not False
+
+    @property
+    def offboard_since(self) -> float | None:
+        """When ``in_offboard`` last turned true (None while it is false)."""
+        state = self.state
+        if state.mode_recorded:
+            return state.recorded_offboard_since
+        return self.gate.offboard_since
+
     def offboard_selected(self) -> bool:
         """OFFBOARD is the selected mode (what makes an arm an offboard request): as recorded,
         else as the gate model has the user's intention."""
@@ -163,11 +187,11 @@ class StreamBatch:
     Within a run nothing changes what a check reads: no other event of the vehicle, no gate
     transition and no change of the declared control mode (first true OCM flag) falls inside
     it; only the messages themselves do (which one is the latest keep-alive or setpoint).
-    ``state`` and ``gate`` are copies of the shared state and the gate model as every message
-    of the run saw them: the engine may close a run only after its next message has moved the
-    live ones on (a gate transition it caused). While a check's ``on_batch`` runs, the
-    engine points ``ctx.state`` and ``ctx.gate`` at these copies, so code shared with
-    ``on_event`` reads the right values.
+    ``state`` and ``gate`` are a copy of the shared state and a snapshot of the gate model as
+    every message of the run saw them: the engine may close a run only after its next message
+    has moved the live ones on (a gate transition it caused). While a check's ``on_batch``
+    runs, the engine points ``ctx.state`` and ``ctx.gate`` at these copies, so code shared
+    with ``on_event`` (``ctx.in_offboard``, ``ctx.flying``) reads the right values.
 
     ``on_batch`` must report exactly what ``on_event`` would for the same messages one at a
     time; ``Check.replay`` does that, and a check's own fast path proves the common case
@@ -186,10 +210,10 @@ class StreamBatch:
         "state",
     )
 
-    def __init__(self, state: VehicleState, gate: GateModel) -> None:
+    def __init__(self, state: VehicleState, gate: GateView) -> None:
         self.events: list[Event] = []
         self.state = copy.copy(state)
-        self.gate = copy.copy(gate)
+        self.gate = gate.snapshot()
         self.mode_at_start = state.control_mode
         """The declaration the run's first message saw: ``replay`` moves ``state.control_mode``
         through the run's own declarations and puts this back for the next check."""

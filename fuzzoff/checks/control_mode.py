@@ -99,7 +99,7 @@ class SetpointNotDeclared(Check):
         self.sent = True
         flag = declared_flag(self.ctx)
         row = row_for(self.ctx.profile, flag)
-        if not self.ctx.state.in_offboard or row is None:
+        if not self.ctx.in_offboard or row is None:
             self.episodes.close_all()
             return
         key = f"{event.kind}/{flag}"
@@ -132,7 +132,7 @@ class SetpointNotDeclared(Check):
             return
         self.sent = True
         row = self.ctx.row_for(batch.state.declared_flag)
-        if not batch.state.in_offboard or row is None:
+        if not self.ctx.in_offboard or row is None:
             return  # close_all with nothing open
         kinds = {cls.kind for cls in batch.classes() if cls in PX4_SETPOINTS}
         if not row.allowed.issuperset(kinds):
@@ -192,23 +192,24 @@ class DeclaredSetpointMissing(Check):
         state = self.ctx.state
         if isinstance(event, MavlinkTarget) and event.origin == "sent":
             self.mav_sent = event
-            if state.in_offboard and self._taken(event, self.ctx.gate.receiver):
+            if self.ctx.in_offboard and self._taken(event, self.ctx.gate.receiver):
                 self.mav_taken = event.t
         if state.armed is not self.armed:
             self.armed = state.armed
             self.armed_at = event.t
         # A vehicle parked disarmed in OFFBOARD (accepted from 1.14) needs no setpoint yet.
-        active = state.in_offboard and state.armed is not False
+        active = self.ctx.flying
         if not active:
             self.mav_since = None
         elif self.mav_since is None:
-            self.mav_since = max(state.offboard_since or event.t, self.armed_at)
+            self.mav_since = max(self.ctx.offboard_since or event.t, self.armed_at)
             self.mav_checked = False
         flag = declared_flag(self.ctx) if active else None
         if flag != self.flag:
-            if self.flag is None and state.offboard_since is not None:
+            since = self.ctx.offboard_since
+            if self.flag is None and since is not None:
                 # Counted from the switch itself (an accepted ack) or the arming, if later.
-                self.since = max(state.offboard_since, self.armed_at)
+                self.since = max(since, self.armed_at)
             else:
                 self.since = None if flag is None else event.t
             self.flag = flag
@@ -227,7 +228,7 @@ class DeclaredSetpointMissing(Check):
         if not new.isdisjoint(SETPOINT_NAMES):
             self._note_first_seen(batch.of(PX4_SETPOINTS), new)
         if not present.isdisjoint(MAVLINK_SETPOINTS):
-            self._note_mavlink(batch.events, batch.state.in_offboard)
+            self._note_mavlink(batch.events, self.ctx.in_offboard)
 
     def _settled(self, state: VehicleState) -> bool:
         """Nothing due can be reported and a message of this state moves no period on."""
@@ -235,7 +236,7 @@ class DeclaredSetpointMissing(Check):
             return False
         if self.mav_since is not None and not self.mav_checked:
             return False
-        active = state.in_offboard and state.armed is not False
+        active = self.ctx.flying
         return (
             state.armed is self.armed
             and active is (self.mav_since is not None)
@@ -382,7 +383,7 @@ class ControlModeChanged(Check):
         if isinstance(event, FailsafeFlags | Parameter):
             self.memo.clear()
             return
-        if not self.ctx.state.in_offboard:
+        if not self.ctx.in_offboard:
             self.flag = None
             self._close()
             return
@@ -406,7 +407,7 @@ class ControlModeChanged(Check):
         mavlink = batch.of(MAVLINK_SETPOINTS) if classes & _MAVLINK else []
         if ControlMode not in classes and not mavlink:
             return
-        if not batch.state.in_offboard:
+        if not self.ctx.in_offboard:
             self.flag = None
             self._close()
             return
@@ -531,7 +532,7 @@ class RequiredEstimateMissing(Check):
         if isinstance(event, ControlMode):
             self.saw_mode = True
         request = isinstance(event, Command) and event.is_offboard_switch
-        if not (self.ctx.state.in_offboard or request):
+        if not (self.ctx.in_offboard or request):
             self.bad_key = None
             return
         missing = self._missing()
@@ -571,7 +572,7 @@ class RequiredEstimateMissing(Check):
             return
         self.saw_mode = True
         key = None
-        if batch.state.in_offboard:
+        if self.ctx.in_offboard:
             missing = self._missing()
             if missing is not None:
                 key = f"{missing[0]}/{missing[1]}"

@@ -218,7 +218,7 @@ class SetpointFrozen(Check):
         """A run of one message (duration 0) is never reported: the moving fast path needs it."""
 
     def on_event(self, event: Event) -> None:
-        if not self.ctx.state.flying:  # out of offboard, or disarmed
+        if not self.ctx.flying:  # out of offboard, or disarmed
             if self.runs:
                 for kind in list(self.runs):
                     self._close(kind)
@@ -257,7 +257,7 @@ class SetpointFrozen(Check):
         events = batch.of(self.setpoints)
         if not events:
             return
-        if not self.ctx.state.flying:  # every message closes every run: the first one does
+        if not self.ctx.flying:  # every message closes every run: the first one does
             for kind in list(self.runs):
                 self._close(kind)
             return

@@ -139,7 +139,7 @@ class LossActionSummary(Check):
     def on_event(self, event: Event) -> None:
         if self.done:
             return
-        if self.ctx.gate.in_offboard or self.ctx.state.in_offboard:
+        if self.ctx.gate.in_offboard or self.ctx.in_offboard:
             self.done = True
             self.ctx.report("OFB701", loss_summary(self.ctx), event.t, short=loss_short(self.ctx))
 
@@ -166,7 +166,7 @@ class LossActionUnavailable(Check):
             and event.what == "failsafe"
             and event.armed is not False
         )
-        if not (loss or gate.in_offboard or self.ctx.state.in_offboard):
+        if not (loss or gate.in_offboard or self.ctx.in_offboard):
             return
         if isinstance(event, GateTransition) and event.what not in (
             "failsafe",

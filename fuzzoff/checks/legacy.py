@@ -76,7 +76,7 @@ class LegacyTripletCurrentOnly(Check):
         self.episodes = Episodes(ctx, "OFB802")
 
     def on_event(self, event: Event) -> None:
-        if not self.ctx.state.in_offboard:
+        if not self.ctx.in_offboard:
             self.episodes.close_all()
             return
         if not isinstance(event, PositionSetpointTriplet):
@@ -108,7 +108,7 @@ class LegacySetpointInvalid(Check):
         self.episodes = Episodes(ctx, "OFB803")
 
     def on_event(self, event: Event) -> None:
-        if not self.ctx.state.in_offboard:
+        if not self.ctx.in_offboard:
             self.episodes.close_all()
             return
         if not isinstance(event, PositionSetpointTriplet):

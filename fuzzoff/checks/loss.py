@@ -110,7 +110,7 @@ class OffboardLoss(Check):
             gate = self.ctx.gate
             gate_models_it = gate.armed and gate.user_intention == NAV_STATE_OFFBOARD
             # The gate is the authority where it models offboard; the recorded mode otherwise.
-            self.last_flying = state.flying and not gate_models_it
+            self.last_flying = self.ctx.flying and not gate_models_it
         elif isinstance(event, GateTransition):
             if event.what == "signal_lost":
                 self.lost = event
@@ -120,7 +120,7 @@ class OffboardLoss(Check):
             self._sample(event)
             if self.pending is not None and event.nav_state is not None and not event.in_offboard:
                 self._flush(self.left)
-            if self.last_flying and not state.flying:
+            if self.last_flying and not self.ctx.flying:
                 self._gap_from_recording(event.t)  # only the silence spent in OFFBOARD counts
                 self.last_flying = False
 
@@ -138,7 +138,7 @@ class OffboardLoss(Check):
         run = keepalive_run(batch)
         gate = self.ctx.gate
         gate_models_it = gate.armed and gate.user_intention == NAV_STATE_OFFBOARD
-        flying = batch.state.flying and not gate_models_it
+        flying = self.ctx.flying and not gate_models_it
         timeout = loss_timeout(self.ctx)
         last = self.last
         if (self.last_flying and last is not None and not run.times[0] - last < timeout) or (

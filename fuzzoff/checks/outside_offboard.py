@@ -78,7 +78,7 @@ class SetpointsOutsideOffboard(Check):
             return
         if self._owned():
             if self.run is not None:  # _settle's own test, without the call on every message
-                self._settle(entered=state.in_offboard, t=event.t)
+                self._settle(entered=self.ctx.in_offboard, t=event.t)
             return
         if isinstance(event, Command):
             request = event.is_offboard_switch or (event.is_arm and self.ctx.offboard_selected())
@@ -120,7 +120,7 @@ class SetpointsOutsideOffboard(Check):
             setpoints = [e for e in setpoints if e.origin == "sent"]
         if self._owned():
             if self.run is not None:
-                self._settle(entered=batch.state.in_offboard, t=setpoints[0].t)
+                self._settle(entered=self.ctx.in_offboard, t=setpoints[0].t)
             return
         self._add(setpoints[0], len(setpoints), setpoints[-1])
         run = self.run
@@ -133,7 +133,7 @@ class SetpointsOutsideOffboard(Check):
     def _owned(self) -> bool:
         """In offboard, or in an external mode: the setpoints are the ones PX4 flies."""
         state = self.ctx.state
-        if state.in_offboard:
+        if self.ctx.in_offboard:
             return True
         return state.mode_recorded and state.nav_state in EXTERNAL_MODES
 

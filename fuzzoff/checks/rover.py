@@ -128,7 +128,7 @@ class RoverCombination(Check):
             return
         # direct_actuator too: rover setpoints published under it are ignored by PX4, so they
         # do not match the flag their combination needs (OFB503)
-        if not self.ctx.state.in_offboard or event.first_flag() is None:
+        if not self.ctx.in_offboard or event.first_flag() is None:
             self._clear()
             return
         published = {k for k, (t, _) in self.last.items() if event.t - t <= self.window}
@@ -221,7 +221,7 @@ class RoverDirectActuator(Check):
             return
         tables = tr.rover_tables(self.ctx.profile)
         mode = self.ctx.state.control_mode
-        if tables is None or not isinstance(mode, ControlMode) or not self.ctx.state.in_offboard:
+        if tables is None or not isinstance(mode, ControlMode) or not self.ctx.in_offboard:
             self.episodes.clear("OFB506")
             return
         offences = {}

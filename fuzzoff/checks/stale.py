@@ -58,7 +58,7 @@ class StaleSetpoints(Check):
         if self.last_ocm is None or event.t - self.last_ocm > self.stale:
             self.ocm_since = event.t  # the keep-alive itself paused: not "kept coming"
         self.last_ocm = event.t
-        if not self.ctx.state.flying:
+        if not self.ctx.flying:
             self._close(event.t)
             return
         alternatives = self._alternatives(self.ctx.state.declared_flag)  # this OCM's first flag
@@ -104,7 +104,7 @@ class StaleSetpoints(Check):
         if widest > self.stale or (last_ocm is not None and ocm_times[0] - last_ocm > self.stale):
             self.replay(batch)  # the keep-alive paused: ocm_since moves
             return
-        if batch.state.flying:
+        if self.ctx.flying:
             alternatives = self._alternatives(batch.state.declared_flag)
             if alternatives is not None and (
                 self.episode is not None

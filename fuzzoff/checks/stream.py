@@ -34,7 +34,7 @@ from fuzzoff.events import (
 )
 from fuzzoff.findings import Severity
 from fuzzoff.gate import GateTransition
-from fuzzoff.gate.model import SAME_ITERATION_S
+from fuzzoff.gate.commander import SAME_ITERATION_S
 from fuzzoff.state import DOUBLE_ACK_WINDOW_S
 
 NEAR_LOSS_FRACTION = 0.8
@@ -109,14 +109,14 @@ class KeepaliveRate(Check):
                 if not (self.quick and gap + PROOF_SLACK_S < self.max_gap):
                     self._gap(event, last, proven_gap(self.ctx, event, gap))
             self.last, self.last_where = event.t, event.where
-            self.last_in_offboard = state.flying
+            self.last_in_offboard = self.ctx.flying
             self.dropout_since_last = False
             self.request_in_gap = None
         elif isinstance(event, Dropout):
             self.dropout_since_last = True
         else:
             if isinstance(event, Command):
-                if event.is_offboard_switch or (event.is_arm and state.in_offboard):
+                if event.is_offboard_switch or (event.is_arm and self.ctx.in_offboard):
                     self._request(event.t)
             elif isinstance(event, VehicleStatus) and self.switches.entered_by_request(
                 event, self.last
@@ -124,7 +124,7 @@ class KeepaliveRate(Check):
                 self._request(event.t)  # no commands recorded (MAVROS): the switch itself
             if isinstance(event, CommandAck):
                 self._ack(event, left)
-            elif self.last_in_offboard and not state.flying:
+            elif self.last_in_offboard and not self.ctx.flying:
                 # left at a recorded status, or (no mode recorded) at the command itself
                 self.last_in_offboard = False
                 self._silence_until_left(event)
@@ -151,17 +151,17 @@ class KeepaliveRate(Check):
             return
         newest = keepalives[-1]
         self.last, self.last_where = newest.t, newest.where
-        self.last_in_offboard = batch.state.flying
+        self.last_in_offboard = self.ctx.flying
         self.dropout_since_last = False
         self.request_in_gap = None
 
     def _ack(self, ack: CommandAck, left: Event | None) -> None:
-        if self.last_in_offboard and not self.ctx.state.flying:
+        if self.last_in_offboard and not self.ctx.flying:
             # a switch away accepted at this ack: the window ends here, not at the next status
             # message (PX4's HEARTBEAT is 1 Hz)
             self.last_in_offboard = False
             self.left_at = ack
-        elif left is not None and self.left_at is left and self.ctx.state.flying:
+        elif left is not None and self.left_at is left and self.ctx.flying:
             # Commander's ack after the receiver's rejects the switch: still in OFFBOARD
             self.last_in_offboard = True
             self.left_at = None
@@ -169,16 +169,16 @@ class KeepaliveRate(Check):
     def _gap(self, event: Event, last: float, proven: float) -> None:
         if proven >= self.max_gap:
             found = _Gap(last, event.t, proven, event.where)
-            state = self.ctx.state
+            ctx = self.ctx
             if self.last_in_offboard:
                 self._report(found, IN_OFFBOARD)
-            elif self.request_in_gap is not None or state.flying:
+            elif self.request_in_gap is not None or ctx.flying:
                 # PX4 judges the newest keep-alive's age, whenever the silence began: flying in
                 # OFFBOARD at its end, the whole gap counts; else its age at the request
                 asked = self.request_in_gap
-                if not state.flying and asked is not None:
+                if not ctx.flying and asked is not None:
                     # in OFFBOARD but disarmed (1.14+ accepts that switch): nothing flies
-                    found.counts = 0.0 if state.in_offboard else asked - last
+                    found.counts = 0.0 if ctx.in_offboard else asked - last
                 self._report(found, ACROSS_SWITCH)
             else:
                 self.recent.append(found)
@@ -493,10 +493,9 @@ class KeepaliveMargin(Check):
             )
 
     def on_event(self, event: Event) -> None:
-        state = self.ctx.state
-        if event is not state.keepalive:
+        if event is not self.ctx.state.keepalive:
             return
-        flying = state.flying
+        flying = self.ctx.flying
         if flying and self.stretch_start is None:
             self.stretch_start = event.t
         elif not flying and self.stretch_start is not None:
@@ -518,7 +517,7 @@ class KeepaliveMargin(Check):
             return
         run = keepalive_run(batch)
         times = run.times
-        if not batch.state.flying:
+        if not self.ctx.flying:
             if self.stretch_start is not None:
                 self._close(times[0])
             self.last = times[-1]

@@ -3,12 +3,18 @@
 ``GateModel(profile, params).feed(event)`` returns the transitions the event causes (after the
 model has advanced its clock to ``event.t``, which may itself time out the signal);
 ``finish(t_end)`` flushes timeouts up to the end of the recording. See px4-offboard-gate.md and
-docs/gate.md. Modules: ``signal`` (proof of life, 2), ``requests`` (switch and arm, 4),
-``failsafe`` (loss action, 5), ``receiver`` (MAVLink receiver, 6), ``controllers`` and
-``tracker`` (7-10), ``params`` (13), ``compare`` (recording vs model), ``model``.
+docs/gate.md ("Code layout"). ``model`` is the façade; its parts, sharing one ``state.GateState``:
+``keepalive`` (keep-alives and the loss window, 2), ``verdict`` (PX4's recorded verdict on the
+signal), ``mavlink`` (the MAVLink receiver, 6) and ``setpoints`` (controllers, 7-10),
+``effective`` (the effective mode and loss action, 5), ``commander`` (requests, 4 and 13a),
+``history`` and ``acks`` (the recording against the prediction, 12 and 4.3). The tables and
+small models they use: ``signal``, ``requests``, ``failsafe``, ``receiver``, ``controllers``,
+``tracker``, ``landed``, ``params`` (13), ``compare``. Checks read the model through
+``view.GateView``.
 """
 
 from fuzzoff.gate.model import GateModel
 from fuzzoff.gate.transitions import GateTransition, TransitionKind
+from fuzzoff.gate.view import GateView
 
-__all__ = ["GateModel", "GateTransition", "TransitionKind"]
+__all__ = ["GateModel", "GateTransition", "GateView", "TransitionKind"]

@@ -33,6 +33,8 @@ input such as an RC switch."""
 LINK_LAG = 0.5
 """How much later than the vehicle a mode reported over a link may be recorded (HEARTBEAT in a
 ground-station tlog, ``/mavros/state``): transport latency, not PX4's timing."""
+NOT_OFFBOARD = "no OFFBOARD on either side: other modes' own rules are not modelled; followed"
+"""Said of a difference that does not concern the offboard gate (a ``mode`` row, not OFB202)."""
 SAMPLED_SLACK = 0.1
 """Extra slack when the keep-alive is a logged, subsampled copy (ULog logs
 ``offboard_control_mode`` at 10 Hz, gate spec 13a)."""
@@ -86,18 +88,14 @@ class Comparator:
     def sampled_keepalive(self) -> None:
         self.slack = self.base_slack + SAMPLED_SLACK
 
-    def due(self) -> float:
-        due = INF
-        if self.pending is not None:
-            due = self.pending.t + self.slack
-        if self.ack_wait is not None and self.ack_wait.t + ACK_WINDOW < due:
-            due = self.ack_wait.t + ACK_WINDOW
-        return due
+    def difference_due(self) -> float:
+        """When the pending difference is confirmed if it lasts (inf if none)."""
+        return INF if self.pending is None else self.pending.t + self.slack
 
-    def ack_due_first(self) -> bool:
-        if self.ack_wait is None:
-            return False
-        return self.pending is None or self.ack_wait.t + ACK_WINDOW <= self.pending.t + self.slack
+    def ack_due(self) -> float:
+        """When the ack waiting for a second one is judged (inf if none). An ack due at the
+        same time as a difference is judged first (``GateModel`` orders them so)."""
+        return INF if self.ack_wait is None else self.ack_wait.t + ACK_WINDOW
 
     # -- modes
 

@@ -1,5 +1,8 @@
 """The gate's per-message caches give what the uncached computation gives.
 
+A snapshot (what the checks read while they judge a run of stream messages at once) keeps the
+prediction the run saw while the live model moves on.
+
 ``receiver.shape`` keys ``receive``'s verdict; the model keeps accepted verdicts per shape and
 drops them when a parameter or an estimate changes; stamped keep-alives keep the cached deadline
 only while the loss does not move earlier.
@@ -29,7 +32,7 @@ from fuzzoff.gate import GateModel
 from fuzzoff.gate.estimates import Estimates
 from fuzzoff.gate.receiver import FLOAT_FIELDS, ReceiverContext, receive, shape
 from fuzzoff.profiles import Profile
-from tests.gate.streams import ALL, in_offboard, local_ned, of, run
+from tests.gate.streams import ALL, POSCTL, in_offboard, local_ned, of, run, status
 
 FLOATS = st.sampled_from([0.0, -0.0, 1.5, -2.0, 1e308, -1e308, math.nan, math.inf, -math.inf])
 VEC = st.tuples(FLOATS, FLOATS, FLOATS)
@@ -214,3 +217,17 @@ def test_a_stamp_that_jumps_back_moves_the_loss_earlier() -> None:
     trs = run("main", events, t_end=3.0)
     lost = of("signal_lost", trs)
     assert lost and math.isclose(lost[0].t_earliest or 0.0, 1.5, abs_tol=1e-9)
+
+
+def test_a_snapshot_keeps_the_prediction_its_run_saw() -> None:
+    gate = GateModel(Profile(px4="1.15"), {}, "1")
+    for event in (in_offboard(), ControlMode(t=0.0, position=True)):
+        gate.feed(event)
+    snap = gate.snapshot()
+    assert snap.in_offboard and snap.armed is True and snap.offboard_since == 0.0
+    gate.feed(status(0.5, POSCTL, False, POSCTL))  # a pilot's switch and a disarm
+    gate.feed(Parameter(t=0.6, name="COM_OF_LOSS_T", value=2.0))
+    assert not gate.in_offboard and gate.armed is False and gate.offboard_since is None
+    assert snap.in_offboard and snap.armed is True and snap.nav_state == 14
+    assert snap.params is gate.params and snap.params["COM_OF_LOSS_T"] == 2.0
+    assert snap.loss_timeout == 1.0 and gate.loss_timeout == 2.0
