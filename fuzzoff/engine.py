@@ -24,6 +24,7 @@ from fuzzoff.events import (
     TrajectorySetpoint,
     VehiclePosition,
     VehicleStatus,
+    Where,
     is_keepalive,
 )
 from fuzzoff.findings import (
@@ -45,7 +46,7 @@ from fuzzoff.profiles import (
     ProfileError,
     px4_profile_for,
 )
-from fuzzoff.recording import RecordingInfo, SourceProblem, path_text
+from fuzzoff.recording import RecordingInfo, SourceProblem, first_byte, path_text
 from fuzzoff.releases import PX4Profile
 from fuzzoff.state import VehicleState
 from fuzzoff.type_mask import POSITION_BITS
@@ -473,7 +474,14 @@ def lint_file(
         report.complete = False
         report.problems.append(exc.line())
         report.findings.append(
-            Finding("OFB001", unreadable.name, Severity.ERROR, exc.line(), summary=_unreadable(exc))
+            Finding(
+                "OFB001",
+                unreadable.name,
+                Severity.ERROR,
+                exc.line(),
+                where=_place(exc),
+                summary=_unreadable(exc),
+            )
         )
         return report
     try:
@@ -511,6 +519,7 @@ def lint_file(
                     Severity.ERROR,
                     line,
                     time_s=problem.time_s,
+                    where=_place(problem),
                     summary=_unreadable(problem),
                 )
             )
@@ -523,6 +532,7 @@ def lint_file(
                     settings.severity_of("OFB004", Severity.INFO),
                     line,
                     time_s=problem.time_s,
+                    where=_place(problem),
                     summary=_unreadable(problem),
                 )
             )
@@ -559,6 +569,12 @@ def _unreadable(problem: SourceError | SourceProblem) -> str:
     """The problem without the file's name (the report's heading names the file)."""
     at = f" at {problem.where}" if problem.where else ""
     return clip(f"{problem.what}{at}")
+
+
+def _place(problem: SourceError | SourceProblem) -> Where | None:
+    """The byte of the file a problem's line names, as a finding's place (no topic)."""
+    offset = first_byte(problem.where)
+    return None if offset is None else Where("", offset=offset)
 
 
 def _problem(exc: SourceError) -> SourceProblem:
