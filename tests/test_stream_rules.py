@@ -434,3 +434,33 @@ def test_ofb103_reports_each_loss_when_the_next_comes_before_the_recorded_answer
     # each at its failsafe: one iteration after the end of the loss window (2.0-2.1, 3.4-3.5 s)
     assert [round(f.time_s or 0.0, 1) for f in found] == [2.1, 3.5]
     assert all("recorded: still OFFBOARD" in f.message for f in found)
+
+
+def test_ofb103_says_the_recording_has_no_mode_yet_rather_than_still_unknown() -> None:
+    """A switch and an arm without acks, the stream lost, and the first status only after the
+    loss's recorded-answer window: there is no recorded mode yet to compare, not an 'unknown'
+    mode the vehicle stayed in."""
+    arm = Command(t=0.6, command=400, params=(1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
+    events = [*ocm(every(0.0, 2.0, 0.1)), switch(0.5), arm, *ocm(every(7.0, 8.0, 0.1))]
+    (found,) = codes(lint_events([*events, status(9.0, POSCTL)]), "OFB103")
+    assert "still unknown" not in found.message and "unknown" not in found.short
+    assert found.message.endswith("recorded: no mode yet (no status names one before it)")
+    assert "recorded: no mode yet" in found.short
+
+
+@pytest.mark.parametrize("detected", [True, False])
+def test_ofb202_says_an_assumed_release_may_be_the_cause(detected: bool) -> None:
+    """A disarmed switch without a stream, refused: PX4 1.13 does that, the 1.15 the
+    recording's missing version made fuzzoff assume accepts it. The disagreement says that
+    the assumption may be why, and how to give the release; with a known release it does not."""
+    events = [status(0.0, POSCTL, armed=False), switch(1.0), ack(1.01, 1)]
+    events.append(status(2.0, POSCTL, armed=False))
+    info = RecordingInfo("stream", "tlog", kinds={e.kind for e in events})
+    profile = Profile(px4="1.15", vehicle="mc", px4_detected=detected, vehicle_detected=True)
+    found, _ = run_events(events, info, profile, Settings())
+    (disagrees,) = codes(found, "OFB202")
+    assert ("assumed" in disagrees.message) is not detected
+    assert ("may be the cause" in disagrees.message) is not detected
+    if not detected:
+        assert "--px4" in disagrees.message and "--vehicle" not in disagrees.message
+        assert disagrees.short.endswith("; PX4 release assumed")
