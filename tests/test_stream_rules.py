@@ -7,7 +7,7 @@ from dataclasses import replace
 import pytest
 
 from fuzzoff.config import Settings
-from fuzzoff.engine import run_events
+from fuzzoff.engine import lint_file, run_events
 from fuzzoff.events import (
     Command,
     ControlMode,
@@ -21,6 +21,7 @@ from fuzzoff.events import (
 from fuzzoff.findings import Severity
 from fuzzoff.profiles import Profile
 from fuzzoff.recording import RecordingInfo
+from tests.helpers import CORPORA
 from tests.streams import OFFBOARD, POSCTL, ack, codes, every, lint_events, ocm, status, switch
 
 
@@ -464,3 +465,29 @@ def test_ofb202_says_an_assumed_release_may_be_the_cause(detected: bool) -> None
     if not detected:
         assert "--px4" in disagrees.message and "--vehicle" not in disagrees.message
         assert disagrees.short.endswith("; PX4 release assumed")
+
+
+def test_ofb102_on_a_ulog_says_dropped_setpoints_are_no_keepalive_and_where_to_look() -> None:
+    """A real PX4 1.16.2 ULog of a client streaming LOCAL_ENU setpoints, which PX4 drops: the
+    log shows no keep-alive, which is what PX4 accepted, not what was sent."""
+    found = lint_file(CORPORA / "sitl" / "enu_frame-1.16.2.ulg").findings
+    (request,) = codes(found, "OFB102")
+    assert request.short.startswith("switch to OFFBOARD with no keep-alive PX4 accepted")
+    assert "coordinate_frame, type_mask or target" in request.message
+    assert "the companion's side of the link" in request.message
+    # where the stream as sent is recorded, the keep-alive is what was sent: no such note
+    sent = [status(0.0, POSCTL), switch(1.0)]
+    (plain,) = codes(lint_events(sent), "OFB102")
+    assert "PX4 accepted" not in plain.short and "companion's side" not in plain.message
+    (logged,) = codes(lint_events(sent, fmt="ulog"), "OFB102")
+    assert "no keep-alive PX4 accepted" in logged.short
+
+
+def test_ofb101_on_a_ulog_gap_px4_acts_on_says_the_log_holds_what_px4_accepted() -> None:
+    sampled = {"control_mode": 0.1}
+    lost = codes(lint_events(flying((2.0, 4.0)), fmt="ulog", sampled=sampled), "OFB101")
+    assert lost and all("the companion's side of the link" in f.message for f in lost)
+    short_gap = codes(lint_events(flying((2.0, 2.75)), fmt="ulog", sampled=sampled), "OFB101")
+    assert short_gap and not any("companion's side" in f.message for f in short_gap)
+    sent = codes(lint_events(flying((2.0, 4.0))), "OFB101")
+    assert sent and not any("companion's side" in f.message for f in sent)

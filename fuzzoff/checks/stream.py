@@ -16,7 +16,9 @@ from functools import cache
 from fuzzoff.checks._keepalive import (
     KEEPALIVE_EVENTS,
     PROOF_SLACK_S,
+    RECEIVED_NOTE,
     RecordedSwitches,
+    as_received,
     keepalive_run,
     loss_timeout,
     mode_note,
@@ -238,6 +240,8 @@ class KeepaliveRate(Check):
             )
             just = ", only just" if margin else ""
             verdict = f"keeps the signal{just} (lost at {timeout:.2f} s)"
+        if as_received(ctx) and severity is not Severity.INFO:
+            message += f"; {RECEIVED_NOTE}"
         place = context.partition(" (")[0]  # "in OFFBOARD (until it left)": the place only
         place = SHORT_CONTEXT.get(place, place)
         short = f"keep-alive gap {gap.proven:.2f} s {place}; {px4_label(ctx)} {verdict}"
@@ -396,10 +400,14 @@ class StreamBeforeRequest(Check):
             f"{what} with {had}; docs: stream for at least {self.min_stream:.0f} s first; "
             f"{px4_label(self.ctx)} would: {would}"
         )
+        received = as_received(self.ctx) and not fresh
+        if received:
+            message += f"; {RECEIVED_NOTE}"
+        accepted = " PX4 accepted" if received else ""
         if last is None:
-            stream = "with no keep-alive"
+            stream = f"with no keep-alive{accepted}"
         elif not fresh:
-            stream = f"{t - last:.2f} s after the last keep-alive"
+            stream = f"{t - last:.2f} s after the last keep-alive{accepted}"
         else:
             stream = f"after {t - (run_start or t):.2f} s of keep-alive"
         short = f"{what} {stream} (docs: {self.min_stream:g} s of it)"
