@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import itertools
+import re
 from typing import Any
 
 import pytest
 
 from fuzzoff import type_mask as tmask
 from fuzzoff.config import Settings
+from fuzzoff.engine import lint_file
 from fuzzoff.events import (
     Event,
     Parameter,
@@ -21,7 +23,10 @@ from fuzzoff.events import (
 from fuzzoff.findings import Finding, Severity
 from fuzzoff.profiles import Profile
 from fuzzoff.tables import mavlink as tm
+from tests.helpers import CORPORA
 from tests.streams import codes, lint_events
+
+SITL = CORPORA / "sitl"
 
 PAGE_PROFILES = ("1.13", "1.14", "1.15", "1.16", "1.17", "main")
 VEHICLES = ("mc", "fw", "vtol", "rover-ackermann", "rover-differential", "rover-mecanum")
@@ -554,3 +559,20 @@ def test_ofb101_names_the_ignored_messages_that_came_in_the_gap() -> None:
     # on 1.13 PX4 handles them (fuzzoff does not count them as keep-alive there): not said
     (older,) = codes(lint(events, px4="1.13"), "OFB101")
     assert "SET_ACTUATOR_CONTROL_TARGET" not in older.message
+
+
+def test_real_mavsdk_set_actuator_control_on_px4_1_16_2() -> None:
+    """MAVSDK 4.1 hovering in OFFBOARD on a velocity setpoint calls set_actuator_control (real
+    PX4 1.16.2 SITL, corpora/sitl): the keep-alive gap says what PX4 did with the 40 Hz of
+    SET_ACTUATOR_CONTROL_TARGET in it, and OFB608 names the stretch; PX4's own log (its
+    failsafe flag) shows the loss."""
+    tlog = lint_file(SITL / "mavsdk4_actuator-1.16.2.tlog").findings
+    (gap,) = codes(tlog, "OFB101")
+    assert re.search(r"; \d+ SET_ACTUATOR_CONTROL_TARGET in it, ignored$", gap.short), gap.short
+    (ignored,) = codes(tlog, "OFB608")
+    assert ignored.severity is Severity.ERROR and "in OFFBOARD)" in ignored.message
+    assert codes(tlog, "OFB103")
+    ulog = lint_file(SITL / "mavsdk4_actuator-1.16.2.ulg").findings
+    (logged_gap,) = codes(ulog, "OFB101")
+    assert "the companion's side of the link" in logged_gap.message
+    assert codes(ulog, "OFB103") and not codes(ulog, "OFB608")  # no trace in PX4's own log
