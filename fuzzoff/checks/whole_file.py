@@ -26,8 +26,8 @@ from fuzzoff.gate import GateTransition
 class OffboardUse(Check):
     """OFB005's watch: did this vehicle use offboard (recorded or predicted in OFFBOARD or in an
     external mode, px4-ros2-interface-lib's, which the same rules judge, or asked to switch to
-    OFFBOARD), and when did its first keep-alive come? It
-    reports nothing itself: ``recording_findings`` does, for the whole recording."""
+    OFFBOARD), and when did its first keep-alive come? It reports nothing itself:
+    ``recording_findings`` does, for the whole recording."""
 
     codes = ("OFB005",)
     wants = (*KEEPALIVE_TYPES, VehicleStatus, Command, GateTransition)
