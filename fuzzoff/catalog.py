@@ -35,9 +35,17 @@ from fuzzoff._version import __version__
 from fuzzoff.findings import Severity
 from fuzzoff.profiles import VEHICLE_TYPES
 
+PROJECT_URL = "https://github.com/fuzzoff/fuzzoff"
+"""The project's home: its public repository. A placeholder until the repository's address is
+decided; every address of the project in a report (SARIF's ``informationUri`` and each rule's
+``helpUri``) is derived from it, so that confirming it is a one-line change."""
+
 RULE_PAGE = "docs/rules/{code}.md"
 """Where a rule's page sits in the repository, relative to its root. The project publishes no web
 site, so reports link here (the HTML report carries the pages themselves)."""
+
+PAGE_BRANCH = "main"
+"""The branch whose copy of a rule page ``Rule.page_url`` names."""
 
 REFERENCE_PREFIXES = (
     "https://docs.px4.io/",
@@ -130,6 +138,11 @@ class Rule:
     def page(self) -> str:
         """The rule's page in the repository, relative to its root."""
         return RULE_PAGE.format(code=self.code)
+
+    @property
+    def page_url(self) -> str:
+        """The rule's page in the project's repository, as an absolute address."""
+        return f"{PROJECT_URL}/blob/{PAGE_BRANCH}/{self.page}"
 
     def applies_to(self, px4: str, vehicle: str) -> bool:
         return px4 in self.px4 and vehicle in self.vehicles

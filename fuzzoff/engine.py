@@ -14,6 +14,7 @@ from typing import cast
 from fuzzoff.catalog import get_rule
 from fuzzoff.checks import CheckContext, load_all
 from fuzzoff.checks.base import SENT_STREAM_RULES, STREAM_TYPES, Check, StreamBatch
+from fuzzoff.checks.whole_file import in_readable_part, recording_findings
 from fuzzoff.config import Settings
 from fuzzoff.events import (
     Command,
@@ -24,6 +25,7 @@ from fuzzoff.events import (
     TrajectorySetpoint,
     VehiclePosition,
     VehicleStatus,
+    Where,
     is_keepalive,
 )
 from fuzzoff.findings import (
@@ -34,7 +36,6 @@ from fuzzoff.findings import (
     RunStats,
     Severity,
     clip,
-    first_clause,
 )
 from fuzzoff.formats import SourceError, open_source, recordings_in
 from fuzzoff.gate import GateModel, GateTransition
@@ -45,7 +46,7 @@ from fuzzoff.profiles import (
     ProfileError,
     px4_profile_for,
 )
-from fuzzoff.recording import RecordingInfo, SourceProblem, path_text
+from fuzzoff.recording import RecordingInfo, SourceProblem, first_byte, path_text
 from fuzzoff.releases import PX4Profile
 from fuzzoff.state import VehicleState
 from fuzzoff.type_mask import POSITION_BITS
@@ -356,11 +357,9 @@ def _run_events(
         if on_event is not None and count % 4096 == 0:
             on_event(count)
     findings: list[Finding] = []
-    not_checkable: dict[str, str] = {}
     for run in runs.values():
         findings.extend(run.finish(t_end))
-        for code, needs in run.ctx.not_checkable.items():
-            not_checkable.setdefault(code, needs)
+    contexts = [run.ctx for run in runs.values()]
     unseen = sorted(v for v, run in runs.items() if run.offboard_seen)
     if unseen and settings.enabled("OFB002"):
         flag = any(runs[v].gate.follows_flag for v in unseen)
@@ -369,19 +368,8 @@ def _run_events(
         # No event at all: every rule that needs a stream is not checkable.
         empty = VehicleRun("", profile, settings, info, None)
         findings.extend(empty.finish(0.0))
-        not_checkable.update(empty.ctx.not_checkable)
-    for code, needs in sorted(not_checkable.items()):
-        rule = get_rule(code)
-        if settings.enabled("OFB002"):
-            findings.append(
-                Finding(
-                    code="OFB002",
-                    name=get_rule("OFB002").name,
-                    severity=settings.severity_of("OFB002", Severity.INFO),
-                    message=f"{code} ({rule.name}) cannot be checked on this recording: {needs}",
-                    summary=clip(f"{code} not checkable: {first_clause(needs)}"),
-                )
-            )
+        contexts.append(empty.ctx)
+    findings.extend(recording_findings(contexts, settings))
     stats: RunStats = {
         "events": count,
         "duration_s": round(t_end, 6),
@@ -434,6 +422,10 @@ def _takes_runs(check: Check) -> bool:
 
 
 def _sort_key(finding: Finding) -> tuple[float, str, str]:
+    """In time order, whole-file findings first; but what could not be checked (OFB002) last,
+    after what was found."""
+    if finding.code == "OFB002":
+        return (math.inf, finding.vehicle, finding.code)
     t = -math.inf if finding.time_s is None else finding.time_s
     return (t, finding.vehicle, finding.code)
 
@@ -472,7 +464,14 @@ def lint_file(
         report.complete = False
         report.problems.append(exc.line())
         report.findings.append(
-            Finding("OFB001", unreadable.name, Severity.ERROR, exc.line(), summary=_unreadable(exc))
+            Finding(
+                "OFB001",
+                unreadable.name,
+                Severity.ERROR,
+                exc.line(),
+                where=_place(exc),
+                summary=_unreadable(exc),
+            )
         )
         return report
     try:
@@ -510,6 +509,7 @@ def lint_file(
                     Severity.ERROR,
                     line,
                     time_s=problem.time_s,
+                    where=_place(problem),
                     summary=_unreadable(problem),
                 )
             )
@@ -522,10 +522,13 @@ def lint_file(
                     settings.severity_of("OFB004", Severity.INFO),
                     line,
                     time_s=problem.time_s,
+                    where=_place(problem),
                     summary=_unreadable(problem),
                 )
             )
     report.complete = not report.problems
+    if not report.complete:
+        findings = [in_readable_part(f) for f in findings]
     vehicle_assumed = info.vehicle_assumed if settings.vehicle is None else None
     if settings.enabled("OFB003") and (
         not (profile.px4_detected and profile.vehicle_detected) or vehicle_assumed
@@ -558,6 +561,12 @@ def _unreadable(problem: SourceError | SourceProblem) -> str:
     """The problem without the file's name (the report's heading names the file)."""
     at = f" at {problem.where}" if problem.where else ""
     return clip(f"{problem.what}{at}")
+
+
+def _place(problem: SourceError | SourceProblem) -> Where | None:
+    """The byte of the file a problem's line names, as a finding's place (no topic)."""
+    offset = first_byte(problem.where)
+    return None if offset is None else Where("", offset=offset)
 
 
 def _problem(exc: SourceError) -> SourceProblem:

@@ -365,6 +365,22 @@ MAVLINK_SETPOINTS: tuple[type[MavlinkTarget], ...] = (
     SetAttitudeTarget,
 )
 
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class SetActuatorControlTarget(Event):
+    """``SET_ACTUATOR_CONTROL_TARGET`` (#139): eight normalised controls of one actuator
+    control group (MAVSDK's ``set_actuator_control``, MAVROS ``actuator_control``). Not a
+    keep-alive: the docs list the three setpoints above, and PX4 1.14+ has no handler for it."""
+
+    kind: ClassVar[str] = "set_actuator_control_target"
+
+    group_mlx: int = 0
+    controls: tuple[float, ...] = (0.0,) * 8
+    target_system: int = 0
+    target_component: int = 0
+    source_system: int | None = None
+    source_component: int | None = None
+
 PX4_SETPOINTS: tuple[type[Event], ...] = (
     TrajectorySetpoint,
     AttitudeSetpoint,
@@ -630,6 +646,7 @@ ALL_EVENT_TYPES: tuple[type[Event], ...] = (
     *PX4_SETPOINTS,
     PositionSetpointTriplet,
     *MAVLINK_SETPOINTS,
+    SetActuatorControlTarget,
     VehicleStatus,
     VehicleControlModeStatus,
     FailsafeFlags,

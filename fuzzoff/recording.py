@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import abc
 import os
+import re
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -38,6 +39,19 @@ WHERE_LIMIT = 120
 
 def _cut(text: str, limit: int) -> str:
     return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
+_FIRST_BYTE = re.compile(r"bytes? (\d+)\b")
+
+
+def first_byte(where: str | None) -> int | None:
+    """The byte of the file a problem's ``where`` starts at, when it names one: readers write
+    ``byte N``, ``bytes A-B``, ``byte N of SIZE``, ``byte N (why)``. None for anything else
+    (a topic, a message count, a byte of another file inside a ROS 2 bag's folder)."""
+    if where is None:
+        return None
+    found = _FIRST_BYTE.match(where)
+    return int(found.group(1)) if found else None
 
 
 class SourceError(Exception):

@@ -81,7 +81,7 @@ def test_skipped_when_not_checkable_or_not_for_this_profile(tmp_path: Path) -> N
         "OFB002",
         "rule-not-checkable",
         Severity.INFO,
-        f"{mc_rule.code} ({mc_rule.name}) cannot be checked on this recording: "
+        f"1 rule cannot be checked on this recording: {mc_rule.code} ({mc_rule.name}) "
         "needs vehicle_status",
     )
     by_code = cases(parse(render(one_file([note]), Settings()), tmp_path)[0])

@@ -3,15 +3,18 @@
 from __future__ import annotations
 
 import itertools
+import re
 from typing import Any
 
 import pytest
 
 from fuzzoff import type_mask as tmask
 from fuzzoff.config import Settings
+from fuzzoff.engine import lint_file
 from fuzzoff.events import (
     Event,
     Parameter,
+    SetActuatorControlTarget,
     SetAttitudeTarget,
     SetPositionTargetGlobal,
     SetPositionTargetLocal,
@@ -20,7 +23,10 @@ from fuzzoff.events import (
 from fuzzoff.findings import Finding, Severity
 from fuzzoff.profiles import Profile
 from fuzzoff.tables import mavlink as tm
+from tests.helpers import CORPORA
 from tests.streams import codes, lint_events
+
+SITL = CORPORA / "sitl"
 
 PAGE_PROFILES = ("1.13", "1.14", "1.15", "1.16", "1.17", "main")
 VEHICLES = ("mc", "fw", "vtol", "rover-ackermann", "rover-differential", "rover-mecanum")
@@ -499,3 +505,74 @@ def test_legacy_drops_are_one_finding_per_stretch() -> None:
     (found,) = codes(lint(events, px4="legacy"), "OFB609")
     assert found.time_s == 0.0
     assert found.end_s == pytest.approx(1.9)
+
+
+# -- OFB608: messages PX4 has no handler for (gate spec 6.6) ----------------------------------
+
+
+def actuators(start: float, stop: float, groups: tuple[int, ...] = (0, 1)) -> list[Event]:
+    """MAVSDK's set_actuator_control: one message per group every 50 ms."""
+    n = round((stop - start) / 0.05)
+    return [
+        SetActuatorControlTarget(
+            t=round(start + i * 0.05, 3),
+            vehicle="1",
+            target_system=1,
+            target_component=1,
+            group_mlx=group,
+        )
+        for i in range(n)
+        for group in groups
+    ]
+
+
+def test_ofb608_one_finding_per_stretch_with_how_many_and_how_many_in_offboard() -> None:
+    in_offboard = VehicleStatus(t=0.5, vehicle="1", nav_state=14, armed=True)
+    left = VehicleStatus(t=1.5, vehicle="1", nav_state=2, armed=True)
+    events = [heartbeat(0.0), in_offboard, left, *actuators(1.0, 2.0), *actuators(4.0, 4.5)]
+    first, second = codes(lint(events), "OFB608")
+    assert first.severity is Severity.ERROR
+    assert (first.time_s, first.end_s) == (1.0, pytest.approx(1.95))
+    assert first.short.startswith("40 SET_ACTUATOR_CONTROL_TARGET ignored by PX4 1.16")
+    assert "(20 in OFFBOARD)" in first.message and "no keep-alive" in first.message
+    # a pause of over a second starts a new stretch
+    assert second.time_s == 4.0 and second.short.startswith("20 SET_ACTUATOR_CONTROL_TARGET")
+    assert "in OFFBOARD" not in second.message
+
+
+@pytest.mark.parametrize(("px4", "fires"), [("1.13", False), ("1.14", True), ("main", True)])
+def test_ofb608_only_where_px4_has_no_handler(px4: str, fires: bool) -> None:
+    events = [heartbeat(0.0), *actuators(1.0, 1.2)]
+    assert bool(codes(lint(events, px4=px4), "OFB608")) is fires
+
+
+def test_ofb101_names_the_ignored_messages_that_came_in_the_gap() -> None:
+    """MAVSDK in OFFBOARD switched from a velocity setpoint to set_actuator_control: the
+    keep-alive stops, and the gap says what PX4 did with the 40 Hz that kept coming."""
+    status = [VehicleStatus(t=t, vehicle="1", nav_state=14, armed=True) for t in (0.0, 1.0, 2.0)]
+    velocity = [aimed(round(0.05 * i, 3), 1) for i in range(21)]
+    events = [*status, *velocity, *actuators(1.05, 2.55)]
+    events.append(VehicleStatus(t=3.0, vehicle="1", nav_state=2, armed=True))
+    (gap,) = codes(lint(events), "OFB101")
+    assert gap.short.endswith("; 60 SET_ACTUATOR_CONTROL_TARGET in it, ignored")
+    assert "in the gap came 60 SET_ACTUATOR_CONTROL_TARGET, which PX4 1.16 ignores" in gap.message
+    # on 1.13 PX4 handles them (fuzzoff does not count them as keep-alive there): not said
+    (older,) = codes(lint(events, px4="1.13"), "OFB101")
+    assert "SET_ACTUATOR_CONTROL_TARGET" not in older.message
+
+
+def test_real_mavsdk_set_actuator_control_on_px4_1_16_2() -> None:
+    """MAVSDK 4.1 hovering in OFFBOARD on a velocity setpoint calls set_actuator_control (real
+    PX4 1.16.2 SITL, corpora/sitl): the keep-alive gap says what PX4 did with the 40 Hz of
+    SET_ACTUATOR_CONTROL_TARGET in it, and OFB608 names the stretch; PX4's own log (its
+    failsafe flag) shows the loss."""
+    tlog = lint_file(SITL / "mavsdk4_actuator-1.16.2.tlog").findings
+    (gap,) = codes(tlog, "OFB101")
+    assert re.search(r"; \d+ SET_ACTUATOR_CONTROL_TARGET in it, ignored$", gap.short), gap.short
+    (ignored,) = codes(tlog, "OFB608")
+    assert ignored.severity is Severity.ERROR and "in OFFBOARD)" in ignored.message
+    assert codes(tlog, "OFB103")
+    ulog = lint_file(SITL / "mavsdk4_actuator-1.16.2.ulg").findings
+    (logged_gap,) = codes(ulog, "OFB101")
+    assert "the companion's side of the link" in logged_gap.message
+    assert codes(ulog, "OFB103") and not codes(ulog, "OFB608")  # no trace in PX4's own log

@@ -11,7 +11,7 @@ from typing import Any
 
 import pytest
 
-from fuzzoff.catalog import load_catalog, render_page
+from fuzzoff.catalog import PROJECT_URL, load_catalog, render_page
 from fuzzoff.config import Settings
 from fuzzoff.events import Where
 from fuzzoff.findings import FileReport, Finding, Report, Severity
@@ -62,13 +62,23 @@ def test_multitool_finds_nothing_to_complain_about(tmp_path: Path) -> None:
     real = tmp_path / "real.sarif"
     result = run_cli(["lint", str(recording), "--format", "sarif", "--output", str(real)])
     assert result.returncode in (0, 1), result.stderr
+    cut = tmp_path / "cut.tlog"
+    cut.write_bytes(recording.read_bytes()[:-5])
+    incomplete = tmp_path / "incomplete.sarif"
+    result = run_cli(["lint", str(cut), "--format", "sarif", "--output", str(incomplete)])
+    assert result.returncode == 2, result.stderr
     # A canary with a schema error proves the validator looked (it stays silent on some inputs).
     canary = tmp_path / "canary.sarif"
     log = sarif_log(hostile_report(), Settings())
-    log["runs"][0]["results"] = log["runs"][0]["results"][:1]
+    # the one result with a byte offset: its region stays valid once startLine is gone
+    log["runs"][0]["results"] = [
+        r
+        for r in log["runs"][0]["results"]
+        if "byteOffset" in r["locations"][0]["physicalLocation"]["region"]
+    ]
     log["runs"][0]["results"][0]["locations"][0]["physicalLocation"]["region"]["startLine"] = 0
     canary.write_text(json.dumps(log), encoding="utf-8")
-    problems = validate(tool, [hostile, real, canary], tmp_path / "validation.sarif")
+    problems = validate(tool, [hostile, real, incomplete, canary], tmp_path / "validation.sarif")
     where = [p["locations"][0]["physicalLocation"]["artifactLocation"]["uri"] for p in problems]
     assert problems and all(uri.endswith("canary.sarif") for uri in where), problems
     assert {p["ruleId"] for p in problems} == {"JSON1008"}
@@ -79,17 +89,53 @@ def test_every_rule_is_described_with_its_whole_page() -> None:
     rules = run["tool"]["driver"]["rules"]
     catalog = load_catalog()
     assert [r["id"] for r in rules] == list(catalog)
-    assert run["tool"]["driver"]["informationUri"] == "https://pypi.org/project/fuzzoff/"
+    assert run["tool"]["driver"]["informationUri"] == PROJECT_URL
     for descriptor in rules:
         rule = catalog[descriptor["id"]]
-        # no made-up address: SARIF wants an absolute helpUri and the project has no site
-        assert "helpUri" not in descriptor
+        # the page in the repository, derived from the one project address
+        assert descriptor["helpUri"] == f"{PROJECT_URL}/blob/main/docs/rules/{rule.code}.md"
+        assert (ROOT / rule.page).is_file()
         assert descriptor["help"]["markdown"] == render_page(rule)
         assert descriptor["properties"]["page"] == f"docs/rules/{rule.code}.md"
         assert descriptor["shortDescription"]["text"]
         assert descriptor["fullDescription"]["text"]
         assert "Why is this bad?" in descriptor["help"]["markdown"]
         assert descriptor["defaultConfiguration"]["level"] in ("error", "warning", "note")
+
+
+def test_a_run_with_unreadable_input_is_not_a_successful_execution(tmp_path: Path) -> None:
+    """A truncated tlog: exit status 2, so SARIF says the execution did not succeed, with the
+    unreadable part as an error notification, and OFB001's region is the byte its line names."""
+    good = gap_recording(tmp_path / "gap.tlog")
+    cut = tmp_path / "cut.tlog"
+    data = good.read_bytes()
+    cut.write_bytes(data[: len(data) - 5])
+    result = run_cli(["lint", "gap.tlog", "cut.tlog", "--format", "sarif"], cwd=tmp_path)
+    assert result.returncode == 2, result.stderr
+    (invocation,) = json.loads(result.stdout)["runs"][0]["invocations"]
+    assert invocation["executionSuccessful"] is False
+    assert invocation["exitCode"] == 2
+    (notice,) = invocation["toolExecutionNotifications"]
+    assert notice["level"] == "error" and "cut.tlog" in notice["message"]["text"]
+    (unreadable,) = [
+        r for r in json.loads(result.stdout)["runs"][0]["results"] if r["ruleId"] == "OFB001"
+    ]
+    named = int(unreadable["message"]["text"].split(" at byte ")[-1].split()[0])
+    assert 0 < named < len(data)
+    assert unreadable["locations"][0]["physicalLocation"]["region"]["byteOffset"] == named
+    readable = run_cli(["lint", "gap.tlog", "--format", "sarif"], cwd=tmp_path)
+    (invocation,) = json.loads(readable.stdout)["runs"][0]["invocations"]
+    assert invocation["executionSuccessful"] is True
+    assert invocation["exitCode"] == readable.returncode
+
+
+def test_a_result_without_a_known_byte_has_no_byte_offset() -> None:
+    """Byte 0 would name the file's first byte: a finding whose reader gives no offset (a
+    whole-file finding, a ULog topic) has line 1 alone."""
+    finding = Finding("OFB003", "profile-assumed", Severity.INFO, "assumed")
+    report = Report(files=[FileReport("flight.ulg", "ulog", Profile(), findings=[finding])])
+    (res,) = sarif_log(report, Settings())["runs"][0]["results"]
+    assert res["locations"][0]["physicalLocation"]["region"] == {"startLine": 1}
 
 
 def test_results_point_at_their_rule_recording_time_and_topic(tmp_path: Path) -> None:

@@ -7,7 +7,7 @@ from dataclasses import replace
 import pytest
 
 from fuzzoff.config import Settings
-from fuzzoff.engine import run_events
+from fuzzoff.engine import lint_file, run_events
 from fuzzoff.events import (
     Command,
     ControlMode,
@@ -21,6 +21,7 @@ from fuzzoff.events import (
 from fuzzoff.findings import Severity
 from fuzzoff.profiles import Profile
 from fuzzoff.recording import RecordingInfo
+from tests.helpers import CORPORA
 from tests.streams import OFFBOARD, POSCTL, ack, codes, every, lint_events, ocm, status, switch
 
 
@@ -434,3 +435,59 @@ def test_ofb103_reports_each_loss_when_the_next_comes_before_the_recorded_answer
     # each at its failsafe: one iteration after the end of the loss window (2.0-2.1, 3.4-3.5 s)
     assert [round(f.time_s or 0.0, 1) for f in found] == [2.1, 3.5]
     assert all("recorded: still OFFBOARD" in f.message for f in found)
+
+
+def test_ofb103_says_the_recording_has_no_mode_yet_rather_than_still_unknown() -> None:
+    """A switch and an arm without acks, the stream lost, and the first status only after the
+    loss's recorded-answer window: there is no recorded mode yet to compare, not an 'unknown'
+    mode the vehicle stayed in."""
+    arm = Command(t=0.6, command=400, params=(1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
+    events = [*ocm(every(0.0, 2.0, 0.1)), switch(0.5), arm, *ocm(every(7.0, 8.0, 0.1))]
+    (found,) = codes(lint_events([*events, status(9.0, POSCTL)]), "OFB103")
+    assert "still unknown" not in found.message and "unknown" not in found.short
+    assert found.message.endswith("recorded: no mode yet (no status names one before it)")
+    assert "recorded: no mode yet" in found.short
+
+
+@pytest.mark.parametrize("detected", [True, False])
+def test_ofb202_says_an_assumed_release_may_be_the_cause(detected: bool) -> None:
+    """A disarmed switch without a stream, refused: PX4 1.13 does that, the 1.15 the
+    recording's missing version made fuzzoff assume accepts it. The disagreement says that
+    the assumption may be why, and how to give the release; with a known release it does not."""
+    events = [status(0.0, POSCTL, armed=False), switch(1.0), ack(1.01, 1)]
+    events.append(status(2.0, POSCTL, armed=False))
+    info = RecordingInfo("stream", "tlog", kinds={e.kind for e in events})
+    profile = Profile(px4="1.15", vehicle="mc", px4_detected=detected, vehicle_detected=True)
+    found, _ = run_events(events, info, profile, Settings())
+    (disagrees,) = codes(found, "OFB202")
+    assert ("assumed" in disagrees.message) is not detected
+    assert ("may be the cause" in disagrees.message) is not detected
+    if not detected:
+        assert "--px4" in disagrees.message and "--vehicle" not in disagrees.message
+        assert disagrees.short.endswith("; PX4 release assumed")
+
+
+def test_ofb102_on_a_ulog_says_dropped_setpoints_are_no_keepalive_and_where_to_look() -> None:
+    """A real PX4 1.16.2 ULog of a client streaming LOCAL_ENU setpoints, which PX4 drops: the
+    log shows no keep-alive, which is what PX4 accepted, not what was sent."""
+    found = lint_file(CORPORA / "sitl" / "enu_frame-1.16.2.ulg").findings
+    (request,) = codes(found, "OFB102")
+    assert request.short.startswith("switch to OFFBOARD with no keep-alive PX4 accepted")
+    assert "coordinate_frame, type_mask or target" in request.message
+    assert "the companion's side of the link" in request.message
+    # where the stream as sent is recorded, the keep-alive is what was sent: no such note
+    sent = [status(0.0, POSCTL), switch(1.0)]
+    (plain,) = codes(lint_events(sent), "OFB102")
+    assert "PX4 accepted" not in plain.short and "companion's side" not in plain.message
+    (logged,) = codes(lint_events(sent, fmt="ulog"), "OFB102")
+    assert "no keep-alive PX4 accepted" in logged.short
+
+
+def test_ofb101_on_a_ulog_gap_px4_acts_on_says_the_log_holds_what_px4_accepted() -> None:
+    sampled = {"control_mode": 0.1}
+    lost = codes(lint_events(flying((2.0, 4.0)), fmt="ulog", sampled=sampled), "OFB101")
+    assert lost and all("the companion's side of the link" in f.message for f in lost)
+    short_gap = codes(lint_events(flying((2.0, 2.75)), fmt="ulog", sampled=sampled), "OFB101")
+    assert short_gap and not any("companion's side" in f.message for f in short_gap)
+    sent = codes(lint_events(flying((2.0, 4.0))), "OFB101")
+    assert sent and not any("companion's side" in f.message for f in sent)

@@ -28,7 +28,8 @@ Failures the damage campaign found (shrunk by Hypothesis), kept here:
   flipped: in the header, in the chunk's type byte (a chunk read as a SummaryOffset record) and
   in its compression's name. The summary's index disagreed, the file was read front to back,
   and the chunk, parsed as another record, gave no message and no error. Now OFB001: the record
-  type that has no place in the data section, and nothing was read (no vehicle type: OFB003).
+  type that has no place in the data section, and nothing was read (no vehicle type: OFB003;
+  no offboard in the part read: OFB005).
 * ``mcap_chunk_type_flipped`` (OFB004, the case above with a sound summary): the second
   chunk's type byte reads 0x0e; its index and every other header field agree, so its messages
   are read through the summary, and the line says so.
@@ -235,6 +236,8 @@ def main() -> None:
         {"code": "OFB001", "severity": "error", "time_s": None},
         {"code": "OFB003", "severity": "info", "time_s": None},
         MALFORMED,
+        # nothing read, so no offboard in the part read
+        {"code": "OFB005", "severity": "info", "time_s": None},
     ]
     says = ["a record of type 0x0e in the data section (a damaged record type)"]
     profile = {"px4": "1.15", "vehicle": "mc", "detected": False}

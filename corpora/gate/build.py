@@ -14,7 +14,8 @@ stream rules the flights also touch):
 * ``recorded_stays_offboard`` (1.15): the same stream, but the log stays in OFFBOARD through the
   gap (as if COM_OF_LOSS_T were larger on the vehicle than in the log): OFB202 at the first status
   that contradicts the model (6.5 s).
-* ``no_offboard`` (1.15): a POSCTL flight with no offboard use: OFB701, OFB702, OFB202 clean.
+* ``no_offboard`` (1.15): a POSCTL flight with no offboard use: OFB005 says so; OFB701, OFB702,
+  OFB202 clean.
 * ``rc_lost_117_return`` (1.17.0): no manual control; on loss 1.17 replaces Position by
   NAV_RCL_ACT (Return): the log shows AUTO_RTL; OFB702 says the configured Position was replaced
   when the loss ran the fallback (an error at the loss, rules.md), OFB202 clean.
@@ -30,7 +31,7 @@ stream rules the flights also touch):
 * ``auto_takeoff_no_offboard`` (1.15): as pyulog's ``sample_px4_events.ulg`` (a real auto
   flight, too large for this corpus): disarmed in AUTO_LOITER, an arm command, PX4 runs
   AUTO_TAKEOFF (NAV_TAKEOFF, which the model does not model), then Hold and Return. No offboard
-  at all: OFB202 clean (rules/OFB202.toml: only differences that involve OFFBOARD).
+  at all: OFB005, and OFB202 clean (rules/OFB202.toml: only differences that involve OFFBOARD).
 """
 
 from __future__ import annotations
@@ -148,9 +149,11 @@ def offboard_flight(
 
 
 # Findings every 1.15 ULog flight of this corpus also gets, checked against the rule texts:
-# OFB002 x5: OFB104, OFB105 (keep-alive subsampled by the logger), OFB106 (timestamps rewritten),
-# OFB203 and OFB302 (only PX4's own copies of the messages) cannot be judged on a ULog.
-NOT_CHECKABLE_115 = [("OFB002", "info", None)] * 5
+# One OFB002 listing OFB104, OFB105 (keep-alive subsampled by the logger), OFB106 (timestamps
+# rewritten), OFB203 and OFB302 (only PX4's own copies of the messages): not judged on a ULog.
+NOT_CHECKABLE_115 = [("OFB002", "info", None)]
+# A flight that never used offboard says so (OFB005), once.
+NO_OFFBOARD = [("OFB005", "info", None)]
 # The 3 s gap in OFFBOARD: OFB101 (docs: keep-alive gaps under 0.5 s) from the last keep-alive,
 # and OFB103 at PX4's failsafe: its loss is due at 6.0 s and seen by a 10 Hz check pass within
 # 0.1 s, then one iteration. The recorded failsafe (the status at 6.1 s) dates it; PX4's flag
@@ -204,7 +207,7 @@ def cases() -> list[Case]:
             "loss_and_resume_agrees",
             offboard_flight((POSCTL, True)),
             [*NOT_CHECKABLE_115, ("OFB701", "info", SWITCH_T), *GAP],
-            ["OFB202", "OFB702"],
+            ["OFB005", "OFB202", "OFB702"],
         ),
         Case(
             "recorded_stays_offboard",
@@ -220,7 +223,7 @@ def cases() -> list[Case]:
         Case(
             "no_offboard",
             sorted([valid(), *statuses(None)], key=lambda e: e.t),
-            [],  # nothing to judge: no keep-alive, so no rule is even "not checkable"
+            NO_OFFBOARD,  # no keep-alive, so no rule is even "not checkable"
             ["OFB202", "OFB701", "OFB702"],
         ),
         Case(
@@ -266,7 +269,7 @@ def cases() -> list[Case]:
         Case(
             "auto_takeoff_no_offboard",
             auto_takeoff(),
-            [],  # no keep-alive: nothing to judge
+            NO_OFFBOARD,  # no keep-alive: nothing to judge
             ["OFB202", "OFB701", "OFB702"],
         ),
     ]

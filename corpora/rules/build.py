@@ -732,16 +732,17 @@ def context_findings(case: Case) -> list[tuple[str, str, float | None]]:
 
     * OFB701 (info): the loss-action summary at the offboard request (1.5 s; the legacy flights
       have no recorded command, so at the first OFFBOARD status, 1.6 s).
-    * OFB002 (info, no time), one per rule the format cannot show: in MCAP OFB305 (no estimator
-      flags on ROS 2); in a 1.15 ULog OFB104, OFB105 (subsampled keep-alive), OFB106, OFB203,
-      OFB302 (only PX4's copies of the messages); in a legacy ULog OFB104, OFB105.
+    * OFB002 (info, no time), one line for the rules the format cannot show: in MCAP OFB305 (no
+      estimator flags on ROS 2); in a 1.15 ULog OFB104, OFB105 (subsampled keep-alive), OFB106,
+      OFB203, OFB302 (only PX4's copies of the messages); in a legacy ULog OFB104, OFB105.
+    * OFB005 (info, no time) where the flight never used offboard.
     """
-    not_checkable = {"mcap": 1, "tlog": 0, "ulg": 2 if case.px4 == "legacy" else 5}[case.fmt]
+    not_checkable = [("OFB002", "info", None)] if case.fmt in ("mcap", "ulg") else []
     request = (
         case.request if case.request is not None else 1.6 if case.px4 == "legacy" else SWITCH_T
     )
-    summary = [("OFB701", "info", request)] if case.offboard else []
-    return [("OFB002", "info", None)] * not_checkable + summary
+    summary = [("OFB701", "info", request)] if case.offboard else [("OFB005", "info", None)]
+    return not_checkable + summary
 
 
 def write(case: Case) -> None:

@@ -5,7 +5,8 @@ written as a tlog (``fuzzoff.formats.tlog.writer``: the MAVLink the companion se
 autopilot's HEARTBEAT, COMMAND_ACK, PARAM_VALUE and AUTOPILOT_VERSION) and, where a MAVROS bag
 can show the rule, as a ROS 1 bag of MAVROS ``setpoint_raw`` topics and ``state``
 (``fuzzoff.formats.rosbag1.writer``). A bag cannot show OFB607 (MAVROS fills the target ids from its
-own parameters) or OFB509 (no parameters in a bag). Each ``NAME.expected.json`` lists the
+own parameters), OFB509 (no parameters in a bag) or OFB608 (MAVROS's ``actuator_control`` topic is
+not read). Each ``NAME.expected.json`` lists the
 findings planted here, judged against the rule texts (rules/OFB5*.toml, rules/OFB6*.toml),
 and ``clean``: the rules the recording exercises that must stay silent.
 
@@ -34,6 +35,7 @@ from fuzzoff.events import (
     CommandAck,
     Event,
     Parameter,
+    SetActuatorControlTarget,
     SetAttitudeTarget,
     SetPositionTargetGlobal,
     SetPositionTargetLocal,
@@ -198,7 +200,7 @@ class Case:
     """The profile the recording's AUTOPILOT_VERSION names."""
 
 
-MC_RULES = ["OFB601", "OFB602", "OFB605", "OFB606", "OFB607"]
+MC_RULES = ["OFB601", "OFB602", "OFB605", "OFB606", "OFB607", "OFB608"]
 LEGACY_RULES = ["OFB607", "OFB609", "OFB801"]
 LEGACY_VERSION = "1.8.2"
 FW_RULES = ["OFB601", "OFB602", "OFB603", "OFB604", "OFB606", "OFB607"]
@@ -241,6 +243,14 @@ def cases() -> list[Case]:
 
     def legacy_flight(extra: Maker | None = None) -> list[Event]:
         return flight("mc", local, extra, version=LEGACY_VERSION)
+
+    def gripper(t: float) -> Event:
+        # a payload servo on actuator control group 1 beside the position stream (MAVSDK's
+        # set_actuator_control, MAVROS actuator_control): PX4 1.14+ ignores the message
+        controls = (0.0, 0.0, 0.0, 0.0, 0.0, 1.0 if t >= 5.5 else -1.0, 0.0, 0.0)
+        return SetActuatorControlTarget(
+            t=t, sender_time_us=round(t * 1e6) + 5_000_000, group_mlx=1, controls=controls, **SENT
+        )
 
     def heading_hold(t: float) -> Event:
         return attitude(t, 7, q=(math.cos(0.25), 0.0, 0.0, math.sin(0.25)), thrust=0.3)
@@ -303,6 +313,15 @@ def cases() -> list[Case]:
             [],
             MC_RULES,
             bag=False,
+        ),
+        Case(
+            "ofb608_actuator_control_beside_position",
+            "mc",
+            flight("mc", local, gripper),
+            [("OFB608", "error", EXTRA_FROM)],
+            ["OFB601", "OFB602", "OFB605", "OFB606", "OFB607"],
+            bag=False,
+            notes=["the position stream keeps OFFBOARD; the actuator messages do nothing"],
         ),
         Case(
             "ofb607_second_vehicle_target",

@@ -6,8 +6,10 @@ subsampled by the default logger profile (``offboard_control_mode`` every 100 ms
 ``trajectory_setpoint`` every 200 ms), ``vehicle_status`` on change and every second, PX4's own
 verdict in ``failsafe_flags``. Each gets ``NAME.expected.json`` with the findings planted here,
 judged against the rule texts (rules/OFB*.toml). Every offboard flight also gets the info
-notes a ULog always gets: OFB002 for the rules that need the stream as sent (a ULog holds PX4's
-subsampled copies) and OFB701, the loss-action summary, at the first offboard request.
+notes a ULog always gets: one OFB002 for the rules that need the stream as sent (a ULog holds
+PX4's subsampled copies) and OFB701, the loss-action summary, at the first offboard request; a
+flight without offboard gets OFB005 instead of OFB701 (and lists it as clean where it flew
+offboard).
 
 * ``good_offboard``: PX4 1.15.4, 2 s of keep-alive before an accepted switch, arming in
   OFFBOARD, a moving position setpoint, AUTO_LAND; no finding (profile detected).
@@ -30,7 +32,8 @@ subsampled copies) and OFB701, the loss-action summary, at the first offboard re
 * ``no_ver_sw_release``: the good flight without ``ver_sw_release`` in the info section: OFB003
   (PX4 version assumed; the vehicle type still comes from ``vehicle_status``).
 * ``auto_mission``: takeoff, mission, landing; PX4 logs its own ``trajectory_setpoint`` and
-  attitude setpoints, there is no ``offboard_control_mode``: no stream finding (docs/ulog.md).
+  attitude setpoints, there is no ``offboard_control_mode``: no stream finding (docs/ulog.md),
+  and OFB005: no offboard in this recording.
 * ``truncated``: the lost-stream flight cut inside the first message after 13.0 s: OFB001 at
   13.0 s (the last complete message), exit status 2; the findings before the cut stay.
 """
@@ -311,7 +314,8 @@ a keep-alive to be judged at all)."""
 
 
 def not_checkable(*codes: str) -> list[dict[str, Any]]:
-    return [finding("OFB002", "info", None) for _ in codes]
+    """The one OFB002 line that lists ``codes`` (none when there are none)."""
+    return [finding("OFB002", "info", None)] if codes else []
 
 
 def offboard_context(*codes: str) -> list[dict[str, Any]]:
@@ -330,6 +334,7 @@ def write(
     complete: bool = True,
     px4_version: str | None = "1.15.4",
     cut_after: float | None = None,
+    clean: list[str] | None = None,
 ) -> None:
     path = write_ulog(HERE / f"{name}.ulg", events, px4_version=px4_version)
     if cut_after is not None:
@@ -348,13 +353,15 @@ def write(
         "profile": profile,
         "findings": findings,
     }
+    if clean:
+        spec["clean"] = clean
     (HERE / f"{name}.expected.json").write_text(json.dumps(spec, indent=2) + "\n")
 
 
 def main() -> None:
     p115 = {"px4": "1.15", "vehicle": "mc", "detected": True}
     context = offboard_context(*NOT_CHECKABLE_ON_ULOG)
-    write("good_offboard", good_flight(), context, exit_status=0, profile=p115)
+    write("good_offboard", good_flight(), context, exit_status=0, profile=p115, clean=["OFB005"])
     write(
         "keepalive_gap_0_8s",
         with_gap(dropout=False),
@@ -391,7 +398,8 @@ def main() -> None:
     write(
         "auto_mission",
         auto_mission(),
-        not_checkable("OFB105", "OFB203", "OFB302"),  # no keep-alive: nothing else to say
+        # no keep-alive: nothing else to say but that offboard was never used
+        [*not_checkable("OFB105", "OFB203", "OFB302"), finding("OFB005", "info", None)],
         exit_status=0,
         profile=p115,
     )

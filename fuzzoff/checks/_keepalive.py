@@ -107,6 +107,23 @@ def loss_timeout(ctx: CheckContext) -> float:
     return ctx.gate.loss_timeout
 
 
+def as_received(ctx: CheckContext) -> bool:
+    """Is the recording's keep-alive what PX4 accepted, not what was sent? A ULog holds PX4's
+    own ``offboard_control_mode``: a setpoint its receiver dropped (a coordinate_frame or a
+    type_mask it does not take, another target) or a message it ignores never reaches it."""
+    return ctx.info.format == "ulog"
+
+
+RECEIVED_NOTE = (
+    "this log holds the keep-alive PX4 accepted (offboard_control_mode): setpoints its receiver "
+    "dropped (a coordinate_frame, type_mask or target it does not take) and messages it ignores "
+    "are no keep-alive and leave no trace in it; the companion's side of the link (its tlog, or "
+    "the /fmu/in topics) shows what was sent"
+)
+"""Said where a ULog shows no keep-alive before a request (OFB102) or a gap PX4 acts on
+(OFB101)."""
+
+
 def px4_label(ctx: CheckContext) -> str:
     """``PX4 1.15`` (or ``PX4 legacy``) for "docs: …; PX4 1.15 would: …" messages."""
     return f"PX4 {ctx.profile.px4}"

@@ -71,9 +71,14 @@ class CheckContext:
     """The gate model's prediction, read-only (during ``on_batch``: as the run saw it)."""
     findings: list[Finding] = field(default_factory=list)
     not_checkable: dict[str, str] = field(default_factory=dict)
-    """code -> what the recording would need (becomes one OFB002 finding per code)."""
+    """code -> what the recording would need (one OFB002 finding lists them all)."""
     stream_recorded: bool = True
     """False: the recording holds no sent stream, and ``SENT_STREAM_RULES`` are off."""
+    offboard_used: bool = False
+    """The vehicle was in OFFBOARD (or an external mode) or asked to switch there, as far as
+    the events so far show (kept by ``whole_file.OffboardUse`` while OFB005 is enabled)."""
+    first_keepalive: float | None = None
+    """When this vehicle's first keep-alive came (kept with ``offboard_used``)."""
     _rows: dict[str | None, FlagRow | None] = field(default_factory=dict)
 
     def row_for(self, first_flag: str | None) -> FlagRow | None:

@@ -27,13 +27,28 @@ class GateDisagrees(Check):
     def on_event(self, event: Event) -> None:
         if isinstance(event, GateTransition) and event.what == "disagreement":
             profile = self.ctx.profile
+            message = (
+                f"{event.message} (PX4 {profile.px4} {profile.vehicle}, "
+                f"evaluation slack {self.ctx.gate.compare.slack:.2f} s)"
+            )
+            short = clip(event.message)
+            assumed = _assumed(self.ctx)
+            if assumed:
+                # the model ran on a guess: the guess may be what differs, not PX4
+                what = " and ".join(name for name, _ in assumed)
+                verb = "is" if len(assumed) == 1 else "are"
+                options = " and ".join(option for _, option in assumed)
+                message += (
+                    f"; the {what} {verb} assumed (the recording does not say, OFB003) and "
+                    f"may be the cause: give the vehicle's own with {options}"
+                )
+                short += f"; {what} assumed"
             self.ctx.report(
                 "OFB202",
-                f"{event.message} (PX4 {profile.px4} {profile.vehicle}, "
-                f"evaluation slack {self.ctx.gate.compare.slack:.2f} s)",
+                message,
                 event.t,
                 event.cause.where if event.cause is not None else None,
-                short=clip(event.message),
+                short=short,
             )
 
     def finish(self, t_end: float) -> None:
@@ -43,6 +58,21 @@ class GateDisagrees(Check):
                 "needs the vehicle's mode (vehicle_status, HEARTBEAT, /mavros/state) or its "
                 "command acks",
             )
+
+
+def _assumed(ctx: CheckContext) -> list[tuple[str, str]]:
+    """What of the profile the model ran on was assumed, neither read from the recording nor
+    given: (what, the option that gives it)."""
+    profile = ctx.profile
+    vehicle_known = profile.vehicle_detected and (
+        profile.vehicle_forced or ctx.info.vehicle_assumed is None
+    )
+    assumed = []
+    if not profile.px4_detected:
+        assumed.append(("PX4 release", "--px4"))
+    if not vehicle_known:
+        assumed.append(("vehicle type", "--vehicle"))
+    return assumed
 
 
 def _param_source(ctx: CheckContext, name: str) -> str:

@@ -98,6 +98,8 @@ class OffboardLoss(Check):
         """The previous recorded status's time."""
         self.left: _Change | None = None
         """The latest recorded change out of OFFBOARD (None while the recording shows it)."""
+        self.mode_seen = False
+        """A recorded status has named a mode."""
 
     def on_event(self, event: Event) -> None:
         if self.pending is not None and event.t - self.pending.t > RECORDED_ANSWER_WINDOW_S:
@@ -152,6 +154,7 @@ class OffboardLoss(Check):
     def _sample(self, status: VehicleStatus) -> None:
         """Keep where the recording shows the vehicle leaving OFFBOARD."""
         if status.nav_state is not None:
+            self.mode_seen = True
             if status.in_offboard:
                 self.left = None
             elif self.left is None:
@@ -223,11 +226,23 @@ class OffboardLoss(Check):
             message += f"; recorded: {answer.text()}"
             short += f"; recorded: {answer.text(brief=True)}"
         elif self.ctx.state.mode_recorded:
-            message += f"; recorded: still {nav_state_name(self.ctx.state.nav_state)}"
-            short += f"; recorded: still {nav_state_name(self.ctx.state.nav_state)}"
+            recorded = self._recorded_now()
+            message += f"; recorded: {recorded}"
+            short += f"; recorded: {recorded}"
         else:
             message += " (the recording has no mode to compare)"
         self.ctx.report("OFB103", message, pending.t, pending.where, short=short)
+
+    def _recorded_now(self) -> str:
+        """The recorded mode while no change out of OFFBOARD answered the loss: still the
+        same mode, or none yet (no status before it named one), or a switch away
+        accepted by its ack whose mode no status has named yet."""
+        nav = self.ctx.state.nav_state
+        if nav is not None:
+            return f"still {nav_state_name(nav)}"
+        if not self.mode_seen:
+            return "no mode yet (no status names one before it)"
+        return "a switch away from OFFBOARD accepted, its mode not yet in a status"
 
     def finish(self, t_end: float) -> None:
         self._flush(None)

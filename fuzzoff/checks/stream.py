@@ -10,13 +10,16 @@ from __future__ import annotations
 
 import math
 from bisect import bisect_left
+from collections import Counter
 from dataclasses import dataclass
 from functools import cache
 
 from fuzzoff.checks._keepalive import (
     KEEPALIVE_EVENTS,
     PROOF_SLACK_S,
+    RECEIVED_NOTE,
     RecordedSwitches,
+    as_received,
     keepalive_run,
     loss_timeout,
     mode_note,
@@ -24,6 +27,7 @@ from fuzzoff.checks._keepalive import (
     px4_label,
 )
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
+from fuzzoff.checks.ignored_messages import IGNORED, ignores, message_name
 from fuzzoff.events import (
     Command,
     CommandAck,
@@ -66,13 +70,15 @@ class _Gap:
     """The part of the gap PX4 acts on, where that is less than the whole (a gap that ends
     before a request: none; across a request PX4 refused: the keep-alive's age at it);
     None: all of it."""
+    ignored: str = ""
+    """The messages PX4 ignores that came in the gap (OFB608's), as "82 NAME", or ""."""
 
 
 class KeepaliveRate(Check):
     """OFB101: gaps of 500 ms or more in offboard, or in the second before an offboard request."""
 
     codes = ("OFB101",)
-    wants = (*KEEPALIVE_EVENTS, Command, CommandAck, VehicleStatus)
+    wants = (*KEEPALIVE_EVENTS, Command, CommandAck, VehicleStatus, *IGNORED)
 
     def __init__(self, ctx: CheckContext) -> None:
         super().__init__(ctx)
@@ -93,8 +99,15 @@ class KeepaliveRate(Check):
         """The ack of a switch away from OFFBOARD that ended the window while no keep-alive
         came: judged once no second ack can undo it (1.16/1.17 ack a switch twice, and only
         the last, Commander's, decides: gate spec 4.3)."""
+        self.count_ignored = ignores(ctx)
+        self.ignored: list[tuple[float, str]] = []
+        """(time, message name) of each message PX4 ignores since the newest keep-alive."""
 
     def on_event(self, event: Event) -> None:
+        if isinstance(event, IGNORED):  # not a keep-alive: said with the gap it falls in
+            if self.count_ignored and event.origin == "sent" and self.last is not None:
+                self.ignored.append((event.t, message_name(event)))
+            return
         state = self.ctx.state
         left = self.left_at
         if left is not None and (
@@ -112,6 +125,7 @@ class KeepaliveRate(Check):
             self.last_in_offboard = self.ctx.flying
             self.dropout_since_last = False
             self.request_in_gap = None
+            self.ignored.clear()
         elif isinstance(event, Dropout):
             self.dropout_since_last = True
         else:
@@ -154,6 +168,7 @@ class KeepaliveRate(Check):
         self.last_in_offboard = self.ctx.flying
         self.dropout_since_last = False
         self.request_in_gap = None
+        self.ignored.clear()
 
     def _ack(self, ack: CommandAck, left: Event | None) -> None:
         if self.last_in_offboard and not self.ctx.flying:
@@ -166,9 +181,16 @@ class KeepaliveRate(Check):
             self.last_in_offboard = True
             self.left_at = None
 
+    def _ignored_in(self, end: float) -> str:
+        """The messages PX4 ignores that came up to ``end`` since the newest keep-alive."""
+        names = [name for t, name in self.ignored if t <= end]
+        if not names:
+            return ""
+        return ", ".join(f"{n} {name}" for name, n in Counter(names).items())
+
     def _gap(self, event: Event, last: float, proven: float) -> None:
         if proven >= self.max_gap:
-            found = _Gap(last, event.t, proven, event.where)
+            found = _Gap(last, event.t, proven, event.where, ignored=self._ignored_in(event.t))
             ctx = self.ctx
             if self.last_in_offboard:
                 self._report(found, IN_OFFBOARD)
@@ -190,9 +212,9 @@ class KeepaliveRate(Check):
             return
         gap = proven_gap(self.ctx, event, event.t - self.last)
         if gap >= self.max_gap:
-            self._report(
-                _Gap(self.last, event.t, gap, self.last_where), f"{IN_OFFBOARD} (until it left)"
-            )
+            found = _Gap(self.last, event.t, gap, self.last_where)
+            found.ignored = self._ignored_in(event.t)
+            self._report(found, f"{IN_OFFBOARD} (until it left)")
 
     def _request(self, t: float) -> None:
         if self.last is not None and self.request_in_gap is None:
@@ -238,9 +260,18 @@ class KeepaliveRate(Check):
             )
             just = ", only just" if margin else ""
             verdict = f"keeps the signal{just} (lost at {timeout:.2f} s)"
+        if as_received(ctx) and severity is not Severity.INFO:
+            message += f"; {RECEIVED_NOTE}"
         place = context.partition(" (")[0]  # "in OFFBOARD (until it left)": the place only
         place = SHORT_CONTEXT.get(place, place)
         short = f"keep-alive gap {gap.proven:.2f} s {place}; {px4_label(ctx)} {verdict}"
+        if gap.ignored:
+            # what the sender did send meanwhile, and what PX4 made of it
+            message += (
+                f"; in the gap came {gap.ignored}, which {px4_label(ctx)} ignores: no "
+                "keep-alive (OFB608)"
+            )
+            short += f"; {gap.ignored} in it, ignored"
         ctx.report(
             "OFB101", message, gap.start, gap.where, severity=severity, end=gap.end, short=short
         )
@@ -250,10 +281,9 @@ class KeepaliveRate(Check):
         if left is not None:
             self._silence_until_left(left)
         elif self.last is not None and self.last_in_offboard and t_end - self.last >= self.max_gap:
-            self._report(
-                _Gap(self.last, t_end, t_end - self.last, self.last_where),
-                f"{IN_OFFBOARD} (stream stopped, recording ends)",
-            )
+            found = _Gap(self.last, t_end, t_end - self.last, self.last_where)
+            found.ignored = self._ignored_in(t_end)
+            self._report(found, f"{IN_OFFBOARD} (stream stopped, recording ends)")
 
 
 class StreamBeforeRequest(Check):
@@ -396,10 +426,14 @@ class StreamBeforeRequest(Check):
             f"{what} with {had}; docs: stream for at least {self.min_stream:.0f} s first; "
             f"{px4_label(self.ctx)} would: {would}"
         )
+        received = as_received(self.ctx) and not fresh
+        if received:
+            message += f"; {RECEIVED_NOTE}"
+        accepted = " PX4 accepted" if received else ""
         if last is None:
-            stream = "with no keep-alive"
+            stream = f"with no keep-alive{accepted}"
         elif not fresh:
-            stream = f"{t - last:.2f} s after the last keep-alive"
+            stream = f"{t - last:.2f} s after the last keep-alive{accepted}"
         else:
             stream = f"after {t - (run_start or t):.2f} s of keep-alive"
         short = f"{what} {stream} (docs: {self.min_stream:g} s of it)"

@@ -14,6 +14,7 @@ import re
 import xml.etree.ElementTree as ET
 
 from fuzzoff.catalog import Rule, load_catalog
+from fuzzoff.checks.whole_file import not_checkable_reasons
 from fuzzoff.config import Settings
 from fuzzoff.findings import FileReport, Finding, Report
 from fuzzoff.fuzz.known import KNOWN
@@ -21,8 +22,6 @@ from fuzzoff.report import CampaignReport, campaign_seeds
 from fuzzoff.report.sanitize import CI_TEXT_LIMIT, escape_bidi, printable
 
 _NOT_XML = re.compile("[^\t\n\r\x20-\x7e\xa0-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
-_NOT_CHECKABLE = re.compile(r"^(OFB\d{3}) \(")
-"""The code at the start of an OFB002 message (engine.run_events writes ``CODE (name) ...``)."""
 
 
 def xml_text(text: str) -> str:
@@ -47,13 +46,12 @@ def rule_line(rule: Rule) -> str:
 
 
 def not_checkable(file: FileReport) -> dict[str, str]:
-    """Code -> the OFB002 message saying why it cannot be checked on this recording."""
+    """Code -> why it cannot be checked on this recording, from the file's OFB002 line."""
     out = {}
     for finding in file.findings:
         if finding.code == "OFB002":
-            match = _NOT_CHECKABLE.match(finding.message)
-            if match:
-                out[match.group(1)] = finding.message
+            for code, reason in not_checkable_reasons(finding.message).items():
+                out[code] = f"cannot be checked on this recording: {reason}"
     return out
 
 

@@ -1,14 +1,17 @@
 """``--format sarif``: SARIF 2.1.0 for code-scanning services (GitHub, Azure DevOps, ...).
 
 Every catalog rule is in ``tool.driver.rules`` with its whole page as help text (plain and
-Markdown), which GitHub code scanning shows beside each result. There is no ``helpUri``: SARIF
-requires an absolute URI there, and the project publishes no site of rule pages; the page's
-references link to PX4's docs and source instead. The tool's ``informationUri`` is its package
-page. A recording is binary, so a result points at the file without a
-text region; the time, vehicle and topic go into the message and the result's properties, and
-``partialFingerprints`` is computed here from rule, vehicle, topic and time window (GitHub cannot
-fingerprint a binary file itself). Paths under the working folder are written relative to the
-``SRCROOT`` base, which is what code scanning matches against the repository.
+Markdown), which GitHub code scanning shows beside each result, and its page in the project's
+repository as ``helpUri``; the tool's ``informationUri`` is the repository itself. Both come
+from ``catalog.PROJECT_URL``. A recording is binary, so a result points at the file with a
+region of line 1 and, where the reader knows it, the byte offset (for OFB001 and OFB004 the
+byte their line names); the time, vehicle and topic go into the message and the result's
+properties, and ``partialFingerprints`` is computed here from rule, vehicle, topic and time
+window (GitHub cannot fingerprint a binary file itself). Paths under the working folder are
+written relative to the ``SRCROOT`` base, which is what code scanning matches against the
+repository. A run with input that could not be read completely (exit status 2) is not a
+successful execution: ``executionSuccessful`` is false and each unreadable part is an error
+notification.
 """
 
 from __future__ import annotations
@@ -21,15 +24,15 @@ from typing import Any
 from urllib.parse import quote
 
 from fuzzoff import __version__
-from fuzzoff.catalog import Rule, load_catalog, render_page
+from fuzzoff.catalog import PROJECT_URL, Rule, load_catalog, render_page
 from fuzzoff.config import Settings
 from fuzzoff.findings import Finding, Report, Severity
 from fuzzoff.report import CampaignReport
 from fuzzoff.report.sanitize import CI_TEXT_LIMIT, escape_bidi, printable
 
 SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
-INFORMATION_URI = "https://pypi.org/project/fuzzoff/"
-"""Where the tool is described: its package page (the README), where ``pip install`` gets it."""
+INFORMATION_URI = PROJECT_URL
+"""Where the tool is described: its repository (the README)."""
 FINGERPRINT_KEY = "fuzzoffFinding/v1"
 LEVEL = {Severity.ERROR: "error", Severity.WARNING: "warning", Severity.INFO: "note"}
 BASE_ID = "SRCROOT"
@@ -49,6 +52,7 @@ def rule_descriptor(rule: Rule) -> dict[str, Any]:
         "shortDescription": {"text": _first_sentence(rule.summary)},
         "fullDescription": {"text": " ".join(rule.summary.split())},
         "help": {"text": page, "markdown": page},
+        "helpUri": rule.page_url,
         "defaultConfiguration": {"level": LEVEL[rule.severity]},
         "properties": {
             "tags": ["px4", "offboard", *(["heuristic"] if rule.heuristic else [])],
@@ -95,13 +99,14 @@ def message_text(finding: Finding) -> str:
 
 
 def region(finding: Finding) -> dict[str, int]:
-    """The byte offset where the reader knows it; ``startLine`` 1 because GitHub reads no bytes.
+    """``startLine`` 1, and the byte offset where the reader knows it (none where it does not:
+    byte 0 would name the file's first byte).
 
     GitHub code scanning places results by line and does not read ``byteOffset``, so a binary
     recording gets line 1 beside the SARIF binary form.
     """
     offset = finding.where.offset if finding.where is not None else None
-    return {"startLine": 1, "byteOffset": offset or 0}
+    return {"startLine": 1} if offset is None else {"startLine": 1, "byteOffset": offset}
 
 
 def result(
@@ -169,7 +174,9 @@ def sarif_log(report: Report, settings: Settings, root: Path | None = None) -> d
         },
         "invocations": [
             {
-                "executionSuccessful": True,
+                # input that could not be read completely: the analysis did not complete
+                "executionSuccessful": report.complete,
+                "exitCode": report.exit_status(settings.fail_on),
                 "toolExecutionNotifications": notifications,
                 "properties": {"fail_on": settings.fail_on.label, "complete": report.complete},
             }
@@ -228,6 +235,7 @@ def render_campaign(campaign: CampaignReport) -> str:
                     "driver": {
                         "name": "fuzzoff",
                         "version": __version__,
+                        "informationUri": INFORMATION_URI,
                         "rules": rules,
                     }
                 },

@@ -78,9 +78,14 @@ def finding_line(finding: Finding, *, vehicle: bool = True) -> Text:
     return line
 
 
+DETAIL_LIMIT = 1000
+"""Longest message ``--verbose`` shows (a recording can make one any length; fuzzoff's own
+longest, the OFB002 lines, stay under it)."""
+
+
 def finding_detail(finding: Finding) -> Text:
     """``--verbose``: the whole message, then the time window and the exact place."""
-    text = Text(printable(finding.message))
+    text = Text(printable(finding.message, DETAIL_LIMIT))
     extra = []
     if finding.end_s is not None and finding.time_s is not None:
         extra.append(f"until {finding.end_s:.3f}s")

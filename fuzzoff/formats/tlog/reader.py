@@ -22,6 +22,7 @@ from fuzzoff.events import (
     FailsafeFlags,
     LandDetected,
     Parameter,
+    SetActuatorControlTarget,
     SetAttitudeTarget,
     SetPositionTargetGlobal,
     SetPositionTargetLocal,
@@ -55,6 +56,7 @@ COMMAND_ACK = 77
 SET_ATTITUDE_TARGET = 82
 SET_POSITION_TARGET_LOCAL_NED = 84
 SET_POSITION_TARGET_GLOBAL_INT = 86
+SET_ACTUATOR_CONTROL_TARGET = 139
 AUTOPILOT_VERSION = 148
 EXTENDED_SYS_STATE = 245
 STATUSTEXT = 253
@@ -71,6 +73,7 @@ WANTED = frozenset(
         SET_ATTITUDE_TARGET,
         SET_POSITION_TARGET_LOCAL_NED,
         SET_POSITION_TARGET_GLOBAL_INT,
+        SET_ACTUATOR_CONTROL_TARGET,
         AUTOPILOT_VERSION,
         STATUSTEXT,
         SYS_STATUS,
@@ -90,6 +93,8 @@ PROBE_WANTED = frozenset({HEARTBEAT, AUTOPILOT_VERSION, COMMAND_LONG, COMMAND_IN
 KEEPALIVE_IDS = frozenset(
     {SET_POSITION_TARGET_LOCAL_NED, SET_POSITION_TARGET_GLOBAL_INT, SET_ATTITUDE_TARGET}
 )
+SENT_STREAM_IDS = KEEPALIVE_IDS | {SET_ACTUATOR_CONTROL_TARGET}
+"""Setpoint messages a companion sends: a log holding any of them holds the sent stream."""
 
 MAV_COMP_ID_AUTOPILOT1 = 1
 MAV_AUTOPILOT_PX4 = 12
@@ -111,6 +116,7 @@ _KIND_OF_ID: dict[int, tuple[str, ...]] = {
     SET_POSITION_TARGET_LOCAL_NED: (SetPositionTargetLocal.kind,),
     SET_POSITION_TARGET_GLOBAL_INT: (SetPositionTargetGlobal.kind,),
     SET_ATTITUDE_TARGET: (SetAttitudeTarget.kind,),
+    SET_ACTUATOR_CONTROL_TARGET: (SetActuatorControlTarget.kind,),
     COMMAND_LONG: (Command.kind,),
     COMMAND_INT: (Command.kind,),
     SET_MODE: (Command.kind,),
@@ -225,7 +231,7 @@ class TlogSource(Source):
         if info.px4_version is None:
             info.notes.append("no AUTOPILOT_VERSION in the log: PX4 version unknown")
         companions = commanders - autopilots - ground_stations
-        if not any(stats.by_id.get(i) for i in KEEPALIVE_IDS) and not companions:
+        if not any(stats.by_id.get(i) for i in SENT_STREAM_IDS) and not companions:
             info.stream_recorded = False
             info.stream_missing = (
                 "holds no setpoint and no command from a companion: a ground station's log "
@@ -353,6 +359,7 @@ class _Decoder:
             SET_POSITION_TARGET_LOCAL_NED: self._local,
             SET_POSITION_TARGET_GLOBAL_INT: self._global,
             SET_ATTITUDE_TARGET: self._attitude,
+            SET_ACTUATOR_CONTROL_TARGET: self._actuator_control,
             COMMAND_LONG: self._command_long,
             COMMAND_INT: self._command_int,
             SET_MODE: self._set_mode,
@@ -472,6 +479,25 @@ class _Decoder:
                 body_yaw_rate=m.body_yaw_rate,
                 thrust=m.thrust,
                 thrust_body=tuple(thrust_body) if thrust_body and any(thrust_body) else None,
+            )
+            for v in self._targets(m.target_system)
+        ]
+
+    def _actuator_control(self, m: Any, t: float, where: Where) -> Iterable[Event]:
+        if self._from_autopilot(m):
+            return self._ignore(m, "from the autopilot")
+        return [
+            SetActuatorControlTarget(
+                t=t,
+                vehicle=v,
+                where=where,
+                sender_time_us=m.time_usec,
+                group_mlx=m.group_mlx,
+                controls=tuple(m.controls),
+                target_system=m.target_system,
+                target_component=m.target_component,
+                source_system=m.get_srcSystem(),
+                source_component=m.get_srcComponent(),
             )
             for v in self._targets(m.target_system)
         ]

@@ -40,6 +40,7 @@ from fuzzoff.events import (
     LandDetected,
     MavlinkTarget,
     Parameter,
+    SetActuatorControlTarget,
     SetAttitudeTarget,
     SetPositionTargetGlobal,
     SetPositionTargetLocal,
@@ -73,6 +74,7 @@ SUPPORTED: tuple[type[Event], ...] = (
     SetPositionTargetLocal,
     SetPositionTargetGlobal,
     SetAttitudeTarget,
+    SetActuatorControlTarget,
     Command,
     CommandAck,
     Parameter,
@@ -148,7 +150,7 @@ class _Writer:
     def autopilot_of(self, event: Event) -> Sender:
         return (self.vehicle_sysid(event), self.autopilot[1])
 
-    def sender_of(self, event: Command | MavlinkTarget) -> Sender:
+    def sender_of(self, event: Command | MavlinkTarget | SetActuatorControlTarget) -> Sender:
         if event.source_system is not None and event.source_component is not None:
             return (event.source_system, event.source_component)
         sysid = self.vehicle_sysid(event)
@@ -217,6 +219,15 @@ class _Writer:
                 event.body_pitch_rate,
                 event.body_yaw_rate,
                 event.thrust,
+            )
+            return [self.link(self.sender_of(event)).pack(msg)]
+        if isinstance(event, SetActuatorControlTarget):
+            msg = mavlink.MAVLink_set_actuator_control_target_message(
+                _boot_ms(event) * 1000,
+                event.group_mlx,
+                event.target_system,
+                event.target_component,
+                list(event.controls),
             )
             return [self.link(self.sender_of(event)).pack(msg)]
         if isinstance(event, Command):
