@@ -31,6 +31,8 @@ from typing import Any, ClassVar, Literal
 
 Origin = Literal["sent", "vehicle", "model"]
 Transport = Literal["ros2", "mavlink", "mavros", "uorb"]
+CommandMessage = Literal["COMMAND_LONG", "COMMAND_INT", "SET_MODE"]
+"""The MAVLink message a ``Command`` came in (PX4 checks their addresses differently)."""
 
 Vec2 = tuple[float, float]
 Vec3 = tuple[float, float, float]
@@ -515,6 +517,8 @@ class Command(Event):
     source_component: int | None = None
     from_external: bool | None = None
     transport: Transport = "mavlink"
+    message: CommandMessage | None = None
+    """The MAVLink message as recorded (None: not MAVLink, or not said)."""
 
     @property
     def is_offboard_switch(self) -> bool:

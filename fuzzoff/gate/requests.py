@@ -26,6 +26,7 @@ ACCEPTED = 0
 TEMPORARILY_REJECTED = 1
 DENIED = 2
 UNSUPPORTED = 3
+FAILED = 4
 NO_ATTITUDE = "no attitude or angular-velocity estimate (OFFBOARD mode requirement, D11)"
 STICK_MODES = frozenset({0, 1, 2, 10, 15})
 """Nav states flown with the sticks: Manual, Altitude, Position, Acro, Stabilized."""

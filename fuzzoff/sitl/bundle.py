@@ -85,6 +85,8 @@ def find_build(release: str | None, px4_build: Path | None, root: Path | None = 
     have = releases(root)
     if not have:
         raise BundleError(f"no PX4 SITL bundles in {root} (set FUZZOFF_PX4_SITL to their folder)")
+    if release in have:  # the exact name wins over "1.16.2-ros2" for "1.16.2"
+        return Build(root / release, release)
     matches = [r for r in have if r == release or r.startswith(release + ".")]
     matches += [r for r in have if r.startswith(release + "-") and r not in matches]
     if not matches:

@@ -92,8 +92,13 @@ class Driver:
 
         return send
 
-    def set_mode(self, nav_state: int, label: str) -> Ack | None:
-        return self.note(f"switch to {label}", self.link.set_mode(nav_state))
+    def set_mode(
+        self, nav_state: int, label: str, target: tuple[int, int] | None = None
+    ) -> Ack | None:
+        """DO_SET_MODE to the autopilot, or to ``target`` (system, component) as a client that
+        addresses it wrongly would (sent once: PX4 may answer nothing)."""
+        to = "" if target is None else f" addressed to {target[0]}/{target[1]}"
+        return self.note(f"switch to {label}{to}", self.link.set_mode(nav_state, target))
 
     def arm(self) -> Ack | None:
         return self.note("arm", self.link.arm(True))

@@ -327,12 +327,17 @@ class Link:
     # -- commands
 
     def command(
-        self, command: int, *params: float, timeout: float = 1.5, retries: int = 2
+        self,
+        command: int,
+        *params: float,
+        timeout: float = 1.5,
+        retries: int = 2,
+        target: tuple[int, int] | None = None,
     ) -> Ack | None:
-        """COMMAND_LONG to the autopilot; the last of its acks (PX4 1.16/1.17 send two for a
-        mode switch), or None when PX4 never acked it."""
+        """COMMAND_LONG to the autopilot (or to ``target``, system and component); the last of
+        its acks (PX4 1.16/1.17 send two for a mode switch), or None when PX4 never acked it."""
         values = [*params, *([0.0] * (7 - len(params)))]
-        sysid, compid = self.target
+        sysid, compid = self.target if target is None else target
         for attempt in range(retries + 1):
             with self._cond:
                 seen = len(self.view.acks)
@@ -349,11 +354,17 @@ class Link:
             return acks[-1]
         return None
 
-    def set_mode(self, nav_state: int) -> Ack | None:
+    def set_mode(self, nav_state: int, target: tuple[int, int] | None = None) -> Ack | None:
         custom = nav_state_to_custom_mode(nav_state)
         main, sub = (custom >> 16) & 0xFF, (custom >> 24) & 0xFF
         return self.command(
-            MAV_CMD_DO_SET_MODE, mavlink.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED, main, sub
+            MAV_CMD_DO_SET_MODE,
+            mavlink.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED,
+            main,
+            sub,
+            target=target,
+            retries=0 if target is not None else 2,
+            timeout=0.5 if target is not None else 1.5,
         )
 
     def arm(self, arm: bool = True) -> Ack | None:

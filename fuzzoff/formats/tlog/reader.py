@@ -18,6 +18,7 @@ from fuzzoff.events import (
     MAV_CMD_DO_SET_MODE,
     Command,
     CommandAck,
+    CommandMessage,
     Event,
     FailsafeFlags,
     LandDetected,
@@ -510,6 +511,7 @@ class _Decoder:
         command: int,
         params: tuple[float, float, float, float, float, float, float],
         target_component: int,
+        message: CommandMessage,
     ) -> Iterable[Event]:
         if self._from_autopilot(m):
             return self._ignore(m, "from the autopilot")
@@ -525,23 +527,24 @@ class _Decoder:
                 source_system=m.get_srcSystem(),
                 source_component=m.get_srcComponent(),
                 from_external=True,
+                message=message,
             )
             for v in self._targets(m.target_system)
         ]
 
     def _command_long(self, m: Any, t: float, where: Where) -> Iterable[Event]:
         params = (m.param1, m.param2, m.param3, m.param4, m.param5, m.param6, m.param7)
-        return self._command(m, t, where, m.command, params, m.target_component)
+        return self._command(m, t, where, m.command, params, m.target_component, "COMMAND_LONG")
 
     def _command_int(self, m: Any, t: float, where: Where) -> Iterable[Event]:
         params = (m.param1, m.param2, m.param3, m.param4, float(m.x), float(m.y), m.z)
-        return self._command(m, t, where, m.command, params, m.target_component)
+        return self._command(m, t, where, m.command, params, m.target_component, "COMMAND_INT")
 
     def _set_mode(self, m: Any, t: float, where: Where) -> Iterable[Event]:
         """SET_MODE (#11, MAVROS set_mode) -> DO_SET_MODE as PX4 handles it."""
         main, sub = split_custom_mode(m.custom_mode)
         params = (float(m.base_mode), float(main), float(sub), 0.0, 0.0, 0.0, 0.0)
-        return self._command(m, t, where, MAV_CMD_DO_SET_MODE, params, 0)
+        return self._command(m, t, where, MAV_CMD_DO_SET_MODE, params, 0, "SET_MODE")
 
     # -- from the vehicle -----------------------------------------------------------------
 

@@ -122,6 +122,31 @@ def _param_bytes(name: str, value: float) -> tuple[float, int]:
     return float(value), MAV_PARAM_TYPE_REAL32
 
 
+def _command_message(event: Command) -> Any:
+    """The MAVLink message ``event.message`` names (COMMAND_LONG when it names none)."""
+    p = event.params
+    if event.message == "SET_MODE":  # DO_SET_MODE's base mode, main and sub mode
+        base, main, sub = (int(v) for v in p[:3])
+        custom = (main & 0xFF) << 16 | (sub & 0xFF) << 24
+        return mavlink.MAVLink_set_mode_message(event.target_system, base, custom)
+    if event.message == "COMMAND_INT":
+        return mavlink.MAVLink_command_int_message(
+            event.target_system,
+            event.target_component,
+            0,  # frame: MAV_FRAME_GLOBAL, unused by mode and arming commands
+            event.command,
+            0,
+            0,
+            *p[:4],
+            int(p[4]),
+            int(p[5]),
+            p[6],
+        )
+    return mavlink.MAVLink_command_long_message(
+        event.target_system, event.target_component, event.command, 0, *p
+    )
+
+
 class _Writer:
     def __init__(
         self,
@@ -231,10 +256,7 @@ class _Writer:
             )
             return [self.link(self.sender_of(event)).pack(msg)]
         if isinstance(event, Command):
-            p = event.params
-            msg = mavlink.MAVLink_command_long_message(
-                event.target_system, event.target_component, event.command, 0, *p
-            )
+            msg = _command_message(event)
             return [self.link(self.sender_of(event)).pack(msg)]
         if isinstance(event, VehicleStatus):
             self.last_status[self.vehicle_sysid(event)] = event
