@@ -115,6 +115,8 @@ class Release:
     """No mode switch out of TERMINATION, armed or not (4.1, 1.16+)."""
     acks_switch_twice: bool
     """A MAVLink mode switch is acked twice: the receiver's ACCEPTED, then Commander's (4.3)."""
+    altitude_cruise_mode: bool
+    """DO_SET_MODE main mode 11 is ALTITUDE_CRUISE (nav_state 8, 4.1; seen on 1.17.0 SITL)."""
     alien_command_answer: AlienCommandAnswer
     """A COMMAND_LONG / COMMAND_INT for another system or component (and for system 0 where
     ``handles_broadcast_command`` is False): acked FAILED (up to 1.15) or ignored, no ack (1.16+).
@@ -204,6 +206,7 @@ LEGACY = Release(
     unsupported_main_mode="rejected_unverified",
     never_leaves_termination=False,
     acks_switch_twice=False,
+    altitude_cruise_mode=False,
     alien_command_answer="ack_failed",
     handles_broadcast_command=False,
     old_code_unverified=True,
@@ -309,6 +312,7 @@ V1_17 = replace(
     covers="v1.17: offboard loss without RC uses NAV_RCL_ACT, double mode ack",
     minors=(17,),
     nav_rcl_fallback="before_degrade",
+    altitude_cruise_mode=True,
     msg_folder="1.17",
     ulog_era="1.17",
 )

@@ -79,7 +79,7 @@ class Requests:
         s = self.s
         t = cmd.t
         if cmd.is_mode_switch:
-            target = decode_mode(cmd)
+            target = decode_mode(cmd, s.release)
         elif cmd.command == MAV_CMD_COMPONENT_ARM_DISARM:
             target = None
         else:

@@ -100,6 +100,12 @@ class Driver:
         to = "" if target is None else f" addressed to {target[0]}/{target[1]}"
         return self.note(f"switch to {label}{to}", self.link.set_mode(nav_state, target))
 
+    def set_custom_mode(self, main: int, sub: int, label: str) -> Ack | None:
+        """DO_SET_MODE with this main and sub mode as sent, whether PX4 has the mode or not."""
+        return self.note(
+            f"switch to {label} (main {main}, sub {sub})", self.link.set_custom_mode(main, sub)
+        )
+
     def arm(self) -> Ack | None:
         return self.note("arm", self.link.arm(True))
 

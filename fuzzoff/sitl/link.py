@@ -367,6 +367,12 @@ class Link:
             timeout=0.5 if target is not None else 1.5,
         )
 
+    def set_custom_mode(self, main: int, sub: int) -> Ack | None:
+        """DO_SET_MODE with a main and sub mode as given (a mode PX4 may not have)."""
+        return self.command(
+            MAV_CMD_DO_SET_MODE, mavlink.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED, main, sub, retries=0
+        )
+
     def arm(self, arm: bool = True) -> Ack | None:
         return self.command(MAV_CMD_COMPONENT_ARM_DISARM, 1.0 if arm else 0.0)
 

@@ -184,6 +184,15 @@ def switch_to_broadcast(d: Driver) -> None:
     d.land_and_wait()
 
 
+def hold_with_unknown_sub_mode(d: Driver) -> None:
+    """Offboard flight, then a "hold" sent as AUTO with sub-mode 42, which no PX4 has: the
+    vehicle stays in OFFBOARD (1.16 and 1.17 first ack it ACCEPTED), the stream goes on."""
+    _offboard_takeoff(d)
+    d.set_custom_mode(4, 42, "a hold that does not exist")
+    d.stream(d.position(0, 0, ALT), 3.0)
+    d.land_and_wait()
+
+
 SCENARIOS: dict[str, Scenario] = {
     s.name: s
     for s in (
@@ -299,6 +308,14 @@ SCENARIOS: dict[str, Scenario] = {
             ("OFB204",),
             shown_in=(".tlog",),
             hazard_until=(1, 18),
+        ),
+        Scenario(
+            "hold_with_unknown_sub_mode",
+            "offboard flight, then DO_SET_MODE AUTO sub-mode 42 (no such mode) as a hold, land",
+            hold_with_unknown_sub_mode,
+            "hazard",
+            "a mode request PX4 cannot honour: the vehicle stays in OFFBOARD",
+            ("OFB205",),
         ),
     )
 }

@@ -145,7 +145,9 @@ def _model_decision(
 
 
 def _model_accepts(row: dict[str, Any]) -> bool:
-    return row["what"] in ("request_accepted", "arm_accepted", "mode", "disarmed")
+    if row["what"] == "mode":  # a switch to another mode: refused where it gives a reason
+        return not row.get("reason")
+    return row["what"] in ("request_accepted", "arm_accepted", "disarmed")
 
 
 def compare(
