@@ -46,7 +46,15 @@ from fuzzoff.profiles import (
     ProfileError,
     px4_profile_for,
 )
-from fuzzoff.recording import RecordingInfo, SourceProblem, first_byte, path_text
+from fuzzoff.recording import (
+    PLOT_SAMPLE_S,
+    PlotSamples,
+    RecordingInfo,
+    SourceProblem,
+    add_sample,
+    first_byte,
+    path_text,
+)
 from fuzzoff.releases import PX4Profile
 from fuzzoff.state import VehicleState
 from fuzzoff.type_mask import POSITION_BITS
@@ -105,15 +113,15 @@ class Timeline:
     notes: list[Event] = field(default_factory=list)
     """The vehicle's text messages, the commands sent and their acks (at most ``NOTE_LIMIT``)."""
     positions: list[tuple[float, float, float, float]] = field(default_factory=list)
-    """(t, x, y, z) of the vehicle's local position, NED metres, one per ``SAMPLE_S`` at most."""
+    """(t, x, y, z) of the vehicle's local position, NED metres, one per ``SAMPLE_S`` at most:
+    the positions judged, and those the reader thinned out of the events (``PlotSamples``)."""
     setpoint_positions: list[tuple[float, float, float, float]] = field(default_factory=list)
     """(t, x, y, z) of the position setpoints (trajectory setpoints, local NED MAVLink ones)."""
 
 
 NOTE_LIMIT = 5000
 """Text messages, commands and acks a timeline keeps per vehicle (a recording may flood them)."""
-SAMPLE_S = 0.05
-"""Shortest time between two kept samples of a plotted series (20 Hz is plenty for a plot)."""
+SAMPLE_S = PLOT_SAMPLE_S
 
 
 class VehicleRun:
@@ -258,10 +266,10 @@ class VehicleRun:
             if len(self.timeline.notes) < NOTE_LIMIT:
                 self.timeline.notes.append(event)
         elif isinstance(event, VehiclePosition):
-            _sample(self.timeline.positions, event.t, (event.x, event.y, event.z))
+            add_sample(self.timeline.positions, event.t, (event.x, event.y, event.z))
         elif _plotted_position(event):
             assert isinstance(event, TrajectorySetpoint | SetPositionTargetLocal)
-            _sample(self.timeline.setpoint_positions, event.t, event.position)
+            add_sample(self.timeline.setpoint_positions, event.t, event.position)
 
     def finish(self, t_end: float) -> list[Finding]:
         self._flush()
@@ -289,13 +297,6 @@ def _plotted_position(event: Event) -> bool:
     )
 
 
-def _sample(
-    series: list[tuple[float, float, float, float]], t: float, xyz: tuple[float, float, float]
-) -> None:
-    if any(math.isfinite(v) for v in xyz) and (not series or t - series[-1][0] >= SAMPLE_S):
-        series.append((t, *xyz))
-
-
 def run_events(
     events: Iterable[Event],
     info: RecordingInfo,
@@ -305,13 +306,16 @@ def run_events(
     timelines: dict[str, Timeline] | None = None,
     on_event: Callable[[int], None] | None = None,
     batching: bool = True,
+    end_t: Callable[[], float | None] | None = None,
 ) -> tuple[list[Finding], RunStats]:
     """Run the gate and every enabled check over ``events`` (one recording, any vehicles).
 
     ``batching=False`` hands every stream message to every check one at a time, as the
-    checks' ``on_batch`` must be equivalent to (the tests compare the two)."""
+    checks' ``on_batch`` must be equivalent to (the tests compare the two). ``end_t`` gives,
+    once the events are used up, the time of the recording's last message when it is later
+    than its last event (``recording.Aside``): the recording ends there."""
     with _fewer_collections():
-        return _run_events(events, info, profile, settings, timelines, on_event, batching)
+        return _run_events(events, info, profile, settings, timelines, on_event, batching, end_t)
 
 
 @contextmanager
@@ -335,6 +339,7 @@ def _run_events(
     timelines: dict[str, Timeline] | None,
     on_event: Callable[[int], None] | None,
     batching: bool,
+    end_t: Callable[[], float | None] | None,
 ) -> tuple[list[Finding], RunStats]:
     runs: dict[str, VehicleRun] = {}
     kinds: Counter[str] = Counter()
@@ -356,6 +361,9 @@ def _run_events(
         count += 1
         if on_event is not None and count % 4096 == 0:
             on_event(count)
+    last_message = end_t() if end_t is not None else None
+    if last_message is not None and last_message > t_end:
+        t_end = last_message
     findings: list[Finding] = []
     for run in runs.values():
         findings.extend(run.finish(t_end))
@@ -442,7 +450,8 @@ def lint_file(
     """Lint one recording. Never raises for a bad file: it becomes OFB001 and ``complete=False``.
 
     ``batching=False`` gives every check the stream one message at a time (see ``run_events``);
-    ``plot_data`` has the reader add what only the HTML report's plots show (positions)."""
+    ``plot_data`` has the reader hand what only the HTML report's plots show (the positions it
+    thins out of the events) to ``timelines``, beside the events: the findings are the same."""
     settings = (settings or Settings()).for_recording(path)
     path = Path(path)
     name = path_text(path)
@@ -450,7 +459,7 @@ def lint_file(
     try:
         source = open_source(path)
         source.px4_hint = settings.px4
-        source.plot_data = plot_data
+        plot = source.aside.plot = PlotSamples() if plot_data else None
 
         def show() -> None:
             fraction = source.progress() if progress is not None else None
@@ -494,9 +503,12 @@ def lint_file(
             timelines=timelines,
             on_event=tick,
             batching=batching,
+            end_t=lambda: source.aside.end_t,
         )
     finally:
         source.close()
+    if plot is not None and timelines is not None:
+        _add_plotted(timelines, plot)
     malformed = get_rule("OFB004")
     for problem in source.problems:
         line = problem.line(name)
@@ -546,6 +558,17 @@ def lint_file(
     if progress is not None:
         progress(1.0)
     return report
+
+
+def _add_plotted(timelines: dict[str, Timeline], plot: PlotSamples) -> None:
+    """The positions the reader thinned out of the events, in the timelines beside the ones
+    judged (in time order, one per ``SAMPLE_S`` at most, as if all had been events)."""
+    for vehicle, samples in plot.positions.items():
+        timeline = timelines.setdefault(vehicle, Timeline())
+        merged: list[tuple[float, float, float, float]] = []
+        for t, *xyz in sorted(timeline.positions + samples, key=lambda sample: sample[0]):
+            add_sample(merged, t, (xyz[0], xyz[1], xyz[2]))
+        timeline.positions = merged
 
 
 def _until_unreadable(events: Iterable[Event], problems: list[SourceProblem]) -> Iterator[Event]:
