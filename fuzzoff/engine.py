@@ -7,7 +7,6 @@ import math
 from collections import Counter
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from contextlib import contextmanager
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import cast
 
@@ -57,6 +56,7 @@ from fuzzoff.recording import (
 )
 from fuzzoff.releases import PX4Profile
 from fuzzoff.state import VehicleState
+from fuzzoff.timeline import Timeline
 from fuzzoff.type_mask import POSITION_BITS
 
 Progress = Callable[[float], None]
@@ -97,26 +97,6 @@ def resolve_profile(info: RecordingInfo, settings: Settings) -> Profile:
         px4_forced=settings.px4 is not None,
         vehicle_forced=settings.vehicle is not None,
     )
-
-
-@dataclass(slots=True)
-class Timeline:
-    """Optional per-vehicle series for the gate command and the HTML report."""
-
-    keepalive: list[float] = field(default_factory=list)
-    recorded_modes: list[tuple[float, int | None, bool | None]] = field(default_factory=list)
-    transitions: list[GateTransition] = field(default_factory=list)
-    setpoint_kinds: dict[str, list[float]] = field(default_factory=dict)
-    loss_timeout: float | None = None
-    """The gate's effective loss timeout (recording's COM_OF_LOSS_T, overrides, defaults)."""
-    recorded_params: dict[str, float] = field(default_factory=dict)
-    notes: list[Event] = field(default_factory=list)
-    """The vehicle's text messages, the commands sent and their acks (at most ``NOTE_LIMIT``)."""
-    positions: list[tuple[float, float, float, float]] = field(default_factory=list)
-    """(t, x, y, z) of the vehicle's local position, NED metres, one per ``SAMPLE_S`` at most:
-    the positions judged, and those the reader thinned out of the events (``PlotSamples``)."""
-    setpoint_positions: list[tuple[float, float, float, float]] = field(default_factory=list)
-    """(t, x, y, z) of the position setpoints (trajectory setpoints, local NED MAVLink ones)."""
 
 
 NOTE_LIMIT = 5000

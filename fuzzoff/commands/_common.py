@@ -275,3 +275,29 @@ def render_rich(draw: Callable[[Console], None], output: str | None = None) -> N
         console = Console(file=buffer, highlight=False, no_color=True, width=160)
     draw(console)
     write_output(buffer.getvalue(), output)
+
+
+def check_save_dir(directory: Path, label: str | None = None) -> None:
+    """Refuse a ``--save-dir`` that cannot hold reproducers before the campaign runs, not after
+    it. The folders it lacks are made and removed again, so that the system says what is wrong
+    (a file on the way, a folder that cannot be written) and a campaign that finds nothing
+    leaves nothing behind. ``label`` names the folder in the message."""
+    label = label or f"--save-dir {directory}"
+    made: list[Path] = []
+    folder = directory
+    while not folder.is_dir() and folder != folder.parent:
+        if folder.exists() or folder.is_symlink():
+            raise ConfigError(f"{label}: {folder} is not a folder")
+        made.append(folder)
+        folder = folder.parent
+    try:
+        for missing in reversed(made):
+            missing.mkdir()
+        if not os.access(directory, os.W_OK | os.X_OK):
+            raise ConfigError(f"{label}: the folder cannot be written")
+    except OSError as exc:
+        raise ConfigError(f"{label}: cannot create {exc.filename}: {exc.strerror or exc}") from None
+    finally:
+        for missing in made:
+            if missing.is_dir():
+                missing.rmdir()

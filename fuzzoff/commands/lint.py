@@ -15,18 +15,17 @@ from fuzzoff.commands._common import (
     add_rule_options,
     check_output,
     existing_paths,
-    render_rich,
     report_targets,
     settings_from_args,
     settings_per_recording,
-    write_output,
 )
+from fuzzoff.commands._lint_output import print_problems, write_report
 from fuzzoff.config import ConfigError, Settings
 from fuzzoff.engine import lint_file, lint_paths, lint_with_timelines
 from fuzzoff.findings import Report
-from fuzzoff.fleet import fleet_wanted
+from fuzzoff.fleet import is_url
 from fuzzoff.formats import RECORDING_SUFFIXES, find_recordings, recordings_in
-from fuzzoff.report import FORMATS, renderer
+from fuzzoff.report import FORMATS
 from fuzzoff.report.sanitize import printable
 
 
@@ -91,36 +90,16 @@ def _lint_with_progress(paths: list[str], settings: Settings) -> Report:
     return report
 
 
-def _terminal(
-    args: argparse.Namespace, report: Report, settings: Settings, output: str | None
-) -> None:
-    from rich.console import Console
-
-    from fuzzoff.report.terminal import print_report
-
-    def draw(console: Console) -> None:
-        print_report(
-            console,
-            report,
-            settings.fail_on,
-            quiet=args.quiet,
-            statistics=args.statistics,
-            verbose=args.verbose,
-        )
-
-    render_rich(draw, output)
-
-
 def run(args: argparse.Namespace) -> int:
     settings = settings_from_args(args)
     if args.jobs < 1:
         raise ConfigError("--jobs must be at least 1")
     # As ruff: no path means the current folder.
     args.paths = args.paths or ["."]
-    if fleet_wanted(args):
-        from fuzzoff.fleet.lint_run import run_fleet
+    if _fleet_wanted(args):
+        from fuzzoff.commands._lint_fleet import run_fleet
 
-        return run_fleet(args, settings, _terminal)
+        return run_fleet(args, settings)
     existing_paths(args.paths)
     # A folder with nothing to lint is a mistake (a wrong path, a recording step that failed):
     # passing it would turn a CI job green without looking at a single flight.
@@ -137,12 +116,17 @@ def run(args: argparse.Namespace) -> int:
     settings_per_recording(settings, paths)
     report = _lint(args, paths, settings, {fmt for fmt, _ in targets})
     for fmt, output in targets:
-        if fmt == "terminal":
-            _terminal(args, report, settings, output)
-        else:
-            write_output(renderer(fmt)(report, settings), output)
-    malformed = settings.enabled("OFB004")  # read around, nothing lost: the user may silence it
-    for f in report.files:
-        for line in [*f.problems, *(f.malformed if malformed else [])]:
-            print(f"fuzzoff: {printable(line)}", file=sys.stderr)
+        write_report(args, report, settings, fmt, output)
+    print_problems(report, settings)  # OFB004's lines (nothing lost) unless it is silenced
     return report.exit_status(settings.fail_on)
+
+
+def _fleet_wanted(args: argparse.Namespace) -> bool:
+    """Does this lint need the fleet path (a cluster, URLs, the dataset or its options)?"""
+    return bool(
+        args.scheduler is not None
+        or "parquet" in (args.format or ())
+        or args.timeout is not None
+        or args.force
+        or any(is_url(p) for p in args.paths)
+    )
