@@ -6,9 +6,9 @@ import gc
 import math
 from collections import Counter
 from collections.abc import Callable, Iterable, Iterator, Sequence
-from contextlib import contextmanager
+from contextlib import AbstractContextManager, contextmanager
 from pathlib import Path
-from typing import cast
+from typing import Protocol, cast
 
 from fuzzoff.catalog import get_rule
 from fuzzoff.checks import CheckContext, load_all
@@ -609,9 +609,67 @@ def _assumed(
     )
 
 
-def _lint_one(args: tuple[Callable[[str, Settings], FileReport], str, Settings]) -> FileReport:
+class Lint(Protocol):
+    """Lints one recording with the settings it is judged with (``lint_file``,
+    ``lint_file_with_timelines``); a module-level function, so that workers can be sent it."""
+
+    def __call__(
+        self, path: str, settings: Settings, *, progress: Progress | None = None
+    ) -> FileReport: ...
+
+
+Watch = Callable[[str], AbstractContextManager[Progress | None]]
+"""Shows one recording's progress while it is linted (a progress bar's task)."""
+
+
+def plan_lint(
+    paths: Sequence[str | Path], settings: Settings | None = None
+) -> list[tuple[str, Settings]]:
+    """The recordings under ``paths`` (files, bag folders and folders, searched once), each
+    with the settings it is judged with (``Settings.resolved_for``): what ``lint_each`` takes."""
+    settings = settings or Settings()
+    return [(str(f), settings.resolved_for(f)) for f in recordings_in(paths)]
+
+
+def _lint_one(args: tuple[Lint, str, Settings]) -> FileReport:
     lint, path, settings = args
     return lint(path, settings)
+
+
+def lint_each(
+    plan: Sequence[tuple[str, Settings]],
+    *,
+    lint: Lint = lint_file,
+    jobs: int = 1,
+    on_file: Callable[[FileReport], None] | None = None,
+    watch: Watch | None = None,
+) -> Report:
+    """Lint each recording of ``plan`` (``plan_lint``) with its settings, in order: in this
+    process, where ``watch`` may show each one's progress, or in ``jobs`` worker processes.
+    The one way a local lint runs (``lint_paths``, ``fuzzoff lint``; a fleet's lint runs
+    the same plan on Dask, ``fleet.lint_run``)."""
+    report = Report()
+
+    def done(file_report: FileReport) -> None:
+        report.files.append(file_report)
+        if on_file is not None:
+            on_file(file_report)
+
+    if jobs > 1 and len(plan) > 1:
+        # imported here: a one-process lint need not pay for it at start-up
+        from concurrent.futures import ProcessPoolExecutor
+
+        with ProcessPoolExecutor(max_workers=jobs) as pool:
+            for file_report in pool.map(_lint_one, [(lint, f, s) for f, s in plan]):
+                done(file_report)
+    elif watch is None:
+        for f, s in plan:
+            done(lint(f, s))
+    else:
+        for f, s in plan:
+            with watch(f) as progress:
+                done(lint(f, s, progress=progress))
+    return report
 
 
 def lint_paths(
@@ -620,32 +678,10 @@ def lint_paths(
     *,
     jobs: int = 1,
     on_file: Callable[[FileReport], None] | None = None,
-    lint: Callable[[str, Settings], FileReport] = lint_file,
+    lint: Lint = lint_file,
 ) -> Report:
-    """Lint files and folders (searched recursively). ``jobs`` > 1 uses worker processes.
-
-    ``lint`` lints one file (a module-level function, so that workers can be sent it).
-    """
-    settings = settings or Settings()
-    files = [str(f) for f in recordings_in(paths)]
-    report = Report()
-    if jobs > 1 and len(files) > 1:
-        # imported here: a one-process lint need not pay for it at start-up
-        from concurrent.futures import ProcessPoolExecutor
-
-        with ProcessPoolExecutor(max_workers=jobs) as pool:
-            file_reports = pool.map(_lint_one, [(lint, f, settings) for f in files])
-            for file_report in file_reports:
-                report.files.append(file_report)
-                if on_file is not None:
-                    on_file(file_report)
-    else:
-        for f in files:
-            file_report = lint(f, settings)
-            report.files.append(file_report)
-            if on_file is not None:
-                on_file(file_report)
-    return report
+    """Lint files and folders (searched recursively). ``jobs`` > 1 uses worker processes."""
+    return lint_each(plan_lint(paths, settings), lint=lint, jobs=jobs, on_file=on_file)
 
 
 def timeline_loss_timeout(
@@ -671,22 +707,17 @@ def timeline_loss_timeout(
     return float(value), f"PX4 {profile.px4} default"
 
 
-def lint_file_with_timelines(path: str | Path, settings: Settings) -> FileReport:
+def lint_file_with_timelines(
+    path: str | Path, settings: Settings, *, progress: Progress | None = None
+) -> FileReport:
     """``lint_file`` with what the HTML report plots: every vehicle's timeline (every recorded
     position, not one per ``POSITION_PERIOD_S``) and the loss timeout the gate used."""
     settings = settings.for_recording(path)
     timelines: dict[str, Timeline] = {}
-    report = lint_file(path, settings, timelines=timelines, plot_data=True)
+    report = lint_file(path, settings, progress=progress, timelines=timelines, plot_data=True)
     report.timelines = timelines
     report.loss_timeouts = {
         vehicle: timeline_loss_timeout(tl, report.profile, settings)
         for vehicle, tl in timelines.items()
     }
     return report
-
-
-def lint_with_timelines(
-    paths: Sequence[str | Path], settings: Settings, *, jobs: int = 1
-) -> Report:
-    """Like ``lint_paths`` but every file report carries its timelines."""
-    return lint_paths(paths, settings, jobs=jobs, lint=lint_file_with_timelines)

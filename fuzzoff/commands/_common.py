@@ -191,15 +191,20 @@ def print_notes(settings: Settings) -> None:
         print(f"fuzzoff: {note}", file=sys.stderr)
 
 
-def settings_per_recording(settings: Settings, recordings: list[str]) -> None:
-    """Read every recording's nearest configuration before any work: a mistake in one is a
+def resolve_recordings(settings: Settings, recordings: list[str]) -> list[tuple[str, Settings]]:
+    """Each recording with the settings it is judged with, resolved once, before any work
+    (``Settings.resolved_for``): a mistake in a recording's nearest configuration is a
     usage error now, not a failure halfway through the run. Their notes are printed once."""
     seen = set(settings.notes)
+    plan = []
     for recording in recordings:
-        for note in settings.for_recording(recording).notes:
+        resolved = settings.resolved_for(recording)
+        plan.append((recording, resolved))
+        for note in resolved.notes:
             if note not in seen:
                 seen.add(note)
                 print(f"fuzzoff: {note}", file=sys.stderr)
+    return plan
 
 
 def existing_paths(paths: list[str]) -> None:

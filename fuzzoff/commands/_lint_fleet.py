@@ -18,7 +18,7 @@ from fuzzoff.commands._common import (
     check_output,
     existing_paths,
     report_targets,
-    settings_per_recording,
+    resolve_recordings,
     write_stdout,
 )
 from fuzzoff.commands._lint_output import print_problems, write_report
@@ -83,7 +83,10 @@ def run_fleet(args: argparse.Namespace, settings: Settings) -> int:
     for fmt, output in reports:
         if fmt != PARQUET:
             check_output(output, local)
-    settings_per_recording(settings, local)
+    # every local recording's configuration checked, and its notes printed, before any work;
+    # the tasks resolve each again where they run (a fetched URL's copy is judged with the
+    # command's own: fleet.task)
+    resolve_recordings(settings, local)
     lint: Lint = lint_file
     if any(fmt == "html" for fmt, _ in reports):
         from fuzzoff.engine import lint_file_with_timelines
