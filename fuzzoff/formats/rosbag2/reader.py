@@ -140,7 +140,7 @@ class Rosbag2Source(Source):
 
     def open(self) -> None:
         self.decoding.release = px4_msgs.release_for(self.px4_hint)
-        self.decoding.thin_positions(0.0 if self.plot_data else POSITION_PERIOD_S)
+        self.decoding.thin_positions(POSITION_PERIOD_S, self.aside)
         if not self.path.exists():
             raise SourceError(self.path, "no such file or folder")
         if self._summary_damaged():

@@ -16,6 +16,7 @@ from typing import Any, BinaryIO
 
 from fuzzoff.events import (
     MAV_CMD_DO_SET_MODE,
+    NOWHERE,
     Command,
     CommandAck,
     CommandMessage,
@@ -255,11 +256,19 @@ class TlogSource(Source):
         if self._fatal:
             return  # the probe already raised the one SourceError for this file
         self.probe()
-        thinned = None if self.plot_data else THINNED
-        framer = Framer(self._file(), self._size, WANTED, verify=True, thinned=thinned)
+        framer = Framer(self._file(), self._size, WANTED, verify=True, thinned=THINNED)
         self._framer = framer
         framer.on_chunk = self.on_progress
         decoder = _Decoder(self._autopilots, self._vehicles())
+        plot = self.aside.plot
+        if plot is not None:
+
+            def aside(ts: int, msg: Any) -> None:
+                first = framer.stats.first_ts or ts
+                if decoder.from_autopilot(msg):
+                    plot.position(_position_event(msg, (ts - first) / 1e6))
+
+            framer.on_thinned = aside
         first_ts: int | None = None
         try:
             for offset, ts, msgid, msg in framer.records():
@@ -269,6 +278,9 @@ class TlogSource(Source):
                 t = (ts - first_ts) / 1e6
                 yield from decoder.decode(msgid, msg, t, offset)
         finally:
+            last_ts = framer.stats.last_ts
+            if first_ts is not None and last_ts is not None:  # every packet, event or not
+                self.aside.read((last_ts - first_ts) / 1e6)
             self._report(framer.stats, first_ts)
             self.stats.update(self._stats(framer.stats, decoder))
 
@@ -391,6 +403,10 @@ class _Decoder:
         key = f"{msg.get_type()} {why}"
         self.ignored[key] = self.ignored.get(key, 0) + 1
         return ()
+
+    def from_autopilot(self, msg: Any) -> bool:
+        """Is ``msg`` from a vehicle's autopilot (whose messages become events)?"""
+        return self._from_autopilot(msg)
 
     def _from_autopilot(self, msg: Any) -> bool:
         compid = msg.get_srcComponent()
@@ -664,8 +680,7 @@ class _Decoder:
     def _position(self, m: Any, t: float, where: Where) -> Iterable[Event]:
         if not self._from_autopilot(m):
             return self._ignore(m, "not from an autopilot")
-        vehicle = str(m.get_srcSystem())
-        return (VehiclePosition(t=t, vehicle=vehicle, where=where, x=m.x, y=m.y, z=m.z),)
+        return (_position_event(m, t, where),)
 
     def _extended_sys_state(self, m: Any, t: float, where: Where) -> Iterable[Event]:
         """PX4's ``landed_state``: ON_GROUND while its land detector says landed; IN_AIR,
@@ -693,3 +708,8 @@ class _Decoder:
             text=_text(m.text),
         )
         return (text,)
+
+
+def _position_event(m: Any, t: float, where: Where = NOWHERE) -> VehiclePosition:
+    """LOCAL_POSITION_NED as the vehicle's position (NED metres)."""
+    return VehiclePosition(t=t, vehicle=str(m.get_srcSystem()), where=where, x=m.x, y=m.y, z=m.z)
