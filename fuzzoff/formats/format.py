@@ -70,7 +70,6 @@ class Format:
         function: Callable[..., Path] = _load(self.writer)
         return function(path, events, **self.writer_options(px4))
 
-
     def start_s(self, path: Path) -> float | None:
         """When the recording at ``path`` started on the wall clock, where it says."""
         function: Callable[[Path], float | None] = _load(self.clock)

@@ -28,9 +28,11 @@ from fuzzoff.formats.mcap import check as mcap_check
 from fuzzoff.formats.mcap import indexed as mcap_indexed
 from fuzzoff.formats.mcap.order import ChunkOrder
 from fuzzoff.formats.mcap.stream import McapStream
-from fuzzoff.formats.ros2msgs.decode import Decoder, Ros2Decoding, TopicDecoder, message_of
+from fuzzoff.formats.ros2msgs.decode import Decoder, Ros2Decoding, TopicDecoder, px4_topic
 from fuzzoff.formats.rosbag2 import metadata as ros2_metadata
 from fuzzoff.formats.rosbag2.sqlite import SQLITE_ERRORS, SalvageCopies
+from fuzzoff.formats.rosbag2.sqlite import dangling as sqlite_dangling
+from fuzzoff.formats.rosbag2.sqlite import rows as sqlite_rows
 from fuzzoff.formats.rosbag2.sqlite import topics as sqlite_topics
 from fuzzoff.profiles import ROVER_ASSUMED
 from fuzzoff.recording import (
@@ -80,10 +82,11 @@ def _topics_held(path: Path) -> set[tuple[Any, Any]]:
 
 
 def _decoded_topic(topic: Any, msgtype: Any) -> bool:
-    """A topic fuzzoff decodes (a PX4 topic, or a MAVROS one it reads)."""
+    """A topic fuzzoff decodes or must say it could not (a PX4 topic, whatever type it is
+    recorded as, or a MAVROS one it reads)."""
     if not (isinstance(topic, str) and isinstance(msgtype, str)):  # a damaged database
         return False
-    return message_of(topic, msgtype)[0] is not None or mavros_topic(topic, msgtype) is not None
+    return px4_topic(topic, msgtype) or mavros_topic(topic, msgtype) is not None
 
 
 _SQLITE_TYPES = {str: "text", bytes: "blob", float: "real", type(None): "null"}
@@ -94,6 +97,15 @@ def _some(names: list[str]) -> str:
     """The first three names, and how many more."""
     more = f" and {len(names) - 3} more" if len(names) > 3 else ""
     return ", ".join(names[:3]) + more
+
+
+def _dangling(lacking: dict[Any, int], where: str) -> SourceProblem:
+    """Rows naming topic ids the topics table lacks (id -> rows): no topic says how to read
+    them, and rosbags' reading by topic never meets them."""
+    n = sum(lacking.values())
+    rows = f"{n} message rows name" if n > 1 else "1 message row names"
+    ids = _some([repr(ident) if isinstance(ident, str) else str(ident) for ident in lacking])
+    return SourceProblem(f"{rows} a topic id the topics table lacks ({ids}): not read", where)
 
 
 def _why(exc: BaseException) -> str:
@@ -408,8 +420,10 @@ class Rosbag2Source(Source):
         except (*SQLITE_ERRORS, OSError):
             return None
         try:
-            topics = self._sqlite_topics(db)
+            topics, _ = self._sqlite_topics(db)
             for topic_id, decoder in topics.items():
+                if decoder is None:
+                    continue
                 first = db.execute(
                     "SELECT data FROM messages WHERE topic_id = ? ORDER BY id LIMIT 1", (topic_id,)
                 ).fetchone()
@@ -461,7 +475,10 @@ class Rosbag2Source(Source):
         for conn in reader.connections:
             if self._decoder(conn.topic, conn.msgtype, conn.msgdef) is not None:
                 selected.append(conn)
+            elif (conn.topic, conn.msgtype) in self.decoding.unknown:
+                self.decoding.count_unread(conn.topic, conn.msgtype, conn.msgcount)
         if not selected:  # rosbags reads every message when given no connection
+            self._unreachable_rows(reader, where, short=False)
             return
         indexed = self._indexed(where, {(conn.topic, conn.msgtype) for conn in selected})
         if indexed is not None:
@@ -497,18 +514,64 @@ class Rosbag2Source(Source):
                 )
         else:
             listed = sum(conn.msgcount for conn in selected)
-            if count < listed:  # e.g. a metadata.yaml whose topics the database does not have
-                self._fewer(where, selected, count, listed)
+            unreachable = self._unreachable_rows(reader, where, short=count < listed)
+            if count < listed and not unreachable:  # e.g. another bag's metadata.yaml
+                self._fewer(reader, where, selected, count, listed)
         finally:
             self._messages += count
 
-    def _fewer(self, where: Path, selected: list[Any], count: int, listed: int) -> None:
+    def _unreachable_rows(self, reader: Any, where: Path, short: bool) -> bool:
+        """Message rows of the bag's databases that no reading by topic reaches, each kind
+        said in one line (OFB001): rows whose topic id the topics table lacks, and rows
+        missing between the first id and the last. True when there are any. The rows' topic
+        ids are scanned only where the counts leave room for such rows: the reading fell
+        ``short`` of the topics' counts, or the tables hold more rows than the topics count."""
+        files = [path for path in self._data_files(where) if path.suffix == ".db3"]
+        counted = {path: sqlite_rows(path) for path in files}
+        found = False
+        for path, rows in counted.items():
+            if rows is not None and rows.missing:
+                found = True
+                what = (
+                    f"{rows.missing} of the {rows.last_id} message rows are missing from the "
+                    f"database (ids absent between 1 and {rows.last_id}: deleted or lost)"
+                )
+                self.problems.append(SourceProblem(what, self._column(path, where, "id")))
+        held = sum(rows.held for rows in counted.values() if rows is not None)
+        if not files or (not short and held == sum(c.msgcount for c in reader.connections)):
+            return found
+        for path in files:
+            lacking = sqlite_dangling(path)
+            if lacking:
+                column = self._column(path, where, "topic_id")
+                self.problems.append(_dangling(lacking, column))
+                found = True
+        return found
+
+    def _column(self, path: Path, where: Path, column: str) -> str:
+        """``messages.COLUMN``, in the data file's name when a bag folder is read."""
+        return f"messages.{column}" + ("" if path == self.path else f" in {path.name}")
+
+    def _fewer(
+        self, reader: Any, where: Path, selected: list[Any], count: int, listed: int
+    ) -> None:
         """Fewer messages were read than the index lists. If the data files hold no more than
         were read, the index is what is wrong (metadata.yaml from another recording, a
-        damaged count): said, nothing lost; else the rest were not read."""
+        damaged count): said, nothing lost; unless the data end before the bag's end that
+        metadata.yaml states from the same start (its last messages are gone); else the rest
+        were not read."""
         index = "metadata.yaml" if where.is_dir() else where.name
         topics = {(conn.topic, conn.msgtype) for conn in selected}
         held = ros2_metadata.held_messages(self._data_files(where), topics)
+        short = self._ends_early(reader, where)
+        if short is not None:
+            what = (
+                f"{listed - count} of the {listed} messages {index} lists on the PX4 topics "
+                f"are not in the data, which ends {short / 1e9:.3f} s before the bag's end "
+                "(its last messages are missing)"
+            )
+            self.problems.append(SourceProblem(what))
+            return
         if held is not None and held <= count:
             what = (
                 f"{index} lists {listed} messages on the PX4 topics, the data files hold "
@@ -521,6 +584,17 @@ class Rosbag2Source(Source):
             "are not in the data (the two disagree)"
         )
         self.problems.append(SourceProblem(what))
+
+    def _ends_early(self, reader: Any, where: Path) -> int | None:
+        """How many ns before metadata.yaml's end the data files' last message is, where the
+        two agree on the start (not another bag's metadata.yaml); None where they do not."""
+        if not where.is_dir():
+            return None
+        span = ros2_metadata.data_span(self._data_files(where))
+        listed_end = reader.end_time - 1
+        if span is None or span[0] != reader.start_time or span[1] >= listed_end:
+            return None
+        return int(listed_end - span[1])
 
     def _untimed(self, stamp: Any, where: Path) -> None:
         """A message whose time is not an integer (a damaged database): skipped, counted."""
@@ -636,8 +710,9 @@ class Rosbag2Source(Source):
         self, db: sqlite3.Connection, path: Path, exc: BaseException
     ) -> Iterator[Event]:
         count = 0
+        lacking: dict[Any, int] = {}
         try:
-            topics = self._sqlite_topics(db)
+            topics, unknown = self._sqlite_topics(db)
             order = ChunkOrder()
             t0 = self._t0
             rows = db.execute("SELECT topic_id, timestamp, data FROM messages ORDER BY id")
@@ -651,6 +726,10 @@ class Rosbag2Source(Source):
                         t0 = self._t0 = stamp
                     decoder = topics.get(topic_id)
                     if decoder is None:
+                        if topic_id in unknown:
+                            self.decoding.count_unread(*unknown[topic_id], 1)
+                        elif topic_id not in topics:
+                            lacking[topic_id] = lacking.get(topic_id, 0) + 1
                         continue
                     event = decoder.event(raw, (stamp - t0) / 1e9)
                     if event is not None:
@@ -676,14 +755,21 @@ class Rosbag2Source(Source):
         finally:
             self._messages += count
             db.close()
+        if lacking:
+            self.problems.append(_dangling(lacking, self._column(path, path, "topic_id")))
 
-    def _sqlite_topics(self, db: sqlite3.Connection) -> dict[int, Decoder]:
-        out: dict[int, Decoder] = {}
+    def _sqlite_topics(
+        self, db: sqlite3.Connection
+    ) -> tuple[dict[Any, Decoder | None], dict[Any, tuple[str, str]]]:
+        """Topic id -> its decoder (None: a topic fuzzoff does not read), and the PX4 topics
+        of a type it cannot decode (whose rows are counted as not read)."""
+        out: dict[Any, Decoder | None] = {}
+        unknown: dict[Any, tuple[str, str]] = {}
         for topic_id, name, msgtype, text, fmt in sqlite_topics(db):
-            decoder = self._connect(name, msgtype, text, fmt)
-            if decoder is not None:
-                out[topic_id] = decoder
-        return out
+            out[topic_id] = decoder = self._connect(name, msgtype, text, fmt)
+            if decoder is None and (name, msgtype) in self.decoding.unknown:
+                unknown[topic_id] = (name, msgtype)
+        return out, unknown
 
     def _finish(self) -> None:
         if self._t0 is not None:
