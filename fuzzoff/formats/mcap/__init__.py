@@ -7,8 +7,9 @@ from pathlib import Path
 from typing import Any
 
 from fuzzoff.formats.format import Format
+from fuzzoff.formats.ros2.storage import MCAP_MAGIC
 
-MAGIC = b"\x89MCAP"
+MAGIC = MCAP_MAGIC
 
 
 def _detect(path: Path, head: bytes) -> str | None:

@@ -18,7 +18,6 @@ from pathlib import Path
 from typing import Any
 
 from rosbags.interfaces import MessageDefinitionFormat
-from rosbags.rosbag2 import Reader
 from ruamel.yaml import YAML
 
 from fuzzoff.events import Event
@@ -28,6 +27,8 @@ from fuzzoff.formats.mcap import check as mcap_check
 from fuzzoff.formats.mcap import indexed as mcap_indexed
 from fuzzoff.formats.mcap.order import ChunkOrder
 from fuzzoff.formats.mcap.stream import McapStream
+from fuzzoff.formats.ros2.reader import StorageReader
+from fuzzoff.formats.ros2.storage import data_files, storage_of
 from fuzzoff.formats.ros2msgs.decode import Decoder, Ros2Decoding, TopicDecoder, px4_topic
 from fuzzoff.formats.rosbag2 import metadata as ros2_metadata
 from fuzzoff.formats.rosbag2.sqlite import SQLITE_ERRORS, SalvageCopies
@@ -43,7 +44,6 @@ from fuzzoff.recording import (
     SourceProblem,
 )
 
-DATA_SUFFIXES = (".db3", ".mcap")
 STATUS_WINDOW_NS = 10_000_000_000
 """The vehicle type is looked up in the first VehicleStatus of the first 10 s (PX4 sends it
 at 1-2 Hz and on every change)."""
@@ -71,13 +71,13 @@ def _topics_held(path: Path) -> set[tuple[Any, Any]]:
     """(topic, type) of every topic a data file names: a database's topics table (rosbags'
     own opening of one would also count its messages, 0.5 s on a million), an MCAP's
     channels through rosbags."""
-    if path.suffix == ".db3":
+    if storage_of(path) == "sqlite3":
         db = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
         try:
             return {(name, msgtype) for _, name, msgtype, _, _ in sqlite_topics(db)}
         finally:
             db.close()
-    with Reader(path) as single:
+    with StorageReader(path) as single:
         return {(conn.topic, conn.msgtype) for conn in single.connections}
 
 
@@ -163,7 +163,7 @@ class Rosbag2Source(Source):
                 self._salvage_plan(ValueError(fault), fault)
                 return
         try:
-            reader = Reader(self.path)
+            reader = StorageReader(self.path)
             reader.open()
         except Exception as exc:
             self._salvage_plan(exc)
@@ -394,7 +394,7 @@ class Rosbag2Source(Source):
             try:
                 if path in self._stream_only:
                     raise ValueError("read front to back")
-                with Reader(path) as reader:
+                with StorageReader(path) as reader:
                     for conn in reader.connections:
                         self._decoder(conn.topic, conn.msgtype, conn.msgdef)
                     if reader.message_count:
@@ -402,7 +402,7 @@ class Rosbag2Source(Source):
                         # as for a whole bag: definitions, release and vehicle type up front
                         self._presample(reader)
             except Exception:  # salvaged below, and again in the reading pass
-                if path.suffix == ".db3":
+                if storage_of(path) == "sqlite3":
                     start = self._probe_salvage(path)
                 else:
                     stream = McapStream(path, self.decoding, None, self._connect)
@@ -526,7 +526,7 @@ class Rosbag2Source(Source):
         missing between the first id and the last. True when there are any. The rows' topic
         ids are scanned only where the counts leave room for such rows: the reading fell
         ``short`` of the topics' counts, or the tables hold more rows than the topics count."""
-        files = [path for path in self._data_files(where) if path.suffix == ".db3"]
+        files = [path for path in self._data_files(where) if storage_of(path) == "sqlite3"]
         counted = {path: sqlite_rows(path) for path in files}
         found = False
         for path, rows in counted.items():
@@ -641,22 +641,22 @@ class Rosbag2Source(Source):
     def _single_mcap(self, where: Path) -> Path | None:
         """The data file of a bag (or a bag file) stored as one MCAP file, else None."""
         files = self._data_files(where)
-        return files[0] if len(files) == 1 and files[0].suffix == ".mcap" else None
+        return files[0] if len(files) == 1 and storage_of(files[0]) == "mcap" else None
 
     def _data_files(self, where: Path) -> list[Path]:
         if where.is_file():
             return [where]
-        return sorted(p for p in where.iterdir() if p.suffix in DATA_SUFFIXES)
+        return data_files(where)
 
     def _read_file(self, path: Path) -> Iterator[Event]:
         if path in self._stream_only:
             yield from self._salvage_mcap(path)
             return
         try:
-            reader = Reader(path)
+            reader = StorageReader(path)
             reader.open()
         except Exception as exc:
-            if path.suffix == ".mcap":
+            if storage_of(path) == "mcap":
                 yield from self._salvage_mcap(path, refused=_why(exc))
             else:
                 yield from self._salvage_sqlite(path, exc)
