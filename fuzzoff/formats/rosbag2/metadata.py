@@ -68,7 +68,7 @@ def fault(folder: Path, files: list[Path]) -> str | None:
 
 def _storage_fault(info: dict[str, Any], files: list[Path]) -> str | None:
     storage = info["storage_identifier"]
-    kinds = sorted({SUFFIX[held] for path in files if (held := storage_of(path)) is not None})
+    kinds = sorted({SUFFIX[kind] for path in files if (kind := storage_of(path)) is not None})
     if storage not in SUFFIX:
         return f"metadata.yaml names the storage {_shown(storage)}, which rosbag2 does not have"
     if kinds and kinds != [SUFFIX[storage]]:

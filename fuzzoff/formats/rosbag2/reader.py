@@ -555,46 +555,39 @@ class Rosbag2Source(Source):
     def _fewer(
         self, reader: Any, where: Path, selected: list[Any], count: int, listed: int
     ) -> None:
-        """Fewer messages were read than the index lists. If the data files hold no more than
-        were read, the index is what is wrong (metadata.yaml from another recording, a
-        damaged count): said, nothing lost; unless the data end before the bag's end that
-        metadata.yaml states from the same start (its last messages are gone); else the rest
-        were not read."""
+        """Fewer messages were read than the index lists. Where the data files hold no more
+        than were read, either the index or the data is damaged: metadata.yaml from another
+        recording (its start is not the data's) is said, nothing lost; one whose start is the
+        data's cannot be told from data that lost messages (at the end, where the ids show no
+        gap), so the rest count as not read. Else the rest were not read."""
         index = "metadata.yaml" if where.is_dir() else where.name
         topics = {(conn.topic, conn.msgtype) for conn in selected}
         held = ros2_metadata.held_messages(self._data_files(where), topics)
-        short = self._ends_early(reader, where)
-        if short is not None:
+        missing = f"{listed - count} of the {listed} messages {index} lists on the PX4 topics"
+        if held is not None and held <= count:
+            short = self._short_of(reader, where)
+            if short is None:
+                what = f"{index} lists {listed} messages on the PX4 topics, the data files hold "
+                self.problems.append(SourceProblem(f"{what}{held}: every one was read", lost=False))
+                return
+            ending = f", which end {short / 1e9:.3f} s before the bag's end" if short else ""
             what = (
-                f"{listed - count} of the {listed} messages {index} lists on the PX4 topics "
-                f"are not in the data, which ends {short / 1e9:.3f} s before the bag's end "
-                "(its last messages are missing)"
+                f"{missing} are not in the data files{ending} (messages lost, or "
+                f"{index}'s counts damaged: which cannot be told)"
             )
             self.problems.append(SourceProblem(what))
             return
-        if held is not None and held <= count:
-            what = (
-                f"{index} lists {listed} messages on the PX4 topics, the data files hold "
-                f"{held}: every one was read"
-            )
-            self.problems.append(SourceProblem(what, lost=False))
-            return
-        what = (
-            f"{listed - count} of the {listed} messages {index} lists on the PX4 topics "
-            "are not in the data (the two disagree)"
-        )
-        self.problems.append(SourceProblem(what))
+        self.problems.append(SourceProblem(f"{missing} are not in the data (the two disagree)"))
 
-    def _ends_early(self, reader: Any, where: Path) -> int | None:
-        """How many ns before metadata.yaml's end the data files' last message is, where the
-        two agree on the start (not another bag's metadata.yaml); None where they do not."""
+    def _short_of(self, reader: Any, where: Path) -> int | None:
+        """How many ns before metadata.yaml's end the data files' last message is (0 or more),
+        where the two agree on the start (not another bag's metadata.yaml); else None."""
         if not where.is_dir():
             return None
         span = ros2_metadata.data_span(self._data_files(where))
-        listed_end = reader.end_time - 1
-        if span is None or span[0] != reader.start_time or span[1] >= listed_end:
+        if span is None or span[0] != reader.start_time:
             return None
-        return int(listed_end - span[1])
+        return max(0, int(reader.end_time - 1 - span[1]))
 
     def _untimed(self, stamp: Any, where: Path) -> None:
         """A message whose time is not an integer (a damaged database): skipped, counted."""
