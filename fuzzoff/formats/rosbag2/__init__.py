@@ -7,7 +7,7 @@ import re
 from pathlib import Path
 
 from fuzzoff.formats.format import Format
-from fuzzoff.formats.mcap import release_options
+from fuzzoff.formats.ros2 import release_options
 from fuzzoff.formats.ros2.storage import data_files, storage_from_head, storage_of
 from fuzzoff.recording import SourceError
 
