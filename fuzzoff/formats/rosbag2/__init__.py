@@ -74,6 +74,7 @@ FORMAT = Format(
     suffixes=(".db3",),
     written_suffix="",
     transports=("ros2",),
+    is_folder=is_bag_folder,
     detect_folder=detect_folder,
     writer_options=release_options,
 )
