@@ -370,11 +370,12 @@ class Ros2Source(Source):
     def _fewer(
         self, reader: Any, where: Path, selected: list[Any], count: int, listed: int
     ) -> None:
-        """Fewer messages were read than the index lists. Where the data files hold no more
-        than were read, either the index or the data is damaged: metadata.yaml from another
-        recording (its start is not the data's) is said, nothing lost; one whose start is the
-        data's cannot be told from data that lost messages (at the end, where the ids show no
-        gap), so the rest count as not read. Else the rest were not read."""
+        """Fewer messages were read than the index lists (an MCAP's statistics, a bag's
+        metadata.yaml). Where the data files hold no more than were read (``_held``), either
+        the index or the data is damaged: an index that is not the data's own (``_short_of``
+        None: another bag's metadata.yaml) is said, nothing lost; one whose start is the
+        data's cannot be told from data that lost messages (at the end, where a database's
+        ids show no gap), so the rest count as not read. Else the rest were not read."""
         index = "metadata.yaml" if where.is_dir() else where.name
         topics = {(conn.topic, conn.msgtype) for conn in selected}
         held = self._held(where, topics)
