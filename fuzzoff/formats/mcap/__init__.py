@@ -7,14 +7,13 @@ from pathlib import Path
 
 from fuzzoff.formats.format import Format
 from fuzzoff.formats.ros2 import release_options
-from fuzzoff.formats.ros2.storage import MCAP_MAGIC
-
-MAGIC = MCAP_MAGIC
+from fuzzoff.formats.ros2.storage import storage_from_head
 
 
 def _detect(path: Path, head: bytes) -> str | None:
-    """An MCAP beside a metadata.yaml is a ROS 2 bag's data file: the rosbag2 entry's."""
-    if head.startswith(MAGIC) and not path.parent.joinpath("metadata.yaml").is_file():
+    """An MCAP, whatever its name; one beside a metadata.yaml is a ROS 2 bag's data file: the
+    rosbag2 entry's."""
+    if storage_from_head(head) == "mcap" and not path.parent.joinpath("metadata.yaml").is_file():
         return "mcap"
     return None
 
