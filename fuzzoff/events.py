@@ -29,6 +29,10 @@ from itertools import compress
 from operator import attrgetter
 from typing import Any, ClassVar, Literal
 
+# Named through ``events`` by the gate, the reports and the fuzz streams, beside Command.
+from fuzzoff.mavlink_ids import MAV_CMD_COMPONENT_ARM_DISARM as MAV_CMD_COMPONENT_ARM_DISARM
+from fuzzoff.mavlink_ids import MAV_CMD_DO_SET_MODE as MAV_CMD_DO_SET_MODE
+
 Origin = Literal["sent", "vehicle", "model"]
 Transport = Literal["ros2", "mavlink", "mavros", "uorb"]
 CommandMessage = Literal["COMMAND_LONG", "COMMAND_INT", "SET_MODE"]
@@ -383,6 +387,7 @@ class SetActuatorControlTarget(Event):
     source_system: int | None = None
     source_component: int | None = None
 
+
 PX4_SETPOINTS: tuple[type[Event], ...] = (
     TrajectorySetpoint,
     AttitudeSetpoint,
@@ -493,8 +498,6 @@ class LandDetected(Event):
 # ---------------------------------------------------------------------------------------------
 # Commands, acks, parameters, vehicle identity
 
-MAV_CMD_DO_SET_MODE = 176
-MAV_CMD_COMPONENT_ARM_DISARM = 400
 VEHICLE_CMD_SET_NAV_STATE = 100001
 PX4_MAIN_MODE_OFFBOARD = 6
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+from fuzzoff.mavlink_ids import MAV_FRAME_LOCAL_NED
 from fuzzoff.sitl.link import Ack, Link, LinkError
 
 POSITION = 0x0DF8
@@ -19,8 +20,6 @@ VELOCITY = 0x0DC7
 """type_mask: velocity only."""
 ACCELERATION = 0x0C3F
 """type_mask: acceleration only (FORCE bit clear)."""
-MAV_FRAME_LOCAL_NED = 1
-MAV_FRAME_LOCAL_ENU = 4
 NAV_POSCTL, NAV_LOITER, NAV_RTL, NAV_OFFBOARD, NAV_TAKEOFF, NAV_LAND = 2, 4, 5, 14, 17, 18
 MANUAL_EVERY_S = 0.1
 """A MAVLink joystick at 10 Hz: PX4 declares manual control lost after COM_RC_LOSS_T (0.5 s)."""

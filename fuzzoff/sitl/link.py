@@ -24,6 +24,15 @@ os.environ.setdefault("MAVLINK20", "1")  # formats.md 7.2: before any pymavlink 
 from pymavlink import mavutil
 from pymavlink.dialects.v20 import development as mavlink
 
+from fuzzoff.mavlink_ids import (
+    MAV_AUTOPILOT_PX4,
+    MAV_CMD_COMPONENT_ARM_DISARM,
+    MAV_CMD_DO_SET_MODE,
+    MAV_CMD_REQUEST_MESSAGE,
+    MAV_CMD_SET_MESSAGE_INTERVAL,
+    MAV_COMP_ID_ONBOARD_COMPUTER,
+    MAV_MODE_FLAG_SAFETY_ARMED,
+)
 from fuzzoff.modes import custom_mode_to_nav_state, nav_state_to_custom_mode
 from fuzzoff.sitl.clock import PX4Clock
 from fuzzoff.sitl.recorder import TlogRecorder
@@ -31,16 +40,9 @@ from fuzzoff.sitl.recorder import TlogRecorder
 DIALECT = "development"
 COMPANION_SYSID = 245
 """The client's default system id: not 1 (PX4's), nor 255 (a ground station's usual one)."""
-MAV_COMP_ID_ONBOARD_COMPUTER = 191
-MAV_AUTOPILOT_PX4 = 12
 PREARM_BIT = mavlink.MAV_SYS_STATUS_PREARM_CHECK
 RC_RECEIVER_BIT = mavlink.MAV_SYS_STATUS_SENSOR_RC_RECEIVER
 """Present and healthy in SYS_STATUS while PX4 has manual control (an RC or a MAVLink joystick)."""
-MAV_MODE_FLAG_SAFETY_ARMED = 128
-MAV_CMD_DO_SET_MODE = 176
-MAV_CMD_COMPONENT_ARM_DISARM = 400
-MAV_CMD_SET_MESSAGE_INTERVAL = 511
-MAV_CMD_REQUEST_MESSAGE = 512
 AUTOPILOT_VERSION_ID = 148
 BUSY_TELEMETRY = {
     "ATTITUDE": 30,

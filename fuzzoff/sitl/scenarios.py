@@ -12,8 +12,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Literal
 
+from fuzzoff.mavlink_ids import MAV_FRAME_LOCAL_ENU
 from fuzzoff.sitl.driver import (
-    MAV_FRAME_LOCAL_ENU,
     NAV_LOITER,
     NAV_OFFBOARD,
     NAV_TAKEOFF,

@@ -139,6 +139,13 @@ def message_of(topic: str, msgtype: str) -> tuple[str | None, TopicRef | None]:
     return None, ref
 
 
+def px4_topic(topic: str, msgtype: str) -> bool:
+    """A topic fuzzoff reads, or must say it could not: a PX4 message type, or the name of a
+    PX4 topic it decodes whatever type it is recorded as."""
+    message, ref = message_of(topic, msgtype)
+    return message is not None or (ref is not None and ref.name in MESSAGE_FOR_NAME)
+
+
 @dataclass(slots=True)
 class TopicDecoder:
     """Decodes one connection's payloads into events; counts what it could not decode."""
@@ -285,6 +292,9 @@ class Ros2Decoding:
     decoders: list[Decoder] = field(default_factory=list)
     mavros: MavrosConverter = field(default_factory=MavrosConverter)
     unknown: list[tuple[str, str]] = field(default_factory=list)
+    """PX4 topics recorded as a type fuzzoff cannot decode (name, type)."""
+    unread: dict[tuple[str, str], int] = field(default_factory=dict)
+    """How many messages of each of ``unknown`` the recording holds, where the reader counted."""
     evidence: set[str] | None = None
     """Releases every definition seen so far fits (for profile detection)."""
     notes: list[str] = field(default_factory=list)
@@ -471,13 +481,22 @@ class Ros2Decoding:
     def vehicles(self) -> list[str]:
         return sorted({d.vehicle for d in self.decoders})
 
+    def count_unread(self, topic: str, msgtype: str, messages: int) -> None:
+        """``messages`` more messages of an ``unknown`` topic were not read."""
+        key = (topic, msgtype)
+        self.unread[key] = self.unread.get(key, 0) + messages
+
     def problems(self) -> list[SourceProblem]:
         out = []
         for topic, msgtype in self.unknown:
+            held = self.unread.get((topic, msgtype))
+            unread = f"its {held} messages were not read" if held is not None else "not read"
+            if held == 1:
+                unread = "its 1 message was not read"
             out.append(
                 SourceProblem(
                     f"topic {topic} has message type {msgtype or '(none)'}, which fuzzoff "
-                    "cannot decode as a PX4 topic; not read",
+                    f"cannot decode as a PX4 topic: {unread}",
                     topic,
                 )
             )

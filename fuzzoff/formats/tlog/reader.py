@@ -15,7 +15,6 @@ from pathlib import Path
 from typing import Any, BinaryIO
 
 from fuzzoff.events import (
-    MAV_CMD_DO_SET_MODE,
     NOWHERE,
     Command,
     CommandAck,
@@ -36,6 +35,17 @@ from fuzzoff.events import (
 )
 from fuzzoff.findings import RecordingStats
 from fuzzoff.formats.tlog.frames import RESYNC_LIMIT, Framer, FrameStats, message_name
+from fuzzoff.mavlink_ids import (
+    MAV_AUTOPILOT_PX4,
+    MAV_CMD_DO_SET_MODE,
+    MAV_COMP_ID_AUTOPILOT1,
+    MAV_LANDED_STATE_ON_GROUND,
+    MAV_LANDED_STATE_UNDEFINED,
+    MAV_MODE_FLAG_CUSTOM_MODE_ENABLED,
+    MAV_MODE_FLAG_SAFETY_ARMED,
+    MAV_SYS_STATUS_SENSOR_RC_RECEIVER,
+    MAV_TYPE_GCS,
+)
 from fuzzoff.modes import custom_mode_to_nav_state, nav_state_name, split_custom_mode
 from fuzzoff.profiles import MAV_TYPE_VEHICLE
 from fuzzoff.recording import (
@@ -98,16 +108,6 @@ KEEPALIVE_IDS = frozenset(
 SENT_STREAM_IDS = KEEPALIVE_IDS | {SET_ACTUATOR_CONTROL_TARGET}
 """Setpoint messages a companion sends: a log holding any of them holds the sent stream."""
 
-MAV_COMP_ID_AUTOPILOT1 = 1
-MAV_AUTOPILOT_PX4 = 12
-MAV_TYPE_GCS = 6
-MAV_MODE_FLAG_CUSTOM_MODE_ENABLED = 1
-MAV_MODE_FLAG_SAFETY_ARMED = 128
-MAV_LANDED_STATE_UNDEFINED = 0
-MAV_LANDED_STATE_ON_GROUND = 1
-MAV_SYS_STATUS_SENSOR_RC_RECEIVER = 1 << 16
-"""SYS_STATUS bit PX4 sets present and healthy while it has manual control (RC or a MAVLink
-joystick: its ``manual_control_signal_lost`` is false)."""
 INT_PARAM_TYPES = frozenset({1, 2, 3, 4, 5, 6})
 """MAV_PARAM_TYPE UINT8..INT32: the float's four bytes hold the integer (PX4's encoding)."""
 

@@ -49,6 +49,17 @@ from fuzzoff.events import (
     VehiclePosition,
     VehicleStatus,
 )
+from fuzzoff.mavlink_ids import (
+    MAV_AUTOPILOT_INVALID,
+    MAV_AUTOPILOT_PX4,
+    MAV_MODE_FLAG_CUSTOM_MODE_ENABLED,
+    MAV_MODE_FLAG_SAFETY_ARMED,
+    MAV_PARAM_TYPE_INT32,
+    MAV_PARAM_TYPE_REAL32,
+    MAV_STATE_ACTIVE,
+    MAV_TYPE_GCS,
+    MAV_TYPE_QUADROTOR,
+)
 from fuzzoff.modes import nav_state_to_custom_mode
 
 Sender = tuple[int, int]
@@ -56,15 +67,6 @@ Sender = tuple[int, int]
 DEFAULT_START_US = 1_735_689_600_000_000
 """2025-01-01 00:00:00 UTC: the wall clock of the first record."""
 
-MAV_AUTOPILOT_PX4 = 12
-MAV_TYPE_GCS = 6
-MAV_AUTOPILOT_INVALID = 8
-MAV_TYPE_QUADROTOR = 2
-MAV_MODE_FLAG_CUSTOM_MODE_ENABLED = 1
-MAV_MODE_FLAG_SAFETY_ARMED = 128
-MAV_STATE_ACTIVE = 4
-MAV_PARAM_TYPE_INT32 = 6
-MAV_PARAM_TYPE_REAL32 = 9
 FIRMWARE_VERSION_TYPE_OFFICIAL = 255
 
 FLOAT_PARAMS = frozenset({"COM_OF_LOSS_T", "COM_OBC_LOSS_T", "COM_RC_LOSS_T", "COM_DL_LOSS_T"})
