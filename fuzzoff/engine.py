@@ -11,9 +11,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import cast
 
-from fuzzoff.catalog import get_rule
+from fuzzoff.catalog import get_rule, sent_stream_rules
 from fuzzoff.checks import CheckContext, load_all
-from fuzzoff.checks.base import SENT_STREAM_RULES, STREAM_TYPES, Check, StreamBatch
+from fuzzoff.checks.base import STREAM_TYPES, Check, StreamBatch
 from fuzzoff.checks.whole_file import in_readable_part, recording_findings
 from fuzzoff.config import Settings
 from fuzzoff.events import (
@@ -383,7 +383,7 @@ def _stream_not_recorded(
     vehicles: list[str], info: RecordingInfo, settings: Settings, follows_flag: bool
 ) -> Finding:
     """The one OFB002 of a recording without the sent stream that shows offboard in use."""
-    codes = ", ".join(c for c in SENT_STREAM_RULES if settings.enabled(c))
+    codes = ", ".join(c for c in sent_stream_rules() if settings.enabled(c))
     who = f" on vehicle {', '.join(vehicles)}" if any(vehicles) else ""
     missing = info.stream_missing or "does not hold the stream sent to the vehicle"
     if follows_flag:

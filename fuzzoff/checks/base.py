@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 from operator import attrgetter
 from typing import Any, ClassVar
 
-from fuzzoff.catalog import get_rule
+from fuzzoff.catalog import get_rule, sent_stream_rules
 from fuzzoff.config import Settings
 from fuzzoff.events import (
     KEEPALIVE_ROS,
@@ -42,21 +42,6 @@ from fuzzoff.tables.control_mode import FlagRow, row_for
 
 REGISTRY: list[type[Check]] = []
 
-SENT_STREAM_RULES: tuple[str, ...] = (
-    "OFB101",
-    "OFB102",
-    "OFB103",
-    "OFB104",
-    "OFB105",
-    "OFB106",
-    "OFB107",
-    "OFB203",
-    "OFB303",
-)
-"""The rules that judge the keep-alive and setpoint stream as sent. On a recording that cannot
-hold it (``RecordingInfo.stream_recorded``) they are not run: its absence there says nothing
-about the sender, and the engine says so in one OFB002."""
-
 
 @dataclass(slots=True)
 class CheckContext:
@@ -73,7 +58,7 @@ class CheckContext:
     not_checkable: dict[str, str] = field(default_factory=dict)
     """code -> what the recording would need (one OFB002 finding lists them all)."""
     stream_recorded: bool = True
-    """False: the recording holds no sent stream, and ``SENT_STREAM_RULES`` are off."""
+    """False: the recording holds no sent stream, and the ``sent_stream`` rules are off."""
     offboard_used: bool = False
     """The vehicle was in OFFBOARD (or an external mode) or asked to switch there, as far as
     the events so far show (kept by ``whole_file.OffboardUse`` while OFB005 is enabled)."""
@@ -91,7 +76,7 @@ class CheckContext:
             return row
 
     def enabled(self, code: str) -> bool:
-        if not self.stream_recorded and code in SENT_STREAM_RULES:
+        if not self.stream_recorded and code in sent_stream_rules():
             return False
         try:
             rule = get_rule(code)
