@@ -9,6 +9,7 @@ import ast
 import importlib.util
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -207,3 +208,53 @@ def test_refresh_expected_writes_a_rules_findings_in_the_recorded_corpora_only(
     built.write_text((ROOT / "corpora" / "stream" / "ofb105_good.expected.json").read_text())
     assert refresh_expected.main(["OFB005", "OFB701", "--corpora", str(corpora)]) == 0
     assert capsys.readouterr().out == ""
+
+
+# -- Add a PX4 release ----------------------------------------------------------------------------
+
+RELEASE_TESTS = (
+    "tests/test_releases.py",
+    "tests/test_rule_pages.py",
+    "tests/test_config.py::test_a_px4_release_that_is_not_modelled_is_an_error",
+    "tests/test_fuzz_cli_errors.py::test_a_px4_release_not_modelled_is_refused_as_lint_refuses_it",
+)
+"""The tests that read the release table. With a release added (and the docs built), the whole
+suite failed only in test_releases, test_config and test_fuzz_cli_errors, which named 1.18 as the
+newest release and 1.19 as one past it, until they read both from the table; test_rule_pages'
+pattern of docs addresses stopped at 1.18."""
+
+
+def add_release(releases_py: Path) -> str:
+    """The recipe's one edit: ``V1_19 = replace(V1_18, ...)`` before ``MAIN``, in ``RELEASES``
+    and ``PX4Profile``, ``MAIN`` pointed at it. Returns the new name."""
+    text = releases_py.read_text()
+    newest = re.findall(r"^(V1_(\d+)) = replace\(", text, re.M)[-1]
+    old, minor = newest[0], int(newest[1])
+    new, name = f"V1_{minor + 1}", f"1.{minor + 1}"
+    record = (
+        f'{new} = replace({old}, name="{name}", covers="v{name}: as 1.{minor}", '
+        f"minors=({minor + 1},))\n\n"
+    )
+    edits = [
+        (f'"1.{minor}", "main"]', f'"1.{minor}", "{name}", "main"]'),
+        (f"MAIN = replace(\n    {old},", f"{record}MAIN = replace(\n    {new},"),
+        (f"{old}, MAIN)", f"{old}, {new}, MAIN)"),
+    ]
+    for before, after in edits:
+        assert text.count(before) == 1, before
+        text = text.replace(before, after)
+    releases_py.write_text(text)
+    return name
+
+
+def test_a_release_added_to_the_table_needs_no_other_edit(tmp_path: Path) -> None:
+    copy = scratch_copy(tmp_path)
+    cache = tmp_path / "cache"
+    name = add_release(copy / "fuzzoff" / "releases.py")
+    listed = run_in(copy, "-m", "fuzzoff.cli", "profiles", "--format", "json", cache=cache)
+    assert [p["profile"] for p in json.loads(listed.stdout)["px4"]][-2:] == [name, "main"]
+    built = run_in(copy, "docs/rules/build.py", cache=cache)  # the recipe's docs step
+    assert built.returncode == 0, built.stderr
+    assert f"1.18, {name}, main" in (copy / "docs" / "rules" / "OFB608.md").read_text()
+    done = pytest_in(copy, *RELEASE_TESTS, cache=cache)
+    assert done.returncode == 0, done.stdout[-3000:]
