@@ -151,11 +151,11 @@ class VehicleRun:
         self.checks = [cls(self.ctx) for cls in load_all() if cls.wanted(self.ctx)]
         self.handlers: dict[type, list[Callable[[Event], None]]] = {}
         self.batched = [c for c in self.checks if batching and _takes_runs(c)]
-        """Checks that take the stream messages as runs (``StreamBatch``), not one by one."""
+        """Checks that take stream messages: each gets them as runs (``StreamBatch``)."""
         self._wants = [
             (check.subscriptions, check.on_event, check in self.batched) for check in self.checks
         ]
-        self._takers = [check.on_batch for check in self.batched if check.on_batch is not None]
+        self._takers = [check.on_batch for check in self.batched]
         self._batch: StreamBatch | None = None
         self.timeline = timeline
         self.last_t = 0.0
@@ -173,7 +173,8 @@ class VehicleRun:
         return handlers
 
     def _flush(self) -> None:
-        """Hand the open run to the checks that take runs (before anything that changes state)."""
+        """Hand the open run to the checks that take stream messages (before anything that
+        changes state)."""
         batch = self._batch
         if batch is None:
             return
@@ -415,10 +416,8 @@ def _stream_not_recorded(
 
 
 def _takes_runs(check: Check) -> bool:
-    """Does the check define ``on_batch`` and want any stream message?"""
-    return check.on_batch is not None and any(
-        issubclass(cls, check.subscriptions) for cls in STREAM_TYPES
-    )
+    """Does the check want any stream message (then it takes them as runs)?"""
+    return any(issubclass(cls, check.subscriptions) for cls in STREAM_TYPES)
 
 
 def _sort_key(finding: Finding) -> tuple[float, str, str]:
