@@ -10,9 +10,9 @@ from contextlib import AbstractContextManager, contextmanager
 from pathlib import Path
 from typing import Protocol, cast
 
-from fuzzoff.catalog import get_rule
+from fuzzoff.catalog import get_rule, sent_stream_rules
 from fuzzoff.checks import CheckContext, load_all
-from fuzzoff.checks.base import SENT_STREAM_RULES, STREAM_TYPES, Check, StreamBatch
+from fuzzoff.checks.base import STREAM_TYPES, Check, StreamBatch
 from fuzzoff.checks.whole_file import in_readable_part, recording_findings
 from fuzzoff.config import Settings
 from fuzzoff.events import (
@@ -139,11 +139,11 @@ class VehicleRun:
         self.checks = [cls(self.ctx) for cls in load_all() if cls.wanted(self.ctx)]
         self.handlers: dict[type, list[Callable[[Event], None]]] = {}
         self.batched = [c for c in self.checks if batching and _takes_runs(c)]
-        """Checks that take the stream messages as runs (``StreamBatch``), not one by one."""
+        """Checks that take stream messages: each gets them as runs (``StreamBatch``)."""
         self._wants = [
             (check.subscriptions, check.on_event, check in self.batched) for check in self.checks
         ]
-        self._takers = [check.on_batch for check in self.batched if check.on_batch is not None]
+        self._takers = [check.on_batch for check in self.batched]
         self._batch: StreamBatch | None = None
         self.timeline = timeline
         self.last_t = 0.0
@@ -161,7 +161,8 @@ class VehicleRun:
         return handlers
 
     def _flush(self) -> None:
-        """Hand the open run to the checks that take runs (before anything that changes state)."""
+        """Hand the open run to the checks that take stream messages (before anything that
+        changes state)."""
         batch = self._batch
         if batch is None:
             return
@@ -371,7 +372,7 @@ def _stream_not_recorded(
     vehicles: list[str], info: RecordingInfo, settings: Settings, follows_flag: bool
 ) -> Finding:
     """The one OFB002 of a recording without the sent stream that shows offboard in use."""
-    codes = ", ".join(c for c in SENT_STREAM_RULES if settings.enabled(c))
+    codes = ", ".join(c for c in sent_stream_rules() if settings.enabled(c))
     who = f" on vehicle {', '.join(vehicles)}" if any(vehicles) else ""
     missing = info.stream_missing or "does not hold the stream sent to the vehicle"
     if follows_flag:
@@ -403,10 +404,8 @@ def _stream_not_recorded(
 
 
 def _takes_runs(check: Check) -> bool:
-    """Does the check define ``on_batch`` and want any stream message?"""
-    return check.on_batch is not None and any(
-        issubclass(cls, check.subscriptions) for cls in STREAM_TYPES
-    )
+    """Does the check want any stream message (then it takes them as runs)?"""
+    return any(issubclass(cls, check.subscriptions) for cls in STREAM_TYPES)
 
 
 def _sort_key(finding: Finding) -> tuple[float, str, str]:

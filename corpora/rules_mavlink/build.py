@@ -413,6 +413,7 @@ def cases() -> list[Case]:
             bag=False,
             px4="legacy",
         ),
+        # -- scripts/add_rule.py adds a new rule's cases above this line
     ]
 
 
