@@ -51,8 +51,10 @@ def releases(root: Path | None = None) -> list[str]:
     return sorted(found, key=_release_key)
 
 
-def _release_key(name: str) -> tuple[int, ...]:
-    return tuple(int(n) for n in re.findall(r"\d+", name)[:3])
+def _release_key(name: str) -> tuple[tuple[int, ...], str]:
+    """The release's numbers, then the name: bundles of one release (``1.16.2``,
+    ``1.16.2-ros2``) in the same order whatever order the folder lists them in."""
+    return tuple(int(n) for n in re.findall(r"\d+", name)[:3]), name
 
 
 @dataclass(frozen=True, slots=True)
@@ -85,7 +87,10 @@ def find_build(release: str | None, px4_build: Path | None, root: Path | None = 
     have = releases(root)
     if not have:
         raise BundleError(f"no PX4 SITL bundles in {root} (set FUZZOFF_PX4_SITL to their folder)")
-    matches = [r for r in have if r == release or r.startswith(release + ".")]
+    if release in have:
+        # the exact name wins: "1.16.2" is the plain bundle, not "1.16.2-ros2" beside it
+        return Build(root / release, release)
+    matches = [r for r in have if r.startswith(release + ".")]
     matches += [r for r in have if r.startswith(release + "-") and r not in matches]
     if not matches:
         raise BundleError(f"--release {release}: no such bundle; have {', '.join(have)}")
