@@ -1,0 +1,199 @@
+"""One flight over PX4's ROS 2 bridge, run inside a private network namespace (``netns``).
+
+PX4 (a bundle with ``uxrce_dds_client``) and the Micro XRCE-DDS Agent start together
+(``run-px4.sh`` with ``PX4_AGENT``); a recorder subscribes to the example's inputs and to PX4's
+outputs as soon as PX4 is on DDS; once PX4 says its pre-flight checks pass, the recording
+starts and, ``LEAD_S`` later, the example node. When the plan is done the recording stops
+first (as a user stops ``ros2 bag record`` before the node), then PX4, which closes its ULog.
+Outputs, in the working folder: ``STEM.mcap/`` and ``STEM.db3/`` (bag folders), ``STEM.ulg``
+(PX4's log cut to the topics fuzzoff reads) and ``STEM.json`` (what happened, PX4's answers).
+
+Run as ``python -m fuzzoff.sitl.ros2.flight`` by ``netns.run_flight``; needs cyclonedds.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import threading
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from cyclonedds.domain import DomainParticipant
+
+from fuzzoff.sitl import bundle
+from fuzzoff.sitl.ros2.bag import Recording, write_bag
+from fuzzoff.sitl.ros2.dds import Publisher, RawReader
+from fuzzoff.sitl.ros2.example import TICK_S, OffboardControl, Plan
+from fuzzoff.sitl.ros2.names import RECEIVED, SENT, BridgeTopic, bridge_topic
+from fuzzoff.sitl.trim import trim
+
+READY_TIMEOUT_S = 90.0
+LEAD_S = 0.5
+"""The recording starts this long before the node (``ros2 bag record`` started first)."""
+POLL_S = 0.002
+
+
+@dataclass(slots=True)
+class Watch:
+    """What PX4 said last, decoded for the flight's own decisions and its summary."""
+
+    status: dict[str, Any] = field(default_factory=dict)
+    acks: list[dict[str, Any]] = field(default_factory=list)
+    modes: list[tuple[float, int, int, bool]] = field(default_factory=list)
+    """(monotonic s, nav_state, arming_state, failsafe) at each change"""
+
+
+class Recorder:
+    """Readers of every topic polled by one thread; each sample's bytes to the recording."""
+
+    def __init__(self, participant: DomainParticipant, topics: list[BridgeTopic]) -> None:
+        self.readers = [RawReader(participant, t) for t in topics]
+        self.recording: Recording | None = None
+        self.watch = Watch()
+        self.error: BaseException | None = None
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._loop, daemon=True)
+
+    def start(self) -> None:
+        self._thread.start()
+
+    def close(self) -> None:
+        self._stop.set()
+        self._thread.join(5.0)
+
+    def _loop(self) -> None:
+        try:
+            while not self._stop.is_set():
+                for reader in self.readers:
+                    reader.take(self._deliver)
+                time.sleep(POLL_S)
+        except BaseException as exc:  # reported by the flight, which stops
+            self.error = exc
+
+    def _deliver(self, topic: BridgeTopic, data: bytes, received_ns: int) -> None:
+        if self.recording is not None:
+            self.recording.add(topic, data, received_ns)
+        if topic.message == "VehicleStatus":
+            self._status(self._decode(topic, data))
+        elif topic.message == "VehicleCommandAck":
+            ack = self._decode(topic, data)
+            self.watch.acks.append(
+                {"t": time.monotonic(), "command": ack.command, "result": ack.result}
+            )
+
+    def _decode(self, topic: BridgeTopic, data: bytes) -> Any:
+        return next(r for r in self.readers if r.topic == topic).decode(data)
+
+    def _status(self, status: Any) -> None:
+        self.watch.status = {
+            "nav_state": status.nav_state,
+            "arming_state": status.arming_state,
+            "failsafe": status.failsafe,
+            "pre_flight_checks_pass": status.pre_flight_checks_pass,
+        }
+        key = (status.nav_state, status.arming_state, bool(status.failsafe))
+        if not self.watch.modes or self.watch.modes[-1][1:] != key:
+            self.watch.modes.append((time.monotonic(), *key))
+
+    def offered(self) -> dict[str, list[Any]]:
+        return {r.topic.ros_topic: list(r.offered.values()) for r in self.readers if r.offered}
+
+
+def fly(
+    release: str,
+    out: Path,
+    stem: str,
+    *,
+    plan: Plan,
+    fly_s: float,
+    tail_s: float,
+    log: Any = print,
+) -> dict[str, Any]:
+    """Fly ``plan`` for ``fly_s`` after the arm (then record ``tail_s`` more); the summary."""
+    build = bundle.find_build(release, None)
+    env = {
+        "PX4_AGENT": str(bundle.default_root() / "agent"),
+        "PX4_PARAM_SDLOG_MODE": "2",
+    }
+    px4 = bundle.start(build, 0, env)
+    summary: dict[str, Any] = {"release": build.release, "plan": plan.__repr__()}
+    participant = DomainParticipant(0)
+    received = [bridge_topic(build.profile_release, m) for m in RECEIVED]
+    sent = [bridge_topic(build.profile_release, m) for m in SENT]
+    recorder = Recorder(participant, sent + received)
+    recorder.start()
+    try:
+        started = time.monotonic()
+        while not recorder.watch.status.get("pre_flight_checks_pass"):
+            if recorder.error is not None:
+                raise recorder.error
+            if not px4.alive() or time.monotonic() - started > READY_TIMEOUT_S:
+                raise bundle.BundleError(
+                    f"PX4 {build.release} not ready on DDS after {READY_TIMEOUT_S:.0f} s: "
+                    + px4.console_tail()
+                )
+            time.sleep(0.1)
+        log(f"PX4 {build.release} on DDS, ready {time.monotonic() - started:.1f} s after start")
+        recording = Recording()
+        recorder.recording = recording
+        time.sleep(LEAD_S)
+        node_participant = DomainParticipant(0)
+        node = OffboardControl({t.message: Publisher(node_participant, t) for t in sent}, plan)
+        t0 = time.monotonic()
+        tick = t0 + TICK_S
+        while True:
+            now = time.monotonic()
+            if node.armed_at is not None and now - node.armed_at >= fly_s:
+                break
+            if now - t0 > fly_s + 30:
+                break
+            if now >= tick:
+                node.tick(now)
+                tick += TICK_S
+            time.sleep(min(0.01, max(0.0, tick - time.monotonic())))
+        if tail_s > 0:
+            time.sleep(tail_s)
+        recording.stop()
+        if recorder.error is not None:
+            raise recorder.error
+        summary["notes"] = [(round(t - t0, 3), n) for t, n in node.notes]
+        summary["modes"] = [(round(t - t0, 3), *rest) for t, *rest in recorder.watch.modes]
+        summary["acks"] = [
+            {**a, "t": round(a["t"] - t0, 3)} for a in recorder.watch.acks if a["t"] >= t0
+        ]
+        summary["offered"] = {k: [q._asdict() for q in v] for k, v in recorder.offered().items()}
+    finally:
+        recorder.close()
+        ulog = px4.stop()
+        console = px4.console_tail(3)
+    summary["console_tail"] = console
+    summary["counts"] = {t.ros_topic: recording.count(t.ros_topic) for t in sent + received}
+    for storage, suffix in (("mcap", "mcap"), ("sqlite3", "db3")):
+        target = out / f"{stem}.{suffix}"
+        write_bag(target, recording.records, recorder.offered(), storage)  # type: ignore[arg-type]
+    if ulog is not None:
+        trim(ulog, out / f"{stem}.ulg")
+    px4.cleanup()
+    return summary
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m fuzzoff.sitl.ros2.flight")
+    parser.add_argument("release")
+    parser.add_argument("stem")
+    parser.add_argument("--fly-s", type=float, default=12.0)
+    parser.add_argument("--stop-after-arm-s", type=float, default=None)
+    parser.add_argument("--tail-s", type=float, default=0.0)
+    args = parser.parse_args(argv)
+    plan = Plan(stop_after_arm_s=args.stop_after_arm_s)
+    out = Path(".")  # the caller's folder, reached through the working directory (netns)
+    summary = fly(args.release, out, args.stem, plan=plan, fly_s=args.fly_s, tail_s=args.tail_s)
+    (out / f"{args.stem}.json").write_text(json.dumps(summary, indent=1, default=str) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

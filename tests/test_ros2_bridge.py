@@ -1,0 +1,162 @@
+"""PX4's ROS 2 bridge without DDS: the names of a release's topics, the example's behaviour,
+and the bags the recorder writes (``fuzzoff/sitl/ros2``). The live flight, which needs the
+bundles and cyclonedds, is in ``test_ros2_live.py``."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from rosbags.interfaces import (
+    Nodetype,
+    Qos,
+    QosDurability,
+    QosHistory,
+    QosLiveliness,
+    QosReliability,
+    QosTime,
+)
+from rosbags.rosbag2 import Reader
+
+from fuzzoff.formats import px4_msgs
+from fuzzoff.sitl.ros2.bag import Record, write_bag
+from fuzzoff.sitl.ros2.example import (
+    VEHICLE_CMD_COMPONENT_ARM_DISARM,
+    VEHICLE_CMD_DO_SET_MODE,
+    OffboardControl,
+    Plan,
+)
+from fuzzoff.sitl.ros2.names import BridgeTopic, NamesError, bridge_topic
+from tests.helpers import run_cli
+
+
+def test_a_release_names_its_versioned_topics_as_its_bridge_does() -> None:
+    assert bridge_topic("1.16.2", "VehicleStatus").dds_topic == "rt/fmu/out/vehicle_status_v1"
+    assert bridge_topic("1.16.2", "VehicleCommandAck").ros_topic == "/fmu/out/vehicle_command_ack"
+    head = bridge_topic("1.18.0", "VehicleCommandAck")
+    assert head.ros_topic == "/fmu/out/vehicle_command_ack_v1"
+    assert bridge_topic("1.18.0", "VehicleStatus").ros_topic == "/fmu/out/vehicle_status_v4"
+    setpoint = bridge_topic("1.16.2", "TrajectorySetpoint")
+    assert setpoint.dds_topic == "rt/fmu/in/trajectory_setpoint"
+    assert setpoint.dds_type == "px4_msgs::msg::dds_::TrajectorySetpoint_"
+    assert setpoint.ros_type == "px4_msgs/msg/TrajectorySetpoint"
+    with pytest.raises(NamesError):
+        bridge_topic("1.16.2", "NoSuchMessage")
+
+
+class _Sink:
+    def __init__(self, name: str, sent: list[tuple[str, dict[str, Any]]]) -> None:
+        self.name = name
+        self.sent = sent
+
+    def publish(self, **values: Any) -> None:
+        self.sent.append((self.name, values))
+
+
+def _node(plan: Plan | None = None) -> tuple[OffboardControl, list[tuple[str, dict[str, Any]]]]:
+    sent: list[tuple[str, dict[str, Any]]] = []
+    names = ("OffboardControlMode", "TrajectorySetpoint", "VehicleCommand")
+    return OffboardControl({n: _Sink(n, sent) for n in names}, plan or Plan()), sent
+
+
+def test_the_example_switches_and_arms_on_its_eleventh_tick_and_keeps_streaming() -> None:
+    node, sent = _node()
+    for i in range(30):
+        node.tick(i * 0.1)
+    commands = [v for name, v in sent if name == "VehicleCommand"]
+    assert [c["command"] for c in commands] == [
+        VEHICLE_CMD_DO_SET_MODE,
+        VEHICLE_CMD_COMPONENT_ARM_DISARM,
+    ]
+    assert (commands[0]["param1"], commands[0]["param2"]) == (1.0, 6.0)
+    assert all(c["target_system"] == 1 and c["from_external"] for c in commands)
+    order = [name for name, _ in sent]
+    # ten mode + setpoint pairs, then the two commands before the eleventh pair
+    assert order[20:24] == [
+        "VehicleCommand",
+        "VehicleCommand",
+        "OffboardControlMode",
+        "TrajectorySetpoint",
+    ]
+    setpoints = [v for name, v in sent if name == "TrajectorySetpoint"]
+    assert len(setpoints) == 30 and setpoints[-1]["position"] == [0.0, 0.0, -5.0]
+    assert all(v["position"] for name, v in sent if name == "OffboardControlMode")
+
+
+def test_the_hazard_plan_stops_the_stream_after_the_arm() -> None:
+    node, sent = _node(Plan(stop_after_arm_s=2.0))
+    for i in range(60):
+        node.tick(i * 0.1)
+    setpoints = [v for name, v in sent if name == "TrajectorySetpoint"]
+    assert len(setpoints) == 10 + 20
+    assert node.stopped and node.notes[-1][1] == "the node stops publishing"
+
+
+QOS = Qos(
+    QosHistory.UNKNOWN,
+    0,
+    QosReliability.BEST_EFFORT,
+    QosDurability.TRANSIENT_LOCAL,
+    QosTime(2147483647, 4294967295),
+    QosTime(2147483647, 4294967295),
+    QosLiveliness.AUTOMATIC,
+    QosTime(2147483647, 4294967295),
+    False,
+)
+
+
+def _cdr(topic: BridgeTopic, **values: Any) -> bytes:
+    store = px4_msgs.typestore_for(topic.ros_type, topic.msgdef)
+    cls = store.types[topic.ros_type]
+    fields: list[tuple[str, Any]] = store.fielddefs[topic.ros_type][1]
+    init: dict[str, Any] = {}
+    for name, (nodetype, details) in fields:
+        if name in values:
+            init[name] = values[name]
+        elif nodetype == Nodetype.ARRAY:
+            init[name] = np.zeros(details[1], dtype=np.float32)
+        else:
+            init[name] = False if details[0] == "bool" else 0
+    return bytes(store.serialize_cdr(cls(**init), topic.ros_type))
+
+
+def _records() -> list[Record]:
+    mode = bridge_topic("1.16.2", "OffboardControlMode")
+    status = bridge_topic("1.16.2", "VehicleStatus")
+    t0 = 1_790_000_000_000_000_000
+    out = [Record(status, _cdr(status, nav_state=4, arming_state=1), t0)]
+    out += [
+        Record(mode, _cdr(mode, position=True, timestamp=1), t0 + i * 100_000_000)
+        for i in range(1, 30)
+    ]
+    return out
+
+
+@pytest.mark.parametrize("storage", ["mcap", "sqlite3"])
+def test_a_recorded_bag_holds_the_bytes_times_schemas_and_offered_qos(
+    storage: str, tmp_path: Path
+) -> None:
+    records = _records()
+    bag = write_bag(tmp_path / "flight", records, {"/fmu/out/vehicle_status_v1": [QOS]}, storage)  # type: ignore[arg-type]
+    with Reader(bag) as reader:
+        by_topic = {c.topic: c for c in reader.connections}
+        assert set(by_topic) == {"/fmu/in/offboard_control_mode", "/fmu/out/vehicle_status_v1"}
+        status = by_topic["/fmu/out/vehicle_status_v1"]
+        assert status.msgtype == "px4_msgs/msg/VehicleStatus"
+        assert "MESSAGE_VERSION = 1" in status.msgdef.data
+        assert status.ext.offered_qos_profiles == [QOS]  # type: ignore[union-attr]
+        got = [(c.topic, t, bytes(d)) for c, t, d in reader.messages()]
+    assert got == [(r.topic.ros_topic, r.received_ns, r.data) for r in records]
+
+
+def test_both_storages_of_one_flight_lint_alike(tmp_path: Path) -> None:
+    reports = []
+    for storage in ("mcap", "sqlite3"):
+        bag = write_bag(tmp_path / storage, _records(), {}, storage)  # type: ignore[arg-type]
+        out = run_cli(["lint", str(bag), "--format", "json"])
+        (report,) = json.loads(out.stdout)["files"]
+        reports.append([(f["code"], f["time_s"]) for f in report["findings"]])
+    assert reports[0] == reports[1]
