@@ -160,3 +160,12 @@ def test_both_storages_of_one_flight_lint_alike(tmp_path: Path) -> None:
         (report,) = json.loads(out.stdout)["files"]
         reports.append([(f["code"], f["time_s"]) for f in report["findings"]])
     assert reports[0] == reports[1]
+
+
+def test_the_landing_plan_sends_nav_land_once_and_streams_on() -> None:
+    node, sent = _node(Plan(land_after_arm_s=1.0))
+    for i in range(40):
+        node.tick(i * 0.1)
+    commands = [v["command"] for name, v in sent if name == "VehicleCommand"]
+    assert commands == [176, 400, 21]
+    assert len([v for name, v in sent if name == "TrajectorySetpoint"]) == 40

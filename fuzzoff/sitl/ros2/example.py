@@ -9,7 +9,8 @@ system 1, component 1, ``from_external`` true. Timestamps are the node's clock i
 the host's system clock). It never stops by itself.
 
 ``Plan.stop_after_arm_s`` makes it a hazard: the node stops publishing that long after the arm
-(a crashed or stalled node), with PX4 in OFFBOARD in the air.
+(a crashed or stalled node), with PX4 in OFFBOARD in the air. ``Plan.land_after_arm_s``: the
+node asks PX4 to land (NAV_LAND) and, as the example's timer never stops, streams on.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import time
 from dataclasses import dataclass
 from typing import Any, Protocol
 
+VEHICLE_CMD_NAV_LAND = 21
 VEHICLE_CMD_DO_SET_MODE = 176
 VEHICLE_CMD_COMPONENT_ARM_DISARM = 400
 PX4_CUSTOM_MAIN_MODE_OFFBOARD = 6.0
@@ -35,6 +37,8 @@ class Plan:
     yaw: float = -3.14
     stop_after_arm_s: float | None = None
     """The node stops publishing this long after its arm command (None: it never stops)."""
+    land_after_arm_s: float | None = None
+    """The node sends NAV_LAND this long after its arm command and streams on."""
 
 
 def now_us() -> int:
@@ -53,17 +57,21 @@ class OffboardControl:
         self.counter = 0
         self.armed_at: float | None = None
         self.stopped = False
+        self.landing = False
         self.notes: list[tuple[float, str]] = []
 
     def tick(self, now: float) -> None:
         """``now``: the monotonic clock, for the plan's stop only."""
         if self.stopped:
             return
-        stop = self.plan.stop_after_arm_s
-        if stop is not None and self.armed_at is not None and now - self.armed_at >= stop:
+        if self._due(self.plan.stop_after_arm_s, now):
             self.stopped = True
             self.notes.append((now, "the node stops publishing"))
             return
+        if self._due(self.plan.land_after_arm_s, now) and not self.landing:
+            self.landing = True
+            self._vehicle_command(VEHICLE_CMD_NAV_LAND)
+            self.notes.append((now, "NAV_LAND sent; the stream goes on"))
         if self.counter == SETPOINTS_BEFORE_SWITCH:
             self._vehicle_command(VEHICLE_CMD_DO_SET_MODE, 1.0, PX4_CUSTOM_MAIN_MODE_OFFBOARD)
             self._vehicle_command(VEHICLE_CMD_COMPONENT_ARM_DISARM, 1.0)
@@ -82,6 +90,13 @@ class OffboardControl:
         )
         if self.counter < SETPOINTS_BEFORE_SWITCH + 1:
             self.counter += 1
+
+    def _due(self, after_arm_s: float | None, now: float) -> bool:
+        return (
+            after_arm_s is not None
+            and self.armed_at is not None
+            and now - self.armed_at >= after_arm_s
+        )
 
     def _vehicle_command(self, command: int, param1: float = 0.0, param2: float = 0.0) -> None:
         self.command.publish(

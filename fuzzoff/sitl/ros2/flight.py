@@ -5,7 +5,7 @@ PX4 (a bundle with ``uxrce_dds_client``) and the Micro XRCE-DDS Agent start toge
 outputs as soon as PX4 is on DDS; once PX4 says its pre-flight checks pass, the recording
 starts and, ``LEAD_S`` later, the example node. When the plan is done the recording stops
 first (as a user stops ``ros2 bag record`` before the node), then PX4, which closes its ULog.
-Outputs, in the working folder: ``STEM.mcap/`` and ``STEM.db3/`` (bag folders), ``STEM.ulg``
+Outputs, in the working folder: ``STEM-mcap/`` and ``STEM-sqlite3/`` (bag folders), ``STEM.ulg``
 (PX4's log cut to the topics fuzzoff reads) and ``STEM.json`` (what happened, PX4's answers).
 
 Run as ``python -m fuzzoff.sitl.ros2.flight`` by ``netns.run_flight``; needs cyclonedds.
@@ -23,11 +23,13 @@ from typing import Any
 
 from cyclonedds.domain import DomainParticipant
 
+from fuzzoff.formats.rosbag2.writer import Storage
 from fuzzoff.sitl import bundle
 from fuzzoff.sitl.ros2.bag import Recording, write_bag
 from fuzzoff.sitl.ros2.dds import Publisher, RawReader
-from fuzzoff.sitl.ros2.example import TICK_S, OffboardControl, Plan
+from fuzzoff.sitl.ros2.example import TICK_S, OffboardControl
 from fuzzoff.sitl.ros2.names import RECEIVED, SENT, BridgeTopic, bridge_topic
+from fuzzoff.sitl.ros2.programs import PROGRAMS, Program
 from fuzzoff.sitl.trim import trim
 
 READY_TIMEOUT_S = 90.0
@@ -102,24 +104,20 @@ class Recorder:
         return {r.topic.ros_topic: list(r.offered.values()) for r in self.readers if r.offered}
 
 
-def fly(
-    release: str,
-    out: Path,
-    stem: str,
-    *,
-    plan: Plan,
-    fly_s: float,
-    tail_s: float,
-    log: Any = print,
-) -> dict[str, Any]:
-    """Fly ``plan`` for ``fly_s`` after the arm (then record ``tail_s`` more); the summary."""
+def fly(release: str, out: Path, stem: str, program: Program, log: Any = print) -> dict[str, Any]:
+    """Fly ``program`` on the bundle ``release``; what happened (the run's summary)."""
+    plan, fly_s, tail_s = program.plan, program.fly_s, program.tail_s
     build = bundle.find_build(release, None)
     env = {
         "PX4_AGENT": str(bundle.default_root() / "agent"),
         "PX4_PARAM_SDLOG_MODE": "2",
     }
     px4 = bundle.start(build, 0, env)
-    summary: dict[str, Any] = {"release": build.release, "plan": plan.__repr__()}
+    summary: dict[str, Any] = {
+        "recording": stem,
+        "program": program.name,
+        "release": build.release,
+    }
     participant = DomainParticipant(0)
     received = [bridge_topic(build.profile_release, m) for m in RECEIVED]
     sent = [bridge_topic(build.profile_release, m) for m in SENT]
@@ -171,9 +169,9 @@ def fly(
         console = px4.console_tail(3)
     summary["console_tail"] = console
     summary["counts"] = {t.ros_topic: recording.count(t.ros_topic) for t in sent + received}
-    for storage, suffix in (("mcap", "mcap"), ("sqlite3", "db3")):
-        target = out / f"{stem}.{suffix}"
-        write_bag(target, recording.records, recorder.offered(), storage)  # type: ignore[arg-type]
+    storages: tuple[Storage, ...] = ("mcap", "sqlite3")
+    for storage in storages:
+        write_bag(out / f"{stem}-{storage}", recording.records, recorder.offered(), storage)
     if ulog is not None:
         trim(ulog, out / f"{stem}.ulg")
     px4.cleanup()
@@ -182,15 +180,12 @@ def fly(
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m fuzzoff.sitl.ros2.flight")
-    parser.add_argument("release")
-    parser.add_argument("stem")
-    parser.add_argument("--fly-s", type=float, default=12.0)
-    parser.add_argument("--stop-after-arm-s", type=float, default=None)
-    parser.add_argument("--tail-s", type=float, default=0.0)
+    parser.add_argument("program", choices=sorted(PROGRAMS))
+    parser.add_argument("release", help="a bundle with the bridge (1.16.2-ros2)")
+    parser.add_argument("stem", help="the outputs' name")
     args = parser.parse_args(argv)
-    plan = Plan(stop_after_arm_s=args.stop_after_arm_s)
     out = Path(".")  # the caller's folder, reached through the working directory (netns)
-    summary = fly(args.release, out, args.stem, plan=plan, fly_s=args.fly_s, tail_s=args.tail_s)
+    summary = fly(args.release, out, args.stem, PROGRAMS[args.program])
     (out / f"{args.stem}.json").write_text(json.dumps(summary, indent=1, default=str) + "\n")
     return 0
 
