@@ -30,6 +30,12 @@ def add_parser(sub: Any) -> None:
     actions.required = True
     run = actions.add_parser("run", help="fly a scenario program on a PX4 SITL")
     run.add_argument("scenario", metavar="SCENARIO", help="a name from 'fuzzoff sitl list'")
+    run.add_argument(
+        "--transport",
+        choices=("mavlink", "ros2"),
+        default="mavlink",
+        help="ros2: fly a ROS 2 program over PX4's bridge (uXRCE-DDS; needs cyclonedds and root)",
+    )
     replay = actions.add_parser("replay", help="replay a tlog (or its reproducer) on a PX4 SITL")
     replay.add_argument("path", metavar="FILE", help="a .tlog, or a reproducer's .expected.json")
     replay.add_argument("--speed", type=float, default=1.0, help="time scale (0.01 to 100)")
@@ -65,6 +71,12 @@ def _list() -> int:
     for s in SCENARIOS.values():
         kind = "clean" if s.kind == "clean" else f"hazard ({s.hazard})"
         lines.append(f"  {s.name:<26} {s.summary}; {kind}")
+    from fuzzoff.sitl.ros2.programs import PROGRAMS
+
+    lines.append("ROS 2 programs (--transport ros2):")
+    for p in PROGRAMS.values():
+        kind = "clean" if p.kind == "clean" else f"hazard ({p.hazard})"
+        lines.append(f"  {p.name:<26} {p.summary}; {kind}")
     found = releases()
     lines.append(f"PX4 SITL bundles in {default_root()}: {', '.join(found) or 'none'}")
     write_output("\n".join(lines) + "\n", None)
@@ -74,6 +86,8 @@ def _list() -> int:
 def run_command(args: argparse.Namespace) -> int:
     if args.action == "list":
         return _list()
+    if args.action == "run" and args.transport == "ros2":
+        return _run_ros2(args)
     from fuzzoff.recording import SourceError
     from fuzzoff.sitl import bundle, run
     from fuzzoff.sitl.link import LinkError
@@ -114,6 +128,44 @@ def run_command(args: argparse.Namespace) -> int:
         print(f"error: {printable(str(exc))}", file=sys.stderr)
         return 2
     return report(outcome, args.format, args.output)
+
+
+def _run_ros2(args: argparse.Namespace) -> int:
+    """A ROS 2 program flown over PX4's bridge: its recordings and what PX4 answered."""
+    from fuzzoff.sitl import bundle
+    from fuzzoff.sitl.ros2 import run as ros2_run
+    from fuzzoff.sitl.ros2.programs import PROGRAMS
+
+    if args.scenario not in PROGRAMS:
+        raise ConfigError(
+            f"no ROS 2 program {args.scenario!r}; have {', '.join(PROGRAMS)} ('fuzzoff sitl list')"
+        )
+    if args.param or args.speed_factor is not None or args.instance:
+        raise ConfigError("--param, --speed-factor and --instance are MAVLink-only for now")
+    try:
+        build = bundle.find_bridge_build(args.release, args.px4_build)
+    except bundle.BundleError as exc:
+        raise ConfigError(str(exc)) from None
+    save_dir = args.save_dir or Path(tempfile.mkdtemp(prefix="fuzzoff-sitl-"))
+    try:
+        outcome = ros2_run.fly(
+            args.scenario,
+            build,
+            save_dir,
+            lambda line: print(f"fuzzoff: {printable(line)}", file=sys.stderr),
+        )
+    except ros2_run.FlightError as exc:
+        print(f"error: {printable(str(exc))}", file=sys.stderr)
+        return 2
+    if args.format == "json":
+        data = {
+            **outcome.summary,
+            "recordings": [str(p) for p in outcome.recordings],
+        }
+        write_output(json.dumps(data, indent=2) + "\n", args.output)
+    else:
+        write_output(ros2_run.render(outcome), args.output)
+    return 0
 
 
 def _recording(path: Path, params: dict[str, float]) -> tuple[Path, dict[str, float], bool]:
