@@ -169,3 +169,18 @@ def test_the_landing_plan_sends_nav_land_once_and_streams_on() -> None:
     commands = [v["command"] for name, v in sent if name == "VehicleCommand"]
     assert commands == [176, 400, 21]
     assert len([v for name, v in sent if name == "TrajectorySetpoint"]) == 40
+
+
+def test_an_arm_from_a_new_publisher_leaves_the_streaming_ones_alone() -> None:
+    made: list[tuple[str, dict[str, Any]]] = []
+    node, sent = _node(Plan(arm_from_new_publisher=True, setpoints_before_switch=0))
+    node.new_sink = lambda message: _Sink(message, made)
+    node.tick(0.0)
+    assert [v["command"] for _, v in sent if "command" in v] == [VEHICLE_CMD_DO_SET_MODE]
+    assert [v["command"] for _, v in made] == [VEHICLE_CMD_COMPONENT_ARM_DISARM]
+    # the switch and the arm come before the first setpoint of the tick
+    assert [name for name, _ in sent] == [
+        "VehicleCommand",
+        "OffboardControlMode",
+        "TrajectorySetpoint",
+    ]

@@ -2,7 +2,8 @@
 flown on PX4 1.16.2 and the 1.18 head through the Micro XRCE-DDS Agent, recorded as
 ``ros2 bag record`` records (mcap and sqlite3) beside PX4's ULog (issue 28 item 1).
 
-- every *clean* recording lints with exit 0 and nothing at warning or above;
+- every *clean* recording lints with exit 0 and nothing at warning or above (where today's
+  rules still say more, its expected file lists it under ``known_false``: a strict xfail);
 - every *hazard* recording gives one of its error codes (where the recording cannot show it,
   its expected file says why under ``missed``: a strict xfail);
 - the two storages of one flight give the same findings, and hold the same records;
@@ -43,8 +44,9 @@ def _cases(kind: str) -> list[Any]:
         if spec["kind"] != kind:
             continue
         marks = []
-        if spec.get("missed"):
-            marks.append(pytest.mark.xfail(strict=True, reason="; ".join(spec["missed"])))
+        why = spec.get("missed") or spec.get("known_false")
+        if why:
+            marks.append(pytest.mark.xfail(strict=True, reason="; ".join(why)))
         cases.append(pytest.param(spec, id=spec["recording"], marks=marks))
     return cases
 
@@ -73,7 +75,7 @@ def test_both_storages_of_a_flight_hold_the_same_records_and_findings(stem: str)
     assert strip[0] == strip[1]
 
 
-@pytest.mark.parametrize("stem", sorted(RUNS))
+@pytest.mark.parametrize("stem", sorted(s for s in RUNS if "in_only" not in s))
 def test_the_release_of_a_bridge_bag_is_detected_from_its_topics(stem: str) -> None:
     profile = _lint(HERE / f"{stem}-mcap")[2]
     release = RUNS[stem]["release"]
@@ -101,3 +103,25 @@ def test_a_bridge_bag_holds_what_a_ros2_recorder_writes(stem: str) -> None:
                 assert qos.durability == QosDurability.VOLATILE
         first = next(iter(reader.messages()))
         assert bytes(first[2])[:4] == b"\x00\x01\x00\x00"  # CDR little endian, as sent
+
+
+IN_ONLY = HERE / "example_in_only-1.16.2-ros2-mcap"
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="issue 28 miss 5: a bag of /fmu/in topics only is 'PX4 1.15 assumed' although its"
+    " schemas are 1.16's (layouts equal, the definitions' text differs)",
+)
+def test_a_bag_of_inputs_only_is_dated_from_its_schemas() -> None:
+    assert _lint(IN_ONLY)[2]["px4"] == "1.16"
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="issue 28 miss 5: OFB102 says 'after 0.00 s' when the stream starts at the bag's"
+    " first message",
+)
+def test_a_switch_one_second_into_the_stream_is_not_called_instant() -> None:
+    said = [f["summary"] for f in _lint(IN_ONLY)[1] if f["code"] == "OFB102"]
+    assert said and not any("after 0.00 s" in m for m in said)

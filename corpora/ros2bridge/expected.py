@@ -58,10 +58,13 @@ def expected_for(recording: Path, run: dict[str, Any]) -> dict[str, Any]:
         "px4_release": run["release"],
         "findings": findings,
     }
+    if program.notes:
+        spec["notes"] = program.notes
     if program.kind == "clean":
+        why = program.missed or "to review"
         spec["known_false"] = sorted(
             {
-                f"{f['code']} {f['severity']}: to review ({f['message']})"
+                f"{f['code']} {f['severity']}: {why} ({f['message']})"
                 for f in report["findings"]
                 if f["severity"] in ("warning", "error")
             }
@@ -72,20 +75,48 @@ def expected_for(recording: Path, run: dict[str, Any]) -> dict[str, Any]:
         why = [
             NOT_IN_ULOG[c] for c in program.codes if recording.suffix == ".ulg" and c in NOT_IN_ULOG
         ]
-        spec["missed"] = why or ["to review: fuzzoff does not give the hazard's error"]
+        spec["missed"] = why or [
+            f"{program.missed or 'to review'}: fuzzoff does not give the hazard's error"
+        ]
     assert not compare(findings, report["findings"])
     return spec
 
 
+TABLE = "<!-- the table is written by expected.py -->"
+
+
+def row(spec: dict[str, Any]) -> str:
+    errors = sorted({f["code"] for f in spec["findings"] if f["severity"] == "error"})
+    warnings = sorted({f["code"] for f in spec["findings"] if f["severity"] == "warning"})
+    lint = f"exit {spec['exit_status']}"
+    lint += f", errors {' '.join(errors)}" if errors else ""
+    lint += f", warnings {' '.join(warnings)}" if warnings else ""
+    if spec.get("missed") or spec.get("known_false"):
+        lint += " (see `missed`/`known_false`)"
+    program = spec["program"].split(":")[0].split()[-1]
+    return (
+        f"| `{spec['recording']}` | {program} | {spec['px4_release']} | {spec['profile']['px4']}"
+        f" | {spec['kind']} | {lint} |"
+    )
+
+
 def main() -> int:
     runs: dict[str, dict[str, Any]] = json.loads((HERE / "runs.json").read_text())
+    rows = []
     for stem, run in sorted(runs.items()):
         for suffix in RECORDINGS:
             recording = HERE / f"{stem}{suffix}"
             spec = expected_for(recording, run)
             target = HERE / f"{recording.name}.expected.json"
             target.write_text(json.dumps(spec, indent=2) + "\n")
+            rows.append(row(spec))
             print(f"{target.name}: exit {spec['exit_status']}, {len(spec['findings'])} findings")
+    readme = HERE / "README.md"
+    head, _, rest = readme.read_text().partition(TABLE)
+    _, _, tail = rest.partition(TABLE)
+    header = "| recording | program | PX4 bundle | detected | kind | lint today |\n"
+    header += "| --- | --- | --- | --- | --- | --- |\n"
+    readme.write_text(f"{head}{TABLE}\n{header}" + "\n".join(rows) + f"\n{TABLE}{tail}")
     return 0
 
 

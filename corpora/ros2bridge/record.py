@@ -38,6 +38,11 @@ RUNS: tuple[tuple[str, str], ...] = (
     ("example_stops", "1.16.2-ros2"),
     ("example_stops", "1.18.0-beta1-head"),
     ("example_lands", "1.16.2-ros2"),
+    ("example_lands_through", "1.18.0-beta1-head"),
+    ("example_no_setpoint", "1.16.2-ros2"),
+    ("example_arm_lost", "1.16.2-ros2"),
+    ("example_late_bag", "1.16.2-ros2"),
+    ("example_in_only", "1.16.2-ros2"),
 )
 """(program of ``fuzzoff.sitl.ros2.programs``, bundle): one PX4 boot each."""
 MAX_BYTES = 1_000_000

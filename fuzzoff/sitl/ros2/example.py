@@ -16,6 +16,7 @@ node asks PX4 to land (NAV_LAND) and, as the example's timer never stops, stream
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Protocol
 
@@ -39,6 +40,11 @@ class Plan:
     """The node stops publishing this long after its arm command (None: it never stops)."""
     land_after_arm_s: float | None = None
     """The node sends NAV_LAND this long after its arm command and streams on."""
+    setpoints_before_switch: int = SETPOINTS_BEFORE_SWITCH
+    arm_from_new_publisher: bool = False
+    """The ARM goes out through a VehicleCommand publisher the node creates for it (a node that
+    makes its publishers when it needs them): a reader on the same host matches the new writer
+    at once, PX4's agent some 100 ms later, and PX4 never gets the ARM."""
 
 
 def now_us() -> int:
@@ -49,7 +55,14 @@ def now_us() -> int:
 class OffboardControl:
     """One node: ``tick()`` is its 100 ms timer callback."""
 
-    def __init__(self, sinks: dict[str, Sink], plan: Plan = Plan()) -> None:
+    def __init__(
+        self,
+        sinks: dict[str, Sink],
+        plan: Plan = Plan(),
+        new_sink: Callable[[str], Sink] | None = None,
+    ) -> None:
+        """``new_sink(message)``: a new publisher (``Plan.arm_from_new_publisher``)."""
+        self.new_sink = new_sink
         self.mode = sinks["OffboardControlMode"]
         self.setpoint = sinks["TrajectorySetpoint"]
         self.command = sinks["VehicleCommand"]
@@ -72,9 +85,13 @@ class OffboardControl:
             self.landing = True
             self._vehicle_command(VEHICLE_CMD_NAV_LAND)
             self.notes.append((now, "NAV_LAND sent; the stream goes on"))
-        if self.counter == SETPOINTS_BEFORE_SWITCH:
+        switch_at = self.plan.setpoints_before_switch
+        if self.counter == switch_at:
             self._vehicle_command(VEHICLE_CMD_DO_SET_MODE, 1.0, PX4_CUSTOM_MAIN_MODE_OFFBOARD)
-            self._vehicle_command(VEHICLE_CMD_COMPONENT_ARM_DISARM, 1.0)
+            sink = self.command
+            if self.plan.arm_from_new_publisher and self.new_sink is not None:
+                sink = self.new_sink("VehicleCommand")
+            self._vehicle_command(VEHICLE_CMD_COMPONENT_ARM_DISARM, 1.0, sink=sink)
             self.armed_at = now
             self.notes.append((now, "DO_SET_MODE offboard and ARM sent"))
         self.mode.publish(
@@ -88,7 +105,7 @@ class OffboardControl:
         self.setpoint.publish(
             timestamp=now_us(), position=list(self.plan.position), yaw=self.plan.yaw
         )
-        if self.counter < SETPOINTS_BEFORE_SWITCH + 1:
+        if self.counter < switch_at + 1:
             self.counter += 1
 
     def _due(self, after_arm_s: float | None, now: float) -> bool:
@@ -98,8 +115,10 @@ class OffboardControl:
             and now - self.armed_at >= after_arm_s
         )
 
-    def _vehicle_command(self, command: int, param1: float = 0.0, param2: float = 0.0) -> None:
-        self.command.publish(
+    def _vehicle_command(
+        self, command: int, param1: float = 0.0, param2: float = 0.0, sink: Sink | None = None
+    ) -> None:
+        (sink or self.command).publish(
             timestamp=now_us(),
             param1=param1,
             param2=param2,

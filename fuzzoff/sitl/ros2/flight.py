@@ -107,7 +107,10 @@ class Recorder:
 def fly(release: str, out: Path, stem: str, program: Program, log: Any = print) -> dict[str, Any]:
     """Fly ``program`` on the bundle ``release``; what happened (the run's summary)."""
     plan, fly_s, tail_s = program.plan, program.fly_s, program.tail_s
-    build = bundle.find_build(release, None)
+    if "/" in release:  # a build folder (--px4-build)
+        build = bundle.find_build(None, Path(release))
+    else:
+        build = bundle.find_build(release, None)
     env = {
         "PX4_AGENT": str(bundle.default_root() / "agent"),
         "PX4_PARAM_SDLOG_MODE": "2",
@@ -121,13 +124,16 @@ def fly(release: str, out: Path, stem: str, program: Program, log: Any = print) 
     participant = DomainParticipant(0)
     received = [bridge_topic(build.profile_release, m) for m in RECEIVED]
     sent = [bridge_topic(build.profile_release, m) for m in SENT]
-    recorder = Recorder(participant, sent + received)
+    recorder = Recorder(participant, sent + (received if program.topics == "all" else []))
+    watcher = Recorder(participant, received) if program.topics != "all" else recorder
     recorder.start()
+    if watcher is not recorder:
+        watcher.start()
     try:
         started = time.monotonic()
-        while not recorder.watch.status.get("pre_flight_checks_pass"):
-            if recorder.error is not None:
-                raise recorder.error
+        while not watcher.watch.status.get("pre_flight_checks_pass"):
+            if watcher.error is not None:
+                raise watcher.error
             if not px4.alive() or time.monotonic() - started > READY_TIMEOUT_S:
                 raise bundle.BundleError(
                     f"PX4 {build.release} not ready on DDS after {READY_TIMEOUT_S:.0f} s: "
@@ -136,14 +142,22 @@ def fly(release: str, out: Path, stem: str, program: Program, log: Any = print) 
             time.sleep(0.1)
         log(f"PX4 {build.release} on DDS, ready {time.monotonic() - started:.1f} s after start")
         recording = Recording()
-        recorder.recording = recording
-        time.sleep(LEAD_S)
+        if program.record_from_s is None:
+            recorder.recording = recording
+            time.sleep(LEAD_S)
         node_participant = DomainParticipant(0)
-        node = OffboardControl({t.message: Publisher(node_participant, t) for t in sent}, plan)
+        by_message = {t.message: t for t in sent}
+        node = OffboardControl(
+            {t.message: Publisher(node_participant, t) for t in sent},
+            plan,
+            new_sink=lambda message: Publisher(node_participant, by_message[message]),
+        )
         t0 = time.monotonic()
         tick = t0 + TICK_S
         while True:
             now = time.monotonic()
+            if recorder.recording is None and now - t0 >= (program.record_from_s or 0.0):
+                recorder.recording = recording
             if node.armed_at is not None and now - node.armed_at >= fly_s:
                 break
             if now - t0 > fly_s + 30:
@@ -158,13 +172,15 @@ def fly(release: str, out: Path, stem: str, program: Program, log: Any = print) 
         if recorder.error is not None:
             raise recorder.error
         summary["notes"] = [(round(t - t0, 3), n) for t, n in node.notes]
-        summary["modes"] = [(round(t - t0, 3), *rest) for t, *rest in recorder.watch.modes]
+        summary["modes"] = [(round(t - t0, 3), *rest) for t, *rest in watcher.watch.modes]
         summary["acks"] = [
-            {**a, "t": round(a["t"] - t0, 3)} for a in recorder.watch.acks if a["t"] >= t0
+            {**a, "t": round(a["t"] - t0, 3)} for a in watcher.watch.acks if a["t"] >= t0
         ]
         summary["offered"] = {k: [q._asdict() for q in v] for k, v in recorder.offered().items()}
     finally:
         recorder.close()
+        if watcher is not recorder:
+            watcher.close()
         ulog = px4.stop()
         console = px4.console_tail(3)
     summary["console_tail"] = console
@@ -181,7 +197,7 @@ def fly(release: str, out: Path, stem: str, program: Program, log: Any = print) 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m fuzzoff.sitl.ros2.flight")
     parser.add_argument("program", choices=sorted(PROGRAMS))
-    parser.add_argument("release", help="a bundle with the bridge (1.16.2-ros2)")
+    parser.add_argument("release", help="a bundle with the bridge (1.16.2-ros2) or a build folder")
     parser.add_argument("stem", help="the outputs' name")
     args = parser.parse_args(argv)
     out = Path(".")  # the caller's folder, reached through the working directory (netns)

@@ -7,7 +7,7 @@ codes fuzzoff should give. Times count from the node's arm command.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Literal
 
 from fuzzoff.sitl.ros2.example import Plan
@@ -25,7 +25,15 @@ class Program:
     tail_s: float = 0.0
     """How long the recording goes on after the loop."""
     hazard: str | None = None
-    notes: tuple[str, ...] = field(default=())
+    record_from_s: float | None = None
+    """The recording starts this long after the node (None: ``flight.LEAD_S`` before it)."""
+    topics: Literal["all", "in"] = "all"
+    """What the recording subscribes to: the node's inputs to PX4 and PX4's outputs, or only
+    the ``/fmu/in`` topics (a companion that records what it sends)."""
+    missed: str | None = None
+    """The issue 28 miss this program reproduces (a finding fuzzoff does not give yet)."""
+    notes: str | None = None
+    """What the recorded flight showed that its summary does not say."""
 
 
 PROGRAMS: dict[str, Program] = {
@@ -57,6 +65,58 @@ PROGRAMS: dict[str, Program] = {
             "hazard",
             ("OFB203",),
             hazard="setpoints streamed into PX4's own landing while armed",
+        ),
+        Program(
+            "example_lands_through",
+            "as example_lands, hovering 2 s, recorded through touchdown and the disarm (issue 28"
+            " miss 1: after 'Disarmed by landing' the status shows OFFBOARD again)",
+            Plan(land_after_arm_s=6.0),
+            40.0,
+            "hazard",
+            ("OFB203",),
+            hazard="setpoints streamed into PX4's own landing while armed, through touchdown",
+            missed="issue 28 miss 1",
+        ),
+        Program(
+            "example_no_setpoint",
+            "offboard_control switching and arming in the tick before its first setpoint (issue"
+            " 28 miss 2's sequence, DO_SET_MODE and ARM 0.4 ms apart, with no stream before)",
+            Plan(setpoints_before_switch=0),
+            6.0,
+            "clean",
+            notes="PX4 1.16.2 accepted both here (the ARM denial of issue 28 miss 2 did not"
+            " happen)",
+        ),
+        Program(
+            "example_arm_lost",
+            "offboard_control whose ARM goes through a publisher made for it: the bag has the ARM,"
+            " PX4 never gets it and stays disarmed in OFFBOARD (issue 28 miss 3)",
+            Plan(arm_from_new_publisher=True),
+            6.0,
+            "hazard",
+            ("OFB201",),
+            hazard="an ARM PX4 never answered: the vehicle stays disarmed",
+            missed="issue 28 miss 3",
+        ),
+        Program(
+            "example_late_bag",
+            "the clean example with the recording started 0.16 s before the first command (issue"
+            " 28 miss 4's setting)",
+            Plan(),
+            10.0,
+            "clean",
+            record_from_s=0.94,
+            notes="no false OFB202 here (issue 28 miss 4 did not happen)",
+        ),
+        Program(
+            "example_in_only",
+            "the clean example recorded on its /fmu/in topics only (issue 28 miss 5: the release"
+            " assumed, not read from the schemas)",
+            Plan(),
+            10.0,
+            "clean",
+            topics="in",
+            missed="issue 28 miss 5",
         ),
     )
 }
