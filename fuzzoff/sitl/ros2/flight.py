@@ -200,7 +200,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("release", help="a bundle with the bridge (1.16.2-ros2) or a build folder")
     parser.add_argument("stem", help="the outputs' name")
     args = parser.parse_args(argv)
-    out = Path(".")  # the caller's folder, reached through the working directory (netns)
+    out = Path(".")  # the caller's folder: netns binds it at its own path and enters it
     summary = fly(args.release, out, args.stem, PROGRAMS[args.program])
     (out / f"{args.stem}.json").write_text(json.dumps(summary, indent=1, default=str) + "\n")
     return 0

@@ -5,25 +5,27 @@ network namespace whose only interface is loopback (with multicast routed to it)
 reaches the machine's network, and a private ``/tmp`` keeps PX4's ``/tmp/px4_lock-0`` apart
 from other PX4 instances on the machine. Needs root (or user namespaces) and ``unshare``/``ip``.
 
-The flight's outputs reach the caller's folder through the working directory: the namespace's
-``/tmp`` hides the caller's, so the folder is entered before ``/tmp`` is replaced.
+The flight's outputs reach the caller's folder at the same path: the namespace's ``/tmp`` hides
+the caller's, so the folder is entered before ``/tmp`` is replaced and bound again at its path.
 """
 
 from __future__ import annotations
 
+import os
 import shutil
 import subprocess
 import sys
 from pathlib import Path
 
 SETUP = (
-    "mount -t tmpfs none /tmp && ip link set lo up && ip link set lo multicast on"
+    'mount -t tmpfs none /tmp && mkdir -p "$FUZZOFF_OUT"'
+    ' && mount --no-canonicalize --bind . "$FUZZOFF_OUT" && cd "$FUZZOFF_OUT"'
+    " && ip link set lo up && ip link set lo multicast on"
     ' && ip route add 224.0.0.0/4 dev lo && exec "$@"'
 )
-
-
-class NetnsError(Exception):
-    """The namespace could not be made (no unshare, no permission)."""
+"""A private /tmp; the caller's folder bound again at its own path (the shell's working
+directory still reaches it under the new /tmp; ``--no-canonicalize`` keeps mount from turning
+``.`` into a path, which would name the new /tmp); loopback with multicast; the flight."""
 
 
 def available() -> str | None:
@@ -62,5 +64,11 @@ def run_flight(
         *args,
     ]
     return subprocess.run(
-        argv, cwd=out, capture_output=True, text=True, timeout=timeout, check=False
+        argv,
+        cwd=out,
+        env={**os.environ, "FUZZOFF_OUT": str(out.resolve())},
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        check=False,
     )
