@@ -62,3 +62,44 @@ def test_the_ros2_example_flies_over_the_bridge_and_its_bag_lints_clean(tmp_path
     assert lint.returncode == 0, [f["message"] for f in report["findings"]]
     assert report["profile"]["px4"] == "1.16"
     assert os.listdir(save)
+
+
+MATRIX = os.environ.get("FUZZOFF_SITL_MATRIX") == "1"
+MATRIX_BUNDLES = ("1.16.2", "1.18.0")
+
+
+def _matrix() -> list[object]:
+    from fuzzoff.sitl.ros2.programs import PROGRAMS
+
+    return [
+        pytest.param(name, release, id=f"{name}-{release}")
+        for release in MATRIX_BUNDLES
+        for name in PROGRAMS
+    ]
+
+
+@pytest.mark.skipif(WHY_NOT is not None, reason=f"live ROS 2 flight: {WHY_NOT}")
+@pytest.mark.skipif(not MATRIX, reason="the whole matrix runs with make test-sitl")
+@pytest.mark.parametrize(("program", "release"), _matrix())
+def test_every_ros2_program_flies_and_its_bags_say_what_it_is(
+    program: str, release: str, tmp_path: Path
+) -> None:
+    """Each program on each bridge release: the flight is flown and recorded, and a clean one
+    lints clean, a hazard gives its error, where fuzzoff already reports it (``missed``)."""
+    from fuzzoff.sitl.ros2.programs import PROGRAMS
+
+    spec = PROGRAMS[program]
+    args = ["sitl", "run", program, "--transport", "ros2", "--release", release]
+    out = run_cli_process([*args, "--save-dir", str(tmp_path), "--format", "json"], timeout=300)
+    assert out.returncode == 0, out.stdout + out.stderr
+    bag = next(Path(p) for p in json.loads(out.stdout)["recordings"] if p.endswith("-mcap"))
+    lint = run_cli(["lint", str(bag), "--format", "json"])
+    (report,) = json.loads(lint.stdout)["files"]
+    if spec.missed is not None:
+        return
+    if spec.kind == "clean":
+        assert lint.returncode == 0, [f["message"] for f in report["findings"]]
+    else:
+        assert any(
+            f["code"] in spec.codes and f["severity"] == "error" for f in report["findings"]
+        ), [f["message"] for f in report["findings"]]
