@@ -184,3 +184,14 @@ def test_an_arm_from_a_new_publisher_leaves_the_streaming_ones_alone() -> None:
         "OffboardControlMode",
         "TrajectorySetpoint",
     ]
+
+
+def test_the_agent_pid_is_read_from_what_run_px4_says(tmp_path: Path) -> None:
+    from fuzzoff.sitl.ros2 import agent
+
+    console = tmp_path / "console.log"
+    console.write_text("INFO boot\nrun-px4.sh: agent PID 4242 (udp4 port 8888), log x\n")
+    assert agent.started_pid(console) == 4242
+    console.write_text("INFO boot\n")
+    with pytest.raises(agent.AgentError):
+        agent.started_pid(console)

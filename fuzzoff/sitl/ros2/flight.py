@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import subprocess
 import threading
 import time
 from dataclasses import dataclass, field
@@ -25,6 +26,7 @@ from cyclonedds.domain import DomainParticipant
 
 from fuzzoff.formats.rosbag2.writer import Storage
 from fuzzoff.sitl import bundle
+from fuzzoff.sitl.ros2 import agent
 from fuzzoff.sitl.ros2.bag import Recording, write_bag
 from fuzzoff.sitl.ros2.dds import Publisher, RawReader
 from fuzzoff.sitl.ros2.example import TICK_S, OffboardControl
@@ -104,6 +106,35 @@ class Recorder:
         return {r.topic.ros_topic: list(r.offered.values()) for r in self.readers if r.offered}
 
 
+class AgentRestart:
+    """Stops PX4's agent and starts a new one when the program says (``agent.py``)."""
+
+    def __init__(self, program: Program, px4: bundle.Px4Process) -> None:
+        self.program = program
+        self.px4 = px4
+        self.notes: list[tuple[float, str]] = []
+        self.stopped_at: float | None = None
+        self.new: subprocess.Popen[bytes] | None = None
+
+    def step(self, now: float, armed_at: float | None) -> None:
+        stop_after = self.program.agent_stop_after_arm_s
+        if stop_after is None or armed_at is None or self.new is not None:
+            return
+        if self.stopped_at is None and now - armed_at >= stop_after:
+            agent.stop(agent.started_pid(self.px4.console))
+            self.stopped_at = now
+            self.notes.append((now, "the agent is stopped"))
+        elif self.stopped_at is not None and now - self.stopped_at >= self.program.agent_down_s:
+            folder = bundle.default_root() / "agent"
+            self.new = agent.start(folder, self.px4.workdir / "agent-restarted.log")
+            self.notes.append((now, "a new agent is started"))
+
+    def close(self) -> None:
+        if self.new is not None and self.new.poll() is None:
+            self.new.terminate()
+            self.new.wait(5.0)
+
+
 def fly(release: str, out: Path, stem: str, program: Program, log: Any = print) -> dict[str, Any]:
     """Fly ``program`` on the bundle ``release``; what happened (the run's summary)."""
     plan, fly_s, tail_s = program.plan, program.fly_s, program.tail_s
@@ -126,6 +157,7 @@ def fly(release: str, out: Path, stem: str, program: Program, log: Any = print) 
     sent = [bridge_topic(build.profile_release, m) for m in SENT]
     recorder = Recorder(participant, sent + (received if program.topics == "all" else []))
     watcher = Recorder(participant, received) if program.topics != "all" else recorder
+    restart = AgentRestart(program, px4)
     recorder.start()
     if watcher is not recorder:
         watcher.start()
@@ -156,6 +188,7 @@ def fly(release: str, out: Path, stem: str, program: Program, log: Any = print) 
         tick = t0 + TICK_S
         while True:
             now = time.monotonic()
+            restart.step(now, node.armed_at)
             if recorder.recording is None and now - t0 >= (program.record_from_s or 0.0):
                 recorder.recording = recording
             if node.armed_at is not None and now - node.armed_at >= fly_s:
@@ -171,13 +204,15 @@ def fly(release: str, out: Path, stem: str, program: Program, log: Any = print) 
         recording.stop()
         if recorder.error is not None:
             raise recorder.error
-        summary["notes"] = [(round(t - t0, 3), n) for t, n in node.notes]
+        notes = sorted(node.notes + restart.notes)
+        summary["notes"] = [(round(t - t0, 3), n) for t, n in notes]
         summary["modes"] = [(round(t - t0, 3), *rest) for t, *rest in watcher.watch.modes]
         summary["acks"] = [
             {**a, "t": round(a["t"] - t0, 3)} for a in watcher.watch.acks if a["t"] >= t0
         ]
         summary["offered"] = {k: [q._asdict() for q in v] for k, v in recorder.offered().items()}
     finally:
+        restart.close()
         recorder.close()
         if watcher is not recorder:
             watcher.close()

@@ -34,6 +34,10 @@ class Program:
     """The issue 28 miss this program reproduces (a finding fuzzoff does not give yet)."""
     notes: str | None = None
     """What the recorded flight showed that its summary does not say."""
+    agent_stop_after_arm_s: float | None = None
+    """The agent is stopped this long after the arm (PX4 loses the bridge) ..."""
+    agent_down_s: float = 2.0
+    """... and a new one started this much later (PX4 #26022: does PX4 come back?)."""
 
 
 PROGRAMS: dict[str, Program] = {
@@ -76,6 +80,20 @@ PROGRAMS: dict[str, Program] = {
             ("OFB203",),
             hazard="setpoints streamed into PX4's own landing while armed, through touchdown",
             missed="issue 28 miss 1",
+        ),
+        Program(
+            "example_agent_restart",
+            "offboard_control in the air while the Micro XRCE-DDS Agent is stopped 5 s after the"
+            " arm and started again 2 s later; the node keeps publishing (issue 28 item 3, PX4"
+            " #26022)",
+            Plan(),
+            16.0,
+            "hazard",
+            ("OFB103",),
+            hazard="the bridge lost mid-flight: PX4's offboard loss while the node streams on",
+            agent_stop_after_arm_s=5.0,
+            missed="issue 28 item 3 (the bag's stream never stops; PX4's outputs fall silent and"
+            " come back with a failsafe status)",
         ),
         Program(
             "example_no_setpoint",
