@@ -195,3 +195,29 @@ def test_the_agent_pid_is_read_from_what_run_px4_says(tmp_path: Path) -> None:
     console.write_text("INFO boot\n")
     with pytest.raises(agent.AgentError):
         agent.started_pid(console)
+
+
+def test_a_replay_plan_is_the_bags_inputs_to_px4_from_their_first_message(
+    tmp_path: Path,
+) -> None:
+    from fuzzoff.sitl.ros2.replay import load_plan, plan_from_bag, save_plan
+
+    bag = Path(__file__).parent.parent / "corpora" / "ros2bridge" / "example-1.16.2-ros2-sqlite3"
+    plan = plan_from_bag(bag, "1.16.2")
+    assert {m.topic for m in plan.messages} == {
+        "/fmu/in/offboard_control_mode",
+        "/fmu/in/trajectory_setpoint",
+        "/fmu/in/vehicle_command",
+    }
+    assert plan.messages[0].offset_s == 0.0
+    offsets = [m.offset_s for m in plan.messages]
+    assert offsets == sorted(offsets) and 12.0 < offsets[-1] < 15.0
+    with Reader(bag) as reader:
+        sent = [bytes(d) for c, _, d in reader.messages() if c.topic.startswith("/fmu/in/")]
+    assert [m.data for m in plan.messages] == sent
+    assert load_plan(save_plan(plan, tmp_path / "plan.json")) == plan
+
+
+def test_a_ros2_replay_takes_a_bag_folder() -> None:
+    out = run_cli(["sitl", "replay", "flight.tlog", "--transport", "ros2", "--release", "1.16.2"])
+    assert out.returncode == 2 and "a ROS 2 replay takes a bag folder" in out.stderr

@@ -15,7 +15,7 @@ import pytest
 
 from fuzzoff.sitl import bundle
 from fuzzoff.sitl.ros2.run import missing
-from tests.helpers import run_cli, run_cli_process
+from tests.helpers import CORPORA, run_cli, run_cli_process
 
 
 def _why_not() -> str | None:
@@ -103,3 +103,17 @@ def test_every_ros2_program_flies_and_its_bags_say_what_it_is(
         assert any(
             f["code"] in spec.codes and f["severity"] == "error" for f in report["findings"]
         ), [f["message"] for f in report["findings"]]
+
+
+@pytest.mark.skipif(WHY_NOT is not None, reason=f"live ROS 2 flight: {WHY_NOT}")
+@pytest.mark.skipif(not MATRIX, reason="the whole matrix runs with make test-sitl")
+def test_a_recorded_bag_replayed_over_the_bridge_makes_px4_do_it_again(tmp_path: Path) -> None:
+    """``sitl replay BAG --transport ros2``: the node's stream stops 6 s after the arm in the
+    recording, and PX4 runs its loss failsafe again."""
+    bag = CORPORA / "ros2bridge" / "example_stops-1.16.2-ros2-mcap"
+    args = ["sitl", "replay", str(bag), "--transport", "ros2", "--release", "1.16.2"]
+    out = run_cli_process([*args, "--save-dir", str(tmp_path), "--format", "json"], timeout=300)
+    assert out.returncode == 0, out.stdout + out.stderr
+    summary = json.loads(out.stdout)
+    assert {a["command"] for a in summary["acks"]} >= {176, 400}
+    assert any(failsafe for *_, failsafe in summary["modes"])

@@ -135,6 +135,10 @@ class Publisher:
     def publish(self, **values: Any) -> None:
         self._writer.write(zero_sample(self.topic, **values))
 
+    def write(self, sample: Any) -> None:
+        """A sample of this topic's type as it is (a replayed message)."""
+        self._writer.write(sample)
+
 
 Received = Callable[[BridgeTopic, bytes, int], None]
 """(topic, the sample's bytes, receive time in ns since the epoch)"""

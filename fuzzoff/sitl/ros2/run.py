@@ -1,4 +1,5 @@
-"""``fuzzoff sitl run PROGRAM --transport ros2``: one flight over PX4's ROS 2 bridge.
+"""``fuzzoff sitl run PROGRAM --transport ros2`` and ``fuzzoff sitl replay BAG --transport
+ros2``: one flight over PX4's ROS 2 bridge.
 
 The flight runs in a private network namespace (``netns``) with this Python, which needs the
 ``ros2live`` extra (cyclonedds). Its outputs go to the save folder: the bag in mcap and sqlite3
@@ -15,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from fuzzoff.sitl import bundle
-from fuzzoff.sitl.ros2 import netns
+from fuzzoff.sitl.ros2 import netns, replay
 from fuzzoff.sitl.ros2.programs import PROGRAMS
 
 FLIGHT_TIMEOUT_S = 240.0
@@ -49,14 +50,38 @@ def fly(
 ) -> FlightOutcome:
     if program not in PROGRAMS:
         raise FlightError(f"no ROS 2 program {program!r}; have {', '.join(PROGRAMS)}")
+    log(f"{program} on PX4 {build.release} over its ROS 2 bridge (private network namespace)")
+    return _flight(program, program, build, save_dir)
+
+
+def replay_bag(
+    path: Path,
+    build: bundle.Build,
+    save_dir: Path,
+    log: Callable[[str], None] = print,
+) -> FlightOutcome:
+    """A recorded bag's ``/fmu/in`` messages sent to a fresh PX4 at their recorded times."""
+    try:
+        plan = replay.plan_from_bag(path, build.profile_release)
+    except replay.ReplayError as exc:
+        raise FlightError(str(exc)) from None
+    save_dir.mkdir(parents=True, exist_ok=True)
+    stem = f"{path.name}-on-{build.release}"
+    plan_file = replay.save_plan(plan, save_dir.resolve() / f"{stem}.plan.json")
+    log(f"{len(plan.messages)} messages of {path} to PX4 {build.release} over its ROS 2 bridge")
+    return _flight(str(plan_file), "replay", build, save_dir, stem)
+
+
+def _flight(
+    what: str, name: str, build: bundle.Build, save_dir: Path, stem: str | None = None
+) -> FlightOutcome:
     why = missing()
     if why is not None:
         raise FlightError(why)
-    stem = f"{program}-{build.release}"
-    log(f"{program} on PX4 {build.release} over its ROS 2 bridge (private network namespace)")
+    stem = stem or f"{name}-{build.release}"
     bundled = build.folder.parent.resolve() == bundle.default_root().resolve()
     target = build.release if bundled else str(build.folder)
-    done = netns.run_flight(save_dir.resolve(), [program, target, stem], timeout=FLIGHT_TIMEOUT_S)
+    done = netns.run_flight(save_dir.resolve(), [what, target, stem], timeout=FLIGHT_TIMEOUT_S)
     summary_file = save_dir / f"{stem}.json"
     if done.returncode != 0 or not summary_file.exists():
         tail = (done.stderr or done.stdout).strip().splitlines()[-3:]
@@ -64,20 +89,17 @@ def fly(
     summary: dict[str, Any] = json.loads(summary_file.read_text())
     recordings = [save_dir / f"{stem}-{s}" for s in ("mcap", "sqlite3")]
     recordings += [p for p in [save_dir / f"{stem}.ulg"] if p.exists()]
-    return FlightOutcome(program, build.release, save_dir, summary, recordings)
+    return FlightOutcome(name, build.release, save_dir, summary, recordings)
 
 
 def render(outcome: FlightOutcome) -> str:
     s = outcome.summary
     lines = [f"PX4 {outcome.release}, {outcome.program} over the ROS 2 bridge: {outcome.folder}"]
-    for t, note in s.get("notes", []):
-        lines.append(f"  {t:8.3f} s  {note}")
-    for ack in s.get("acks", []):
-        lines.append(
-            f"  {ack['t']:8.3f} s  ack of command {ack['command']}: result {ack['result']}"
-        )
+    rows: list[tuple[float, str]] = [(t, note) for t, note in s.get("notes", [])]
+    rows += [(a["t"], f"ack of command {a['command']}: result {a['result']}") for a in s["acks"]]
     for t, nav, arming, failsafe in s.get("modes", []):
         state = "armed" if arming == 2 else "disarmed"
-        lines.append(f"  {t:8.3f} s  nav_state {nav}, {state}{', failsafe' if failsafe else ''}")
+        rows.append((t, f"nav_state {nav}, {state}{', failsafe' if failsafe else ''}"))
+    lines += [f"  {t:8.3f} s  {text}" for t, text in sorted(rows)]
     lines += [f"  {p.name}" for p in outcome.recordings]
     return "\n".join(lines) + "\n"
