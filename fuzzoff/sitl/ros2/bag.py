@@ -2,10 +2,11 @@
 
 Each record is a sample's bytes exactly as they arrived over DDS (the CDR encapsulation header
 first) with the time it was received (the recorder host's system clock, in ns since the
-epoch, as rosbag2 stamps). The bag holds each topic's ROS 2 name and type, its message
-definition (the schema: the release's ``.msg`` text), and the QoS its writers offered as
-discovered. rosbags' writer writes the bag, in ``mcap`` or ``sqlite3`` storage; both
-storages of one flight hold the same records.
+epoch, as rosbag2 stamps; the recorder polls its readers every 2 ms). The bag holds each
+topic's ROS 2 name and type, its message definition (the schema: the release's ``.msg`` text
+as ``fuzzoff/formats/px4_msgs`` bundles it, the wire fields and ``MESSAGE_VERSION`` without
+px4_msgs' comments), and the QoS its writers offered as discovered. rosbags' writer writes
+the bag, in ``mcap`` or ``sqlite3`` storage; both storages of one flight hold the same records.
 """
 
 from __future__ import annotations

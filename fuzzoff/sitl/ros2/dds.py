@@ -4,7 +4,9 @@ A type is a cyclonedds ``IdlStruct`` built from the release's ``.msg`` fields (r
 rosbags' parser), named as the ROS 2 middleware names it, so that the agent's Fast-DDS matches
 it with PX4's topics. Samples are written in XCDR1 (``DataRepresentation`` CDR v0), the
 encoding ROS 2 and the agent use. A reader hands back each sample's bytes as they arrived
-(encapsulation header included), which is what a bag stores.
+(encapsulation header included), which is what a bag stores: cyclonedds' ``DataReader.take``
+deserializes, so the bytes come from its C layer's take (``ddspy_take``), as ``take`` itself
+gets them.
 """
 
 from __future__ import annotations
