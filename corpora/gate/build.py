@@ -41,7 +41,12 @@ client records it: its ``/fmu/in`` stream and commands, PX4's ``/fmu/out/vehicle
   OFFBOARD, the land detector says landed at 14.5 s, the client disarms at 15.0 s and PX4 does
   (``vehicle_status`` disarmed at 15.05 s). The gate model accepts the disarm for the land
   detector's verdict, as from a ULog or a tlog (``tests/gate/test_landed_from_bags.py``); without
-  the topic it would take the vehicle, armed for 13 s, as airborne and refuse it. OFB202 clean.
+  the topic it would take the vehicle, armed for 13 s, as airborne and refuse it. OFB202 clean,
+  and OFB006 (both sides' px4_msgs are 1.16's).
+* ``px4_msgs_mismatch_ros2`` (PX4 1.16, OFB006): the same client built against px4_msgs of 1.14
+  (its ``/fmu/in`` topics and schemas), PX4 1.16's ``/fmu/out/vehicle_status_v1`` answering:
+  PX4 never takes the stream, the switch and the arm; it stays in POSCTL, disarmed. OFB006,
+  and OFB202 where the model, which cannot see that, expected the switch.
 """
 
 from __future__ import annotations
@@ -61,7 +66,9 @@ from fuzzoff.events import (
     TrajectorySetpoint,
     VehicleStatus,
 )
+from fuzzoff.formats import px4_msgs
 from fuzzoff.formats.mcap.writer import write_mcap
+from fuzzoff.formats.ros2msgs.messages import RawMessage, encode, to_message
 from fuzzoff.formats.ulog.writer import write_ulog
 
 HERE = Path(__file__).resolve().parent
@@ -302,6 +309,16 @@ def write(case: Case) -> None:
 
 
 LANDED_T, DISARM_T, DESCEND_T = 14.5, 15.0, 9.0
+MISMATCH_FINDINGS: list[dict[str, Any]] = [
+    {"code": "OFB006", "severity": "error", "time_s": None},
+    # the stream before the switch while disarmed, the loss summary at the request
+    {"code": "OFB203", "severity": "info", "time_s": 0.0},
+    {"code": "OFB701", "severity": "info", "time_s": SWITCH_T},
+    # the model takes the switch (1.16 accepts it disarmed); PX4 never got it
+    {"code": "OFB202", "severity": "warning", "time_s": 2.0},
+    {"code": "OFB002", "severity": "info", "time_s": None},
+]
+"""``px4_msgs_mismatch_ros2``'s findings, judged by hand against the rule texts."""
 
 
 def landed_disarm_ros2() -> list[Event]:
@@ -330,7 +347,46 @@ def landed_disarm_ros2() -> list[Event]:
     return sorted(events, key=lambda e: e.t)
 
 
+def built_with(release: str, events: list[Event]) -> list[RawMessage]:
+    """The companion's ``/fmu/in`` messages as a program built with ``release``'s px4_msgs
+    publishes them: that release's topic names, schemas and layouts."""
+    out = []
+    for event in events:
+        msg = to_message(event, release)
+        text = px4_msgs.definition(release, msg.message) or ""
+        out.append(RawMessage(event.t, msg.topic, msg.typename, text, encode(msg)))
+    return out
+
+
+def px4_msgs_mismatch_ros2() -> tuple[list[Event], list[RawMessage]]:
+    """The client of ``landed_disarm_ros2`` built with 1.14's px4_msgs, PX4 1.16 answering:
+    nothing it sends reaches PX4, which stays in POSCTL, disarmed."""
+    flight = landed_disarm_ros2()
+    sent = [e for e in flight if e.origin == "sent" and e.t < 10.0]
+    status = [
+        VehicleStatus(t=round(0.5 * i, 6), nav_state=POSCTL, armed=False, user_intention=POSCTL)
+        for i in range(21)
+    ]
+    return status, built_with("1.14", sent)
+
+
 def write_ros2() -> None:
+    mismatch = "px4_msgs_mismatch_ros2"
+    status, raw = px4_msgs_mismatch_ros2()
+    path = write_mcap(HERE / f"{mismatch}.mcap", status, release="1.16", extra=raw)
+    (HERE / f"{mismatch}.expected.json").write_text(
+        json.dumps(
+            {
+                "recording": path.name,
+                "args": ["--px4", "1.16", "--vehicle", "mc"],
+                "exit_status": 1,
+                "complete": True,
+                "findings": MISMATCH_FINDINGS,
+            },
+            indent=2,
+        )
+        + "\n"
+    )
     name = "landed_disarm_ros2"
     path = write_mcap(HERE / f"{name}.mcap", landed_disarm_ros2(), release="1.16")
     expected: dict[str, Any] = {
@@ -345,7 +401,7 @@ def write_ros2() -> None:
             {"code": "OFB701", "severity": "info", "time_s": SWITCH_T},
             {"code": "OFB002", "severity": "info", "time_s": None},
         ],
-        "clean": ["OFB202"],
+        "clean": ["OFB006", "OFB202"],
     }
     (HERE / f"{name}.expected.json").write_text(json.dumps(expected, indent=2) + "\n")
 

@@ -1,0 +1,87 @@
+"""OFB006: a companion built against other px4_msgs than the PX4 it talks to (issue 29 item 1).
+
+The recording's topic names (``_vN``, gate spec §16 S9) and embedded definitions say which
+px4_msgs releases each side fits; the rule compares the companion's ``/fmu/in`` topics with
+PX4's ``/fmu/out`` topics."""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib.util
+import sys
+from pathlib import Path
+from types import ModuleType
+
+from fuzzoff.config import Settings
+from fuzzoff.engine import lint_file
+from fuzzoff.events import Event, VehicleStatus
+from fuzzoff.findings import Finding, Severity
+from fuzzoff.formats.mcap.writer import write_mcap
+from fuzzoff.formats.rosbag2.writer import write_rosbag2
+from tests.helpers import CORPORA
+
+
+def _gate_corpus() -> ModuleType:
+    """corpora/gate/build.py: the flights of the corpus cases and ``built_with``."""
+    spec = importlib.util.spec_from_file_location("gate_corpus", CORPORA / "gate" / "build.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # its dataclasses look their module up
+    spec.loader.exec_module(module)
+    return module
+
+
+gate_corpus = _gate_corpus()
+
+MISMATCH = CORPORA / "gate" / "px4_msgs_mismatch_ros2.mcap"
+MATCHED = CORPORA / "gate" / "landed_disarm_ros2.mcap"
+
+
+def ofb006(path: Path) -> list[Finding]:
+    return [f for f in lint_file(path, Settings()).findings if f.code == "OFB006"]
+
+
+def test_a_companion_built_with_older_px4_msgs_is_an_error() -> None:
+    (finding,) = ofb006(MISMATCH)
+    assert finding.severity is Severity.ERROR and finding.time_s is None
+    assert "/fmu/in/offboard_control_mode fits px4_msgs 1.13, 1.14" in finding.message
+    assert "PX4 expects 1.16, 1.17" in finding.message
+    # TrajectorySetpoint has one layout from 1.14 to 1.18: not named
+    assert "trajectory_setpoint" not in finding.message
+
+
+def test_both_sides_built_with_one_release_give_nothing() -> None:
+    assert ofb006(MATCHED) == []
+
+
+def status(t: float, vehicle: str = "") -> VehicleStatus:
+    return VehicleStatus(t=t, vehicle=vehicle, nav_state=2, armed=False)
+
+
+def test_a_message_under_two_version_names_is_reported(tmp_path: Path) -> None:
+    """A bag without definitions (Humble ``.db3``): the names alone show it. The companion's
+    px4_msgs (1.15) name the status topic without a version; PX4 1.16 publishes ``_v1``."""
+    companion = gate_corpus.built_with("1.15", [status(0.0), status(1.0)])
+    bag = write_rosbag2(
+        tmp_path / "bag",
+        [status(0.5), status(1.5)],
+        release="1.16",
+        definitions=False,
+        extra=companion,
+    )
+    (finding,) = ofb006(bag)
+    assert "/fmu/out/vehicle_status (px4_msgs " in finding.message
+    assert "1.14, 1.15) and" in finding.message
+    assert "/fmu/out/vehicle_status_v1 (px4_msgs 1.16, 1.17)" in finding.message
+
+
+def test_each_vehicle_is_judged_on_its_own_topics(tmp_path: Path) -> None:
+    """Two vehicles: /px4_1's companion matches its PX4, /px4_2's does not."""
+    sent = [e for e in gate_corpus.landed_disarm_ros2() if e.origin == "sent" and e.t < 3.0]
+    events: list[Event] = [status(0.0, "/px4_1"), status(0.0, "/px4_2")]
+    good = [dataclasses.replace(e, vehicle="/px4_1") for e in sent]
+    bad = gate_corpus.built_with("1.14", [dataclasses.replace(e, vehicle="/px4_2") for e in sent])
+    path = write_mcap(tmp_path / "two.mcap", [*events, *good], release="1.16", extra=bad)
+    (finding,) = ofb006(path)
+    assert finding.vehicle == "/px4_2"
+    assert "/px4_2/fmu/in/offboard_control_mode" in finding.message
