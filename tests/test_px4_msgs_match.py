@@ -16,7 +16,9 @@ from fuzzoff.config import Settings
 from fuzzoff.engine import lint_file
 from fuzzoff.events import Event, VehicleStatus
 from fuzzoff.findings import Finding, Severity
+from fuzzoff.formats import px4_msgs
 from fuzzoff.formats.mcap.writer import write_mcap
+from fuzzoff.formats.ros2msgs.messages import RawMessage, encode, to_message
 from fuzzoff.formats.rosbag2.writer import write_rosbag2
 from tests.helpers import CORPORA
 
@@ -85,3 +87,19 @@ def test_each_vehicle_is_judged_on_its_own_topics(tmp_path: Path) -> None:
     (finding,) = ofb006(path)
     assert finding.vehicle == "/px4_2"
     assert "/px4_2/fmu/in/offboard_control_mode" in finding.message
+
+
+def test_a_topic_name_from_other_px4_msgs_than_its_definition(tmp_path: Path) -> None:
+    """px4_ros_com #229: an example built with 1.16's px4_msgs keeps the old name
+    ``/fmu/out/vehicle_status``; PX4 1.16 publishes ``_v1``. The recording holds the name with
+    the 1.16 definition (the subscription's type) beside PX4's own topic."""
+    msg = to_message(status(0.2), "1.16")
+    text = px4_msgs.definition("1.16", "VehicleStatus") or ""
+    old_name = RawMessage(0.2, "/fmu/out/vehicle_status", msg.typename, text, encode(msg))
+    path = write_mcap(
+        tmp_path / "names.mcap", [status(0.5), status(1.5)], release="1.16", extra=[old_name]
+    )
+    (finding,) = ofb006(path)
+    assert "/fmu/out/vehicle_status: its name fits px4_msgs" in finding.message
+    assert "its definition 1.16, 1.17" in finding.message
+    assert "topic name and message version disagree" in finding.summary

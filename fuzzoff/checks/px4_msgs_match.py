@@ -32,6 +32,7 @@ class Px4MsgsMatch(Check):
         self.subscriptions = ()
 
     def finish(self, t_end: float) -> None:
+        self._name_and_definition()
         fits = self.ctx.info.px4_msgs_fits
         if not fits:
             return
@@ -104,4 +105,33 @@ class Px4MsgsMatch(Check):
             None,
             short=f"{' / '.join(t for topics in doubled.values() for t in topics)}: two "
             "versions of one message, one of them from the wrong px4_msgs",
+        )
+
+    def _name_and_definition(self) -> None:
+        """A topic whose name and embedded definition fit no release together: a program whose
+        px4_msgs give one version of the message uses the topic name of another (a name
+        written by hand, or kept from an older example)."""
+        conflicts = {
+            topic: fits
+            for topic, fits in self.ctx.info.px4_msgs_conflicts.items()
+            if (ref := parse_topic(topic)) is not None and ref.namespace == self.ctx.vehicle
+        }
+        if not conflicts:
+            return
+        order = tuple(
+            dict.fromkeys(r for pair in conflicts.values() for side in pair for r in side)
+        )
+        said = "; ".join(
+            f"{topic}: its name fits px4_msgs {releases_text(by_name, order)}, its definition "
+            f"{releases_text(by_definition, order)}"
+            for topic, (by_name, by_definition) in conflicts.items()
+        )
+        self.ctx.report(
+            CODE,
+            f"a topic name and its message's px4_msgs disagree: {said}. From 1.16 PX4 names "
+            "each topic after its message's version (_vN); a program built with the newer "
+            "px4_msgs on the older name (or the reverse) talks on a topic PX4 does not use: "
+            "take the topic names from the px4_msgs the program is built with",
+            None,
+            short=f"{', '.join(conflicts)}: topic name and message version disagree",
         )
