@@ -12,6 +12,8 @@ import sys
 from pathlib import Path
 from types import ModuleType
 
+from mcap.writer import Writer as McapWriter
+
 from fuzzoff.config import Settings
 from fuzzoff.engine import lint_file
 from fuzzoff.events import Event, VehicleStatus
@@ -19,7 +21,6 @@ from fuzzoff.findings import Finding, Severity
 from fuzzoff.formats import px4_msgs
 from fuzzoff.formats.mcap.writer import write_mcap
 from fuzzoff.formats.ros2msgs.messages import RawMessage, encode, to_message
-from fuzzoff.formats.rosbag2.writer import write_rosbag2
 from tests.helpers import CORPORA
 
 
@@ -60,21 +61,52 @@ def status(t: float, vehicle: str = "") -> VehicleStatus:
     return VehicleStatus(t=t, vehicle=vehicle, nav_state=2, armed=False)
 
 
-def test_a_message_under_two_version_names_is_reported(tmp_path: Path) -> None:
-    """A bag without definitions (Humble ``.db3``): the names alone show it. The companion's
-    px4_msgs (1.15) name the status topic without a version; PX4 1.16 publishes ``_v1``."""
-    companion = gate_corpus.built_with("1.15", [status(0.0), status(1.0)])
-    bag = write_rosbag2(
-        tmp_path / "bag",
-        [status(0.5), status(1.5)],
-        release="1.16",
-        definitions=False,
-        extra=companion,
-    )
-    (finding,) = ofb006(bag)
-    assert "/fmu/out/vehicle_status (px4_msgs " in finding.message
-    assert "1.14, 1.15) and" in finding.message
-    assert "/fmu/out/vehicle_status_v1 (px4_msgs 1.16, 1.17)" in finding.message
+def _status_mcap(path: Path, served_old_name: bool) -> Path:
+    """PX4 1.16 publishing ``vehicle_status_v1``, and the old name ``vehicle_status`` of a
+    companion with 1.15's px4_msgs: a subscription nobody serves (no message on it), or the
+    translation node's output (messages on it). Written with the mcap library itself: its
+    writer records a channel that carries no message, as a recorder does for a subscription."""
+    new_text = px4_msgs.definition("1.16", "VehicleStatus") or ""
+    old_text = px4_msgs.definition("1.15", "VehicleStatus") or ""
+    with path.open("wb") as fh:
+        writer = McapWriter(fh)
+        writer.start(profile="ros2", library="test")
+        new = writer.register_schema("px4_msgs/msg/VehicleStatus", "ros2msg", new_text.encode())
+        old = writer.register_schema("px4_msgs/msg/VehicleStatus", "ros2msg", old_text.encode())
+        px4 = writer.register_channel("/fmu/out/vehicle_status_v1", "cdr", new)
+        companion = writer.register_channel("/fmu/out/vehicle_status", "cdr", old)
+        for k in range(5):
+            t = 1_700_000_000_000_000_000 + k * 500_000_000
+            data = encode(to_message(status(0.5 * k), "1.16"))
+            writer.add_message(px4, log_time=t, data=data, publish_time=t)
+            if served_old_name:
+                data = encode(to_message(status(0.5 * k), "1.15"))
+                writer.add_message(companion, log_time=t + 1, data=data, publish_time=t + 1)
+        writer.finish()
+    return path
+
+
+def test_a_subscription_under_another_releases_name_is_reported(tmp_path: Path) -> None:
+    """px4_ros_com #229: a client with 1.15's px4_msgs subscribes to /fmu/out/vehicle_status;
+    PX4 1.16 publishes /fmu/out/vehicle_status_v1 only."""
+    (finding,) = ofb006(_status_mcap(tmp_path / "sub.mcap", served_old_name=False))
+    assert "subscribes to /fmu/out/vehicle_status (px4_msgs " in finding.message
+    assert "PX4's (1.16, 1.17)" in finding.message
+    assert "never served" in finding.summary
+
+
+def test_the_translation_node_serving_the_old_name_is_no_finding(tmp_path: Path) -> None:
+    assert ofb006(_status_mcap(tmp_path / "served.mcap", served_old_name=True)) == []
+
+
+def test_a_companion_topic_the_translation_node_republishes_is_no_finding(
+    tmp_path: Path,
+) -> None:
+    """The 1.14 client's /fmu/in topics beside the same messages under PX4 1.16's names."""
+    sent = [e for e in gate_corpus.landed_disarm_ros2() if e.origin == "sent" and e.t < 3.0]
+    old = gate_corpus.built_with("1.14", sent)
+    path = write_mcap(tmp_path / "t.mcap", [status(0.0), *sent], release="1.16", extra=old)
+    assert ofb006(path) == []
 
 
 def test_each_vehicle_is_judged_on_its_own_topics(tmp_path: Path) -> None:

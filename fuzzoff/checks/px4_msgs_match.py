@@ -4,23 +4,54 @@ From 1.16 PX4 names a ROS 2 topic after its message's version (``/fmu/out/vehicl
 on 1.16 and 1.17, ``_v4`` on 1.18: gate spec §16 S9), and the uXRCE-DDS bridge takes a message
 only under its own name and type. A recording says which px4_msgs each side was built with:
 the names and embedded definitions of the companion's ``/fmu/in`` topics, and those of PX4's
-``/fmu/out`` topics (the reader's ``RecordingInfo.px4_msgs_fits``). A companion topic that fits
-none of the releases PX4's topics fit is one PX4 does not take.
+``/fmu/out`` topics (the reader's ``RecordingInfo.px4_msgs_fits``).
+
+PX4's ROS 2 message translation node (1.16+) republishes a message between its versions: a
+recording made with it running holds both names, each with messages. So an ``/fmu/in`` topic of
+another release is excused where the same message is also there under a name PX4 takes, and an
+``/fmu/out`` name counts as PX4's only where messages came on it (a name with none is a
+subscription nobody serves).
 """
 
 from __future__ import annotations
 
-from collections import defaultdict
+from collections import Counter, defaultdict
 
 from fuzzoff.checks.base import Check, CheckContext
+from fuzzoff.events import (
+    CommandAck,
+    Event,
+    FailsafeFlags,
+    LandDetected,
+    VehicleControlModeStatus,
+    VehiclePosition,
+    VehicleStatus,
+)
 from fuzzoff.formats.ros2msgs.topics import parse_topic
 
 CODE = "OFB006"
+
+PUBLISHED_EVENTS: tuple[type[Event], ...] = (
+    VehicleStatus,
+    CommandAck,
+    FailsafeFlags,
+    VehicleControlModeStatus,
+    LandDetected,
+    VehiclePosition,
+)
+"""What PX4's ``/fmu/out`` topics become: counted per topic where one message has two names."""
 
 
 def releases_text(releases: set[str] | tuple[str, ...], order: tuple[str, ...]) -> str:
     names = [r for r in order if r in releases]
     return ", ".join(names) if names else "none"
+
+
+def _intersection(fits: list[tuple[str, ...]], order: tuple[str, ...]) -> set[str]:
+    common = set(order)
+    for releases in fits:
+        common &= set(releases)
+    return common
 
 
 class Px4MsgsMatch(Check):
@@ -29,39 +60,53 @@ class Px4MsgsMatch(Check):
 
     def __init__(self, ctx: CheckContext) -> None:
         super().__init__(ctx)
-        self.subscriptions = ()
+        fits = ctx.info.px4_msgs_fits
+        self.order = tuple(dict.fromkeys(r for releases in fits.values() for r in releases))
+        self.sent: dict[str, tuple[str, ...]] = {}
+        self.published: dict[str, tuple[str, ...]] = {}
+        self.sent_names: dict[str, list[str]] = defaultdict(list)
+        out_names: dict[str, list[str]] = defaultdict(list)
+        for topic, releases in fits.items():
+            ref = parse_topic(topic)
+            if ref is None or ref.namespace != ctx.vehicle or not releases:
+                continue
+            if ref.direction == "in":
+                self.sent[topic] = releases
+                self.sent_names[ref.name].append(topic)
+            else:
+                self.published[topic] = releases
+                out_names[ref.name].append(topic)
+        self.doubled = {t for topics in out_names.values() if len(topics) > 1 for t in topics}
+        """``/fmu/out`` topics of a message that has two names here."""
+        self.counts: Counter[str] = Counter()
+        self.subscriptions = PUBLISHED_EVENTS if self.doubled else ()
+
+    def on_event(self, event: Event) -> None:
+        self.counts[event.where.topic] += 1
 
     def finish(self, t_end: float) -> None:
         self._name_and_definition()
-        fits = self.ctx.info.px4_msgs_fits
-        if not fits:
-            return
-        order = tuple(dict.fromkeys(r for releases in fits.values() for r in releases))
-        sent: dict[str, tuple[str, ...]] = {}
-        published: dict[str, tuple[str, ...]] = {}
-        names: dict[str, list[str]] = defaultdict(list)
-        for topic, releases in fits.items():
-            ref = parse_topic(topic)
-            if ref is None or ref.namespace != self.ctx.vehicle or not releases:
-                continue
-            (sent if ref.direction == "in" else published)[topic] = releases
-            if ref.direction == "out":
-                names[ref.name].append(topic)
-        if not published:
-            return
-        px4: set[str] = set(order)
-        for releases in published.values():
-            px4 &= set(releases)
+        unserved = {t for t in self.doubled if not self.counts[t]}
+        px4 = _intersection([r for t, r in self.published.items() if t not in unserved], self.order)
         if not px4:
-            self._two_versions(names, published, order)
-            return
-        wrong = {topic: releases for topic, releases in sent.items() if not px4 & set(releases)}
+            return  # PX4's own topics name no release: nothing to compare with
+        self._subscribed(unserved, px4)
+        self._sent(px4)
+
+    def _sent(self, px4: set[str]) -> None:
+        """``/fmu/in`` topics PX4 does not take (unless the same message is also there under a
+        name it takes: the translation node's output)."""
+        order = self.order
+        wrong = {
+            topic: releases
+            for topic, releases in self.sent.items()
+            if not px4 & set(releases) and not self._translated(topic, px4)
+        }
         if not wrong:
             return
-        companion: set[str] = set(order)
-        for releases in wrong.values():
-            companion &= set(releases)
+        companion = _intersection(list(wrong.values()), order)
         built = releases_text(companion, order) if companion else "another release"
+        expected = releases_text(px4, order)
         topics = "; ".join(
             f"{topic} fits px4_msgs {releases_text(releases, order)}"
             for topic, releases in wrong.items()
@@ -69,42 +114,43 @@ class Px4MsgsMatch(Check):
         self.ctx.report(
             CODE,
             f"the companion's messages do not match the PX4 it talks to: {topics} (topic name "
-            f"and definition), while PX4's /fmu/out topics fit px4_msgs "
-            f"{releases_text(px4, order)} only. The companion was built with px4_msgs "
-            f"{built}; PX4 expects {releases_text(px4, order)}. PX4's uXRCE-DDS bridge takes a "
-            "message only under its own name and layout, so these never reach PX4 (no "
-            "keep-alive, no setpoint, no command) or arrive misread: build the companion "
-            "against the px4_msgs branch of PX4's release",
+            f"and definition), while PX4's /fmu/out topics fit px4_msgs {expected} only. The "
+            f"companion was built with px4_msgs {built}; PX4 expects {expected}. PX4's "
+            "uXRCE-DDS bridge takes a message only under its own name and layout, so these "
+            "never reach PX4 (no keep-alive, no setpoint, no command) or arrive misread: build "
+            "the companion against the px4_msgs branch of PX4's release (or, from 1.16, run "
+            "PX4's ROS 2 message translation node beside it)",
             None,
-            short=f"companion px4_msgs {built}, PX4 expects {releases_text(px4, order)}: "
-            f"{len(wrong)} /fmu/in topic(s) PX4 does not take",
+            short=f"companion px4_msgs {built}, PX4 expects {expected}: {len(wrong)} /fmu/in "
+            "topic(s) PX4 does not take",
         )
 
-    def _two_versions(
-        self,
-        names: dict[str, list[str]],
-        published: dict[str, tuple[str, ...]],
-        order: tuple[str, ...],
-    ) -> None:
-        """PX4's topics fit no release together: one message under two version names (a
-        companion subscribed to the name its px4_msgs give, PX4 publishes the other)."""
-        doubled = {name: topics for name, topics in names.items() if len(topics) > 1}
-        if not doubled:
+    def _translated(self, topic: str, px4: set[str]) -> bool:
+        ref = parse_topic(topic)
+        assert ref is not None
+        return any(
+            px4 & set(self.sent[other]) for other in self.sent_names[ref.name] if other != topic
+        )
+
+    def _subscribed(self, unserved: set[str], px4: set[str]) -> None:
+        """``/fmu/out`` names of another release with no message on them, beside PX4's name
+        for the same message: a companion's subscription that never gets a message."""
+        order = self.order
+        wrong = sorted(t for t in unserved if not px4 & set(self.published[t]))
+        if not wrong:
             return
         said = "; ".join(
-            " and ".join(f"{t} (px4_msgs {releases_text(published[t], order)})" for t in topics)
-            for topics in doubled.values()
+            f"{topic} (px4_msgs {releases_text(self.published[topic], order)})" for topic in wrong
         )
         self.ctx.report(
             CODE,
-            f"one PX4 message under two version names: {said}. PX4 publishes only the name of "
-            "its own release; the other is a subscription of a companion built with another "
-            "px4_msgs, which never gets a message (a client waiting for OFFBOARD on it never "
-            "sends its setpoints): build the companion against the px4_msgs branch of PX4's "
-            "release",
+            f"the companion subscribes to {said}, a name of another release than PX4's "
+            f"({releases_text(px4, order)}), which publishes the same message under its own "
+            "name: no message ever came on it, and a client that waits on it (for OFFBOARD, "
+            "say) never sends its setpoints. Build the companion against the px4_msgs branch "
+            "of PX4's release, and take the topic names from it",
             None,
-            short=f"{' / '.join(t for topics in doubled.values() for t in topics)}: two "
-            "versions of one message, one of them from the wrong px4_msgs",
+            short=f"{', '.join(wrong)}: subscribed under another release's name, never served",
         )
 
     def _name_and_definition(self) -> None:
