@@ -105,6 +105,14 @@ class RecordingInfo:
     px4_candidates: list[str] = field(default_factory=list)
     """Where the recording does not name its release but narrows it (a ROS 2 recording's
     message definitions and topic names): the profiles it fits, oldest first."""
+    px4_msgs_fits: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    """A ROS 2 recording's PX4 topics -> the px4_msgs releases (oldest first) that each one's
+    name and embedded definition fit (OFB006 compares the companion's and PX4's)."""
+    px4_msgs_conflicts: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = field(
+        default_factory=dict
+    )
+    """Its PX4 topics whose name and embedded definition fit no release together -> (releases
+    the name fits, releases the definition fits) (OFB006)."""
     vehicle_type: str | None = None
     vehicles: list[str] = field(default_factory=list)
     message_count: int | None = None

@@ -2,8 +2,9 @@
 
 The test stream is the rule's behaviour as tiny event lists (``[test_stream]`` in its TOML page,
 shown by ``fuzzoff rule CODE --verbose``); the page's Example and Use instead sections show client
-code instead. OFB001-OFB004 are about the input and the profile, not about a stream: they are
-exempt, and listed here so that the exemption is visible.
+code instead. OFB001-OFB004 are about the input and the profile, and OFB006 about the message
+definitions a ROS 2 recording carries, not about a stream: they are exempt, and listed here so
+that the exemption is visible (OFB006's cases are in tests/test_px4_msgs_match.py).
 """
 
 from __future__ import annotations
@@ -20,8 +21,9 @@ from fuzzoff.findings import Finding
 from fuzzoff.profiles import DEFAULT_PX4, DEFAULT_VEHICLE, Profile
 from fuzzoff.recording import RecordingInfo
 
-NOT_STREAM_RULES = {"OFB001", "OFB002", "OFB003", "OFB004"}
-"""Rules about reading the file or choosing the profile: no event stream can show them."""
+NOT_STREAM_RULES = {"OFB001", "OFB002", "OFB003", "OFB004", "OFB006"}
+"""Rules about reading the file, choosing the profile or the definitions it carries: no event
+stream can show them."""
 
 RULES = [rule for code, rule in load_catalog().items() if code not in NOT_STREAM_RULES]
 

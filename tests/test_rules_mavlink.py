@@ -152,6 +152,39 @@ def test_partial_group_counts_as_that_group() -> None:
     assert "not a combination" not in found.message
 
 
+@pytest.mark.parametrize("vehicle", ["mc", "fw", "rover-differential"])
+@pytest.mark.parametrize(
+    "ignored", [tmask.X_IGNORE, tmask.Z_IGNORE, tmask.X_IGNORE | tmask.Y_IGNORE]
+)
+def test_global_int_with_part_of_its_position_is_dropped(vehicle: str, ignored: int) -> None:
+    """GLOBAL_INT takes lat, lon and alt only together (gate spec 6.3): on its own, a partial
+    position leaves nothing, and PX4 drops the message with its keep-alive."""
+    mask = POSITION_ONLY_MASK | ignored
+    event = setpoint(tm.GLOBAL, type_mask=mask, coordinate_frame=6)
+    (found,) = codes(lint([event], vehicle=vehicle), "OFB602")
+    assert found.severity is Severity.ERROR
+    assert "ignores all of it" in found.message
+    assert "drops the message silently (no setpoint, no keep-alive)" in found.message
+    # LOCAL_NED takes its axes one by one: no such finding there
+    local = setpoint(tm.LOCAL, type_mask=mask, coordinate_frame=1)
+    assert not [f for f in codes(lint([local], vehicle=vehicle), "OFB602") if "whole" in f.message]
+
+
+def test_global_int_with_part_of_its_position_flies_the_velocity_alone() -> None:
+    mask = mask_for(frozenset({"position", "velocity"})) | tmask.Z_IGNORE
+    event = setpoint(tm.GLOBAL, type_mask=mask, coordinate_frame=6)
+    (found,) = codes(lint([event]), "OFB602")
+    assert found.severity is Severity.ERROR
+    assert "uses lat_int and lon_int but ignores alt" in found.message
+    assert "flies the velocity alone" in found.message
+
+
+@pytest.mark.parametrize("px4", ["1.13", "1.16", "main"])
+def test_global_int_with_the_whole_position_is_clean(px4: str) -> None:
+    event = setpoint(tm.GLOBAL, type_mask=POSITION_ONLY_MASK, coordinate_frame=6)
+    assert codes(lint([event], px4), "OFB602") == []
+
+
 @pytest.mark.parametrize(
     ("px4", "mask", "fields", "problem"),
     [

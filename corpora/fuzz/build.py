@@ -43,14 +43,6 @@ ENTRIES = (
         "mavlink",
         1,
     ),
-    Entry(
-        _MAV + r"PX4 [^)]*\): setpoint_dropped .*SET_POSITION_TARGET_GLOBAL_INT dropped, no "
-        r"keep-alive: no position, velocity or acceleration",
-        "explained",
-        "1.15",
-        None,
-        7,
-    ),
 )
 
 

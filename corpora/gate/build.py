@@ -32,6 +32,21 @@ stream rules the flights also touch):
   flight, too large for this corpus): disarmed in AUTO_LOITER, an arm command, PX4 runs
   AUTO_TAKEOFF (NAV_TAKEOFF, which the model does not model), then Hold and Return. No offboard
   at all: OFB005, and OFB202 clean (rules/OFB202.toml: only differences that involve OFFBOARD).
+
+And one ROS 2 recording (``fuzzoff.formats.mcap.writer``, px4_msgs 1.16), as a px4_ros_com-style
+client records it: its ``/fmu/in`` stream and commands, PX4's ``/fmu/out/vehicle_status`` and
+``/fmu/out/vehicle_land_detected``, no acks:
+
+* ``landed_disarm_ros2`` (1.16): take-off to 2.5 m in OFFBOARD, a descent to the ground in
+  OFFBOARD, the land detector says landed at 14.5 s, the client disarms at 15.0 s and PX4 does
+  (``vehicle_status`` disarmed at 15.05 s). The gate model accepts the disarm for the land
+  detector's verdict, as from a ULog or a tlog (``tests/gate/test_landed_from_bags.py``); without
+  the topic it would take the vehicle, armed for 13 s, as airborne and refuse it. OFB202 clean,
+  and OFB006 (both sides' px4_msgs are 1.16's).
+* ``px4_msgs_mismatch_ros2`` (PX4 1.16, OFB006): the same client built against px4_msgs of 1.14
+  (its ``/fmu/in`` topics and schemas), PX4 1.16's ``/fmu/out/vehicle_status_v1`` answering:
+  PX4 never takes the stream, the switch and the arm; it stays in POSCTL, disarmed. OFB006,
+  and OFB202 where the model, which cannot see that, expected the switch.
 """
 
 from __future__ import annotations
@@ -47,9 +62,13 @@ from fuzzoff.events import (
     ControlMode,
     Event,
     FailsafeFlags,
+    LandDetected,
     TrajectorySetpoint,
     VehicleStatus,
 )
+from fuzzoff.formats import px4_msgs
+from fuzzoff.formats.mcap.writer import write_mcap
+from fuzzoff.formats.ros2msgs.messages import RawMessage, encode, to_message
 from fuzzoff.formats.ulog.writer import write_ulog
 
 HERE = Path(__file__).resolve().parent
@@ -133,9 +152,7 @@ def valid(rc: bool = True) -> FailsafeFlags:
     )
 
 
-def offboard_flight(
-    during_gap: tuple[int, bool], rc: bool = True, gap: bool = True
-) -> list[Event]:
+def offboard_flight(during_gap: tuple[int, bool], rc: bool = True, gap: bool = True) -> list[Event]:
     """The flight; without ``gap`` the stream never stops (``during_gap`` should then say
     OFFBOARD)."""
     flown = [*stream(0.0, STOP_T), *stream(RESUME_T, END_T)] if gap else stream(0.0, END_T)
@@ -291,10 +308,109 @@ def write(case: Case) -> None:
     (HERE / f"{case.name}.expected.json").write_text(json.dumps(expected, indent=2) + "\n")
 
 
+LANDED_T, DISARM_T, DESCEND_T = 14.5, 15.0, 9.0
+MISMATCH_FINDINGS: list[dict[str, Any]] = [
+    {"code": "OFB006", "severity": "error", "time_s": None},
+    # the stream before the switch while disarmed, the loss summary at the request
+    {"code": "OFB203", "severity": "info", "time_s": 0.0},
+    {"code": "OFB701", "severity": "info", "time_s": SWITCH_T},
+    # the model takes the switch (1.16 accepts it disarmed); PX4 never got it
+    {"code": "OFB202", "severity": "warning", "time_s": 2.0},
+    {"code": "OFB002", "severity": "info", "time_s": None},
+]
+"""``px4_msgs_mismatch_ros2``'s findings, judged by hand against the rule texts."""
+
+
+def landed_disarm_ros2() -> list[Event]:
+    """A px4_ros_com-style flight that lands in OFFBOARD and disarms (gate spec 13a)."""
+    events: list[Event] = []
+    for k in range(171):  # 10 Hz, 0-17 s
+        t = round(0.1 * k, 6)
+        us = 5_000_000 + round(t * 1e6)
+        z = -2.5 if t < DESCEND_T else 0.0
+        events.append(ControlMode(t=t, position=True, sender_time_us=us))
+        events.append(TrajectorySetpoint(t=t, position=(0.0, 0.0, z), sender_time_us=us))
+    events += [
+        Command(t=SWITCH_T, command=176, params=(1.0, 6.0, 0, 0, 0, 0, 0), transport="ros2"),
+        Command(t=ARM_T, command=400, params=(1.0, 0, 0, 0, 0, 0, 0), transport="ros2"),
+        Command(t=DISARM_T, command=400, params=(0.0, 0, 0, 0, 0, 0, 0), transport="ros2"),
+        LandDetected(t=0.0, landed=True),
+        LandDetected(t=3.6, landed=False),  # PX4 detects the take-off 1-2 s after the climb
+        LandDetected(t=LANDED_T, landed=True),
+    ]
+    times = sorted({round(0.5 * i, 6) for i in range(35)} | {SWITCH_T + 0.05, ARM_T + 0.05})
+    times = sorted({*times, DISARM_T + 0.05})
+    for t in times:
+        nav = POSCTL if t < SWITCH_T + 0.05 else OFFBOARD
+        armed = ARM_T + 0.05 <= t < DISARM_T + 0.05
+        events.append(VehicleStatus(t=t, nav_state=nav, armed=armed, user_intention=nav))
+    return sorted(events, key=lambda e: e.t)
+
+
+def built_with(release: str, events: list[Event]) -> list[RawMessage]:
+    """The companion's ``/fmu/in`` messages as a program built with ``release``'s px4_msgs
+    publishes them: that release's topic names, schemas and layouts."""
+    out = []
+    for event in events:
+        msg = to_message(event, release)
+        text = px4_msgs.definition(release, msg.message) or ""
+        out.append(RawMessage(event.t, msg.topic, msg.typename, text, encode(msg)))
+    return out
+
+
+def px4_msgs_mismatch_ros2() -> tuple[list[Event], list[RawMessage]]:
+    """The client of ``landed_disarm_ros2`` built with 1.14's px4_msgs, PX4 1.16 answering:
+    nothing it sends reaches PX4, which stays in POSCTL, disarmed."""
+    flight = landed_disarm_ros2()
+    sent = [e for e in flight if e.origin == "sent" and e.t < 10.0]
+    status = [
+        VehicleStatus(t=round(0.5 * i, 6), nav_state=POSCTL, armed=False, user_intention=POSCTL)
+        for i in range(21)
+    ]
+    return status, built_with("1.14", sent)
+
+
+def write_ros2() -> None:
+    mismatch = "px4_msgs_mismatch_ros2"
+    status, raw = px4_msgs_mismatch_ros2()
+    path = write_mcap(HERE / f"{mismatch}.mcap", status, release="1.16", extra=raw)
+    (HERE / f"{mismatch}.expected.json").write_text(
+        json.dumps(
+            {
+                "recording": path.name,
+                "args": ["--px4", "1.16", "--vehicle", "mc"],
+                "exit_status": 1,
+                "complete": True,
+                "findings": MISMATCH_FINDINGS,
+            },
+            indent=2,
+        )
+        + "\n"
+    )
+    name = "landed_disarm_ros2"
+    path = write_mcap(HERE / f"{name}.mcap", landed_disarm_ros2(), release="1.16")
+    expected: dict[str, Any] = {
+        "recording": path.name,
+        "args": ["--px4", "1.16", "--vehicle", "mc"],
+        "exit_status": 0,
+        "complete": True,
+        "findings": [
+            # judged by hand against the rule texts: the setpoints before the switch (info,
+            # disarmed), the loss summary at the request, and OFB201 without acks
+            {"code": "OFB203", "severity": "info", "time_s": 0.0},
+            {"code": "OFB701", "severity": "info", "time_s": SWITCH_T},
+            {"code": "OFB002", "severity": "info", "time_s": None},
+        ],
+        "clean": ["OFB006", "OFB202"],
+    }
+    (HERE / f"{name}.expected.json").write_text(json.dumps(expected, indent=2) + "\n")
+
+
 def main() -> None:
     for case in cases():
         write(case)
         print(f"{case.name}.ulg: {(HERE / f'{case.name}.ulg').stat().st_size} bytes")
+    write_ros2()
 
 
 if __name__ == "__main__":

@@ -70,6 +70,8 @@ POSITION_ONLY = 0x0DF8
 VELOCITY_ONLY = 0x0DC7
 VELOCITY_YAW = 0x09C7
 LOITER_TYPE = 0x3000
+GLOBAL_LATLON_YAW = 0x09FC
+"""lat, lon and yaw; alt, velocity and acceleration ignored."""
 
 
 def ticks(start: float, stop: float, period: float) -> list[float]:
@@ -253,6 +255,11 @@ def cases() -> list[Case]:
             t=t, sender_time_us=round(t * 1e6) + 5_000_000, group_mlx=1, controls=controls, **SENT
         )
 
+    def to_latlon_keep_altitude(t: float) -> Event:
+        # "fly there at the altitude you have": alt ignored, so PX4 ignores lat and lon too,
+        # and with nothing else used drops the message (gate spec 6.3)
+        return global_int(t, GLOBAL_LATLON_YAW, 6, yaw=0.5)
+
     def heading_hold(t: float) -> Event:
         return attitude(t, 7, q=(math.cos(0.25), 0.0, 0.0, math.sin(0.25)), thrust=0.3)
 
@@ -298,6 +305,14 @@ def cases() -> list[Case]:
                 "mask 0x0800 uses every field: P+V+A (OFB602: the docs' list only, PX4's "
                 "position controller flies it per axis: info) and afx/afy/afz (OFB605)"
             ],
+        ),
+        Case(
+            "ofb602_global_altitude_ignored",
+            "mc",
+            flight("mc", local, to_latlon_keep_altitude),
+            [("OFB602", "error", EXTRA_FROM)],
+            ["OFB601", "OFB605", "OFB606", "OFB607"],
+            notes=["GLOBAL_INT takes lat, lon and alt only together: this one is dropped"],
         ),
         Case("good_copter_attitude", "mc", flight("mc", attitude), [], MC_RULES),
         Case(

@@ -23,6 +23,14 @@ through ``fuzzoff.formats.tlog.writer`` (pymavlink packs the packets) and gets
   DO_SET_MODE to Hold, acked twice (the receiver's ACCEPTED, then Commander's) 20 and 26 ms
   later; the next 1 Hz HEARTBEAT shows Hold at 11.0 s. The offboard window ends at the ack, so
   the second of silence until the HEARTBEAT is no gap in OFFBOARD: no OFB101, no OFB103.
+* ``arm_between_acks_1_16_2``: the good flight on PX4 1.16.2, but the client arms 2 ms after
+  the receiver's ACCEPTED of its switch to OFFBOARD, 4 ms before Commander's: OFB207 as a
+  warning (Commander accepted; the client did not wait to know). ``mavsdk_stop_to_hold`` is the
+  good counterpart: every next step comes after the second ack.
+* ``mission_on_rejected_switch_1_17_0``: PX4 1.17.0, flying in OFFBOARD; at 10.0 s the client
+  switches to AUTO_MISSION (no mission on board: Commander rejects it), stops its setpoints and,
+  on the receiver's ACCEPTED, sends MAV_CMD_MISSION_START between the two acks: OFB207 error;
+  the vehicle stays in OFFBOARD without a stream and the loss failsafe follows (OFB101, OFB103).
 * ``no_autopilot_version``: the good flight without AUTOPILOT_VERSION: OFB003 (version
   assumed; the vehicle type still comes from HEARTBEAT ``type``).
 * ``truncated``: the lost-stream flight cut inside a packet: OFB001, exit status 2, and the
@@ -213,6 +221,52 @@ def stop_to_hold() -> list[Event]:
     )
 
 
+def arm_between_acks() -> list[Event]:
+    """The good flight on 1.16.2, armed between the two acks of the switch (OFB207)."""
+    return ordered(
+        identity("1.16.2"),
+        heartbeats(
+            [(0.0, POSCTL, False), (4.0, OFFBOARD, True), (16.0, AUTO_LAND, True)],
+            17.0,
+        ),
+        stream(1.0, 16.0),
+        [set_mode(3.0, 6), ack(3.004, 176), arm(3.006), ack(3.01, 176), ack(3.016, 400)],
+        [set_mode(15.0, 4, 6), ack(15.004, 176), ack(15.01, 176)],
+    )
+
+
+MISSION_START = 300
+AUTO_MAIN, MISSION_SUB = 4, 4
+
+
+def mission_on_rejected_switch() -> list[Event]:
+    """1.17.0: the switch to AUTO_MISSION is rejected by its second ack; the client stopped its
+    setpoints and started the mission on the first (OFB207), and PX4 stays in OFFBOARD."""
+    mission_start = Command(
+        t=10.006,
+        command=MISSION_START,
+        params=(0.0,) * 7,
+        from_external=True,
+        **SENT,
+    )
+    return ordered(
+        identity("1.17.0"),
+        heartbeats(
+            [
+                (0.0, POSCTL, False),
+                (4.0, OFFBOARD, False),
+                (5.0, OFFBOARD, True),
+                (11.0, POSCTL, True),  # the loss failsafe: COM_OBL_RC_ACT 0 -> Position
+            ],
+            13.0,
+        ),
+        stream(1.0, 10.0),
+        [set_mode(3.0, 6), ack(3.004, 176), ack(3.01, 176), arm(4.5), ack(4.51, 400)],
+        [set_mode(10.0, AUTO_MAIN, MISSION_SUB), ack(10.004, 176), mission_start],
+        [ack(10.009, 176, 1)],
+    )
+
+
 def rejected(version: str, acks: list[tuple[float, int]]) -> list[Event]:
     return ordered(
         identity(version),
@@ -239,6 +293,7 @@ def write(
     profile: dict[str, Any],
     complete: bool = True,
     cut: int | None = None,
+    clean: list[str] | None = None,
 ) -> None:
     path = write_tlog(HERE / f"{name}.tlog", events)
     if cut is not None:
@@ -252,6 +307,8 @@ def write(
         "profile": profile,
         "findings": findings,
     }
+    if clean:
+        spec["clean"] = clean
     (HERE / f"{name}.expected.json").write_text(json.dumps(spec, indent=2) + "\n")
 
 
@@ -306,6 +363,28 @@ def main() -> None:
         [finding("OFB701", "info", 3.0)],
         exit_status=0,
         profile={"px4": "1.16", "vehicle": "mc", "detected": True},
+        clean=["OFB207"],
+    )
+    write(
+        "arm_between_acks_1_16_2",
+        arm_between_acks(),
+        [finding("OFB701", "info", 3.0), finding("OFB207", "warning", 3.006)],
+        exit_status=1,
+        profile={"px4": "1.16", "vehicle": "mc", "detected": True},
+    )
+    write(
+        "mission_on_rejected_switch_1_17_0",
+        mission_on_rejected_switch(),
+        [
+            finding("OFB701", "info", 3.0),
+            finding("OFB101", "error", 9.95),
+            finding("OFB207", "error", 10.006),
+            # the gate model cannot know that no mission is on board: it expected the switch
+            finding("OFB202", "warning", 10.009),
+            finding("OFB103", "error", 11.06),
+        ],
+        exit_status=1,
+        profile={"px4": "1.17", "vehicle": "mc", "detected": True},
     )
     write(
         "no_autopilot_version",

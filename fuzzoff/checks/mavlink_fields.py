@@ -38,6 +38,13 @@ VEHICLE_LABELS = {"copter": "multicopter/VTOL", "fixedwing": "fixed-wing", "rove
 
 PositionTarget = SetPositionTargetLocal | SetPositionTargetGlobal
 
+GLOBAL_POSITION_FIELDS = (
+    ("lat_int", tmask.X_IGNORE),
+    ("lon_int", tmask.Y_IGNORE),
+    ("alt", tmask.Z_IGNORE),
+)
+"""The position fields of SET_POSITION_TARGET_GLOBAL_INT and their ignore bits."""
+
 _MASK_KEY = attrgetter("kind", "type_mask")
 _KEY = attrgetter(
     "origin", "kind", "type_mask", "coordinate_frame", "target_system", "target_component"
@@ -274,6 +281,9 @@ class PositionTargetFields(Check):
                     "drops the message (no setpoint, no keep-alive)"
                 )
             }
+        partial = self._global_partial_position(event, head, selected)
+        if partial is not None:
+            return partial
         usable = selected - rules.ignored
         body = self._body_ned_drop(event, head, rules, selected, usable)
         if body is not None:
@@ -300,6 +310,44 @@ class PositionTargetFields(Check):
                 severity,
                 short=f"type_mask {event.type_mask} selects {tm.describe_combo(usable)}: not in "
                 f"the docs' list for a {self.vehicle_label}",
+            )
+        }
+
+    def _global_partial_position(
+        self, event: PositionTarget, head: str, selected: tm.Combo
+    ) -> dict[str, Offence] | None:
+        """GLOBAL_INT (gate spec 6.3): the receiver takes the position only whole; an ignore bit
+        on any of lat, lon or alt drops all three. With no velocity or acceleration left the
+        message is dropped silently (no setpoint, no keep-alive); otherwise only the rest is
+        flown. The legacy and 1.11 handlers are OFB609's."""
+        mask = event.type_mask
+        if event.kind != tm.GLOBAL or not mask & tmask.POSITION_BITS or "position" not in selected:
+            return None
+        ignored = [name for name, bit in GLOBAL_POSITION_FIELDS if mask & bit]
+        used = [name for name, bit in GLOBAL_POSITION_FIELDS if not mask & bit]
+        rest = selected - {"position"}
+        why = (
+            f"{head} uses {' and '.join(used)} but ignores {' and '.join(ignored)}: PX4's "
+            "receiver takes this message's position only whole (lat, lon and alt) and so "
+            "ignores all of it"
+        )
+        if rest:
+            return {
+                "global_partial": Offence(
+                    f"{why}, so the vehicle flies the {tm.describe_combo(rest)} alone and never "
+                    "goes to the position sent (to hold an altitude while moving, send the whole "
+                    "position, or use SET_POSITION_TARGET_LOCAL_NED, whose axes are taken one by "
+                    "one)",
+                    short=f"type_mask {mask}: part of the position ignored, so all of it: "
+                    f"{tm.describe_combo(rest)} only",
+                )
+            }
+        yaw = "" if mask & tmask.YAW_IGNORE and mask & tmask.YAW_RATE_IGNORE else " (yaw alone)"
+        return {
+            "global_partial": Offence(
+                f"{why}; with no velocity or acceleration left{yaw} PX4 drops the message "
+                "silently (no setpoint, no keep-alive); send the whole position",
+                short=f"type_mask {mask}: part of the position ignored: dropped, no keep-alive",
             )
         }
 

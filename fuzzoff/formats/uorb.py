@@ -104,7 +104,7 @@ TOPICS: dict[str, Topic] = {
     ),
     "failsafe_flags": Topic("FailsafeFlags", ev.FailsafeFlags.kind, published=True),
     "vehicle_status_flags": Topic(None, ev.FailsafeFlags.kind, published=True),
-    "vehicle_land_detected": Topic(None, ev.LandDetected.kind, published=True),
+    "vehicle_land_detected": Topic("VehicleLandDetected", ev.LandDetected.kind, published=True),
     "vehicle_local_position": Topic(
         "VehicleLocalPosition", ev.VehiclePosition.kind, published=True
     ),

@@ -17,12 +17,4 @@ KNOWN: dict[str, str] = {
         "PX4 1.11's SET_POSITION_TARGET_GLOBAL_INT handler is unverified (gate spec 6.3): the "
         "gate model takes it as a keep-alive without a setpoint, OFB609 says so as a warning"
     ),
-    _MAV + r"PX4 [^)]*\): setpoint_dropped .*SET_POSITION_TARGET_GLOBAL_INT dropped, no "
-    r"keep-alive: no position, velocity or acceleration": (
-        "a SET_POSITION_TARGET_GLOBAL_INT that ignores part of its position (lat, lon or alt) "
-        "and all of its velocity and acceleration: the gate model drops it (the handler takes "
-        "the position only whole, gate spec 6.3), and no rule says so as an error (OFB602 "
-        "reports the same mask on LOCAL_NED); found by fuzzoff fuzz --px4 1.15 --vehicle mc "
-        "--examples 200 --seed 7"
-    ),
 }

@@ -26,6 +26,7 @@ from typing import Any, NamedTuple
 
 from fuzzoff.events import (
     Event,
+    LandDetected,
     SetAttitudeTarget,
     SetPositionTargetGlobal,
     SetPositionTargetLocal,
@@ -69,6 +70,10 @@ MASK_FORCE = FORCE_SET
 MASK_ATTITUDE_THRUST = ROLL_RATE_IGNORE | PITCH_RATE_IGNORE | BODY_YAW_RATE_IGNORE  # attitude
 MASK_RATES_THRUST = ATTITUDE_IGNORE  # setpoint_attitude/cmd_vel: ignore the attitude
 
+LANDED_STATE_UNDEFINED = 0
+LANDED_STATE_ON_GROUND = 1
+"""``ExtendedState.landed_state`` values (MAVLink ``MAV_LANDED_STATE``)."""
+
 MAVROS_TARGET_SYSTEM = 1
 MAVROS_TARGET_COMPONENT = 1
 """MAVROS's default ``target_system_id`` / ``target_component_id``."""
@@ -88,6 +93,7 @@ TOPIC_TYPES: dict[str, str] = {
     "setpoint_attitude/thrust": _MSG + "Thrust",
     "setpoint_accel/accel": _GEO + "Vector3Stamped",
     "state": _MSG + "State",
+    "extended_state": _MSG + "ExtendedState",
     "local_position/pose": _GEO + "PoseStamped",
 }
 """MAVROS topic (after the ``mavros/`` namespace) -> the message type MAVROS subscribes with."""
@@ -104,6 +110,7 @@ TOPIC_KINDS: dict[str, str] = {
     "setpoint_attitude/thrust": SetAttitudeTarget.kind,
     "setpoint_accel/accel": SetPositionTargetLocal.kind,
     "state": VehicleStatus.kind,
+    "extended_state": LandDetected.kind,
     "local_position/pose": VehiclePosition.kind,
 }
 """MAVROS topic -> the event kind it becomes (``RecordingInfo.kinds``)."""
@@ -214,6 +221,8 @@ class MavrosConverter:
     _body: dict[str, _Pending] = field(default_factory=dict)
     _thrust: dict[str, _Pending] = field(default_factory=dict)
     _handlers: dict[str, Handler | None] = field(default_factory=dict)
+    _landed_state: dict[str, bool | None] = field(default_factory=dict)
+    """The last land-detector verdict per vehicle (only changes become events)."""
 
     def convert(self, topic: str, msg: Any, t: float, index: int | None = None) -> list[Event]:
         """The events MAVROS produces for ``msg`` on ``topic`` at recording time ``t``."""
@@ -238,6 +247,8 @@ class MavrosConverter:
             return lambda msg, t, index: state_to_status(
                 msg, t=t, vehicle=ns, where=Where(topic, index)
             )
+        if name == "extended_state":
+            return lambda msg, t, index: self._landed(msg, t, ns, Where(topic, index))
         if name == "local_position/pose":
             return lambda msg, t, index: self._position(msg, t, ns, Where(topic, index))
         if name in ("setpoint_attitude/attitude", "setpoint_attitude/cmd_vel"):
@@ -263,6 +274,17 @@ class MavrosConverter:
             return make(msg, options, t, ns, Where(topic, index))
 
         return setpoint
+
+    def _landed(self, msg: Any, t: float, ns: str, where: Where) -> Event | None:
+        """``extended_state`` (ExtendedState, MAVLink ``EXTENDED_SYS_STATE`` as MAVROS
+        republishes it) -> ``LandDetected`` when its verdict changes, as the tlog reader gives
+        it: ON_GROUND is landed; IN_AIR, TAKEOFF and LANDING are not; UNDEFINED is unknown."""
+        state = int(msg.landed_state)
+        landed = None if state == LANDED_STATE_UNDEFINED else state == LANDED_STATE_ON_GROUND
+        if ns in self._landed_state and self._landed_state[ns] == landed:
+            return None
+        self._landed_state[ns] = landed
+        return LandDetected(t=t, vehicle=ns, where=where, landed=landed)
 
     def _position(self, msg: Any, t: float, ns: str, where: Where) -> Event | None:
         """``local_position/pose``: where MAVROS says the vehicle is, ENU, from PX4's

@@ -178,6 +178,8 @@ class Ros2Source(Source):
         info.vehicles = self.decoding.vehicles()
         info.px4_version = self.decoding.detected_release()
         info.px4_candidates = self.decoding.fitting_releases()
+        info.px4_msgs_fits = self.decoding.px4_msgs_fits()
+        info.px4_msgs_conflicts = self.decoding.px4_msgs_conflicts()
         info.vehicle_type = self._vehicle
         self._rover(info)
         info.notes.extend(self._notes)

@@ -373,6 +373,23 @@ def _local_position(fields: frozenset[str], vehicle: str, origin: Origin) -> Bui
     return build
 
 
+def _land_detected(fields: frozenset[str], vehicle: str, origin: Origin) -> Builder:
+    """``VehicleLandDetected``: landed as Commander judges a disarm, ``landed`` or
+    ``maybe_landed`` (gate spec 13a), as from a ULog."""
+
+    def build(m: Any, t: float, where: Where, ts: int) -> Event:
+        return ev.LandDetected(
+            t=t,
+            vehicle=vehicle,
+            where=where,
+            sender_time_us=ts,
+            origin=origin,
+            landed=bool(m.landed or m.maybe_landed),
+        )
+
+    return build
+
+
 BUILDERS: dict[str, Callable[[frozenset[str], str, Origin], Builder]] = {
     "OffboardControlMode": _control_mode,
     "TrajectorySetpoint": _trajectory,
@@ -396,6 +413,7 @@ BUILDERS: dict[str, Callable[[frozenset[str], str, Origin], Builder]] = {
     "VehicleControlMode": _control_mode_status,
     "FailsafeFlags": _failsafe_flags,
     "VehicleLocalPosition": _local_position,
+    "VehicleLandDetected": _land_detected,
 }
 """px4_msgs message name -> builder factory (fields of the definition, vehicle, origin)."""
 

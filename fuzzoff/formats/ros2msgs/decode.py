@@ -297,6 +297,13 @@ class Ros2Decoding:
     """How many messages of each of ``unknown`` the recording holds, where the reader counted."""
     evidence: set[str] | None = None
     """Releases every definition seen so far fits (for profile detection)."""
+    topic_fits: dict[str, set[str]] = field(default_factory=dict)
+    """Per PX4 topic, the releases its name and its embedded definition fit (a definition
+    fuzzoff chose for a bag without one is no evidence of what the sender was built with)."""
+    name_fits: dict[str, set[str]] = field(default_factory=dict)
+    """Per PX4 topic, the releases its name alone fits."""
+    definition_fits: dict[str, set[str]] = field(default_factory=dict)
+    """Per PX4 topic, the releases its embedded definition alone fits."""
     notes: list[str] = field(default_factory=list)
     position_period_s: float = 0.0
     """``VehicleLocalPosition`` read at most this often per topic (0: every message)."""
@@ -353,7 +360,7 @@ class Ros2Decoding:
                     f"{topic}: embedded definition not usable ({why}); bundled px4_msgs used"
                 )
                 return decoder
-            self._note_evidence(message, definition)
+            self._note_evidence(message, definition, decoder.topic)
             decoder.use(definition)
         return decoder
 
@@ -366,14 +373,49 @@ class Ros2Decoding:
         fits = set(self.candidates(decoder))
         if fits:
             self.evidence = fits if self.evidence is None else self.evidence & fits
+            self._topic_fits(decoder.topic, fits)
+            self.name_fits[decoder.topic] = fits
 
-    def _note_evidence(self, message: str, definition: Definition) -> None:
+    def _note_evidence(self, message: str, definition: Definition, topic: str = "") -> None:
         fits = {
             r
             for r in px4_msgs.releases_with(message)
             if bundled_layout(message, r) == definition.layout
         }
         self.evidence = fits if self.evidence is None else self.evidence & fits
+        if topic:
+            self._topic_fits(topic, fits)
+            self.definition_fits[topic] = fits
+
+    def _topic_fits(self, topic: str, fits: set[str]) -> None:
+        known = self.topic_fits.get(topic)
+        self.topic_fits[topic] = set(fits) if known is None else known & fits
+
+    def px4_msgs_conflicts(self) -> dict[str, tuple[tuple[str, ...], tuple[str, ...]]]:
+        """PX4 topics whose name and embedded definition fit no release together -> (the
+        releases the name fits, those the definition fits), oldest first: a program whose
+        px4_msgs give one version of the message, on the topic name of another."""
+        order = px4_msgs.folders()
+        out: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {}
+        for topic, fits in sorted(self.topic_fits.items()):
+            by_name = self.name_fits.get(topic)
+            if fits or not by_name or topic not in self.definition_fits:
+                continue
+            by_definition = self.definition_fits[topic]
+            out[topic] = (
+                tuple(r for r in order if r in by_name),
+                tuple(r for r in order if r in by_definition),
+            )
+        return out
+
+    def px4_msgs_fits(self) -> dict[str, tuple[str, ...]]:
+        """Per PX4 topic, the bundled releases (oldest first) its name and embedded definition
+        fit: what the program on each side was built with (``RecordingInfo.px4_msgs_fits``)."""
+        order = px4_msgs.folders()
+        return {
+            topic: tuple(r for r in order if r in fits)
+            for topic, fits in sorted(self.topic_fits.items())
+        }
 
     def candidates(self, decoder: TopicDecoder) -> list[str]:
         """Bundled releases that can carry this topic (suffix / naming), newest first."""

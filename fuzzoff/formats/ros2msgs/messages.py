@@ -44,6 +44,7 @@ _MESSAGE_OF: dict[type[ev.Event], str] = {
     ev.VehicleControlModeStatus: "VehicleControlMode",
     ev.FailsafeFlags: "FailsafeFlags",
     ev.VehiclePosition: "VehicleLocalPosition",
+    ev.LandDetected: "VehicleLandDetected",
 }
 
 _NUMPY = {
@@ -190,6 +191,8 @@ def _event_values(event: ev.Event, message: str, names: set[str]) -> dict[str, A
         for name in ESTIMATES:
             valid = getattr(event, f"{name}_valid")
             v[f"{name}_invalid"] = valid is False
+    elif isinstance(event, ev.LandDetected):
+        v["landed"] = v["maybe_landed"] = bool(event.landed)
     elif isinstance(event, ev.VehiclePosition):
         xy, z = math.isfinite(event.x) and math.isfinite(event.y), math.isfinite(event.z)
         v.update(x=event.x if xy else 0.0, y=event.y if xy else 0.0, z=event.z if z else 0.0)

@@ -9,7 +9,8 @@ ones that carry every field and the ``type_mask`` through unchanged):
 * ``SetPositionTargetGlobal`` -> ``setpoint_raw/global`` (GlobalPositionTarget);
 * ``SetAttitudeTarget`` -> ``setpoint_raw/attitude`` (AttitudeTarget), thrust as is (MAVROS's
   default ``thrust_scaling`` 1.0; thrust outside [0, 1] cannot round-trip, MAVROS clamps it);
-* ``VehicleStatus`` -> ``state`` (State) with the MAVROS mode string of ``nav_state``.
+* ``VehicleStatus`` -> ``state`` (State) with the MAVROS mode string of ``nav_state``;
+* ``LandDetected`` -> ``extended_state`` (ExtendedState): ON_GROUND, IN_AIR or UNDEFINED.
 
 Other events have no MAVROS topic and are left out. The topic namespace is the event's
 ``vehicle`` when it is a ROS namespace (``/uav1`` -> ``/uav1/mavros``), else ``namespace``.
@@ -35,6 +36,7 @@ from rosbags.typesys import Stores, get_typestore
 
 from fuzzoff.events import (
     Event,
+    LandDetected,
     SetAttitudeTarget,
     SetPositionTargetGlobal,
     SetPositionTargetLocal,
@@ -60,6 +62,7 @@ _TOPICS: dict[type[Event], tuple[str, str]] = {
     SetPositionTargetGlobal: ("setpoint_raw/global", "mavros_msgs/msg/GlobalPositionTarget"),
     SetAttitudeTarget: ("setpoint_raw/attitude", "mavros_msgs/msg/AttitudeTarget"),
     VehicleStatus: ("state", "mavros_msgs/msg/State"),
+    LandDetected: ("extended_state", "mavros_msgs/msg/ExtendedState"),
 }
 
 
@@ -95,6 +98,7 @@ class _Builder:
         self.glob = types["mavros_msgs/msg/GlobalPositionTarget"]
         self.att = types["mavros_msgs/msg/AttitudeTarget"]
         self.state = types["mavros_msgs/msg/State"]
+        self.extended = types["mavros_msgs/msg/ExtendedState"]
         self.seq = 0
 
     def _header(self, sender_time_us: int | None) -> Any:
@@ -113,6 +117,8 @@ class _Builder:
             return self._global(event)
         if isinstance(event, SetAttitudeTarget):
             return self._attitude(event)
+        if isinstance(event, LandDetected):
+            return self._extended(event)
         assert isinstance(event, VehicleStatus)
         return self._status(event)
 
@@ -170,6 +176,10 @@ class _Builder:
             mode=mode if connected else "",
             system_status=4 if e.armed else 3,  # MAV_STATE_ACTIVE / STANDBY
         )
+
+    def _extended(self, e: LandDetected) -> Any:
+        state = 0 if e.landed is None else 1 if e.landed else 2  # MAV_LANDED_STATE
+        return self.extended(header=self._header(None), vtol_state=0, landed_state=state)
 
 
 def _degrees(value_1e7: int) -> float:

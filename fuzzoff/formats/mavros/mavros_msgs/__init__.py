@@ -18,6 +18,7 @@ MAVROS_TYPES: tuple[str, ...] = (
     "AttitudeTarget",
     "State",
     "Thrust",
+    "ExtendedState",
 )
 
 
