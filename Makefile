@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 MULTITOOL := build/node/node_modules/.bin/sarif-multitool
 
-.PHONY: install demo test test-tools test-lowest test-sitl check bench fuzz clean
+.PHONY: install demo test test-tools test-lowest test-sitl check bench fuzz new-rule clean
 
 $(STAMP): pyproject.toml
 	$(PY) -m venv $(VENV)
@@ -59,10 +59,10 @@ test-lowest:
 # about a minute a run, 1.15 adds 40 s of boot).
 # `make test` runs only the short live check.
 test-sitl: $(STAMP)
-	FUZZOFF_SITL_MATRIX=1 $(BIN)/python -m pytest -q -n 2 tests/test_sitl_live.py tests/test_sitl.py
+	FUZZOFF_SITL_MATRIX=1 $(BIN)/python -m pytest -q -n 2 tests/test_sitl_live.py tests/test_sitl.py tests/test_ros2_live.py
 
 check: $(STAMP)
-	$(BIN)/ruff check fuzzoff tests bench corpora docs
+	$(BIN)/ruff check fuzzoff tests bench corpora docs scripts
 	$(BIN)/mypy
 
 # A pip install compiles the package to bytecode; an editable one only when Python may write it
@@ -77,6 +77,12 @@ bench: $(STAMP)
 # that each still fails (tests/test_fuzz_reproducers.py).
 fuzz: $(STAMP)
 	$(BIN)/fuzzoff fuzz --budget 600 --seed $${SEED:-1} --save-dir build/fuzz-reproducers --format junit --output build/fuzz-junit.xml
+
+# A new rule's page, check and corpus cases, and the docs (docs/contributing.md, "Add a rule"):
+# make new-rule CODE=OFB204 NAME=switch-before-stream ARGS="--severity error --sent-stream"
+new-rule: $(STAMP)
+	@test -n "$(CODE)" -a -n "$(NAME)" || { echo "usage: make new-rule CODE=OFBnnn NAME=rule-name [ARGS=...]"; exit 2; }
+	$(BIN)/python scripts/add_rule.py $(CODE) $(NAME) $(ARGS)
 
 clean:
 	rm -rf $(VENV) build .pytest_cache .mypy_cache .hypothesis

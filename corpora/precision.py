@@ -97,8 +97,9 @@ def tlog_row() -> Row:
     )
 
 
-def _release_key(release: str) -> tuple[int, ...]:
-    return tuple(int(p) for p in release.split("-")[0].split("."))
+def _release_key(release: str) -> tuple[tuple[int, ...], str]:
+    """Oldest first; a pre-release after its number's others by name (alpha before beta)."""
+    return tuple(int(p) for p in release.split("-")[0].split(".")), release
 
 
 def gate_agreement() -> Counter[tuple[str, bool | None]]:

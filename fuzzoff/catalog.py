@@ -10,7 +10,9 @@ rule whose findings take several severities: when each is given; ``severity`` is
 and what fuzz campaigns need to know: ``explains`` (the outcomes of the gate model,
 ``HAZARD_KINDS``, that a finding of the rule explains) and ``reports`` (those of them the rule
 reports itself: when the recording cannot show them, OFB002 says so and a warning of an
-explaining rule is enough).
+explaining rule is enough), and ``sent_stream`` (the rule judges the keep-alive and setpoint
+stream as the companion sent it: it is not run on a recording that does not hold that stream,
+and OFB002 names it there).
 
 Each page is also a Markdown file in the repository, ``docs/rules/CODE.md``, written from the
 catalog by ``docs/rules/build.py`` (a test keeps the two equal): that is where a rule links to.
@@ -133,6 +135,8 @@ class Rule:
     """The gate outcomes a finding of this rule explains (fuzz campaigns' ``explained``)."""
     reports: tuple[HazardKind, ...] = ()
     """The outcomes among ``explains`` this rule reports itself, not only a cause of."""
+    sent_stream: bool = False
+    """The rule judges the stream as sent: off where the recording does not hold it."""
 
     @property
     def page(self) -> str:
@@ -270,6 +274,7 @@ def _load_rule(path: Path, data: dict[str, Any]) -> Rule:
             severities=_severities(data.get("severities", {}), path),
             explains=_kinds(data.get("explains", ()), "explains", path),
             reports=_kinds(data.get("reports", ()), "reports", path),
+            sent_stream=bool(data.get("sent_stream", False)),
         )
     except KeyError as exc:
         raise CatalogError(f"{path.name}: missing key {exc}") from None
@@ -329,6 +334,15 @@ def read_catalog(directory: Path, cache: Path | None = None) -> dict[str, Rule]:
     pages = _pages(directory, cache)
     rules = [_load_rule(directory / name, data) for name, data in sorted(pages.items())]
     return {r.code: r for r in rules}
+
+
+@functools.cache
+def sent_stream_rules() -> tuple[str, ...]:
+    """The rules that judge the keep-alive and setpoint stream as sent (``sent_stream`` on their
+    page), by code. On a recording that cannot hold that stream (``RecordingInfo.
+    stream_recorded``) they are not run: its absence there says nothing about the sender, and
+    the engine says so in one OFB002."""
+    return tuple(code for code, rule in load_catalog().items() if rule.sent_stream)
 
 
 def get_rule(code: str) -> Rule:

@@ -243,6 +243,12 @@ class Settings:
             return "set with --param"
         return f"set in {Path(origin).name}"
 
+    def resolved_for(self, recording: str | Path) -> Settings:
+        """``for_recording``, resolved once: a lint given these settings does not look for a
+        configuration again (no ``discovery`` left to follow); the per-file ignores it applies
+        again add nothing."""
+        return replace(self.for_recording(recording), discovery=None)
+
     def for_recording(self, recording: str | Path) -> Settings:
         """The settings one recording is judged with: its nearest configuration (for a
         command-line run), the command line on top, then the ``per-file-ignores`` it matches."""

@@ -6,14 +6,13 @@ import gc
 import math
 from collections import Counter
 from collections.abc import Callable, Iterable, Iterator, Sequence
-from contextlib import contextmanager
-from dataclasses import dataclass, field
+from contextlib import AbstractContextManager, contextmanager
 from pathlib import Path
-from typing import cast
+from typing import Protocol, cast
 
-from fuzzoff.catalog import get_rule
+from fuzzoff.catalog import get_rule, sent_stream_rules
 from fuzzoff.checks import CheckContext, load_all
-from fuzzoff.checks.base import SENT_STREAM_RULES, STREAM_TYPES, Check, StreamBatch
+from fuzzoff.checks.base import STREAM_TYPES, Check, StreamBatch
 from fuzzoff.checks.whole_file import in_readable_part, recording_findings
 from fuzzoff.config import Settings
 from fuzzoff.events import (
@@ -46,9 +45,18 @@ from fuzzoff.profiles import (
     ProfileError,
     px4_profile_for,
 )
-from fuzzoff.recording import RecordingInfo, SourceProblem, first_byte, path_text
+from fuzzoff.recording import (
+    PLOT_SAMPLE_S,
+    PlotSamples,
+    RecordingInfo,
+    SourceProblem,
+    add_sample,
+    first_byte,
+    path_text,
+)
 from fuzzoff.releases import PX4Profile
 from fuzzoff.state import VehicleState
+from fuzzoff.timeline import Timeline
 from fuzzoff.type_mask import POSITION_BITS
 
 Progress = Callable[[float], None]
@@ -91,29 +99,9 @@ def resolve_profile(info: RecordingInfo, settings: Settings) -> Profile:
     )
 
 
-@dataclass(slots=True)
-class Timeline:
-    """Optional per-vehicle series for the gate command and the HTML report."""
-
-    keepalive: list[float] = field(default_factory=list)
-    recorded_modes: list[tuple[float, int | None, bool | None]] = field(default_factory=list)
-    transitions: list[GateTransition] = field(default_factory=list)
-    setpoint_kinds: dict[str, list[float]] = field(default_factory=dict)
-    loss_timeout: float | None = None
-    """The gate's effective loss timeout (recording's COM_OF_LOSS_T, overrides, defaults)."""
-    recorded_params: dict[str, float] = field(default_factory=dict)
-    notes: list[Event] = field(default_factory=list)
-    """The vehicle's text messages, the commands sent and their acks (at most ``NOTE_LIMIT``)."""
-    positions: list[tuple[float, float, float, float]] = field(default_factory=list)
-    """(t, x, y, z) of the vehicle's local position, NED metres, one per ``SAMPLE_S`` at most."""
-    setpoint_positions: list[tuple[float, float, float, float]] = field(default_factory=list)
-    """(t, x, y, z) of the position setpoints (trajectory setpoints, local NED MAVLink ones)."""
-
-
 NOTE_LIMIT = 5000
 """Text messages, commands and acks a timeline keeps per vehicle (a recording may flood them)."""
-SAMPLE_S = 0.05
-"""Shortest time between two kept samples of a plotted series (20 Hz is plenty for a plot)."""
+SAMPLE_S = PLOT_SAMPLE_S
 
 
 class VehicleRun:
@@ -151,11 +139,11 @@ class VehicleRun:
         self.checks = [cls(self.ctx) for cls in load_all() if cls.wanted(self.ctx)]
         self.handlers: dict[type, list[Callable[[Event], None]]] = {}
         self.batched = [c for c in self.checks if batching and _takes_runs(c)]
-        """Checks that take the stream messages as runs (``StreamBatch``), not one by one."""
+        """Checks that take stream messages: each gets them as runs (``StreamBatch``)."""
         self._wants = [
             (check.subscriptions, check.on_event, check in self.batched) for check in self.checks
         ]
-        self._takers = [check.on_batch for check in self.batched if check.on_batch is not None]
+        self._takers = [check.on_batch for check in self.batched]
         self._batch: StreamBatch | None = None
         self.timeline = timeline
         self.last_t = 0.0
@@ -173,7 +161,8 @@ class VehicleRun:
         return handlers
 
     def _flush(self) -> None:
-        """Hand the open run to the checks that take runs (before anything that changes state)."""
+        """Hand the open run to the checks that take stream messages (before anything that
+        changes state)."""
         batch = self._batch
         if batch is None:
             return
@@ -258,10 +247,10 @@ class VehicleRun:
             if len(self.timeline.notes) < NOTE_LIMIT:
                 self.timeline.notes.append(event)
         elif isinstance(event, VehiclePosition):
-            _sample(self.timeline.positions, event.t, (event.x, event.y, event.z))
+            add_sample(self.timeline.positions, event.t, (event.x, event.y, event.z))
         elif _plotted_position(event):
             assert isinstance(event, TrajectorySetpoint | SetPositionTargetLocal)
-            _sample(self.timeline.setpoint_positions, event.t, event.position)
+            add_sample(self.timeline.setpoint_positions, event.t, event.position)
 
     def finish(self, t_end: float) -> list[Finding]:
         self._flush()
@@ -289,13 +278,6 @@ def _plotted_position(event: Event) -> bool:
     )
 
 
-def _sample(
-    series: list[tuple[float, float, float, float]], t: float, xyz: tuple[float, float, float]
-) -> None:
-    if any(math.isfinite(v) for v in xyz) and (not series or t - series[-1][0] >= SAMPLE_S):
-        series.append((t, *xyz))
-
-
 def run_events(
     events: Iterable[Event],
     info: RecordingInfo,
@@ -305,13 +287,16 @@ def run_events(
     timelines: dict[str, Timeline] | None = None,
     on_event: Callable[[int], None] | None = None,
     batching: bool = True,
+    end_t: Callable[[], float | None] | None = None,
 ) -> tuple[list[Finding], RunStats]:
     """Run the gate and every enabled check over ``events`` (one recording, any vehicles).
 
     ``batching=False`` hands every stream message to every check one at a time, as the
-    checks' ``on_batch`` must be equivalent to (the tests compare the two)."""
+    checks' ``on_batch`` must be equivalent to (the tests compare the two). ``end_t`` gives,
+    once the events are used up, the time of the recording's last message when it is later
+    than its last event (``recording.Aside``): the recording ends there."""
     with _fewer_collections():
-        return _run_events(events, info, profile, settings, timelines, on_event, batching)
+        return _run_events(events, info, profile, settings, timelines, on_event, batching, end_t)
 
 
 @contextmanager
@@ -335,6 +320,7 @@ def _run_events(
     timelines: dict[str, Timeline] | None,
     on_event: Callable[[int], None] | None,
     batching: bool,
+    end_t: Callable[[], float | None] | None,
 ) -> tuple[list[Finding], RunStats]:
     runs: dict[str, VehicleRun] = {}
     kinds: Counter[str] = Counter()
@@ -356,6 +342,9 @@ def _run_events(
         count += 1
         if on_event is not None and count % 4096 == 0:
             on_event(count)
+    last_message = end_t() if end_t is not None else None
+    if last_message is not None and last_message > t_end:
+        t_end = last_message
     findings: list[Finding] = []
     for run in runs.values():
         findings.extend(run.finish(t_end))
@@ -383,7 +372,7 @@ def _stream_not_recorded(
     vehicles: list[str], info: RecordingInfo, settings: Settings, follows_flag: bool
 ) -> Finding:
     """The one OFB002 of a recording without the sent stream that shows offboard in use."""
-    codes = ", ".join(c for c in SENT_STREAM_RULES if settings.enabled(c))
+    codes = ", ".join(c for c in sent_stream_rules() if settings.enabled(c))
     who = f" on vehicle {', '.join(vehicles)}" if any(vehicles) else ""
     missing = info.stream_missing or "does not hold the stream sent to the vehicle"
     if follows_flag:
@@ -415,10 +404,8 @@ def _stream_not_recorded(
 
 
 def _takes_runs(check: Check) -> bool:
-    """Does the check define ``on_batch`` and want any stream message?"""
-    return check.on_batch is not None and any(
-        issubclass(cls, check.subscriptions) for cls in STREAM_TYPES
-    )
+    """Does the check want any stream message (then it takes them as runs)?"""
+    return any(issubclass(cls, check.subscriptions) for cls in STREAM_TYPES)
 
 
 def _sort_key(finding: Finding) -> tuple[float, str, str]:
@@ -442,7 +429,8 @@ def lint_file(
     """Lint one recording. Never raises for a bad file: it becomes OFB001 and ``complete=False``.
 
     ``batching=False`` gives every check the stream one message at a time (see ``run_events``);
-    ``plot_data`` has the reader add what only the HTML report's plots show (positions)."""
+    ``plot_data`` has the reader hand what only the HTML report's plots show (the positions it
+    thins out of the events) to ``timelines``, beside the events: the findings are the same."""
     settings = (settings or Settings()).for_recording(path)
     path = Path(path)
     name = path_text(path)
@@ -450,7 +438,7 @@ def lint_file(
     try:
         source = open_source(path)
         source.px4_hint = settings.px4
-        source.plot_data = plot_data
+        plot = source.aside.plot = PlotSamples() if plot_data else None
 
         def show() -> None:
             fraction = source.progress() if progress is not None else None
@@ -494,9 +482,12 @@ def lint_file(
             timelines=timelines,
             on_event=tick,
             batching=batching,
+            end_t=lambda: source.aside.end_t,
         )
     finally:
         source.close()
+    if plot is not None and timelines is not None:
+        _add_plotted(timelines, plot)
     malformed = get_rule("OFB004")
     for problem in source.problems:
         line = problem.line(name)
@@ -546,6 +537,17 @@ def lint_file(
     if progress is not None:
         progress(1.0)
     return report
+
+
+def _add_plotted(timelines: dict[str, Timeline], plot: PlotSamples) -> None:
+    """The positions the reader thinned out of the events, in the timelines beside the ones
+    judged (in time order, one per ``SAMPLE_S`` at most, as if all had been events)."""
+    for vehicle, samples in plot.positions.items():
+        timeline = timelines.setdefault(vehicle, Timeline())
+        merged: list[tuple[float, float, float, float]] = []
+        for t, *xyz in sorted(timeline.positions + samples, key=lambda sample: sample[0]):
+            add_sample(merged, t, (xyz[0], xyz[1], xyz[2]))
+        timeline.positions = merged
 
 
 def _until_unreadable(events: Iterable[Event], problems: list[SourceProblem]) -> Iterator[Event]:
@@ -606,9 +608,67 @@ def _assumed(
     )
 
 
-def _lint_one(args: tuple[Callable[[str, Settings], FileReport], str, Settings]) -> FileReport:
+class Lint(Protocol):
+    """Lints one recording with the settings it is judged with (``lint_file``,
+    ``lint_file_with_timelines``); a module-level function, so that workers can be sent it."""
+
+    def __call__(
+        self, path: str, settings: Settings, *, progress: Progress | None = None
+    ) -> FileReport: ...
+
+
+Watch = Callable[[str], AbstractContextManager[Progress | None]]
+"""Shows one recording's progress while it is linted (a progress bar's task)."""
+
+
+def plan_lint(
+    paths: Sequence[str | Path], settings: Settings | None = None
+) -> list[tuple[str, Settings]]:
+    """The recordings under ``paths`` (files, bag folders and folders, searched once), each
+    with the settings it is judged with (``Settings.resolved_for``): what ``lint_each`` takes."""
+    settings = settings or Settings()
+    return [(str(f), settings.resolved_for(f)) for f in recordings_in(paths)]
+
+
+def _lint_one(args: tuple[Lint, str, Settings]) -> FileReport:
     lint, path, settings = args
     return lint(path, settings)
+
+
+def lint_each(
+    plan: Sequence[tuple[str, Settings]],
+    *,
+    lint: Lint = lint_file,
+    jobs: int = 1,
+    on_file: Callable[[FileReport], None] | None = None,
+    watch: Watch | None = None,
+) -> Report:
+    """Lint each recording of ``plan`` (``plan_lint``) with its settings, in order: in this
+    process, where ``watch`` may show each one's progress, or in ``jobs`` worker processes.
+    The one way a local lint runs (``lint_paths``, ``fuzzoff lint``; a fleet's lint runs
+    the same plan on Dask, ``fleet.lint_run``)."""
+    report = Report()
+
+    def done(file_report: FileReport) -> None:
+        report.files.append(file_report)
+        if on_file is not None:
+            on_file(file_report)
+
+    if jobs > 1 and len(plan) > 1:
+        # imported here: a one-process lint need not pay for it at start-up
+        from concurrent.futures import ProcessPoolExecutor
+
+        with ProcessPoolExecutor(max_workers=jobs) as pool:
+            for file_report in pool.map(_lint_one, [(lint, f, s) for f, s in plan]):
+                done(file_report)
+    elif watch is None:
+        for f, s in plan:
+            done(lint(f, s))
+    else:
+        for f, s in plan:
+            with watch(f) as progress:
+                done(lint(f, s, progress=progress))
+    return report
 
 
 def lint_paths(
@@ -617,32 +677,10 @@ def lint_paths(
     *,
     jobs: int = 1,
     on_file: Callable[[FileReport], None] | None = None,
-    lint: Callable[[str, Settings], FileReport] = lint_file,
+    lint: Lint = lint_file,
 ) -> Report:
-    """Lint files and folders (searched recursively). ``jobs`` > 1 uses worker processes.
-
-    ``lint`` lints one file (a module-level function, so that workers can be sent it).
-    """
-    settings = settings or Settings()
-    files = [str(f) for f in recordings_in(paths)]
-    report = Report()
-    if jobs > 1 and len(files) > 1:
-        # imported here: a one-process lint need not pay for it at start-up
-        from concurrent.futures import ProcessPoolExecutor
-
-        with ProcessPoolExecutor(max_workers=jobs) as pool:
-            file_reports = pool.map(_lint_one, [(lint, f, settings) for f in files])
-            for file_report in file_reports:
-                report.files.append(file_report)
-                if on_file is not None:
-                    on_file(file_report)
-    else:
-        for f in files:
-            file_report = lint(f, settings)
-            report.files.append(file_report)
-            if on_file is not None:
-                on_file(file_report)
-    return report
+    """Lint files and folders (searched recursively). ``jobs`` > 1 uses worker processes."""
+    return lint_each(plan_lint(paths, settings), lint=lint, jobs=jobs, on_file=on_file)
 
 
 def timeline_loss_timeout(
@@ -668,22 +706,17 @@ def timeline_loss_timeout(
     return float(value), f"PX4 {profile.px4} default"
 
 
-def lint_file_with_timelines(path: str | Path, settings: Settings) -> FileReport:
+def lint_file_with_timelines(
+    path: str | Path, settings: Settings, *, progress: Progress | None = None
+) -> FileReport:
     """``lint_file`` with what the HTML report plots: every vehicle's timeline (every recorded
     position, not one per ``POSITION_PERIOD_S``) and the loss timeout the gate used."""
     settings = settings.for_recording(path)
     timelines: dict[str, Timeline] = {}
-    report = lint_file(path, settings, timelines=timelines, plot_data=True)
+    report = lint_file(path, settings, progress=progress, timelines=timelines, plot_data=True)
     report.timelines = timelines
     report.loss_timeouts = {
         vehicle: timeline_loss_timeout(tl, report.profile, settings)
         for vehicle, tl in timelines.items()
     }
     return report
-
-
-def lint_with_timelines(
-    paths: Sequence[str | Path], settings: Settings, *, jobs: int = 1
-) -> Report:
-    """Like ``lint_paths`` but every file report carries its timelines."""
-    return lint_paths(paths, settings, jobs=jobs, lint=lint_file_with_timelines)

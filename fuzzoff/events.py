@@ -29,8 +29,14 @@ from itertools import compress
 from operator import attrgetter
 from typing import Any, ClassVar, Literal
 
+# Named through ``events`` by the gate, the reports and the fuzz streams, beside Command.
+from fuzzoff.mavlink_ids import MAV_CMD_COMPONENT_ARM_DISARM as MAV_CMD_COMPONENT_ARM_DISARM
+from fuzzoff.mavlink_ids import MAV_CMD_DO_SET_MODE as MAV_CMD_DO_SET_MODE
+
 Origin = Literal["sent", "vehicle", "model"]
 Transport = Literal["ros2", "mavlink", "mavros", "uorb"]
+CommandMessage = Literal["COMMAND_LONG", "COMMAND_INT", "SET_MODE"]
+"""The MAVLink message a ``Command`` came in (PX4 checks their addresses differently)."""
 
 Vec2 = tuple[float, float]
 Vec3 = tuple[float, float, float]
@@ -381,6 +387,7 @@ class SetActuatorControlTarget(Event):
     source_system: int | None = None
     source_component: int | None = None
 
+
 PX4_SETPOINTS: tuple[type[Event], ...] = (
     TrajectorySetpoint,
     AttitudeSetpoint,
@@ -491,8 +498,6 @@ class LandDetected(Event):
 # ---------------------------------------------------------------------------------------------
 # Commands, acks, parameters, vehicle identity
 
-MAV_CMD_DO_SET_MODE = 176
-MAV_CMD_COMPONENT_ARM_DISARM = 400
 VEHICLE_CMD_SET_NAV_STATE = 100001
 PX4_MAIN_MODE_OFFBOARD = 6
 
@@ -515,6 +520,8 @@ class Command(Event):
     source_component: int | None = None
     from_external: bool | None = None
     transport: Transport = "mavlink"
+    message: CommandMessage | None = None
+    """The MAVLink message as recorded (None: not MAVLink, or not said)."""
 
     @property
     def is_offboard_switch(self) -> bool:

@@ -11,7 +11,7 @@ from fuzzoff.events import Where
 from fuzzoff.profiles import Profile
 
 if TYPE_CHECKING:
-    from fuzzoff.engine import Timeline
+    from fuzzoff.timeline import Timeline
 
 
 class Severity(IntEnum):

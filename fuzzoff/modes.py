@@ -13,6 +13,7 @@ NAV_STATE_NAMES: dict[int, str] = {
     4: "AUTO_LOITER",
     5: "AUTO_RTL",
     6: "POSITION_SLOW",
+    8: "ALTITUDE_CRUISE",
     9: "AUTO_LANDGPSFAIL",
     10: "ACRO",
     12: "DESCEND",

@@ -9,6 +9,7 @@ corrupt), after yielding every event it could read before that point. Damage tha
 from __future__ import annotations
 
 import abc
+import math
 import os
 import re
 from collections.abc import Callable, Iterator
@@ -16,7 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from types import TracebackType
 
-from fuzzoff.events import Event
+from fuzzoff.events import Event, VehiclePosition
 from fuzzoff.findings import RecordingStats
 
 
@@ -30,7 +31,11 @@ POSITION_PERIOD_S = 1.0
 """A plain lint reads the vehicle's position at most this often per vehicle and topic (the
 first message of each period; the others are not decoded): OFB404 compares a setpoint with
 the vehicle's height on the ground, which moves slowly, and every event between two runs of
-setpoints costs the checks a run (``StreamBatch``). The HTML report reads every one."""
+setpoints costs the checks a run (``StreamBatch``). The HTML report plots the others too, but
+they reach it beside the judged events (``PlotSamples``), never through the gate or the checks."""
+
+PLOT_SAMPLE_S = 0.05
+"""Shortest time between two kept samples of a plotted series (20 Hz is plenty for a plot)."""
 
 WHAT_LIMIT = 300
 WHERE_LIMIT = 120
@@ -131,6 +136,49 @@ class RecordingInfo:
         return bool(self.sampled_intervals)
 
 
+class PlotSamples:
+    """What only the HTML report's plots show: the vehicle's positions, per vehicle (t, x, y,
+    z), at most one per ``PLOT_SAMPLE_S`` of the samples given in time order."""
+
+    def __init__(self) -> None:
+        self.positions: dict[str, list[tuple[float, float, float, float]]] = {}
+
+    def position(self, event: VehiclePosition) -> None:
+        add_sample(self.positions.setdefault(event.vehicle, []), event.t, _xyz(event))
+
+
+def _xyz(event: VehiclePosition) -> tuple[float, float, float]:
+    return (event.x, event.y, event.z)
+
+
+def add_sample(
+    series: list[tuple[float, float, float, float]], t: float, xyz: tuple[float, float, float]
+) -> None:
+    """Append (t, x, y, z) unless it is all NaN or within ``PLOT_SAMPLE_S`` of the last one."""
+    if any(math.isfinite(v) for v in xyz) and (not series or t - series[-1][0] >= PLOT_SAMPLE_S):
+        series.append((t, *xyz))
+
+
+@dataclass(slots=True)
+class Aside:
+    """What a reader read but left out of the events, kept beside them (issue 26): the gate
+    and the checks never see it, so neither the outputs asked for nor a reader's thinning
+    changes what is judged.
+
+    ``end_t`` is the time of the last message the reader read, event or not: the recording
+    ends there, not at its last event (checks judge up to the end: a keep-alive gap, a run
+    still open). ``plot`` is set by a caller that plots: readers then hand it the positions
+    they thin out of the events (``POSITION_PERIOD_S``)."""
+
+    plot: PlotSamples | None = None
+    end_t: float | None = None
+
+    def read(self, t: float) -> None:
+        """A message at ``t`` was read and left out of the events (a thinned position)."""
+        if self.end_t is None or t > self.end_t:
+            self.end_t = t
+
+
 class Source(abc.ABC):
     """One recording of one format. Use as a context manager."""
 
@@ -146,10 +194,9 @@ class Source(abc.ABC):
         self.px4_hint: str | None = None
         """The user's ``--px4`` profile, set before ``open()``: readers that must choose message
         definitions the recording does not carry (Humble-era ROS 2 bags) start from it."""
-        self.plot_data = False
-        """Set before ``events()`` for the HTML report: readers then yield every recorded
-        ``VehiclePosition`` (a plain lint gets at most one per ``POSITION_PERIOD_S``) and what
-        dates the recording."""
+        self.aside = Aside()
+        """What the reader read beside the events: the last message's time, and the plotted
+        positions it thinned out (``aside.plot``, set before ``events()``)."""
         self.start_time_s: float | None = None
         """The recording's first time on the wall clock (UNIX seconds), where it has one; set
         by ``events()``. ``t`` of every event counts from it."""

@@ -39,6 +39,9 @@ ControlModeLayout = Literal["ignore_fields", "actuator", "thrust_and_torque"]
 """OffboardControlMode's fields: legacy ``ignore_*``, 1.13's booleans with one ``actuator``,
 1.15's ``thrust_and_torque`` and ``direct_actuator`` (gate spec 7)."""
 
+AlienCommandAnswer = Literal["ack_failed", "ignored"]
+"""What PX4's MAVLink receiver does with a command it is not addressed by (4.4)."""
+
 DocsPage = Literal["002", "000"]
 """The PX4 docs page (seed) that states the offboard rules of a release."""
 
@@ -112,6 +115,14 @@ class Release:
     """No mode switch out of TERMINATION, armed or not (4.1, 1.16+)."""
     acks_switch_twice: bool
     """A MAVLink mode switch is acked twice: the receiver's ACCEPTED, then Commander's (4.3)."""
+    altitude_cruise_mode: bool
+    """DO_SET_MODE main mode 11 is ALTITUDE_CRUISE (nav_state 8, 4.1; seen on 1.17.0 SITL)."""
+    alien_command_answer: AlienCommandAnswer
+    """A COMMAND_LONG / COMMAND_INT for another system or component (and for system 0 where
+    ``handles_broadcast_command`` is False): acked FAILED (up to 1.15) or ignored, no ack (1.16+).
+    Never handled. SET_MODE has no component: system 0 or the vehicle's is handled everywhere."""
+    handles_broadcast_command: bool
+    """A COMMAND_LONG / COMMAND_INT with target_system 0 is handled like one for this vehicle."""
     old_code_unverified: bool
     """The model follows the code of those years, not checked per release: its verdicts on
     requests, controllers and disarming say unverified (legacy, 1.11)."""
@@ -195,6 +206,9 @@ LEGACY = Release(
     unsupported_main_mode="rejected_unverified",
     never_leaves_termination=False,
     acks_switch_twice=False,
+    altitude_cruise_mode=False,
+    alien_command_answer="ack_failed",
+    handles_broadcast_command=False,
     old_code_unverified=True,
     loss_failsafe="state_machine_legacy",
     nav_rcl_fallback="none",
@@ -283,6 +297,7 @@ V1_16 = replace(
     acceleration_needs_attitude=True,
     never_leaves_termination=True,
     acks_switch_twice=True,
+    alien_command_answer="ignored",
     obl_rc_manual_is_stabilized=False,
     reuses_last_valid_setpoint=True,
     docs_acceleration_needs_velocity=False,
@@ -297,6 +312,7 @@ V1_17 = replace(
     covers="v1.17: offboard loss without RC uses NAV_RCL_ACT, double mode ack",
     minors=(17,),
     nav_rcl_fallback="before_degrade",
+    altitude_cruise_mode=True,
     msg_folder="1.17",
     ulog_era="1.17",
 )
@@ -311,6 +327,7 @@ V1_18 = replace(
     attitude_target_needs_thrust=True,
     unsupported_main_mode="rejected",
     acks_switch_twice=False,
+    handles_broadcast_command=True,
     nav_rcl_fallback="after_degrade",
     nav_rcl_hold_no_failsafe=True,
     setpoint_types_control_mode=True,

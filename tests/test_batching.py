@@ -48,6 +48,27 @@ def test_runs_are_used_on_the_hot_path() -> None:
         assert run.batched, kinds
 
 
+@pytest.mark.parametrize(("px4", "vehicle"), [("1.17", "rover-differential"), ("legacy", "mc")])
+def test_every_check_that_wants_stream_messages_takes_them_as_runs(px4: str, vehicle: str) -> None:
+    """One way for keep-alives and setpoints to reach a check: the checks without a fast pass of
+    their own (the rover and legacy rules) get the runs replayed through ``on_event``."""
+    from fuzzoff.checks.base import STREAM_TYPES, Check
+    from fuzzoff.config import Settings
+    from fuzzoff.profiles import Profile
+    from fuzzoff.recording import RecordingInfo
+
+    info = RecordingInfo("x", "mcap", kinds={"offboard_control_mode", "trajectory_setpoint"})
+    profile = Profile(px4=px4, vehicle=vehicle, px4_detected=True, vehicle_detected=True)
+    run = VehicleRun("1", profile, Settings(), info, None)
+    wanting = [c for c in run.checks if any(issubclass(t, c.subscriptions) for t in STREAM_TYPES)]
+    assert run.batched == wanting
+    replaying = {type(c).__name__ for c in wanting if type(c).on_batch is Check.on_batch}
+    expected = {"RoverCombination", "RoverTrajectory"} if vehicle != "mc" else set()
+    assert expected <= replaying
+    if px4 == "legacy":
+        assert "LegacyAccelerationNotIgnored" in replaying
+
+
 @pytest.mark.parametrize("px4", releases.names())
 @settings(max_examples=40, deadline=None, suppress_health_check=list(HealthCheck), derandomize=True)
 @given(data=st.data())

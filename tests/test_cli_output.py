@@ -127,11 +127,24 @@ def test_one_lint_writes_several_reports(tmp_path: Path) -> None:
     assert "fuzzoff summary" in both.stdout and "OFB101" in both.stdout
 
 
+def test_an_output_goes_with_the_format_just_before_it(tmp_path: Path) -> None:
+    """As the line reads: the text on the screen, the HTML in r.html."""
+    result = run_cli(
+        ["lint", str(LOST), "--format", "terminal", "--format", "html", "-o", "r.html"],
+        cwd=tmp_path,
+    )
+    assert result.returncode == 1, result.stderr
+    assert (tmp_path / "r.html").read_text(encoding="utf-8").startswith("<!DOCTYPE html>")
+    assert "fuzzoff summary" in result.stdout and "<html" not in result.stdout
+
+
 @pytest.mark.parametrize(
     ("args", "says"),
     [
         (["--format", "sarif", "--format", "html"], "only one report can go to standard output"),
-        (["-o", "a.json", "-o", "b.json"], "2 --output for 1 --format"),
+        (["-o", "a.json", "-o", "b.json"], "-o a.json has no --format before it"),
+        (["-o", "r.json", "--format", "json"], "-o r.json has no --format before it"),
+        (["--format", "json", "-o", "a.json", "-o", "b.json"], "-o b.json has no --format"),
         (["--format", "json", "-o", "r", "--format", "sarif", "-o", "r"], "named twice"),
     ],
 )

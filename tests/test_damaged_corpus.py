@@ -13,6 +13,14 @@ and lints the copy as a user would (``fuzzoff lint``, in this process). For ever
   incomplete, unless the difference is one the format cannot show: in formats without
   checksums (``LENIENT``), the values inside as many messages as the damage touched.
 
+Each damaged copy is given a name Hypothesis draws too (its own, in upper case, with ``.active``
+after it, with another format's extension, or none): a recording is read by its content, so the
+name changes nothing the campaign checks (issue 26 item 3).
+
+A ROS 2 database's tables are damaged as well as its bytes (issue 26 item 2): message rows whose
+topic id the topics table lacks, a PX4 topic recorded as a type fuzzoff cannot decode, and rows
+deleted. Every such copy loses messages, so its lint must say which (OFB001, exit 2).
+
 Failures it found stay as corpus cases (corpora/damaged/build.py). ``FUZZOFF_DAMAGE_EXAMPLES=2000
 pytest tests/test_damaged_corpus.py`` runs a broad random sweep by hand; unset, each recording
 gets the same ``EXAMPLES`` damaged copies on every run.
@@ -26,16 +34,18 @@ import re
 import resource
 import shutil
 import signal
+import sqlite3
 import struct
 from collections import Counter
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
+from typing import Any
 
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from fuzzoff.formats import SourceError, open_source
@@ -225,8 +235,47 @@ def cut_short(
     return all(whole.get(topic, [])[: len(events)] == events for topic, events in cut.items())
 
 
-def copy_damaged(name: str, tmp: Path, choose: int, hit: Damage) -> tuple[Path, bool]:
-    """The damaged copy: the recording to lint, and whether its metadata.yaml was damaged."""
+NAMES = ("its own", "upper case", ".active", "another format's extension", "none")
+OTHER_EXTENSION = {
+    ".tlog": ".ulg",
+    ".ulg": ".mcap",
+    ".mcap": ".db3",
+    ".bag": ".tlog",
+    ".db3": ".bag",
+}
+
+
+def renamed(path: Path, how: str) -> Path:
+    """``path`` under the name ``how`` says (a name in ``NAMES``)."""
+    if how == "upper case":
+        return path.with_name(path.name.upper())
+    if how == ".active":
+        return path.with_name(path.name + ".active")
+    if how == "another format's extension":
+        return path.with_suffix(OTHER_EXTENSION[path.suffix])
+    if how == "none":
+        return path.with_suffix("")
+    return path
+
+
+def rename_data_file(folder: Path, data: Path, how: str) -> Path:
+    """A bag's data file renamed, and metadata.yaml's list of files with it (where it can
+    still be read as text): a bag renamed by hand."""
+    new = renamed(data, how)
+    if new == data:
+        return data
+    data.rename(new)
+    meta = folder / "metadata.yaml"
+    with suppress(OSError, UnicodeDecodeError):
+        meta.write_text(meta.read_text(encoding="utf-8").replace(data.name, new.name))
+    return new
+
+
+def copy_damaged(
+    name: str, tmp: Path, choose: int, hit: Damage, how: str = "its own"
+) -> tuple[Path, bool]:
+    """The damaged copy, under the name ``how`` says: the recording to lint, and whether its
+    metadata.yaml was damaged."""
     source = CASES[name].recording
     if source.is_dir():
         folder = tmp / source.name
@@ -235,9 +284,13 @@ def copy_damaged(name: str, tmp: Path, choose: int, hit: Damage) -> tuple[Path, 
         target = files[choose % len(files)]
         recording = folder
     else:
-        target = recording = tmp / source.name
+        target = recording = tmp / renamed(source, how).name
         shutil.copyfile(source, target)
     target.write_bytes(damaged(target.read_bytes(), *hit))
+    if source.is_dir():
+        for data in sorted(folder.iterdir()):
+            if data.name != "metadata.yaml":
+                rename_data_file(folder, data, how)
     return recording, target.name == "metadata.yaml"
 
 
@@ -259,12 +312,26 @@ def test_any_damage_is_said_never_lost_in_silence(
     files = sorted(source.iterdir()) if source.is_dir() else [source]
     size = files[choose % len(files)].stat().st_size
     hit = data.draw(damage(size), label="damage")
+    how = data.draw(st.sampled_from(NAMES), label="name")
     tmp = tmp_path_factory.mktemp("damaged")
-    recording, metadata = copy_damaged(name, tmp, choose, hit)
+    recording, metadata = copy_damaged(name, tmp, choose, hit, how)
 
     with deadline(SECONDS):
-        result = run_cli(["lint", str(recording), "--format", "json"])
+        report, lines, _ = lint_as_a_user_would(recording)
         after = events(recording)
+    allowed = 0 if metadata else spots(case, hit[0], hit[2], hit[3])
+    before = undamaged(name)
+    if case.endless and hit[0] == "cut" and cut_short(before, after):
+        return  # a cut between two records: no reader can tell
+    if differs_beyond(before, after, allowed):
+        assert not report["complete"], f"events changed in silence: {lines}"
+
+
+def lint_as_a_user_would(recording: Path) -> tuple[dict[str, Any], list[str], int]:
+    """``fuzzoff lint RECORDING --format json``: its report, stderr lines and exit status,
+    checked for what every lint of a damaged file must hold (no exception, no more than 1 GB,
+    one clean line per OFB001 and OFB004, incomplete exactly when OFB001, then exit 2)."""
+    result = run_cli(["lint", str(recording), "--format", "json"])
     assert resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024 < MEMORY_BYTES
     assert result.returncode in (0, 1, 2)
     (report,) = json.loads(result.stdout)["files"]
@@ -276,12 +343,84 @@ def test_any_damage_is_said_never_lost_in_silence(
         assert line.startswith(f"fuzzoff: {recording}: ") and not UNPRINTABLE.search(line)
         assert len(line) - len(str(recording)) < LINE_LIMIT
     assert report["complete"] == (not unreadable) == (result.returncode != 2)
-    allowed = 0 if metadata else spots(case, hit[0], hit[2], hit[3])
-    before = undamaged(name)
-    if case.endless and hit[0] == "cut" and cut_short(before, after):
-        return  # a cut between two records: no reader can tell
-    if differs_beyond(before, after, allowed):
-        assert not report["complete"], f"events changed in silence: {lines}"
+    return report, lines, result.returncode
+
+
+# -- a ROS 2 database's tables (issue 26 item 2) ---------------------------------------------
+
+TABLES_BAG = CORPORA / "rosbag2" / "two_vehicles"
+TableDamage = tuple[str, int, int, bool]
+"""(how, first row id or topic id, how many rows, metadata.yaml kept)."""
+
+
+def table_damage(rows: int, topics: int) -> st.SearchStrategy[TableDamage]:
+    return st.one_of(
+        st.tuples(
+            st.sampled_from(["dangling topic ids", "missing rows"]),
+            st.integers(1, rows),
+            st.integers(1, rows),
+            st.booleans(),
+        ),
+        st.tuples(st.just("unknown type"), st.integers(1, topics), st.just(0), st.booleans()),
+    )
+
+
+def damage_tables(db3: Path, hit: TableDamage) -> None:
+    how, first, amount, _ = hit
+    with sqlite3.connect(db3) as db:
+        if how == "dangling topic ids":  # a topic id no topic has, as a flipped bit leaves
+            db.execute(
+                "UPDATE messages SET topic_id = topic_id + 1000 WHERE id BETWEEN ? AND ?",
+                (first, first + amount - 1),
+            )
+        elif how == "missing rows":
+            db.execute("DELETE FROM messages WHERE id BETWEEN ? AND ?", (first, first + amount - 1))
+        else:
+            db.execute("UPDATE topics SET type = 'fuzzoff_test/msg/Unknown' WHERE id = ?", (first,))
+
+
+@cache
+def table_counts() -> tuple[int, int]:
+    with sqlite3.connect(f"file:{TABLES_BAG / 'two_vehicles.db3'}?mode=ro", uri=True) as db:
+        rows = db.execute("SELECT MAX(id) FROM messages").fetchone()[0]
+        topics = db.execute("SELECT MAX(id) FROM topics").fetchone()[0]
+    return int(rows), int(topics)
+
+
+@settings(
+    max_examples=SWEEP or EXAMPLES,
+    deadline=None,
+    derandomize=not SWEEP,
+    database=None,
+    suppress_health_check=[HealthCheck.too_slow],
+)
+@given(data=st.data())
+def test_a_database_whose_tables_lose_messages_never_passes(
+    data: st.DataObject, tmp_path_factory: pytest.TempPathFactory
+) -> None:
+    rows, topics = table_counts()
+    hit = data.draw(table_damage(rows, topics), label="damage")
+    how, first, amount, kept = hit
+    # Rows cut from the end leave no trace without metadata.yaml's counts (nor do the ids:
+    # rosbag2 numbers rows from 1): no reader can tell, as with a cut between two records.
+    assume(kept or how != "missing rows" or first + amount - 1 < rows)
+    name = data.draw(st.sampled_from(NAMES), label="name")
+    bag = tmp_path_factory.mktemp("tables") / TABLES_BAG.name
+    shutil.copytree(TABLES_BAG, bag)
+    damage_tables(bag / "two_vehicles.db3", hit)
+    data_file = rename_data_file(bag, bag / "two_vehicles.db3", name)
+    recording = bag
+    if not kept:  # what is linted is then the database itself
+        (bag / "metadata.yaml").unlink()
+        recording = data_file
+
+    with deadline(SECONDS):
+        report, lines, code = lint_as_a_user_would(recording)
+        after = events(recording)
+    before = events(TABLES_BAG)
+    assert before is not None and (after is None or len(after) < len(before))
+    assert code == 2 and not report["complete"], lines
+    assert not any("every one was read" in line for line in lines), lines
 
 
 def test_the_length_damage_writes_the_words_it_names() -> None:

@@ -18,7 +18,7 @@ from fuzzoff.events import (
     TrajectorySetpoint,
     VehicleStatus,
 )
-from fuzzoff.formats import detect_format, open_source
+from fuzzoff.formats import SourceError, detect_format, open_source
 from fuzzoff.formats.format import Format
 from fuzzoff.formats.registry import FORMATS, RECORDING_SUFFIXES
 from fuzzoff.fuzz.recordings import read
@@ -58,11 +58,36 @@ def test_a_renamed_recording_is_still_detected_by_content(tmp_path: Path) -> Non
     assert read(renamed)
 
 
-def test_the_python_api_import_of_recording_info_still_works() -> None:
-    from fuzzoff.recording import RecordingInfo
-    from fuzzoff.sources.base import RecordingInfo as OldName
+def test_a_folder_format_is_asked_through_the_registry(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A format whose recordings are folders is found by its ``is_folder`` and detected by its
+    ``detect_folder``: the search and detection know no format by name."""
+    import fuzzoff.formats as formats
 
-    assert OldName is RecordingInfo
+    folder = tmp_path / "capture"
+    folder.mkdir()
+    (folder / "capture.idx").write_text("")
+    fake = Format(
+        name="fake",
+        reader="fuzzoff.formats.tlog.reader:TlogSource",
+        writer="fuzzoff.formats.tlog.writer:write_tlog",
+        clock="fuzzoff.formats.tlog.clock:start_s",
+        detect_file=lambda path, head: None,
+        names=("fake-folder",),
+        suffixes=(".idx",),
+        written_suffix="",
+        is_folder=lambda path, suffixes: (path / f"{path.name}.idx").is_file(),
+        detect_folder=lambda path: "fake-folder",
+    )
+    monkeypatch.setattr(formats, "FOLDER_FORMATS", (fake, *formats.FOLDER_FORMATS))
+    assert formats.is_bag_folder(folder)
+    assert detect_format(folder) == "fake-folder"
+    assert formats.recordings_in([tmp_path]) == [folder]
+    plain = tmp_path / "plain"
+    plain.mkdir()
+    with pytest.raises(SourceError, match="a folder that is no recording fuzzoff reads"):
+        detect_format(plain)
 
 
 @pytest.mark.parametrize("fmt", FORMATS, ids=lambda f: f.name)

@@ -13,6 +13,7 @@ from urllib.parse import unquote
 
 import pytest
 
+from fuzzoff import releases
 from tests.helpers import CORPORA, ROOT, run_cli, run_cli_process
 
 # A planted fault (the loss rules off) that the first examples already break.
@@ -248,9 +249,17 @@ def test_replay_of_a_reproducer_whose_recording_is_not_readable_is_one_line(
     assert _one_error_line(out.stderr).startswith(f"fuzzoff: {recording}: ")
 
 
+_PAST = f"1.{releases.newest_listed()[1] + 1}"
+"""The release after the newest modelled one."""
+
+
 @pytest.mark.parametrize(
     ("px4", "said"),
-    [("2.0", "PX4 2.0 is not modelled"), ("1.19", "PX4 1.19 is not modelled"), ("1.4", "oldest")],
+    [
+        ("2.0", "PX4 2.0 is not modelled"),
+        (_PAST, f"PX4 {_PAST} is not modelled"),
+        ("1.4", "oldest"),
+    ],
 )
 def test_a_px4_release_not_modelled_is_refused_as_lint_refuses_it(
     tmp_path: Path, px4: str, said: str

@@ -40,7 +40,11 @@ def test_a_1_17_rover_stream_sends_only_what_its_messages_carry(scenario: Scenar
 
 def _as_before(e: Event) -> Event:
     """``e`` as the generator addressed it before: commands and MAVLink setpoints broadcast
-    (target 0), the companion sending as system 1, the autopilot's acks back to it."""
+    (target 0), the companion sending as system 1, the autopilot's acks back to it. Its
+    commands named no MAVLink message: a broadcast COMMAND_LONG as recorded is one PX4 up to 1.17
+    does not take (OFB204, tests/test_command_target.py), which the generator never meant."""
+    if isinstance(e, Command) and e.origin == "sent":
+        e = replace(e, message=None)
     if isinstance(e, Command | MavlinkTarget) and e.origin == "sent":
         e = replace(e, target_system=0, target_component=0)
         if e.source_system == COMPANION[0]:

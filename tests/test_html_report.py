@@ -263,13 +263,20 @@ def test_the_timeline_has_the_position_messages_and_labelled_commands(tmp_path: 
     assert "<b>offboard" not in page  # sent as escaped JSON, shown as text by the script
 
 
-def test_a_plain_lint_reads_the_position_once_a_second_and_the_report_every_one(
+def test_a_lint_judges_one_position_a_second_and_the_report_plots_every_one(
     tmp_path: Path,
 ) -> None:
     # OFB404 needs the vehicle's height on the ground; a lint decodes one position a second
     recording = _flight(tmp_path / "flight.tlog")  # 20 Hz for 5 s
-    assert lint_file(recording).stats["kinds"]["vehicle_position"] == 5
-    assert lint_file_with_timelines(recording, Settings()).stats["kinds"]["vehicle_position"] == 100
+    plain = lint_file(recording)
+    assert plain.stats["kinds"]["vehicle_position"] == 5
+    plotted = lint_file_with_timelines(recording, Settings())
+    # the plots take the others beside the events: what is judged does not change
+    assert plotted.stats == plain.stats and plotted.findings == plain.findings
+    (timeline,) = plotted.timelines.values()
+    plotted_t = [t for t, *_ in timeline.positions]
+    assert len(plotted_t) > 50 and plotted_t == sorted(plotted_t)  # 20 Hz at most
+    assert plotted_t[0] == 0.01 and plotted_t[-1] > 4.9
 
 
 def test_the_recordings_start_on_the_wall_clock() -> None:

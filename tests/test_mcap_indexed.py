@@ -18,8 +18,8 @@ from mcap.writer import CompressionType
 from bench.ros2_data import generate
 from fuzzoff.events import event_to_dict
 from fuzzoff.formats import open_source
-from fuzzoff.formats.mcap import indexed as mcap_indexed
 from fuzzoff.formats.mcap.writer import write_mcap
+from fuzzoff.formats.ros2 import mcap_indexed
 from fuzzoff.formats.ros2msgs.messages import RawMessage
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -127,7 +127,7 @@ def test_an_attitude_target_without_thrust_keeps_the_stream_as_the_record_says(
 def test_an_unknown_main_mode_is_answered_as_the_record_says(release: Release) -> None:
     trs = run(release.name, [status(0.0, POSCTL, True, POSCTL), switch_mode(1.0, 42)])
     rejected = release.unsupported_main_mode == "rejected"
-    assert any("unsupported main mode" in (t.message or "") for t in trs)
+    assert any("no such mode" in (t.message or "") for t in trs)
     assert any("rejected" in t.message for t in trs) is rejected
 
 
@@ -178,8 +178,13 @@ def test_a_release_names_its_own_profile(release: Release) -> None:
         assert px4_profile_for(f"1.{minor}.2") == release.name
 
 
+NEWEST_MINOR = releases.newest_listed()[1]
+NEXT = f"1.{NEWEST_MINOR + 1}"
+"""The release after the newest modelled one (``1.19`` while 1.18 is the newest)."""
+
+
 def test_versions_past_the_newest_release_are_main_and_before_the_oldest_legacy() -> None:
-    assert px4_profile_for("1.19.0") == px4_profile_for("2.0") == "main"
+    assert px4_profile_for(f"{NEXT}.0") == px4_profile_for("2.0") == "main"
     assert px4_profile_for("1.4.1") == px4_profile_for("0.9") == "legacy"
 
 
@@ -190,8 +195,13 @@ _WITH_EXTRA = textwrap.dedent(
     import dataclasses, sys
     from fuzzoff import releases
     newest = releases.RELEASES[-2]
+    minor = releases.newest_listed()[1] + 1
     extra = dataclasses.replace(
-        newest, name="1.19", covers="v1.19: made up by a test", minors=(19,), acks_switch_twice=True
+        newest,
+        name=f"1.{minor}",
+        covers=f"v1.{minor}: made up by a test",
+        minors=(minor,),
+        acks_switch_twice=True,
     )
     releases.RELEASES = (*releases.RELEASES[:-1], extra, releases.RELEASES[-1])
     from fuzzoff.cli import main
@@ -214,21 +224,20 @@ def test_a_new_record_is_a_profile_fuzzoff_profiles_lists() -> None:
     done = _with_extra("profiles", "--format", "json")
     assert done.returncode == 0, done.stderr
     listed = [p["profile"] for p in json.loads(done.stdout)["px4"]]
-    assert listed == [*NAMES[:-1], "1.19", NAMES[-1]]
-    assert {"profile": "1.19", "covers": "v1.19: made up by a test"} in json.loads(done.stdout)[
-        "px4"
-    ]
+    assert listed == [*NAMES[:-1], NEXT, NAMES[-1]]
+    made_up = {"profile": NEXT, "covers": f"v{NEXT}: made up by a test"}
+    assert made_up in json.loads(done.stdout)["px4"]
 
 
 def test_a_new_record_judges_a_lint_with_the_rules_of_its_range() -> None:
     """``--px4 1.19.1`` selects the new record with no note; the rules the catalog gives to
     ``1.13+`` judge it, and its findings are those of the release it copies."""
     gap = str(CORPORA / "tlog" / "keepalive_gap_0_7s.tlog")
-    done = _with_extra("lint", gap, "--px4", "1.19.1", "--format", "json")
+    done = _with_extra("lint", gap, "--px4", f"{NEXT}.1", "--format", "json")
     assert done.returncode in (0, 1), done.stderr
     assert "judged with profile" not in done.stderr
     (file,) = json.loads(done.stdout)["files"]
-    assert file["profile"]["px4"] == "1.19"
+    assert file["profile"]["px4"] == NEXT
     copied = _with_extra("lint", gap, "--px4", NAMES[-2], "--format", "json")
     (same,) = json.loads(copied.stdout)["files"]
     codes = [f["code"] for f in file["findings"]]
@@ -243,8 +252,10 @@ def test_px4_1_18_is_its_own_profile_with_no_note() -> None:
     result = run_cli(["lint", gap, "--px4", "1.18.0", "--format", "json"])
     assert json.loads(result.stdout)["files"][0]["profile"]["px4"] == "1.18"
     assert "judged with profile" not in result.stderr
-    listed = json.loads(run_cli(["profiles", "--format", "json"]).stdout)["px4"]
-    assert [p["profile"] for p in listed][-2:] == ["1.18", "main"]
+    listed = [
+        p["profile"] for p in json.loads(run_cli(["profiles", "--format", "json"]).stdout)["px4"]
+    ]
+    assert listed[-1] == "main" and listed.index("1.18") == listed.index("1.17") + 1
 
 
 @pytest.mark.parametrize(

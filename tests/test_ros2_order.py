@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from fuzzoff.events import ControlMode
-from fuzzoff.formats.mcap.order import MAX_PENDING, ChunkOrder
+from fuzzoff.formats.ros2.order import MAX_PENDING, ChunkOrder
 
 
 def _event(t: float) -> ControlMode:

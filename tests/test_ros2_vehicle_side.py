@@ -11,7 +11,7 @@ from typing import Any
 
 import pytest
 
-from fuzzoff.engine import lint_file
+from fuzzoff.engine import Timeline, lint_file
 from fuzzoff.events import (
     ControlMode,
     Event,
@@ -97,4 +97,9 @@ def test_the_vehicle_position_is_read_once_a_second_and_invalid_heights_are_nan(
         (pytest.approx(1.05), pytest.approx(-1.0)),
     ]
     assert math.isnan(read[-1].z) and read[-1].where.topic == "/fmu/out/vehicle_local_position"
-    assert lint_file(path, plot_data=True).stats["kinds"]["vehicle_position"] == 21
+    # The plots get every position, beside the events: the lint judges the same thinned ones.
+    timelines: dict[str, Timeline] = {}
+    plotted = lint_file(path, timelines=timelines, plot_data=True)
+    assert plotted.stats == lint_file(path).stats
+    assert plotted.stats["kinds"]["vehicle_position"] == len(read)
+    assert len(timelines[""].positions) == 21  # every one, 0.1 s apart

@@ -18,6 +18,7 @@ from types import ModuleType
 
 import pytest
 
+from fuzzoff import releases
 from fuzzoff.catalog import Rule, load_catalog, render_page
 from fuzzoff.formats import px4_msgs
 from tests.helpers import ROOT, run_cli
@@ -26,7 +27,16 @@ RULES = list(load_catalog().values())
 TOOL_RULES = {"OFB001", "OFB002", "OFB003", "OFB004"}
 """Rules about reading the recording: their references are this project's own docs."""
 
-DOCS_PAGE = re.compile(r"^https://docs\.px4\.io/(main|v1\.1[3-8])/en/[a-z0-9_/]+\.html(#[\w-]+)?$")
+DOCS_VERSIONS = "|".join(
+    f"v1\\.{minor}"
+    for release in releases.RELEASES
+    if release.docs_page
+    for minor in release.minors
+)
+"""The docs' versioned folders: every 1.x a release record with a docs page covers."""
+DOCS_PAGE = re.compile(
+    rf"^https://docs\.px4\.io/(main|{DOCS_VERSIONS})/en/[a-z0-9_/]+\.html(#[\w-]+)?$"
+)
 SOURCE_FILE = re.compile(r"^https://github\.com/PX4/PX4-Autopilot/(blob|tree)/v1\.\d+\.\d+/\S+$")
 
 
@@ -152,9 +162,9 @@ def test_the_field_check_catches_a_field_from_another_release() -> None:
     assert ("OffboardControlMode", "actuator") in uses
     assert "actuator" not in fields["OffboardControlMode"]
     assert "actuator" in _fields("1.14")["OffboardControlMode"]
-    cpp = _cpp_field_uses("px4_msgs::msg::OffboardControlMode m{};\nm.actuator = true;", {
-        "OffboardControlMode"
-    })
+    cpp = _cpp_field_uses(
+        "px4_msgs::msg::OffboardControlMode m{};\nm.actuator = true;", {"OffboardControlMode"}
+    )
     assert cpp == [("OffboardControlMode", "actuator")]
 
 

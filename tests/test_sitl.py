@@ -17,6 +17,7 @@ os.environ.setdefault("MAVLINK20", "1")
 
 import itertools
 
+from fuzzoff.sitl import bundle
 from fuzzoff.sitl.clock import PX4Clock
 from fuzzoff.sitl.link import COMPANION_SYSID, open_tlog
 from fuzzoff.sitl.replay import plan_from_tlog, readdress
@@ -210,3 +211,41 @@ def test_a_px4_int_parameter_travels_as_its_bytes_in_the_float() -> None:
     assert value != 3.0 and param_decode(value, param_type) == 3.0
     value, param_type = param_encode("COM_OF_LOSS_T", 1.5, 9)
     assert (value, param_type) == (1.5, 9)
+
+
+def _fake_bundles(root: Path, names: list[str]) -> Path:
+    for name in names:
+        (root / name / "bin").mkdir(parents=True)
+        (root / name / "bin" / "px4").write_bytes(b"")
+    return root
+
+
+def test_a_release_named_exactly_starts_that_bundle_not_its_ros2_sibling(tmp_path: Path) -> None:
+    root = _fake_bundles(tmp_path, ["1.16.2-ros2", "1.16.2", "1.17.0", "1.18.0-beta1-head"])
+    assert bundle.find_build("1.16.2", None, root).folder == root / "1.16.2"
+    assert bundle.find_build("1.16.2-ros2", None, root).release == "1.16.2-ros2"
+    assert bundle.find_build("1.18.0", None, root).release == "1.18.0-beta1-head"
+    assert bundle.releases(root) == ["1.16.2", "1.16.2-ros2", "1.17.0", "1.18.0-beta1-head"]
+    with pytest.raises(bundle.BundleError, match="no such bundle"):
+        bundle.find_build("1.15.4", None, root)
+
+
+def test_a_ros2_flight_takes_the_releases_bundle_with_the_bridge(tmp_path: Path) -> None:
+    root = _fake_bundles(tmp_path, ["1.16.2", "1.16.2-ros2", "1.17.0", "1.18.0-beta1-head"])
+    for name in ("1.16.2-ros2", "1.18.0-beta1-head"):
+        (root / name / "bin" / "commands.txt").write_text("commander\nuxrce_dds_client\n")
+    assert bundle.find_bridge_build("1.16.2", None, root).release == "1.16.2-ros2"
+    assert bundle.find_bridge_build("1.18.0", None, root).release == "1.18.0-beta1-head"
+    with pytest.raises(bundle.BundleError, match="no bundle with the ROS 2 bridge"):
+        bundle.find_bridge_build("1.17.0", None, root)
+
+
+def test_sitl_run_over_ros2_names_an_unknown_program_or_a_mavlink_only_option() -> None:
+    out = run_cli(["sitl", "run", "clean_offboard", "--transport", "ros2", "--release", "1.16.2"])
+    assert out.returncode == 2 and "no ROS 2 program 'clean_offboard'" in out.stderr
+    out = run_cli(
+        ["sitl", "run", "example", "--transport", "ros2", "--release", "1.16.2", "--param", "A=1"]
+    )
+    assert out.returncode == 2 and "MAVLink-only" in out.stderr
+    listed = run_cli(["sitl", "list"]).stdout
+    assert "ROS 2 programs (--transport ros2):" in listed and "example_stops" in listed

@@ -460,6 +460,7 @@ def mcap_cases() -> list[Case]:
             [],
         )
     )
+    # -- scripts/add_rule.py adds a new rule's cases above this line
     return cases
 
 

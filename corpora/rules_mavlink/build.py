@@ -4,11 +4,12 @@ Run ``.venv/bin/python corpora/rules_mavlink/build.py``; it is deterministic. Ea
 written as a tlog (``fuzzoff.formats.tlog.writer``: the MAVLink the companion sent, with the
 autopilot's HEARTBEAT, COMMAND_ACK, PARAM_VALUE and AUTOPILOT_VERSION) and, where a MAVROS bag
 can show the rule, as a ROS 1 bag of MAVROS ``setpoint_raw`` topics and ``state``
-(``fuzzoff.formats.rosbag1.writer``). A bag cannot show OFB607 (MAVROS fills the target ids from its
-own parameters), OFB509 (no parameters in a bag) or OFB608 (MAVROS's ``actuator_control`` topic is
-not read). Each ``NAME.expected.json`` lists the
-findings planted here, judged against the rule texts (rules/OFB5*.toml, rules/OFB6*.toml),
-and ``clean``: the rules the recording exercises that must stay silent.
+(``fuzzoff.formats.rosbag1.writer``). A bag cannot show OFB204, OFB205 (it records no
+command), OFB607 (MAVROS fills the target ids from its own parameters), OFB509 (no parameters
+in a bag) or OFB608 (MAVROS's ``actuator_control`` topic is not read). Each
+``NAME.expected.json`` lists the findings planted here, judged against the rule texts
+(rules/OFB5*.toml, rules/OFB6*.toml), and ``clean``: the rules the recording exercises that
+must stay silent.
 
 Every flight follows one pattern (``flight``): PX4 1.16.2 (AUTOPILOT_VERSION in the tlog), the
 companion (1/191) streams its setpoint at 20 Hz from 1.0 s, switches to OFFBOARD at 3.0 s
@@ -202,7 +203,7 @@ class Case:
     """The profile the recording's AUTOPILOT_VERSION names."""
 
 
-MC_RULES = ["OFB601", "OFB602", "OFB605", "OFB606", "OFB607", "OFB608"]
+MC_RULES = ["OFB204", "OFB205", "OFB601", "OFB602", "OFB605", "OFB606", "OFB607", "OFB608"]
 LEGACY_RULES = ["OFB607", "OFB609", "OFB801"]
 LEGACY_VERSION = "1.8.2"
 FW_RULES = ["OFB601", "OFB602", "OFB603", "OFB604", "OFB606", "OFB607"]
@@ -427,6 +428,7 @@ def cases() -> list[Case]:
             bag=False,
             px4="legacy",
         ),
+        # -- scripts/add_rule.py adds a new rule's cases above this line
     ]
 
 
@@ -452,8 +454,8 @@ def write_spec(
     found = [finding(p, tlog) for p in planted]
     levels = {f["severity"] for f in found}
     applies = [c for c in case.clean if get_rule(c).applies_to(case.px4, case.vehicle)]
-    if not tlog:  # a bag cannot show these two (see the module docstring)
-        applies = [c for c in applies if c not in ("OFB607", "OFB509")]
+    if not tlog:  # a bag cannot show these (see the module docstring)
+        applies = [c for c in applies if c not in ("OFB204", "OFB205", "OFB607", "OFB509")]
     spec = {
         "recording": recording,
         "args": args,

@@ -255,6 +255,7 @@ def cases() -> list[Case]:
             [("OFB506", "error", FIRST_SETPOINT)],
             ["OFB501", "OFB502", "OFB503", "OFB504", "OFB505"],
         ),
+        # -- scripts/add_rule.py adds a new rule's cases above this line
     ]
 
 

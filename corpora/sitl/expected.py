@@ -109,24 +109,47 @@ def _first_loss(findings: list[dict[str, Any]]) -> float:
     return min((f["time_s"] for f in findings if f["code"] == "OFB103"), default=float("inf"))
 
 
-def classify(stem: str) -> tuple[str, list[str], str]:
-    """(kind, the hazard's error codes, what program wrote it)."""
+CONTEXT_UNSEEN = "the hazard cannot be seen in this recording (PX4 logged nothing of it)"
+CONTEXT_RELEASE = "this release does what the program means: no hazard here"
+
+
+def classify(stem: str, suffix: str = "") -> tuple[str, list[str], str]:
+    """(kind, the hazard's error codes, what program wrote it). ``kind`` is ``context`` for a
+    hazard program's recording that cannot show the hazard (``Scenario.shown_in``) or of a
+    release where it is none (``Scenario.hazard_until``): counted neither clean nor hazard."""
     scenario_name = stem.split("-")[0]
     if scenario_name.startswith("mavsdk"):
         version, _, program = scenario_name[len("mavsdk") :].partition("_")
         kind, codes, client, _ = MAVSDK_PROGRAMS[program]
         return kind, list(codes), f"MAVSDK {version}.x (PyPI mavsdk), {client}"
     scenario = SCENARIOS[scenario_name]
+    kind = scenario.kind
+    if kind == "hazard" and context_of(stem, suffix) is not None:
+        kind = "context"
     return (
-        scenario.kind,
+        kind,
         list(scenario.codes),
         f"fuzzoff.sitl.scenarios.{scenario.program.__name__} (pymavlink)",
     )
 
 
+def context_of(stem: str, suffix: str) -> str | None:
+    """Why a hazard program's recording is context, not a hazard (None: it is a hazard)."""
+    name, _, release = stem.partition("-")
+    scenario = SCENARIOS.get(name)
+    if scenario is None:
+        return None
+    if suffix and suffix not in scenario.shown_in:
+        return CONTEXT_UNSEEN
+    major, minor = (int(part) for part in release.split(".")[:2])
+    if scenario.hazard_until is not None and (major, minor) >= scenario.hazard_until:
+        return CONTEXT_RELEASE
+    return None
+
+
 def expected_for(recording: Path, release: str) -> dict[str, Any]:
     stem = recording.name.rsplit(".", 1)[0]
-    kind, codes, program = classify(stem)
+    kind, codes, program = classify(stem, recording.suffix)
     out = run_cli(["lint", str(recording), "--format", "json"])
     data = json.loads(out.stdout)
     (report,) = data["files"]
@@ -146,6 +169,8 @@ def expected_for(recording: Path, release: str) -> dict[str, Any]:
         "px4_release": release,
         "findings": findings,
     }
+    if kind == "context":
+        spec["context"] = context_of(stem, recording.suffix)
     if kind == "clean":
         spec["known_false"] = sorted(
             {
@@ -199,8 +224,10 @@ Written by `record.py` (pymavlink scenario programs, `fuzzoff/sitl/scenarios.py`
 `vehicle_local_position` to stay under 1 MB); the expected files by `expected.py`, the
 model-vs-PX4 table in `docs/sitl.md` by `agreement.py`. *clean*: a correct use of offboard,
 fuzzoff should find nothing at warning or above. *hazard*: fuzzoff should give the error named.
-The pymavlink programs stream at 10 Hz and pause while they wait for an ack (up to about 0.25 s
-around a switch or an arm); MAVSDK streams at 20 Hz throughout and sends each new setpoint at once.
+*context*: a hazard program's recording that cannot show the hazard (a ULog holds no command
+PX4's receiver dropped) or of a release where it is none; counted neither way. The pymavlink
+programs stream at 10 Hz and pause while they wait for an ack (up to about 0.25 s around a
+switch or an arm); MAVSDK streams at 20 Hz throughout and sends each new setpoint at once.
 
 | recording | program | PX4 | what it is | lint today |
 | --- | --- | --- | --- | --- |
@@ -210,16 +237,18 @@ around a switch or an arm); MAVSDK streams at 20 Hz throughout and sends each ne
 def readme_rows(runs: dict[str, Any]) -> list[str]:
     rows = []
     for stem, run in sorted(runs.items()):
-        kind, codes, program = classify(stem)
         scenario = SCENARIOS.get(stem.split("-")[0])
         mavsdk = stem.split("-")[0].partition("_")[2]
         what = scenario.summary if scenario else MAVSDK_PROGRAMS[mavsdk][3]
         hazard = scenario.hazard if scenario else MAVSDK_HAZARDS.get(mavsdk, "")
-        label = "clean" if kind == "clean" else f"hazard {'/'.join(codes)}: {hazard}"
         for suffix in (".tlog", ".ulg"):
             spec_path = HERE / f"{stem}{suffix}.expected.json"
             if not spec_path.exists():
                 continue
+            kind, codes, program = classify(stem, suffix)
+            label = "clean" if kind == "clean" else f"hazard {'/'.join(codes)}: {hazard}"
+            if kind == "context":
+                label = f"context: {context_of(stem, suffix)}"
             spec = json.loads(spec_path.read_text())
             loud = sorted(
                 {

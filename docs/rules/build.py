@@ -17,7 +17,7 @@ from pathlib import Path
 
 from fuzzoff.catalog import Rule, load_catalog, render_page
 from fuzzoff.findings import Severity
-from fuzzoff.profiles import VEHICLE_TYPES
+from fuzzoff.profiles import VEHICLE_NOTES, VEHICLE_TYPES
 from fuzzoff.releases import names as release_names
 
 HERE = Path(__file__).resolve().parent
@@ -67,7 +67,7 @@ def _px4_text(px4: tuple[str, ...]) -> str:
     return " and ".join(px4)
 
 
-VEHICLE_NAMES = {
+VEHICLE_NAMES = {  # plural where the table reads better so; else ``VEHICLE_NOTES``
     "mc": "multicopter",
     "fw": "fixed-wing",
     "vtol": "VTOL",
@@ -75,7 +75,7 @@ VEHICLE_NAMES = {
     "rover-differential": "differential rovers",
     "rover-mecanum": "mecanum rovers",
 }
-FORMAT_NAMES = {
+FORMAT_NAMES = {  # the family a format's recordings belong to; else the format's own name
     "mcap": "ROS 2",
     "rosbag2-sqlite3": "ROS 2",
     "rosbag2-mcap": "ROS 2",
@@ -91,13 +91,13 @@ def _vehicles_text(vehicles: tuple[str, ...]) -> str:
     rovers = tuple(v for v in VEHICLE_TYPES if v.startswith("rover"))
     if vehicles == rovers:
         return "rovers"
-    return ", ".join(VEHICLE_NAMES[v] for v in vehicles)
+    return ", ".join(VEHICLE_NAMES.get(v) or VEHICLE_NOTES.get(v, v) for v in vehicles)
 
 
 def applies_to(rule: Rule) -> str:
     """Vehicles, PX4 versions and recordings, as one cell: ``rovers, 1.16+, ROS 2``."""
     parts = [_vehicles_text(rule.vehicles), _px4_text(rule.px4)]
-    formats = list(dict.fromkeys(FORMAT_NAMES[f] for f in rule.formats))
+    formats = list(dict.fromkeys(FORMAT_NAMES.get(f, f) for f in rule.formats))
     if formats:
         parts.append(", ".join(formats) + " only")
     return ", ".join(parts)

@@ -36,6 +36,7 @@ from fuzzoff.events import (
     TorqueSetpoint,
     TrajectorySetpoint,
 )
+from fuzzoff.mavlink_ids import MAV_FRAME_BODY_NED, MAV_FRAME_LOCAL_NED
 from fuzzoff.tables import mavlink as tm
 
 MotionKind = Literal["straight", "turning"]
@@ -47,9 +48,6 @@ RATE_EPS = math.radians(0.5)
 """rad/s under which a rate counts as zero."""
 TILT_RAD = math.radians(2.0)
 """A commanded attitude tilted less than this from level counts as level (a hover)."""
-
-MAV_FRAME_LOCAL_NED = 1
-MAV_FRAME_BODY_NED = 8
 
 
 @dataclass(frozen=True, slots=True)

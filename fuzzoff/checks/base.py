@@ -5,11 +5,12 @@ types it wants (``wants``; ``GateTransition`` included for checks driven by the 
 and reports through ``self.ctx.report``. Subclassing registers it; a module in this package
 is imported automatically, so adding a rule needs no edit elsewhere.
 
-A check on the hot path may also define ``on_batch``: the engine then hands it the stream
-messages (keep-alives and setpoints, ``STREAM_TYPES``) as runs, a ``StreamBatch`` at a time,
-instead of one call per message. A run never spans anything that changes what the checks read
-(see ``StreamBatch``), so the check can judge it with a tight loop or in one step; every other
-event still reaches ``on_event``, after the runs before it.
+The stream messages (keep-alives and setpoints, ``STREAM_TYPES``) reach every check one way:
+as runs, a ``StreamBatch`` at a time, through ``on_batch``; every other event reaches
+``on_event`` at once, after the runs before it. A run never spans anything that changes what
+the checks read (see ``StreamBatch``). ``Check.on_batch`` replays the run through ``on_event``,
+message by message; a check on the hot path overrides it to judge the run with a tight loop or
+in one step.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from dataclasses import dataclass, field
 from operator import attrgetter
 from typing import Any, ClassVar
 
-from fuzzoff.catalog import get_rule
+from fuzzoff.catalog import get_rule, sent_stream_rules
 from fuzzoff.config import Settings
 from fuzzoff.events import (
     KEEPALIVE_ROS,
@@ -42,21 +43,6 @@ from fuzzoff.tables.control_mode import FlagRow, row_for
 
 REGISTRY: list[type[Check]] = []
 
-SENT_STREAM_RULES: tuple[str, ...] = (
-    "OFB101",
-    "OFB102",
-    "OFB103",
-    "OFB104",
-    "OFB105",
-    "OFB106",
-    "OFB107",
-    "OFB203",
-    "OFB303",
-)
-"""The rules that judge the keep-alive and setpoint stream as sent. On a recording that cannot
-hold it (``RecordingInfo.stream_recorded``) they are not run: its absence there says nothing
-about the sender, and the engine says so in one OFB002."""
-
 
 @dataclass(slots=True)
 class CheckContext:
@@ -73,7 +59,7 @@ class CheckContext:
     not_checkable: dict[str, str] = field(default_factory=dict)
     """code -> what the recording would need (one OFB002 finding lists them all)."""
     stream_recorded: bool = True
-    """False: the recording holds no sent stream, and ``SENT_STREAM_RULES`` are off."""
+    """False: the recording holds no sent stream, and the ``sent_stream`` rules are off."""
     offboard_used: bool = False
     """The vehicle was in OFFBOARD (or an external mode) or asked to switch there, as far as
     the events so far show (kept by ``whole_file.OffboardUse`` while OFB005 is enabled)."""
@@ -91,7 +77,7 @@ class CheckContext:
             return row
 
     def enabled(self, code: str) -> bool:
-        if not self.stream_recorded and code in SENT_STREAM_RULES:
+        if not self.stream_recorded and code in sent_stream_rules():
             return False
         try:
             rule = get_rule(code)
@@ -199,7 +185,8 @@ class StreamBatch:
     with ``on_event`` (``ctx.in_offboard``, ``ctx.flying``) reads the right values.
 
     ``on_batch`` must report exactly what ``on_event`` would for the same messages one at a
-    time; ``Check.replay`` does that, and a check's own fast path proves the common case
+    time; ``Check.replay`` (the default ``on_batch``) does that, and a check's own fast path
+    proves the common case
     (nothing to report, only counters and times move) and replays the rest.
     ``tests/test_batching.py`` and the ``runs`` fuzz property compare the two.
     """
@@ -301,10 +288,13 @@ class Check:
     def on_event(self, event: Event) -> None:
         """Called for every event whose type is in ``wants``, in time order."""
 
-    on_batch: ClassVar[Callable[[Any, StreamBatch], None] | None] = None
-    """Optional: ``on_batch(self, batch)`` takes the stream messages a run at a time (see
-    ``StreamBatch``); ``on_event`` then sees only the other events it wants. The run holds
-    every stream message; the check picks the ones it wants."""
+    def on_batch(self, batch: StreamBatch) -> None:
+        """The stream messages of a run (see ``StreamBatch``); ``on_event`` sees only the other
+        events it wants. The run holds every stream message; the check picks the ones it wants.
+        Here: each one it wants, through ``on_event`` (``replay``). An override must report
+        exactly what this would."""
+        if batch.of(self.subscriptions):
+            self.replay(batch)
 
     def replay(self, batch: StreamBatch, start: int = 0) -> None:
         """``on_event`` for the run's messages from ``start`` on that this check wants, with

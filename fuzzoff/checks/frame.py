@@ -48,13 +48,13 @@ from fuzzoff.events import (
     VehicleStatus,
 )
 from fuzzoff.gate import GateTransition
+from fuzzoff.mavlink_ids import (
+    MAV_CMD_NAV_TAKEOFF,
+    MAV_CMD_NAV_VTOL_TAKEOFF,
+    MAV_FRAME_BODY_NED,
+    MAV_FRAME_LOCAL_NED,
+)
 from fuzzoff.type_mask import VELOCITY_BITS, VZ_IGNORE, Z_IGNORE
-
-MAV_FRAME_LOCAL_NED = 1
-MAV_FRAME_BODY_NED = 8
-
-MAV_CMD_NAV_TAKEOFF = 22
-MAV_CMD_NAV_VTOL_TAKEOFF = 84
 
 TAKEOFF_MODES = frozenset(
     {

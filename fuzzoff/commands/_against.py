@@ -86,8 +86,7 @@ def _checked(args: argparse.Namespace) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from fuzzoff.commands._common import settings_from_args, write_output
-    from fuzzoff.commands.fuzz import check_save_dir
+    from fuzzoff.commands._common import check_save_dir, settings_from_args, write_output
     from fuzzoff.fuzz.reproducers import DEFAULT_DIR
     from fuzzoff.sitl import bundle
     from fuzzoff.sitl.against import DEFAULT_BUDGET_S, SHRINK_RUNS, AgainstConfig, run_against

@@ -50,37 +50,69 @@ def add_output_options(parser: argparse.ArgumentParser, formats: tuple[str, ...]
     parser.add_argument("--output", "-o", metavar="FILE", help="write the report here")
 
 
-def add_report_options(
-    parser: argparse.ArgumentParser, formats: tuple[str, ...] = FORMATS
-) -> None:
-    """``--format`` and ``--output`` that may repeat, in pairs: one lint, several reports."""
+def add_report_options(parser: argparse.ArgumentParser, formats: tuple[str, ...] = FORMATS) -> None:
+    """``--format`` and ``--output`` that may repeat, in pairs: one lint, several reports. An
+    ``--output`` belongs to the ``--format`` just before it, as the line reads (``--format
+    terminal --format html -o r.html`` writes the HTML to r.html, the text to the screen)."""
     parser.add_argument(
         "--format",
-        action="append",
+        action=_FormatAction,
         choices=formats,
-        help="report format (default terminal); repeat it with an --output each for several",
+        help="report format (default terminal); repeat it, each with its --output, for several",
     )
     parser.add_argument(
         "--output",
         "-o",
-        action="append",
+        action=_OutputAction,
         metavar="FILE",
-        help="where the --format of the same position goes (default and '-': standard output)",
+        help="where the --format just before it goes (default and '-': standard output)",
     )
 
 
+class _FormatAction(argparse.Action):
+    """``--format``: one more report, to standard output until an ``--output`` follows it.
+    ``args.format`` and ``args.output`` stay the same length, an output None until given."""
+
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: Any,
+        option_string: str | None = None,
+    ) -> None:
+        namespace.format = [*(namespace.format or []), values]
+        namespace.output = [*(namespace.output or []), None]
+
+
+class _OutputAction(argparse.Action):
+    """``--output``: the file of the ``--format`` just before it, which must have none yet."""
+
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: Any,
+        option_string: str | None = None,
+    ) -> None:
+        outputs = list(namespace.output or [])
+        if not outputs or outputs[-1] is not None:
+            parser.error(
+                f"{option_string} {values} has no --format before it: give each --output "
+                "after its own --format (--format html --output report.html)"
+            )
+        outputs[-1] = values
+        namespace.output = outputs
+
+
 def report_targets(
-    formats: list[str] | None, outputs: list[str] | None
+    formats: list[str] | None, outputs: list[str | None] | None
 ) -> list[tuple[str, str | None]]:
     """``--format``/``--output`` pairs in the order given: ``[("sarif", "a.sarif"), ("html",
-    "r.html"), ("terminal", None)]``. A format without an output of its own goes to standard
-    output, which only one report can; an output needs a format."""
+    "r.html"), ("terminal", None)]``. ``outputs`` holds each format's output, None for none
+    (``add_report_options`` keeps the two lists in step). A format without an output of its
+    own goes to standard output, which only one report can."""
     formats = formats or ["terminal"]
     outputs = outputs or []
-    if len(outputs) > len(formats):
-        raise ConfigError(
-            f"{len(outputs)} --output for {len(formats)} --format: give a --format for each"
-        )
     pairs = [(fmt, outputs[i] if i < len(outputs) else None) for i, fmt in enumerate(formats)]
     pairs = [(fmt, None if out == "-" else out) for fmt, out in pairs]
     to_stdout = [fmt for fmt, out in pairs if out is None]
@@ -159,15 +191,20 @@ def print_notes(settings: Settings) -> None:
         print(f"fuzzoff: {note}", file=sys.stderr)
 
 
-def settings_per_recording(settings: Settings, recordings: list[str]) -> None:
-    """Read every recording's nearest configuration before any work: a mistake in one is a
+def resolve_recordings(settings: Settings, recordings: list[str]) -> list[tuple[str, Settings]]:
+    """Each recording with the settings it is judged with, resolved once, before any work
+    (``Settings.resolved_for``): a mistake in a recording's nearest configuration is a
     usage error now, not a failure halfway through the run. Their notes are printed once."""
     seen = set(settings.notes)
+    plan = []
     for recording in recordings:
-        for note in settings.for_recording(recording).notes:
+        resolved = settings.resolved_for(recording)
+        plan.append((recording, resolved))
+        for note in resolved.notes:
             if note not in seen:
                 seen.add(note)
                 print(f"fuzzoff: {note}", file=sys.stderr)
+    return plan
 
 
 def existing_paths(paths: list[str]) -> None:
@@ -243,3 +280,29 @@ def render_rich(draw: Callable[[Console], None], output: str | None = None) -> N
         console = Console(file=buffer, highlight=False, no_color=True, width=160)
     draw(console)
     write_output(buffer.getvalue(), output)
+
+
+def check_save_dir(directory: Path, label: str | None = None) -> None:
+    """Refuse a ``--save-dir`` that cannot hold reproducers before the campaign runs, not after
+    it. The folders it lacks are made and removed again, so that the system says what is wrong
+    (a file on the way, a folder that cannot be written) and a campaign that finds nothing
+    leaves nothing behind. ``label`` names the folder in the message."""
+    label = label or f"--save-dir {directory}"
+    made: list[Path] = []
+    folder = directory
+    while not folder.is_dir() and folder != folder.parent:
+        if folder.exists() or folder.is_symlink():
+            raise ConfigError(f"{label}: {folder} is not a folder")
+        made.append(folder)
+        folder = folder.parent
+    try:
+        for missing in reversed(made):
+            missing.mkdir()
+        if not os.access(directory, os.W_OK | os.X_OK):
+            raise ConfigError(f"{label}: the folder cannot be written")
+    except OSError as exc:
+        raise ConfigError(f"{label}: cannot create {exc.filename}: {exc.strerror or exc}") from None
+    finally:
+        for missing in made:
+            if missing.is_dir():
+                missing.rmdir()

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
 import sys
 from pathlib import Path
 from typing import Any
@@ -19,6 +18,7 @@ from typing import Any
 from fuzzoff.commands import _against, add_command
 from fuzzoff.commands._common import (
     add_scheduler_option,
+    check_save_dir,
     parse_params,
     settings_from_args,
     write_output,
@@ -260,32 +260,6 @@ def run(args: argparse.Namespace) -> int:
         print(f"error: {budget}ran no example of {names}: nothing was checked", file=sys.stderr)
         return 2
     return 1 if result.failed else 0
-
-
-def check_save_dir(directory: Path, label: str | None = None) -> None:
-    """Refuse a ``--save-dir`` that cannot hold reproducers before the campaign runs, not after
-    it. The folders it lacks are made and removed again, so that the system says what is wrong
-    (a file on the way, a folder that cannot be written) and a campaign that finds nothing
-    leaves nothing behind. ``label`` names the folder in the message."""
-    label = label or f"--save-dir {directory}"
-    made: list[Path] = []
-    folder = directory
-    while not folder.is_dir() and folder != folder.parent:
-        if folder.exists() or folder.is_symlink():
-            raise ConfigError(f"{label}: {folder} is not a folder")
-        made.append(folder)
-        folder = folder.parent
-    try:
-        for missing in reversed(made):
-            missing.mkdir()
-        if not os.access(directory, os.W_OK | os.X_OK):
-            raise ConfigError(f"{label}: the folder cannot be written")
-    except OSError as exc:
-        raise ConfigError(f"{label}: cannot create {exc.filename}: {exc.strerror or exc}") from None
-    finally:
-        for missing in made:
-            if missing.is_dir():
-                missing.rmdir()
 
 
 def _save_all(result: CampaignResult, directory: Path) -> tuple[dict[str, Path], str | None]:

@@ -13,7 +13,6 @@ disagree somewhere, 2 usage error or the recording could not be read completely.
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import json
 import sys
 from typing import Any
@@ -27,10 +26,8 @@ from fuzzoff.commands._common import (
     settings_from_args,
     write_output,
 )
-from fuzzoff.engine import Timeline, lint_file
 from fuzzoff.findings import FileReport
-from fuzzoff.gate import GateTransition
-from fuzzoff.modes import nav_state_name
+from fuzzoff.gate_timeline import Row, gate_report
 from fuzzoff.report.sanitize import escape_bidi, printable
 
 
@@ -49,70 +46,6 @@ def add_parser(sub: Any) -> None:
         "--no-controllers", action="store_true", help="leave out the 'controller' rows"
     )
     parser.set_defaults(run=run)
-
-
-Row = dict[str, Any]
-
-
-def _transition_row(tr: GateTransition) -> Row:
-    return {
-        "time_s": round(tr.t, 6),
-        "source": "model",
-        "what": tr.what,
-        "message": tr.message,
-        "spec": tr.spec,
-        "unverified": tr.unverified,
-        "nav_state": tr.nav_state,
-        "mode": nav_state_name(tr.nav_state) if tr.nav_state is not None else None,
-        "action": tr.action,
-        "reason": tr.reason,
-        "recorded_nav_state": tr.recorded_nav_state,
-        "earliest_s": None if tr.t_earliest is None else round(tr.t_earliest, 6),
-        "seen_in": tr.seen_in,
-    }
-
-
-def _recorded_row(t: float, nav: int | None, armed: bool | None) -> Row:
-    arming = "" if armed is None else (" armed" if armed else " disarmed")
-    return {
-        "time_s": round(t, 6),
-        "source": "recorded",
-        "what": "recorded",
-        "message": f"{nav_state_name(nav)}{arming}",
-        "spec": None,
-        "unverified": False,
-        "nav_state": nav,
-        "mode": nav_state_name(nav) if nav is not None else None,
-        "armed": armed,
-    }
-
-
-def timeline_rows(timeline: Timeline, controllers: bool = True) -> list[Row]:
-    """Model transitions and recorded mode changes of one vehicle, in time order."""
-    rows = [
-        _transition_row(tr) for tr in timeline.transitions if controllers or tr.what != "controller"
-    ]
-    rows += [_recorded_row(t, nav, armed) for t, nav, armed in timeline.recorded_modes]
-    rows.sort(key=lambda r: (r["time_s"], r["source"] != "recorded"))
-    return rows
-
-
-def gate_report(
-    path: str, settings_args: argparse.Namespace, controllers: bool = True
-) -> tuple[FileReport, dict[str, list[Row]]]:
-    settings = settings_from_args(settings_args).for_recording(path)
-    # Only the gate's own rule: the timeline needs the model, not every check.
-    settings = dataclasses.replace(
-        settings,
-        select=frozenset({"OFB202"}),
-        ignore=frozenset(),
-        per_file_ignores=(),
-        discovery=None,
-    )
-    timelines: dict[str, Timeline] = {}
-    report = lint_file(path, settings, timelines=timelines)
-    rows = {v: timeline_rows(tl, controllers) for v, tl in sorted(timelines.items())}
-    return report, rows
 
 
 def _terminal(report: FileReport, rows: dict[str, list[Row]]) -> str:
@@ -177,7 +110,8 @@ def _json(report: FileReport, rows: dict[str, list[Row]]) -> str:
 def run(args: argparse.Namespace) -> int:
     existing_paths([args.path])
     check_output(args.output, [args.path])
-    report, rows = gate_report(args.path, args, controllers=not args.no_controllers)
+    settings = settings_from_args(args)
+    report, rows = gate_report(args.path, settings, controllers=not args.no_controllers)
     text = _json(report, rows) if args.format == "json" else _terminal(report, rows)
     write_output(text, args.output)
     for line in [*report.problems, *report.malformed]:

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -15,18 +17,16 @@ from fuzzoff.commands._common import (
     add_rule_options,
     check_output,
     existing_paths,
-    render_rich,
     report_targets,
+    resolve_recordings,
     settings_from_args,
-    settings_per_recording,
-    write_output,
 )
-from fuzzoff.config import ConfigError, Settings
-from fuzzoff.engine import lint_file, lint_paths, lint_with_timelines
-from fuzzoff.findings import Report
-from fuzzoff.fleet import fleet_wanted
+from fuzzoff.commands._lint_output import print_problems, write_report
+from fuzzoff.config import ConfigError
+from fuzzoff.engine import Lint, Watch, lint_each, lint_file, lint_file_with_timelines
+from fuzzoff.fleet import is_url
 from fuzzoff.formats import RECORDING_SUFFIXES, find_recordings, recordings_in
-from fuzzoff.report import FORMATS, renderer
+from fuzzoff.report import FORMATS
 from fuzzoff.report.sanitize import printable
 
 
@@ -57,58 +57,31 @@ def add_parser(sub: Any) -> None:
     parser.set_defaults(run=run)
 
 
-def _lint(
-    args: argparse.Namespace, paths: list[str], settings: Settings, formats: set[str]
-) -> Report:
-    """One lint for every report asked for: with the timelines the HTML report plots, with a
-    progress bar on stderr where a person watches it, whatever the reports' formats (a long
-    file, or one that is garbage after a good start, can take a while; rich is imported only
-    then: the machine-readable formats need not pay for it at start-up)."""
-    if "html" in formats:
-        return lint_with_timelines(paths, settings, jobs=args.jobs)
-    if sys.stderr.isatty() and not args.no_progress and args.jobs == 1:
-        return _lint_with_progress(paths, settings)
-    return lint_paths(paths, settings, jobs=args.jobs)
-
-
-def _lint_with_progress(paths: list[str], settings: Settings) -> Report:
-    """One file at a time with a progress bar on stderr's terminal (long files take seconds)."""
+@contextmanager
+def _watching(args: argparse.Namespace) -> Iterator[Watch | None]:
+    """A progress bar on stderr where a person watches it, whatever the reports' formats (a
+    long file, or one that is garbage after a good start, can take a while): a task per
+    recording while it is linted, in this process only. rich is imported only then: the
+    machine-readable formats need not pay for it at start-up."""
+    if not sys.stderr.isatty() or args.no_progress or args.jobs != 1:
+        yield None
+        return
     from rich.console import Console
-    from rich.progress import BarColumn, Progress, TaskID, TextColumn, TimeRemainingColumn
+    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
-    report = Report()
     columns = (TextColumn("{task.description}"), BarColumn(), TimeRemainingColumn())
     console = Console(stderr=True, highlight=False)
-    with Progress(*columns, console=console, transient=True) as progress:
-        for f in recordings_in(paths):
-            task = progress.add_task(printable(f.name, 60), total=1.0)
+    with Progress(*columns, console=console, transient=True) as bar:
 
-            def advance(fraction: float, task: TaskID = task) -> None:
-                progress.update(task, completed=fraction)
+        @contextmanager
+        def watch(path: str) -> Iterator[Callable[[float], None]]:
+            task = bar.add_task(printable(Path(path).name, 60), total=1.0)
+            try:
+                yield lambda fraction: bar.update(task, completed=fraction)
+            finally:
+                bar.remove_task(task)
 
-            report.files.append(lint_file(f, settings, progress=advance))
-            progress.remove_task(task)
-    return report
-
-
-def _terminal(
-    args: argparse.Namespace, report: Report, settings: Settings, output: str | None
-) -> None:
-    from rich.console import Console
-
-    from fuzzoff.report.terminal import print_report
-
-    def draw(console: Console) -> None:
-        print_report(
-            console,
-            report,
-            settings.fail_on,
-            quiet=args.quiet,
-            statistics=args.statistics,
-            verbose=args.verbose,
-        )
-
-    render_rich(draw, output)
+        yield watch
 
 
 def run(args: argparse.Namespace) -> int:
@@ -117,10 +90,10 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError("--jobs must be at least 1")
     # As ruff: no path means the current folder.
     args.paths = args.paths or ["."]
-    if fleet_wanted(args):
-        from fuzzoff.fleet.lint_run import run_fleet
+    if _fleet_wanted(args):
+        from fuzzoff.commands._lint_fleet import run_fleet
 
-        return run_fleet(args, settings, _terminal)
+        return run_fleet(args, settings)
     existing_paths(args.paths)
     # A folder with nothing to lint is a mistake (a wrong path, a recording step that failed):
     # passing it would turn a CI job green without looking at a single flight.
@@ -130,19 +103,28 @@ def run(args: argparse.Namespace) -> int:
     if empty:
         suffixes = ", ".join(RECORDING_SUFFIXES)
         raise ConfigError(f"no recordings in {empty[0]} (searched for {suffixes} and bag folders)")
-    paths = [str(f) for _, recordings in found for f in recordings]
+    # each real file once, in order, however often it is named (no folder is searched again)
+    paths = [str(f) for f in recordings_in(f for _, recordings in found for f in recordings)]
     targets = report_targets(args.format, args.output)
     for _, output in targets:
         check_output(output, paths)
-    settings_per_recording(settings, paths)
-    report = _lint(args, paths, settings, {fmt for fmt, _ in targets})
+    plan = resolve_recordings(settings, paths)
+    # One lint for every report asked for, with the timelines the HTML report plots
+    lint: Lint = lint_file_with_timelines if any(f == "html" for f, _ in targets) else lint_file
+    with _watching(args) as watch:
+        report = lint_each(plan, lint=lint, jobs=args.jobs, watch=watch)
     for fmt, output in targets:
-        if fmt == "terminal":
-            _terminal(args, report, settings, output)
-        else:
-            write_output(renderer(fmt)(report, settings), output)
-    malformed = settings.enabled("OFB004")  # read around, nothing lost: the user may silence it
-    for f in report.files:
-        for line in [*f.problems, *(f.malformed if malformed else [])]:
-            print(f"fuzzoff: {printable(line)}", file=sys.stderr)
+        write_report(args, report, settings, fmt, output)
+    print_problems(report, settings)  # OFB004's lines (nothing lost) unless it is silenced
     return report.exit_status(settings.fail_on)
+
+
+def _fleet_wanted(args: argparse.Namespace) -> bool:
+    """Does this lint need the fleet path (a cluster, URLs, the dataset or its options)?"""
+    return bool(
+        args.scheduler is not None
+        or "parquet" in (args.format or ())
+        or args.timeout is not None
+        or args.force
+        or any(is_url(p) for p in args.paths)
+    )

@@ -31,9 +31,17 @@ def add_parser(sub: Any) -> None:
     run = actions.add_parser("run", help="fly a scenario program on a PX4 SITL")
     run.add_argument("scenario", metavar="SCENARIO", help="a name from 'fuzzoff sitl list'")
     replay = actions.add_parser("replay", help="replay a tlog (or its reproducer) on a PX4 SITL")
-    replay.add_argument("path", metavar="FILE", help="a .tlog, or a reproducer's .expected.json")
+    replay.add_argument(
+        "path", metavar="FILE", help="a .tlog, a reproducer's .expected.json; a bag with ros2"
+    )
     replay.add_argument("--speed", type=float, default=1.0, help="time scale (0.01 to 100)")
     for p in (run, replay):
+        p.add_argument(
+            "--transport",
+            choices=("mavlink", "ros2"),
+            default="mavlink",
+            help="ros2: a ROS 2 program or bag over PX4's bridge (uXRCE-DDS; cyclonedds, root)",
+        )
         p.add_argument("--release", metavar="R", help="bundled PX4 release (1.16.2, 1.15)")
         p.add_argument("--px4-build", metavar="DIR", type=Path, help="your own SITL build")
         p.add_argument("--instance", type=int, default=0, help="PX4_INSTANCE (0-9; default 0)")
@@ -65,6 +73,12 @@ def _list() -> int:
     for s in SCENARIOS.values():
         kind = "clean" if s.kind == "clean" else f"hazard ({s.hazard})"
         lines.append(f"  {s.name:<26} {s.summary}; {kind}")
+    from fuzzoff.sitl.ros2.programs import PROGRAMS
+
+    lines.append("ROS 2 programs (--transport ros2):")
+    for p in PROGRAMS.values():
+        kind = "clean" if p.kind == "clean" else f"hazard ({p.hazard})"
+        lines.append(f"  {p.name:<26} {p.summary}; {kind}")
     found = releases()
     lines.append(f"PX4 SITL bundles in {default_root()}: {', '.join(found) or 'none'}")
     write_output("\n".join(lines) + "\n", None)
@@ -74,6 +88,8 @@ def _list() -> int:
 def run_command(args: argparse.Namespace) -> int:
     if args.action == "list":
         return _list()
+    if args.transport == "ros2":
+        return _run_ros2(args)
     from fuzzoff.recording import SourceError
     from fuzzoff.sitl import bundle, run
     from fuzzoff.sitl.link import LinkError
@@ -114,6 +130,51 @@ def run_command(args: argparse.Namespace) -> int:
         print(f"error: {printable(str(exc))}", file=sys.stderr)
         return 2
     return report(outcome, args.format, args.output)
+
+
+def _run_ros2(args: argparse.Namespace) -> int:
+    """A ROS 2 program flown, or a bag replayed, over PX4's bridge: its recordings and what
+    PX4 answered."""
+    from fuzzoff.sitl import bundle
+    from fuzzoff.sitl.ros2 import run as ros2_run
+    from fuzzoff.sitl.ros2.programs import PROGRAMS
+
+    if args.action == "run" and args.scenario not in PROGRAMS:
+        raise ConfigError(
+            f"no ROS 2 program {args.scenario!r}; have {', '.join(PROGRAMS)} ('fuzzoff sitl list')"
+        )
+    if args.param or args.speed_factor is not None or args.instance:
+        raise ConfigError("--param, --speed-factor and --instance are MAVLink-only for now")
+    if getattr(args, "speed", 1.0) != 1.0:
+        raise ConfigError("--speed is MAVLink-only for now: a ROS 2 replay keeps the bag's times")
+    if args.action == "replay" and not Path(args.path).is_dir():
+        raise ConfigError(f"{args.path}: a ROS 2 replay takes a bag folder (metadata.yaml)")
+    try:
+        build = bundle.find_bridge_build(args.release, args.px4_build)
+    except bundle.BundleError as exc:
+        raise ConfigError(str(exc)) from None
+    save_dir = args.save_dir or Path(tempfile.mkdtemp(prefix="fuzzoff-sitl-"))
+
+    def log(line: str) -> None:
+        print(f"fuzzoff: {printable(line)}", file=sys.stderr)
+
+    try:
+        if args.action == "run":
+            outcome = ros2_run.fly(args.scenario, build, save_dir, log)
+        else:
+            outcome = ros2_run.replay_bag(Path(args.path), build, save_dir, log)
+    except ros2_run.FlightError as exc:
+        print(f"error: {printable(str(exc))}", file=sys.stderr)
+        return 2
+    if args.format == "json":
+        data = {
+            **outcome.summary,
+            "recordings": [str(p) for p in outcome.recordings],
+        }
+        write_output(json.dumps(data, indent=2) + "\n", args.output)
+    else:
+        write_output(ros2_run.render(outcome), args.output)
+    return 0
 
 
 def _recording(path: Path, params: dict[str, float]) -> tuple[Path, dict[str, float], bool]:

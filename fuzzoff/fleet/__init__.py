@@ -7,7 +7,6 @@ one into one usage line. See docs/fleet.md.
 
 from __future__ import annotations
 
-import argparse
 import importlib.util
 import re
 
@@ -35,14 +34,3 @@ _URL = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]*://")
 def is_url(text: str) -> bool:
     """``s3://bucket/key``, ``https://...``, ``file:///...``: a recording fsspec fetches."""
     return bool(_URL.match(text))
-
-
-def fleet_wanted(args: argparse.Namespace) -> bool:
-    """Does this lint need the fleet path (a cluster, URLs, the dataset or its options)?"""
-    return bool(
-        args.scheduler is not None
-        or "parquet" in (args.format or ())
-        or args.timeout is not None
-        or args.force
-        or any(is_url(p) for p in args.paths)
-    )

@@ -8,17 +8,22 @@ import stat
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 
-from fuzzoff.formats import rosbag2
-from fuzzoff.formats.registry import BY_REPORTED_NAME, DETECTION_ORDER, RECORDING_SUFFIXES
+from fuzzoff.formats.format import Format
+from fuzzoff.formats.registry import (
+    BY_REPORTED_NAME,
+    DETECTION_ORDER,
+    FOLDER_FORMATS,
+    RECORDING_SUFFIXES,
+)
 from fuzzoff.recording import RecordingInfo, Source, SourceError, SourceProblem
 
 
 def detect_format(path: Path) -> str:
-    """The format of ``path`` from its content (a folder with metadata.yaml is a rosbag2)."""
+    """The format of ``path`` from its content (a folder: the format whose recording it is)."""
     try:
         mode = path.stat().st_mode
         if stat.S_ISDIR(mode):
-            return rosbag2.detect_folder(path)
+            return _folder_format(path)
         if not stat.S_ISREG(mode):
             raise SourceError(path, f"{_special(mode)}, not a file: {_NEEDS_A_FILE}")
         with path.open("rb") as fh:
@@ -46,8 +51,25 @@ def _special(mode: int) -> str:
 
 
 def is_bag_folder(path: Path) -> bool:
-    """A folder that is one ROS 2 bag, not a folder of recordings to search."""
-    return rosbag2.is_bag_folder(path, RECORDING_SUFFIXES)
+    """A folder that is one recording (a ROS 2 bag), not a folder of recordings to search."""
+    return _claimed_by(path) is not None
+
+
+def _claimed_by(folder: Path) -> Format | None:
+    """The format whose recording ``folder`` is (``Format.is_folder``), or None."""
+    for fmt in FOLDER_FORMATS:
+        assert fmt.is_folder is not None
+        if fmt.is_folder(folder, RECORDING_SUFFIXES):
+            return fmt
+    return None
+
+
+def _folder_format(folder: Path) -> str:
+    """The reported format of a folder that is one recording (``Format.detect_folder``)."""
+    fmt = _claimed_by(folder)
+    if fmt is None or fmt.detect_folder is None:
+        raise SourceError(folder, "a folder that is no recording fuzzoff reads (nor a ROS 2 bag)")
+    return fmt.detect_folder(folder)
 
 
 def open_source(path: Path, fmt: str | None = None) -> Source:

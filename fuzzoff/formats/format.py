@@ -51,9 +51,12 @@ class Format:
     first packet could be any file's bytes)."""
     transports: tuple[Transport, ...] = ()
     """The streams whose messages this format records as sent (empty for a vehicle's log)."""
+    is_folder: Callable[[Path, tuple[str, ...]], bool] | None = None
+    """Is a folder one recording of this format (a ROS 2 bag), not a folder of recordings to
+    search? Given the folder and the file names a search takes (``RECORDING_SUFFIXES``)."""
     detect_folder: Callable[[Path], str] | None = None
-    """The format name of a folder that is one recording of this format (raises
-    ``SourceError`` when it is not readable as one)."""
+    """The format name of a folder ``is_folder`` claims (raises ``SourceError`` when it is not
+    readable as one)."""
     writer_options: Callable[[str | None], Mapping[str, Any]] = _no_options
     """The writer's options for a PX4 release or profile name (the message definitions a
     ROS 2 recording embeds, the layouts a ULog declares)."""
@@ -69,7 +72,6 @@ class Format:
         """``events`` written at ``path`` as PX4 ``px4`` would have them recorded."""
         function: Callable[..., Path] = _load(self.writer)
         return function(path, events, **self.writer_options(px4))
-
 
     def start_s(self, path: Path) -> float | None:
         """When the recording at ``path`` started on the wall clock, where it says."""

@@ -21,6 +21,9 @@ DETECTION_ORDER: tuple[Format, ...] = tuple(
     sorted(FORMATS, key=lambda f: f.fallback)  # stable: the fallback ones last
 )
 
+FOLDER_FORMATS: tuple[Format, ...] = tuple(f for f in FORMATS if f.is_folder is not None)
+"""The formats a folder can be one recording of (a ROS 2 bag)."""
+
 BY_NAME: dict[str, Format] = {f.name: f for f in FORMATS}
 """Package name -> format (``rosbag2``)."""
 

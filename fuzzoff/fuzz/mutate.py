@@ -22,7 +22,6 @@ from pathlib import Path
 
 from hypothesis import strategies as st
 
-from fuzzoff.engine import Timeline
 from fuzzoff.events import Command, CommandAck, ControlMode, Event, is_keepalive
 from fuzzoff.fuzz.hazards import hazards
 from fuzzoff.fuzz.recordings import read_with_info
@@ -30,6 +29,7 @@ from fuzzoff.fuzz.scenario import Scenario, TransportName, run
 from fuzzoff.fuzz.streams import settle
 from fuzzoff.profiles import DEFAULT_PX4, DEFAULT_VEHICLE, ProfileError, px4_profile_for
 from fuzzoff.releases import PX4Profile
+from fuzzoff.timeline import Timeline
 
 FAMILIES = ("stall", "drop", "jitter", "skew")
 MAX_SIZE = {"stall": 5.0, "drop": 50.0, "jitter": 1.0, "skew": 5.0}

@@ -15,11 +15,11 @@ from __future__ import annotations
 import re
 from collections.abc import Sequence
 
-from fuzzoff.engine import Timeline
 from fuzzoff.fuzz.hazards import Hazard, hazards
 from fuzzoff.fuzz.scenario import Scenario, run
 from fuzzoff.modes import nav_state_name
 from fuzzoff.releases import PX4Profile
+from fuzzoff.timeline import Timeline
 
 _TIMING = re.compile(r" (?:between [\d.]+ and [\d.]+ s|at [\d.]+ s \([^)]*\))")
 """The time words of a gate failsafe message (its window, or where the recording dated it)."""

@@ -39,7 +39,7 @@ from typing import Any
 
 from fuzzoff.catalog import get_rule
 from fuzzoff.config import Settings
-from fuzzoff.engine import Timeline, lint_file
+from fuzzoff.engine import lint_file
 from fuzzoff.events import NAV_STATE_OFFBOARD, Event, VehicleStatus
 from fuzzoff.findings import Finding, Severity
 from fuzzoff.formats import SourceError
@@ -48,6 +48,7 @@ from fuzzoff.fuzz.hazards import EXPLAINED_BY, OUTCOME_RULE, Hazard, hazards
 from fuzzoff.fuzz.invariants import invariant_violations
 from fuzzoff.fuzz.scenario import Scenario, run
 from fuzzoff.gate.params import default_params, loss_timeout
+from fuzzoff.timeline import Timeline
 
 TOLERANCE_S = 0.15
 """An explaining finding may come this much after the hazard (the gate's 10 Hz evaluation)."""

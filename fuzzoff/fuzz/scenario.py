@@ -13,13 +13,14 @@ from dataclasses import dataclass, field, replace
 from typing import Any, Literal
 
 from fuzzoff.config import Settings
-from fuzzoff.engine import Timeline, run_events
+from fuzzoff.engine import run_events
 from fuzzoff.events import Event, VehicleStatus, Where, event_from_dict, event_to_dict
 from fuzzoff.findings import Finding
 from fuzzoff.formats.registry import written_for
 from fuzzoff.profiles import Profile, px4_profile_for
 from fuzzoff.recording import RecordingInfo
 from fuzzoff.releases import PX4Profile
+from fuzzoff.timeline import Timeline
 
 TransportName = Literal["ros2", "mavlink", "mavros"]
 TRANSPORTS: tuple[TransportName, ...] = ("ros2", "mavlink", "mavros")

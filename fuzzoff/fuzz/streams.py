@@ -69,6 +69,7 @@ def _cmd(t: float, command: int, params: Sequence[float], transport: TransportNa
         source_component=COMPANION[1],
         from_external=True,
         transport="mavlink",
+        message="COMMAND_LONG",
     )
 
 

@@ -13,9 +13,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from fuzzoff.events import MAV_CMD_COMPONENT_ARM_DISARM, NAV_STATE_OFFBOARD, Command
+from fuzzoff.gate.addressing import Addressing, command_addressing
 from fuzzoff.gate.effective import TERMINATION, EffectiveMode
 from fuzzoff.gate.failsafe import rc_present
 from fuzzoff.gate.requests import (
+    ACCEPTED,
+    FAILED,
     Decision,
     arm_decision,
     decode_mode,
@@ -76,12 +79,16 @@ class Requests:
         s = self.s
         t = cmd.t
         if cmd.is_mode_switch:
-            target = decode_mode(cmd)
+            target = decode_mode(cmd, s.release)
         elif cmd.command == MAV_CMD_COMPONENT_ARM_DISARM:
             target = None
         else:
             return True
         before = (s.user_intention, s.armed)
+        address = command_addressing(s.release, cmd, s.rx.own_system, s.rx.own_component)
+        if not address.handled:
+            self._not_addressed(cmd, target, address, before)
+            return True
         if s.armed is None:
             if_disarmed, if_armed = (
                 self._decide(cmd, target, False),
@@ -98,6 +105,26 @@ class Requests:
         unseen = not decision.accepted and decision.reason == "no offboard signal"
         self.rejected_unseen = (cmd, target, before) if unseen and not cmd.is_disarm else None
         return True
+
+    def _not_addressed(
+        self, cmd: Command, target: int | None, address: Addressing, before: Before
+    ) -> None:
+        """A request PX4's receiver does not pass to Commander: nothing changes; up to 1.15 it
+        answers FAILED (the recorded ack is compared), later releases answer nothing."""
+        s = self.s
+        reason = f"addressed to {address.wrong}: {address.effect(s.release)}"
+        failed = address.answer == "ack_failed"
+        decision = Decision(
+            False,
+            "13a",
+            reason,
+            result=FAILED if failed else ACCEPTED,
+            changes=False,
+            unverified=s.release.old_code_unverified,
+        )
+        self._apply(cmd.t, cmd, target, decision)
+        if failed:
+            s.compare.decided(cmd, decision, before, target)
 
     def _decide(self, cmd: Command, target: int | None, armed: bool) -> Decision:
         """PX4's answer to ``cmd`` were the vehicle ``armed`` (4.1, 4.2, 13a)."""

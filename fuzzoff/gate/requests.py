@@ -1,8 +1,8 @@
 """Mode-switch, arming and disarming requests: accepted or rejected, and why (gate spec 4, 13a).
 
-``decode_mode`` turns a command into the nav_state it asks for; ``switch_decision``,
-``arm_decision`` and ``disarm_decision`` return ``Decision`` (accepted, reason, spec, ack
-result).
+``mode_request`` turns a command into the nav_state it asks for (or why the release has none);
+``switch_decision``, ``arm_decision`` and ``disarm_decision`` return ``Decision`` (accepted,
+reason, spec, ack result).
 """
 
 from __future__ import annotations
@@ -26,6 +26,7 @@ ACCEPTED = 0
 TEMPORARILY_REJECTED = 1
 DENIED = 2
 UNSUPPORTED = 3
+FAILED = 4
 NO_ATTITUDE = "no attitude or angular-velocity estimate (OFFBOARD mode requirement, D11)"
 STICK_MODES = frozenset({0, 1, 2, 10, 15})
 """Nav states flown with the sticks: Manual, Altitude, Position, Acro, Stabilized."""
@@ -42,16 +43,44 @@ class Decision:
     unverified: bool = False
 
 
-def decode_mode(cmd: Command) -> int | None:
-    """The nav_state a mode command asks for (None: not a mode or unknown custom mode)."""
+MAIN_AUTO = 4
+MAIN_ALTITUDE_CRUISE = 11
+NAV_AUTO_MISSION = 3
+NAV_ALTITUDE_CRUISE = 8
+
+
+def decode_mode(cmd: Command, release: Release | None = None) -> int | None:
+    """The nav_state a mode command asks for (None: not a mode, or one ``release`` lacks)."""
+    return mode_request(cmd, release)[0]
+
+
+def mode_request(cmd: Command, release: Release | None = None) -> tuple[int | None, str | None]:
+    """(the nav_state a mode command asks for, None), or (None, why PX4 has no such mode) as
+    Commander reads DO_SET_MODE (4.1, seen on 1.16.2-main SITL): AUTO with sub-mode 0 is Mission,
+    an AUTO sub-mode Commander does not know is refused, ALTITUDE_CRUISE (main 11) exists from
+    1.17. Without ``release`` every mode fuzzoff knows counts."""
     if cmd.command == VEHICLE_CMD_SET_NAV_STATE:
-        return whole(cmd.params[0])
-    if cmd.command == MAV_CMD_DO_SET_MODE:
-        base, main, sub = (whole(p) for p in cmd.params[:3])
-        if base is None or base & 1 == 0 or main is None or sub is None:
-            return None
-        return custom_mode_to_nav_state((main & 0xFF) << 16 | (sub & 0xFF) << 24)
-    return None
+        return whole(cmd.params[0]), None
+    if cmd.command != MAV_CMD_DO_SET_MODE:
+        return None, None
+    base, main, sub = (whole(p) for p in cmd.params[:3])
+    if base is None or base & 1 == 0:
+        return None, "base mode without the custom-mode flag"
+    if main is None or sub is None:
+        return None, "main or sub mode not a whole number"
+    main, sub = main & 0xFF, sub & 0xFF
+    if main == MAIN_AUTO and sub == 0:
+        return NAV_AUTO_MISSION, None
+    if main == MAIN_ALTITUDE_CRUISE:
+        if release is None or release.altitude_cruise_mode:
+            return NAV_ALTITUDE_CRUISE, None
+        return None, f"main mode {main} (ALTITUDE_CRUISE, PX4 1.17 and later)"
+    nav = custom_mode_to_nav_state(main << 16 | sub << 24)
+    if nav is not None:
+        return nav, None
+    if main == MAIN_AUTO:
+        return None, f"AUTO sub-mode {sub}"
+    return None, f"main mode {main}"
 
 
 def switch_decision(
@@ -68,15 +97,7 @@ def switch_decision(
     if cmd.command == VEHICLE_CMD_SET_NAV_STATE and not release.handles_set_nav_state:
         return Decision(False, "4.1", "SET_NAV_STATE is not handled before 1.15", UNSUPPORTED)
     if target is None:
-        if release.unsupported_main_mode == "rejected":
-            return Decision(False, "4.1", "unsupported main mode", TEMPORARILY_REJECTED)
-        if release.unsupported_main_mode == "acked_no_change":
-            return Decision(
-                True, "4.1", "unsupported main mode: acked, no mode change", changes=False
-            )
-        return Decision(
-            False, "4.1", "unsupported main mode", TEMPORARILY_REJECTED, unverified=True
-        )
+        return unknown_mode_decision(release, mode_request(cmd, release)[1])
     if release.never_leaves_termination and nav_state == TERMINATION:  # armed or not
         return Decision(False, "4.1", "never out of TERMINATION", TEMPORARILY_REJECTED)
     if target != NAV_STATE_OFFBOARD:
@@ -93,6 +114,20 @@ def switch_decision(
     if signal_ok:
         return Decision(True, "4.1", None)
     return Decision(False, "4.1", "no offboard signal", TEMPORARILY_REJECTED)
+
+
+def unknown_mode_decision(release: Release, problem: str | None) -> Decision:
+    """Commander's answer to DO_SET_MODE for a mode this release does not have (4.1): an
+    unknown AUTO sub-mode is refused on every release; another unknown main mode is acked
+    ACCEPTED with no change (1.14-1.17) or refused (1.18+)."""
+    what = f"no such mode: {problem}" if problem else "no such mode"
+    if problem is not None and problem.startswith("AUTO sub-mode"):
+        return Decision(False, "4.1", what, TEMPORARILY_REJECTED)
+    if release.unsupported_main_mode == "rejected":
+        return Decision(False, "4.1", what, TEMPORARILY_REJECTED)
+    if release.unsupported_main_mode == "acked_no_change":
+        return Decision(True, "4.1", f"{what}: acked, no mode change", changes=False)
+    return Decision(False, "4.1", what, TEMPORARILY_REJECTED, unverified=True)
 
 
 def arm_decision(

@@ -21,13 +21,13 @@ from markdown_it import MarkdownIt
 from fuzzoff import __version__
 from fuzzoff.catalog import Rule, get_rule, render_page
 from fuzzoff.config import Settings
-from fuzzoff.engine import Timeline
 from fuzzoff.findings import FileReport, Finding, Report, Severity
 from fuzzoff.profiles import SOURCE_WORDS
 from fuzzoff.report.html_assets import CSP, report_csp, scripts, uplot_css
 from fuzzoff.report.html_plot import Marker, as_script_data, loss_line, vehicle_plot
 from fuzzoff.report.html_style import CSS
 from fuzzoff.report.sanitize import printable
+from fuzzoff.timeline import Timeline
 
 __all__ = ["CSP", "e", "render", "rule_article"]
 

@@ -18,7 +18,6 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from fuzzoff.engine import Timeline
 from fuzzoff.events import (
     MAV_CMD_COMPONENT_ARM_DISARM,
     MAV_CMD_DO_SET_MODE,
@@ -32,6 +31,7 @@ from fuzzoff.findings import Finding
 from fuzzoff.modes import NAV_STATE_NAMES, custom_mode_to_nav_state, nav_state_name
 from fuzzoff.profiles import Profile
 from fuzzoff.report.sanitize import printable, show_bidi
+from fuzzoff.timeline import Timeline
 
 BUCKETS = 2000
 """Keep-alive intervals are reduced to a min and a max per bucket: at most 4,000 points, enough

@@ -20,9 +20,10 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from fuzzoff.mavlink_ids import MAV_CMD_COMPONENT_ARM_DISARM
 from fuzzoff.sitl import bundle, replay
 from fuzzoff.sitl.driver import NAV_LAND, NAV_LOITER, Driver
-from fuzzoff.sitl.link import MAV_CMD_COMPONENT_ARM_DISARM, Link, LinkError
+from fuzzoff.sitl.link import Link, LinkError
 from fuzzoff.sitl.recorder import TlogRecorder
 from fuzzoff.sitl.run import MANUAL_SETTLE_S, TAIL_S
 from fuzzoff.sitl.session import LOGGER_SETTLE_S, Session

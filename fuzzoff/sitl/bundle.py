@@ -51,8 +51,10 @@ def releases(root: Path | None = None) -> list[str]:
     return sorted(found, key=_release_key)
 
 
-def _release_key(name: str) -> tuple[int, ...]:
-    return tuple(int(n) for n in re.findall(r"\d+", name)[:3])
+def _release_key(name: str) -> tuple[tuple[int, ...], str]:
+    """The release's numbers, then the name: bundles of one release (``1.16.2``,
+    ``1.16.2-ros2``) in the same order whatever order the folder lists them in."""
+    return tuple(int(n) for n in re.findall(r"\d+", name)[:3]), name
 
 
 @dataclass(frozen=True, slots=True)
@@ -85,11 +87,47 @@ def find_build(release: str | None, px4_build: Path | None, root: Path | None = 
     have = releases(root)
     if not have:
         raise BundleError(f"no PX4 SITL bundles in {root} (set FUZZOFF_PX4_SITL to their folder)")
-    matches = [r for r in have if r == release or r.startswith(release + ".")]
+    if release in have:
+        # the exact name wins: "1.16.2" is the plain bundle, not "1.16.2-ros2" beside it
+        return Build(root / release, release)
+    matches = [r for r in have if r.startswith(release + ".")]
     matches += [r for r in have if r.startswith(release + "-") and r not in matches]
     if not matches:
         raise BundleError(f"--release {release}: no such bundle; have {', '.join(have)}")
     return Build(root / matches[-1], matches[-1])
+
+
+def has_bridge(build: Build) -> bool:
+    """Whether the build has PX4's ROS 2 bridge client (``uxrce_dds_client``) in its modules."""
+    commands = build.folder / "bin" / "commands.txt"
+    if commands.exists():
+        return "uxrce_dds_client" in commands.read_text(errors="replace")
+    return (build.folder / "bin" / "px4-uxrce_dds_client").exists()
+
+
+def find_bridge_build(
+    release: str | None, px4_build: Path | None, root: Path | None = None
+) -> Build:
+    """As ``find_build``, for a flight over the ROS 2 bridge: ``1.16.2`` names the bundle of
+    that release with the bridge (``1.16.2-ros2``) when the exact one lacks it."""
+    build = find_build(release, px4_build, root)
+    if has_bridge(build) or px4_build is not None or not release:
+        if not has_bridge(build):
+            raise BundleError(f"{build.folder}: PX4 built without uxrce_dds_client (ROS 2 bridge)")
+        return build
+    root = root or default_root()
+    with_bridge = [
+        r
+        for r in releases(root)
+        if (r == release or r.startswith((release + "-", release + ".")))
+        and has_bridge(Build(root / r, r))
+    ]
+    if not with_bridge:
+        bridged = [r for r in releases(root) if has_bridge(Build(root / r, r))]
+        raise BundleError(
+            f"--release {release}: no bundle with the ROS 2 bridge; have {', '.join(bridged)}"
+        )
+    return Build(root / with_bridge[-1], with_bridge[-1])
 
 
 def _read_release(folder: Path) -> str:

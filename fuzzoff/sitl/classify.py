@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from fuzzoff import events as ev
 from fuzzoff.fuzz.scenario import Scenario
 from fuzzoff.gate.params import default_params, loss_timeout
+from fuzzoff.mavlink_ids import MAV_CMD_COMPONENT_ARM_DISARM
 from fuzzoff.modes import nav_state_name
 from fuzzoff.sitl.truth import Truth
 from fuzzoff.sitl.verdict import CHECK_PERIOD_S, LOOP_S, MODE_SETTLE_S, Item
@@ -79,7 +80,6 @@ def own_changes(truth: Truth, since: float) -> list[OwnChange]:
     return out
 
 
-MAV_CMD_COMPONENT_ARM_DISARM = 400
 HEALTH_TEXT_S = 1.5
 """PX4 reports a failed health check when it finds it and refuses an arm while it stands: its
 text may come a second or so before the refusal."""

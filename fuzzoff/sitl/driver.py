@@ -11,6 +11,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+from fuzzoff.mavlink_ids import MAV_FRAME_LOCAL_NED
 from fuzzoff.sitl.link import Ack, Link, LinkError
 
 POSITION = 0x0DF8
@@ -19,8 +20,6 @@ VELOCITY = 0x0DC7
 """type_mask: velocity only."""
 ACCELERATION = 0x0C3F
 """type_mask: acceleration only (FORCE bit clear)."""
-MAV_FRAME_LOCAL_NED = 1
-MAV_FRAME_LOCAL_ENU = 4
 NAV_POSCTL, NAV_LOITER, NAV_RTL, NAV_OFFBOARD, NAV_TAKEOFF, NAV_LAND = 2, 4, 5, 14, 17, 18
 MANUAL_EVERY_S = 0.1
 """A MAVLink joystick at 10 Hz: PX4 declares manual control lost after COM_RC_LOSS_T (0.5 s)."""
@@ -92,8 +91,19 @@ class Driver:
 
         return send
 
-    def set_mode(self, nav_state: int, label: str) -> Ack | None:
-        return self.note(f"switch to {label}", self.link.set_mode(nav_state))
+    def set_mode(
+        self, nav_state: int, label: str, target: tuple[int, int] | None = None
+    ) -> Ack | None:
+        """DO_SET_MODE to the autopilot, or to ``target`` (system, component) as a client that
+        addresses it wrongly would (sent once: PX4 may answer nothing)."""
+        to = "" if target is None else f" addressed to {target[0]}/{target[1]}"
+        return self.note(f"switch to {label}{to}", self.link.set_mode(nav_state, target))
+
+    def set_custom_mode(self, main: int, sub: int, label: str) -> Ack | None:
+        """DO_SET_MODE with this main and sub mode as sent, whether PX4 has the mode or not."""
+        return self.note(
+            f"switch to {label} (main {main}, sub {sub})", self.link.set_custom_mode(main, sub)
+        )
 
     def arm(self) -> Ack | None:
         return self.note("arm", self.link.arm(True))

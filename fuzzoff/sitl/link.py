@@ -24,6 +24,15 @@ os.environ.setdefault("MAVLINK20", "1")  # formats.md 7.2: before any pymavlink 
 from pymavlink import mavutil
 from pymavlink.dialects.v20 import development as mavlink
 
+from fuzzoff.mavlink_ids import (
+    MAV_AUTOPILOT_PX4,
+    MAV_CMD_COMPONENT_ARM_DISARM,
+    MAV_CMD_DO_SET_MODE,
+    MAV_CMD_REQUEST_MESSAGE,
+    MAV_CMD_SET_MESSAGE_INTERVAL,
+    MAV_COMP_ID_ONBOARD_COMPUTER,
+    MAV_MODE_FLAG_SAFETY_ARMED,
+)
 from fuzzoff.modes import custom_mode_to_nav_state, nav_state_to_custom_mode
 from fuzzoff.sitl.clock import PX4Clock
 from fuzzoff.sitl.recorder import TlogRecorder
@@ -31,16 +40,9 @@ from fuzzoff.sitl.recorder import TlogRecorder
 DIALECT = "development"
 COMPANION_SYSID = 245
 """The client's default system id: not 1 (PX4's), nor 255 (a ground station's usual one)."""
-MAV_COMP_ID_ONBOARD_COMPUTER = 191
-MAV_AUTOPILOT_PX4 = 12
 PREARM_BIT = mavlink.MAV_SYS_STATUS_PREARM_CHECK
 RC_RECEIVER_BIT = mavlink.MAV_SYS_STATUS_SENSOR_RC_RECEIVER
 """Present and healthy in SYS_STATUS while PX4 has manual control (an RC or a MAVLink joystick)."""
-MAV_MODE_FLAG_SAFETY_ARMED = 128
-MAV_CMD_DO_SET_MODE = 176
-MAV_CMD_COMPONENT_ARM_DISARM = 400
-MAV_CMD_SET_MESSAGE_INTERVAL = 511
-MAV_CMD_REQUEST_MESSAGE = 512
 AUTOPILOT_VERSION_ID = 148
 BUSY_TELEMETRY = {
     "ATTITUDE": 30,
@@ -327,12 +329,17 @@ class Link:
     # -- commands
 
     def command(
-        self, command: int, *params: float, timeout: float = 1.5, retries: int = 2
+        self,
+        command: int,
+        *params: float,
+        timeout: float = 1.5,
+        retries: int = 2,
+        target: tuple[int, int] | None = None,
     ) -> Ack | None:
-        """COMMAND_LONG to the autopilot; the last of its acks (PX4 1.16/1.17 send two for a
-        mode switch), or None when PX4 never acked it."""
+        """COMMAND_LONG to the autopilot (or to ``target``, system and component); the last of
+        its acks (PX4 1.16/1.17 send two for a mode switch), or None when PX4 never acked it."""
         values = [*params, *([0.0] * (7 - len(params)))]
-        sysid, compid = self.target
+        sysid, compid = self.target if target is None else target
         for attempt in range(retries + 1):
             with self._cond:
                 seen = len(self.view.acks)
@@ -349,11 +356,23 @@ class Link:
             return acks[-1]
         return None
 
-    def set_mode(self, nav_state: int) -> Ack | None:
+    def set_mode(self, nav_state: int, target: tuple[int, int] | None = None) -> Ack | None:
         custom = nav_state_to_custom_mode(nav_state)
         main, sub = (custom >> 16) & 0xFF, (custom >> 24) & 0xFF
         return self.command(
-            MAV_CMD_DO_SET_MODE, mavlink.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED, main, sub
+            MAV_CMD_DO_SET_MODE,
+            mavlink.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED,
+            main,
+            sub,
+            target=target,
+            retries=0 if target is not None else 2,
+            timeout=0.5 if target is not None else 1.5,
+        )
+
+    def set_custom_mode(self, main: int, sub: int) -> Ack | None:
+        """DO_SET_MODE with a main and sub mode as given (a mode PX4 may not have)."""
+        return self.command(
+            MAV_CMD_DO_SET_MODE, mavlink.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED, main, sub, retries=0
         )
 
     def arm(self, arm: bool = True) -> Ack | None:

@@ -19,11 +19,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from fuzzoff.mavlink_ids import MAV_AUTOPILOT_PX4
 from fuzzoff.modes import nav_state_name
 from fuzzoff.recording import SourceError
 from fuzzoff.sitl.link import Link, LinkError, open_tlog
 
-MAV_AUTOPILOT_PX4 = 12
 NAV_OFFBOARD = 14
 SKIPPED = frozenset({"HEARTBEAT", "TIMESYNC", "SYSTEM_TIME"})
 """Link housekeeping of the recorded client: the live client sends its own."""

@@ -12,8 +12,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Literal
 
+from fuzzoff.mavlink_ids import MAV_FRAME_LOCAL_ENU
 from fuzzoff.sitl.driver import (
-    MAV_FRAME_LOCAL_ENU,
     NAV_LOITER,
     NAV_OFFBOARD,
     NAV_TAKEOFF,
@@ -38,6 +38,11 @@ class Scenario:
     manual: bool = False
     """Send a centred MAVLink joystick at 10 Hz throughout (manual control present)."""
     params: dict[str, float] = field(default_factory=dict)
+    shown_in: tuple[str, ...] = (".tlog", ".ulg")
+    """The recordings that can show the hazard: a ULog holds no command PX4's receiver dropped."""
+    hazard_until: tuple[int, int] | None = None
+    """The first PX4 release (major, minor) that does what the program means: there the run is
+    context (a client relying on that release), not a hazard."""
 
 
 def _offboard_takeoff(d: Driver, z: float = ALT, climb_s: float = 6.0) -> None:
@@ -165,6 +170,29 @@ def frozen_velocity(d: Driver) -> None:
     d.land_and_wait()
 
 
+def switch_to_broadcast(d: Driver) -> None:
+    """The documented sequence, but the switch goes to system 0, component 0 (a script that
+    sends before it has heard PX4's HEARTBEAT): only 1.18 and later take it."""
+    d.stream(d.position(0, 0, ALT), 1.5)
+    d.set_mode(NAV_OFFBOARD, "OFFBOARD", target=(0, 0))
+    d.stream(d.position(0, 0, ALT), 0.5)
+    ack = d.arm()
+    if ack is None or ack.result != 0:
+        d.stream(d.position(0, 0, ALT), 1.0)
+        return
+    d.stream(d.position(0, 0, ALT), 5.0)
+    d.land_and_wait()
+
+
+def hold_with_unknown_sub_mode(d: Driver) -> None:
+    """Offboard flight, then a "hold" sent as AUTO with sub-mode 42, which no PX4 has: the
+    vehicle stays in OFFBOARD (1.16 and 1.17 first ack it ACCEPTED), the stream goes on."""
+    _offboard_takeoff(d)
+    d.set_custom_mode(4, 42, "a hold that does not exist")
+    d.stream(d.position(0, 0, ALT), 3.0)
+    d.land_and_wait()
+
+
 SCENARIOS: dict[str, Scenario] = {
     s.name: s
     for s in (
@@ -271,6 +299,24 @@ SCENARIOS: dict[str, Scenario] = {
             "a motion command frozen for 20 s",
             ("OFB107",),
         ),
+        Scenario(
+            "switch_to_broadcast",
+            "stream, DO_SET_MODE OFFBOARD to system 0 component 0, arm: offboard from 1.18 only",
+            switch_to_broadcast,
+            "hazard",
+            "a switch PX4 does not take (up to 1.17): the vehicle arms in Hold, never offboard",
+            ("OFB204",),
+            shown_in=(".tlog",),
+            hazard_until=(1, 18),
+        ),
+        Scenario(
+            "hold_with_unknown_sub_mode",
+            "offboard flight, then DO_SET_MODE AUTO sub-mode 42 (no such mode) as a hold, land",
+            hold_with_unknown_sub_mode,
+            "hazard",
+            "a mode request PX4 cannot honour: the vehicle stays in OFFBOARD",
+            ("OFB205",),
+        ),
     )
 }
 
@@ -290,6 +336,7 @@ RELEASE_DEPENDENT = (
     "disarm_in_flight",
     "acceleration_only",
     "one_setpoint_then_switch",
+    "switch_to_broadcast",
 )
 
 

@@ -18,11 +18,11 @@ Judged, item by item:
 
 from __future__ import annotations
 
-import argparse
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from fuzzoff.config import load_settings
 from fuzzoff.modes import custom_mode_to_nav_state, nav_state_name
 from fuzzoff.sitl.truth import Mode, Truth, read_tlog, read_truth
 
@@ -94,12 +94,13 @@ def model_rows(
     tlog: Path, release: str, params: dict[str, float]
 ) -> tuple[list[dict[str, Any]], list[str]]:
     """The gate model's timeline for the autopilot in ``tlog`` (``fuzzoff gate``'s rows)."""
-    from fuzzoff.commands.gate import gate_report
+    from fuzzoff.gate_timeline import gate_report
 
-    args = argparse.Namespace(
-        px4=release, vehicle="mc", param=[f"{k}={v}" for k, v in params.items()]
-    )
-    report, rows = gate_report(str(tlog), args, controllers=False)
+    overrides: dict[str, Any] = {"px4": release, "vehicle": "mc"}
+    if params:  # as `fuzzoff gate --px4 RELEASE --vehicle mc --param NAME=VALUE...` has them
+        overrides["params"] = {name.upper(): float(value) for name, value in params.items()}
+    settings = load_settings(Path.cwd(), overrides, per_recording=True)
+    report, rows = gate_report(str(tlog), settings, controllers=False)
     vehicles = [v for v in rows if v != ""] or list(rows)
     mine = rows[vehicles[0]] if vehicles else []
     return [r for r in mine if r["source"] == "model"], list(report.problems)
@@ -145,7 +146,9 @@ def _model_decision(
 
 
 def _model_accepts(row: dict[str, Any]) -> bool:
-    return row["what"] in ("request_accepted", "arm_accepted", "mode", "disarmed")
+    if row["what"] == "mode":  # a switch to another mode: refused where it gives a reason
+        return not row.get("reason")
+    return row["what"] in ("request_accepted", "arm_accepted", "disarmed")
 
 
 def compare(

@@ -53,8 +53,37 @@ def test_4_1_unsupported_main_mode(px4: str, rejected: bool) -> None:
     """4.1: an unknown custom main mode: 1.18 and main reject it; 1.14-1.17 ack it with no
     change."""
     trs = run(px4, [status(0.0, POSCTL, True, POSCTL), switch_mode(1.0, 42)])
-    assert any("unsupported main mode" in (t.message or "") for t in trs)
+    assert any("no such mode" in (t.message or "") for t in trs)
     assert any("rejected" in t.message for t in trs) is rejected
+
+
+@pytest.mark.parametrize("px4", ["1.14", "1.16", "1.17", "1.18", "main"])
+def test_4_1_auto_with_sub_mode_0_is_mission(px4: str) -> None:
+    """4.1 (Commander's AUTO branch; seen on 1.16.2-main SITL): AUTO with sub-mode 0 asks for
+    Mission on every release, not for a mode PX4 lacks."""
+    trs = run(px4, [status(0.0, POSCTL, True, POSCTL), switch_mode(1.0, 4, 0)])
+    (switch,) = [t for t in trs if t.t == 1.0 and t.what == "mode"]
+    assert "AUTO_MISSION" in switch.message and switch.nav_state == 3
+
+
+@pytest.mark.parametrize("px4", ["1.14", "1.16", "1.17", "1.18", "main"])
+def test_4_1_an_unknown_auto_sub_mode_is_refused_everywhere(px4: str) -> None:
+    """4.1: an AUTO sub-mode Commander does not know is denied on every release (1.16/1.17
+    after the receiver's own ACCEPTED), unlike an unknown main mode."""
+    trs = run(px4, [status(0.0, POSCTL, True, POSCTL), switch_mode(1.0, 4, 42)])
+    (switch,) = [t for t in trs if t.t == 1.0]
+    assert "rejected" in switch.message and "AUTO sub-mode 42" in switch.message
+    assert switch.nav_state == POSCTL
+
+
+@pytest.mark.parametrize(("px4", "exists"), [("1.16", False), ("1.17", True), ("main", True)])
+def test_4_1_altitude_cruise_exists_from_1_17(px4: str, exists: bool) -> None:
+    """4.1: main mode 11 is ALTITUDE_CRUISE (nav_state 8) from 1.17.0 (seen on 1.17.0 SITL);
+    before, an unknown main mode (acked, no change)."""
+    trs = run(px4, [status(0.0, POSCTL, True, POSCTL), switch_mode(1.0, 11)])
+    (switch,) = [t for t in trs if t.t == 1.0]
+    assert (switch.nav_state == 8) is exists
+    assert ("no such mode" in switch.message) is not exists
 
 
 @pytest.mark.parametrize("armed", [True, False])

@@ -48,7 +48,7 @@ from fuzzoff.formats.mavros.frames import (
     yaw_flu_to_frd,
 )
 from fuzzoff.modes import mavros_mode_to_nav_state
-from fuzzoff.recording import POSITION_PERIOD_S
+from fuzzoff.recording import POSITION_PERIOD_S, Aside
 from fuzzoff.type_mask import (
     ACCELERATION_BITS,
     ATTITUDE_IGNORE,
@@ -214,8 +214,9 @@ class MavrosConverter:
 
     options: MavrosOptions = field(default_factory=MavrosOptions)
     position_period_s: float = POSITION_PERIOD_S
-    """``local_position/pose`` kept at most this often per vehicle (0: every one, the HTML
-    report's plots)."""
+    """``local_position/pose`` kept at most this often per vehicle (0: every one)."""
+    aside: Aside = field(default_factory=Aside)
+    """Where the thinned positions go (their time; the plots, when asked)."""
     _position_due: dict[str, float] = field(default_factory=dict)
     _body: dict[str, _Pending] = field(default_factory=dict)
     _thrust: dict[str, _Pending] = field(default_factory=dict)
@@ -291,8 +292,15 @@ class MavrosConverter:
         period = self.position_period_s
         if period:
             if t < self._position_due.get(ns, -math.inf):
+                self.aside.read(t)
+                if self.aside.plot is not None:
+                    self.aside.plot.position(self._position_event(msg, t, ns, where))
                 return None
             self._position_due[ns] = t + period - 1e-3
+        return self._position_event(msg, t, ns, where)
+
+    @staticmethod
+    def _position_event(msg: Any, t: float, ns: str, where: Where) -> VehiclePosition:
         x, y, z = enu_to_ned(_vec(msg.pose.position))
         return VehiclePosition(
             t=t,

@@ -1,28 +1,21 @@
-"""ROS 2 MCAP files: reader, damage checks, indexed and streaming paths, time order, writer."""
+"""ROS 2 MCAP files: detection, reader and writer (the reading core, shared with ``rosbag2``, is
+``formats/ros2``: damage checks, indexed and streaming paths, time order)."""
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
 
 from fuzzoff.formats.format import Format
-
-MAGIC = b"\x89MCAP"
+from fuzzoff.formats.ros2 import release_options
+from fuzzoff.formats.ros2.storage import storage_from_head
 
 
 def _detect(path: Path, head: bytes) -> str | None:
-    """An MCAP beside a metadata.yaml is a ROS 2 bag's data file: the rosbag2 entry's."""
-    if head.startswith(MAGIC) and not path.parent.joinpath("metadata.yaml").is_file():
+    """An MCAP, whatever its name; one beside a metadata.yaml is a ROS 2 bag's data file: the
+    rosbag2 entry's."""
+    if storage_from_head(head) == "mcap" and not path.parent.joinpath("metadata.yaml").is_file():
         return "mcap"
     return None
-
-
-def release_options(px4: str | None) -> Mapping[str, Any]:
-    """The px4_msgs definitions a ROS 2 recording of ``px4`` embeds (``main`` when unknown)."""
-    from fuzzoff.formats.px4_msgs import release_for
-
-    return {"release": release_for(px4) or "main"}
 
 
 FORMAT = Format(

@@ -19,7 +19,7 @@ from rosbags.serde import SerdeError
 from rosbags.typesys import get_types_from_idl, get_types_from_msg
 from rosbags.typesys.store import Typestore
 
-from fuzzoff.events import NOWHERE, Event, Origin, VehicleStatus, Where
+from fuzzoff.events import NOWHERE, Event, Origin, VehiclePosition, VehicleStatus, Where
 from fuzzoff.formats import px4_msgs
 from fuzzoff.formats.mavros.convert import MavrosConverter, mavros_topic
 from fuzzoff.formats.mavros.ros2 import MavrosTopicDecoder
@@ -27,7 +27,7 @@ from fuzzoff.formats.ros2msgs.convert import BUILDERS, KIND_OF, Builder
 from fuzzoff.formats.ros2msgs.topics import MESSAGE_FOR_NAME, OUTPUT_MESSAGES, TopicRef, parse_topic
 from fuzzoff.formats.typedefs import bounded
 from fuzzoff.profiles import PX4_VEHICLE_TYPE
-from fuzzoff.recording import SourceProblem
+from fuzzoff.recording import Aside, SourceProblem
 
 _DECODE_ERRORS = (struct.error, IndexError, ValueError, TypeError, UnicodeDecodeError, SerdeError)
 """What rosbags' CDR decoders raise on a payload that does not fit its definition (a length
@@ -137,6 +137,13 @@ def message_of(topic: str, msgtype: str) -> tuple[str | None, TopicRef | None]:
     if ref is not None and ref.name in MESSAGE_FOR_NAME and not msgtype:
         return MESSAGE_FOR_NAME[ref.name], ref
     return None, ref
+
+
+def px4_topic(topic: str, msgtype: str) -> bool:
+    """A topic fuzzoff reads, or must say it could not: a PX4 message type, or the name of a
+    PX4 topic it decodes whatever type it is recorded as."""
+    message, ref = message_of(topic, msgtype)
+    return message is not None or (ref is not None and ref.name in MESSAGE_FOR_NAME)
 
 
 @dataclass(slots=True)
@@ -249,9 +256,29 @@ class ThinnedTopicDecoder(TopicDecoder):
     def event(self, raw: bytes | memoryview, t: float) -> Event | None:
         if t < self.due:
             self.index += 1
+            aside = self.owner.aside
+            aside.read(t)
+            if aside.plot is not None:
+                event = self._plotted(raw, t)
+                if isinstance(event, VehiclePosition):
+                    aside.plot.position(event)
             return None
         self.due = (t // self.period_s + 1) * self.period_s
         return TopicDecoder.event(self, raw, t)
+
+    def _plotted(self, raw: bytes | memoryview, t: float) -> Event | None:
+        """The event of a thinned message, for the plots only: nothing is counted or chosen
+        (a message that needs either is left out of the plot)."""
+        build, definition = self.builder, self.definition
+        if build is None or definition is None:
+            return None
+        message, why = definition.decode(raw)
+        if why is not None:
+            return None
+        try:
+            return build(message, t, Where(self.topic, self.index - 1), message.timestamp)
+        except AttributeError:
+            return None
 
 
 @dataclass(slots=True)
@@ -265,6 +292,9 @@ class Ros2Decoding:
     decoders: list[Decoder] = field(default_factory=list)
     mavros: MavrosConverter = field(default_factory=MavrosConverter)
     unknown: list[tuple[str, str]] = field(default_factory=list)
+    """PX4 topics recorded as a type fuzzoff cannot decode (name, type)."""
+    unread: dict[tuple[str, str], int] = field(default_factory=dict)
+    """How many messages of each of ``unknown`` the recording holds, where the reader counted."""
     evidence: set[str] | None = None
     """Releases every definition seen so far fits (for profile detection)."""
     topic_fits: dict[str, set[str]] = field(default_factory=dict)
@@ -277,11 +307,15 @@ class Ros2Decoding:
     notes: list[str] = field(default_factory=list)
     position_period_s: float = 0.0
     """``VehicleLocalPosition`` read at most this often per topic (0: every message)."""
+    aside: Aside = field(default_factory=Aside)
+    """Where thinned positions go (their time; the plots, when asked)."""
 
-    def thin_positions(self, period_s: float) -> None:
-        """Read the vehicle's position at most once per ``period_s`` (MAVROS's too)."""
+    def thin_positions(self, period_s: float, aside: Aside) -> None:
+        """Read the vehicle's position at most once per ``period_s`` (MAVROS's too); the
+        others go to ``aside``."""
         self.position_period_s = period_s
         self.mavros.position_period_s = period_s
+        self.aside = self.mavros.aside = aside
 
     def connection(
         self, topic: str, msgtype: str, embedded: str | None, fmt: str = "msg"
@@ -489,13 +523,22 @@ class Ros2Decoding:
     def vehicles(self) -> list[str]:
         return sorted({d.vehicle for d in self.decoders})
 
+    def count_unread(self, topic: str, msgtype: str, messages: int) -> None:
+        """``messages`` more messages of an ``unknown`` topic were not read."""
+        key = (topic, msgtype)
+        self.unread[key] = self.unread.get(key, 0) + messages
+
     def problems(self) -> list[SourceProblem]:
         out = []
         for topic, msgtype in self.unknown:
+            held = self.unread.get((topic, msgtype))
+            unread = f"its {held} messages were not read" if held is not None else "not read"
+            if held == 1:
+                unread = "its 1 message was not read"
             out.append(
                 SourceProblem(
                     f"topic {topic} has message type {msgtype or '(none)'}, which fuzzoff "
-                    "cannot decode as a PX4 topic; not read",
+                    f"cannot decode as a PX4 topic: {unread}",
                     topic,
                 )
             )

@@ -253,7 +253,7 @@ class Rosbag1Source(Source):
 
         ``start_ns[0]`` is the recording's first time (set by the salvage once it has read it).
         """
-        converter = MavrosConverter(position_period_s=0.0 if self.plot_data else POSITION_PERIOD_S)
+        converter = MavrosConverter(position_period_s=POSITION_PERIOD_S, aside=self.aside)
         handlers: dict[int, tuple[Handler | None, Callable[[bytes], Any]]] = {}
         counts: dict[int, int] = {}
         first_bad: SourceProblem | None = None

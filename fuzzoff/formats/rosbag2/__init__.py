@@ -7,19 +7,18 @@ import re
 from pathlib import Path
 
 from fuzzoff.formats.format import Format
-from fuzzoff.formats.mcap import MAGIC as MCAP_MAGIC
-from fuzzoff.formats.mcap import release_options
+from fuzzoff.formats.ros2 import release_options
+from fuzzoff.formats.ros2.storage import data_files, storage_from_head, storage_of
 from fuzzoff.recording import SourceError
-
-SQLITE_MAGIC = b"SQLite format 3\x00"
-DATA_SUFFIXES = (".db3", ".mcap")
 
 
 def _detect(path: Path, head: bytes) -> str | None:
-    """A ``.db3`` given on its own, or an MCAP beside a metadata.yaml (a bag's data file)."""
-    if head.startswith(SQLITE_MAGIC):
+    """A SQLite database given on its own, or an MCAP beside a metadata.yaml (a bag's data
+    file), whatever their names."""
+    storage = storage_from_head(head)
+    if storage == "sqlite3":
         return "rosbag2-sqlite3"
-    if head.startswith(MCAP_MAGIC) and path.parent.joinpath("metadata.yaml").is_file():
+    if storage == "mcap" and path.parent.joinpath("metadata.yaml").is_file():
         return "rosbag2-mcap"
     return None
 
@@ -27,21 +26,21 @@ def _detect(path: Path, head: bytes) -> str | None:
 def detect_folder(path: Path) -> str:
     """The storage of a bag folder: its data files say it (metadata.yaml may be missing, cut
     short or another bag's); metadata.yaml only where they do not (file-compressed data)."""
-    suffixes = {p.suffix for p in path.iterdir() if p.suffix in DATA_SUFFIXES}
-    if suffixes == {".mcap"}:
+    storages = {storage_of(p) for p in data_files(path)}
+    if storages == {"mcap"}:
         return "rosbag2-mcap"
-    if suffixes == {".db3"}:
+    if storages == {"sqlite3"}:
         return "rosbag2-sqlite3"
     meta = path / "metadata.yaml"
     if meta.is_file():
         text = meta.read_text(errors="replace")
         return "rosbag2-mcap" if "storage_identifier: mcap" in text else "rosbag2-sqlite3"
-    if suffixes:
+    if storages:
         return "rosbag2-sqlite3"
     raise SourceError(path, "a folder without metadata.yaml or .db3/.mcap files is not a ROS 2 bag")
 
 
-_BAG_PART = re.compile(r"^(?P<stem>.+)_(?P<n>\d+)\.(?:db3|mcap)$")
+_BAG_PART = re.compile(r"^(?P<stem>.+)_(?P<n>\d+)\.(?:db3|mcap)(?:\.active)?$", re.IGNORECASE)
 
 
 def is_bag_folder(path: Path, suffixes: tuple[str, ...]) -> bool:
@@ -55,7 +54,7 @@ def _is_bag_without_metadata(path: Path, suffixes: tuple[str, ...]) -> bool:
     """A rosbag2 folder whose metadata.yaml was never written (the recorder crashed): rosbag2
     names its data files ``<folder>_<n>.db3|mcap``. Such a folder is one bag, not one
     recording per file; a folder of independent recordings does not follow that naming."""
-    parts = [p for p in path.iterdir() if p.suffix in suffixes]
+    parts = [p for p in path.iterdir() if p.suffix.lower() in suffixes]
     if not parts:
         return False
     for part in parts:
@@ -75,6 +74,7 @@ FORMAT = Format(
     suffixes=(".db3",),
     written_suffix="",
     transports=("ros2",),
+    is_folder=is_bag_folder,
     detect_folder=detect_folder,
     writer_options=release_options,
 )

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from fuzzoff.formats.mcap import clock as mcap_clock
+from fuzzoff.formats.ros2.clock import mcap_start_s
+from fuzzoff.formats.ros2.storage import storage_of
 
 
 def start_s(path: Path) -> float | None:
@@ -12,6 +13,6 @@ def start_s(path: Path) -> float | None:
 
     folder = path if path.is_dir() else path.parent
     if not (folder / "metadata.yaml").is_file():  # a data file given alone
-        return mcap_clock.start_s(path) if path.suffix.lower() == ".mcap" else None
+        return mcap_start_s(path) if storage_of(path) == "mcap" else None
     with Reader(folder) as reader:
         return reader.start_time / 1e9 if reader.message_count else None

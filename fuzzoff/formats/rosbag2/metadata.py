@@ -18,8 +18,8 @@ from typing import Any
 from mcap.reader import SeekingReader
 from ruamel.yaml import YAML
 
-STORAGES = {"sqlite3": ".db3", "mcap": ".mcap"}
-"""rosbag2's storage plugins and the suffix of their data files."""
+from fuzzoff.formats.ros2.storage import SUFFIX, storage_of
+
 VERSIONS = range(1, 10)
 """metadata.yaml versions rosbag2 has written (Ardent to Rolling)."""
 REQUIRED = (
@@ -68,10 +68,10 @@ def fault(folder: Path, files: list[Path]) -> str | None:
 
 def _storage_fault(info: dict[str, Any], files: list[Path]) -> str | None:
     storage = info["storage_identifier"]
-    kinds = sorted({path.suffix for path in files})
-    if storage not in STORAGES:
+    kinds = sorted({SUFFIX[kind] for path in files if (kind := storage_of(path)) is not None})
+    if storage not in SUFFIX:
         return f"metadata.yaml names the storage {_shown(storage)}, which rosbag2 does not have"
-    if kinds and kinds != [STORAGES[storage]]:
+    if kinds and kinds != [SUFFIX[storage]]:
         held = " and ".join(kinds)
         return f"metadata.yaml names the storage {_shown(storage)}, but the data files are {held}"
     return None
@@ -113,7 +113,7 @@ def data_span(files: list[Path]) -> Span | None:
     database's timestamp index, an MCAP's statistics); None where a file cannot say cheaply."""
     spans = []
     for path in files:
-        span = _sqlite_span(path) if path.suffix == ".db3" else _mcap_span(path)
+        span = _sqlite_span(path) if storage_of(path) == "sqlite3" else _mcap_span(path)
         if span is None:
             return None
         if span[0] <= span[1]:
@@ -186,7 +186,7 @@ def held_messages(files: list[Path], topics: set[tuple[str, str]]) -> int | None
     of the summary that may be what is damaged)."""
     total = 0
     for path in files:
-        held = _sqlite_held(path, topics) if path.suffix == ".db3" else None
+        held = _sqlite_held(path, topics) if storage_of(path) == "sqlite3" else None
         if held is None:
             return None
         total += held

@@ -12,7 +12,8 @@ import shutil
 import sqlite3
 import struct
 import tempfile
-from contextlib import suppress
+from contextlib import closing, suppress
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -70,6 +71,47 @@ def topics(db: sqlite3.Connection) -> list[tuple[int, Any, Any, str | None, str]
         text, fmt = definitions.get(msgtype, (None, "msg"))
         out.append((topic_id, name, msgtype, text, fmt))
     return out
+
+
+@dataclass(frozen=True, slots=True)
+class Rows:
+    """How one database numbers its message rows."""
+
+    held: int
+    """Message rows in the table."""
+    missing: int
+    """Rows absent between the first id and the last: rosbag2 numbers its rows 1, 2, 3...
+    and never deletes one, so a gap is rows deleted or lost."""
+    last_id: int
+
+
+def rows(path: Path) -> Rows | None:
+    """The message table's row count and id bounds, from its b-trees (no scan of the rows);
+    None where the database cannot say (it will not open: the reading says why)."""
+    try:
+        with closing(sqlite3.connect(f"file:{path}?mode=ro", uri=True)) as db:
+            first, last, held = db.execute(
+                "SELECT MIN(id), MAX(id), COUNT(*) FROM messages"
+            ).fetchone()
+    except SQLITE_ERRORS:
+        return None
+    if not (isinstance(first, int) and isinstance(last, int) and first >= 1):
+        return Rows(held, 0, 0)
+    return Rows(held, max(0, last - held), last)
+
+
+def dangling(path: Path) -> dict[Any, int]:
+    """Topic id the topics table lacks -> how many message rows name it (a scan of the rows:
+    asked only when the counts say some rows belong to no topic)."""
+    try:
+        with closing(sqlite3.connect(f"file:{path}?mode=ro", uri=True)) as db:
+            found = db.execute(
+                "SELECT topic_id, COUNT(*) FROM messages WHERE topic_id NOT IN "
+                "(SELECT id FROM topics) GROUP BY topic_id ORDER BY topic_id"
+            ).fetchall()
+    except SQLITE_ERRORS:
+        return {}
+    return {topic_id: int(count) for topic_id, count in found}
 
 
 def readable_copy(path: Path, folder: Path) -> Path:

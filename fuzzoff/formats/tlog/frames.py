@@ -151,6 +151,9 @@ class Framer:
         self.consumed = 0
         self.on_chunk: Callable[[], None] | None = None
         """Called after each chunk read, so a long stretch with no record still shows progress."""
+        self.on_thinned: Callable[[int, Any], None] | None = None
+        """Called with (timestamp µs, decoded message) for each valid packet ``thinned`` left
+        out, for a caller that plots it beside the records (None: not decoded at all)."""
 
     # -- buffer ---------------------------------------------------------------------------
 
@@ -208,6 +211,15 @@ class Framer:
             return False
         self._due_at[key] = (ts // period + 1) * period
         return True
+
+    def _aside(self, buf: bytes, pos: int, end: int, ts: int) -> None:
+        """Decode a thinned packet (its CRC already checked) for ``on_thinned``."""
+        assert self.on_thinned is not None
+        try:
+            msg = self.mav.decode(bytearray(buf[pos + 8 : end]))
+        except (mavlink.MAVError, struct.error, ValueError, TypeError, IndexError):
+            return
+        self.on_thinned(ts, msg)
 
     def _plausible(self, ts: int) -> bool:
         last = self.stats.last_ts
@@ -283,6 +295,8 @@ class Framer:
                 elif not crc_ok(buf, pos, end, msgid):
                     pos, buf, n = self._resync(pos, "bad CRC")
                     continue
+                if msgid in wanted and self.on_thinned is not None:
+                    self._aside(buf, pos, end, ts)
             elif msgid not in _CRC_EXTRA:
                 self._unknown(msgid, pos, ts)
             first = False

@@ -15,9 +15,10 @@ from pathlib import Path
 from typing import Any, BinaryIO
 
 from fuzzoff.events import (
-    MAV_CMD_DO_SET_MODE,
+    NOWHERE,
     Command,
     CommandAck,
+    CommandMessage,
     Event,
     FailsafeFlags,
     LandDetected,
@@ -34,6 +35,17 @@ from fuzzoff.events import (
 )
 from fuzzoff.findings import RecordingStats
 from fuzzoff.formats.tlog.frames import RESYNC_LIMIT, Framer, FrameStats, message_name
+from fuzzoff.mavlink_ids import (
+    MAV_AUTOPILOT_PX4,
+    MAV_CMD_DO_SET_MODE,
+    MAV_COMP_ID_AUTOPILOT1,
+    MAV_LANDED_STATE_ON_GROUND,
+    MAV_LANDED_STATE_UNDEFINED,
+    MAV_MODE_FLAG_CUSTOM_MODE_ENABLED,
+    MAV_MODE_FLAG_SAFETY_ARMED,
+    MAV_SYS_STATUS_SENSOR_RC_RECEIVER,
+    MAV_TYPE_GCS,
+)
 from fuzzoff.modes import custom_mode_to_nav_state, nav_state_name, split_custom_mode
 from fuzzoff.profiles import MAV_TYPE_VEHICLE
 from fuzzoff.recording import (
@@ -96,16 +108,6 @@ KEEPALIVE_IDS = frozenset(
 SENT_STREAM_IDS = KEEPALIVE_IDS | {SET_ACTUATOR_CONTROL_TARGET}
 """Setpoint messages a companion sends: a log holding any of them holds the sent stream."""
 
-MAV_COMP_ID_AUTOPILOT1 = 1
-MAV_AUTOPILOT_PX4 = 12
-MAV_TYPE_GCS = 6
-MAV_MODE_FLAG_CUSTOM_MODE_ENABLED = 1
-MAV_MODE_FLAG_SAFETY_ARMED = 128
-MAV_LANDED_STATE_UNDEFINED = 0
-MAV_LANDED_STATE_ON_GROUND = 1
-MAV_SYS_STATUS_SENSOR_RC_RECEIVER = 1 << 16
-"""SYS_STATUS bit PX4 sets present and healthy while it has manual control (RC or a MAVLink
-joystick: its ``manual_control_signal_lost`` is false)."""
 INT_PARAM_TYPES = frozenset({1, 2, 3, 4, 5, 6})
 """MAV_PARAM_TYPE UINT8..INT32: the float's four bytes hold the integer (PX4's encoding)."""
 
@@ -254,11 +256,19 @@ class TlogSource(Source):
         if self._fatal:
             return  # the probe already raised the one SourceError for this file
         self.probe()
-        thinned = None if self.plot_data else THINNED
-        framer = Framer(self._file(), self._size, WANTED, verify=True, thinned=thinned)
+        framer = Framer(self._file(), self._size, WANTED, verify=True, thinned=THINNED)
         self._framer = framer
         framer.on_chunk = self.on_progress
         decoder = _Decoder(self._autopilots, self._vehicles())
+        plot = self.aside.plot
+        if plot is not None:
+
+            def aside(ts: int, msg: Any) -> None:
+                first = framer.stats.first_ts or ts
+                if decoder.from_autopilot(msg):
+                    plot.position(_position_event(msg, (ts - first) / 1e6))
+
+            framer.on_thinned = aside
         first_ts: int | None = None
         try:
             for offset, ts, msgid, msg in framer.records():
@@ -268,6 +278,9 @@ class TlogSource(Source):
                 t = (ts - first_ts) / 1e6
                 yield from decoder.decode(msgid, msg, t, offset)
         finally:
+            last_ts = framer.stats.last_ts
+            if first_ts is not None and last_ts is not None:  # every packet, event or not
+                self.aside.read((last_ts - first_ts) / 1e6)
             self._report(framer.stats, first_ts)
             self.stats.update(self._stats(framer.stats, decoder))
 
@@ -391,6 +404,10 @@ class _Decoder:
         self.ignored[key] = self.ignored.get(key, 0) + 1
         return ()
 
+    def from_autopilot(self, msg: Any) -> bool:
+        """Is ``msg`` from a vehicle's autopilot (whose messages become events)?"""
+        return self._from_autopilot(msg)
+
     def _from_autopilot(self, msg: Any) -> bool:
         compid = msg.get_srcComponent()
         return compid == MAV_COMP_ID_AUTOPILOT1 or (msg.get_srcSystem(), compid) in self.autopilots
@@ -510,6 +527,7 @@ class _Decoder:
         command: int,
         params: tuple[float, float, float, float, float, float, float],
         target_component: int,
+        message: CommandMessage,
     ) -> Iterable[Event]:
         if self._from_autopilot(m):
             return self._ignore(m, "from the autopilot")
@@ -525,23 +543,24 @@ class _Decoder:
                 source_system=m.get_srcSystem(),
                 source_component=m.get_srcComponent(),
                 from_external=True,
+                message=message,
             )
             for v in self._targets(m.target_system)
         ]
 
     def _command_long(self, m: Any, t: float, where: Where) -> Iterable[Event]:
         params = (m.param1, m.param2, m.param3, m.param4, m.param5, m.param6, m.param7)
-        return self._command(m, t, where, m.command, params, m.target_component)
+        return self._command(m, t, where, m.command, params, m.target_component, "COMMAND_LONG")
 
     def _command_int(self, m: Any, t: float, where: Where) -> Iterable[Event]:
         params = (m.param1, m.param2, m.param3, m.param4, float(m.x), float(m.y), m.z)
-        return self._command(m, t, where, m.command, params, m.target_component)
+        return self._command(m, t, where, m.command, params, m.target_component, "COMMAND_INT")
 
     def _set_mode(self, m: Any, t: float, where: Where) -> Iterable[Event]:
         """SET_MODE (#11, MAVROS set_mode) -> DO_SET_MODE as PX4 handles it."""
         main, sub = split_custom_mode(m.custom_mode)
         params = (float(m.base_mode), float(main), float(sub), 0.0, 0.0, 0.0, 0.0)
-        return self._command(m, t, where, MAV_CMD_DO_SET_MODE, params, 0)
+        return self._command(m, t, where, MAV_CMD_DO_SET_MODE, params, 0, "SET_MODE")
 
     # -- from the vehicle -----------------------------------------------------------------
 
@@ -661,8 +680,7 @@ class _Decoder:
     def _position(self, m: Any, t: float, where: Where) -> Iterable[Event]:
         if not self._from_autopilot(m):
             return self._ignore(m, "not from an autopilot")
-        vehicle = str(m.get_srcSystem())
-        return (VehiclePosition(t=t, vehicle=vehicle, where=where, x=m.x, y=m.y, z=m.z),)
+        return (_position_event(m, t, where),)
 
     def _extended_sys_state(self, m: Any, t: float, where: Where) -> Iterable[Event]:
         """PX4's ``landed_state``: ON_GROUND while its land detector says landed; IN_AIR,
@@ -690,3 +708,8 @@ class _Decoder:
             text=_text(m.text),
         )
         return (text,)
+
+
+def _position_event(m: Any, t: float, where: Where = NOWHERE) -> VehiclePosition:
+    """LOCAL_POSITION_NED as the vehicle's position (NED metres)."""
+    return VehiclePosition(t=t, vehicle=str(m.get_srcSystem()), where=where, x=m.x, y=m.y, z=m.z)

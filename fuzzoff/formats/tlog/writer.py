@@ -49,6 +49,17 @@ from fuzzoff.events import (
     VehiclePosition,
     VehicleStatus,
 )
+from fuzzoff.mavlink_ids import (
+    MAV_AUTOPILOT_INVALID,
+    MAV_AUTOPILOT_PX4,
+    MAV_MODE_FLAG_CUSTOM_MODE_ENABLED,
+    MAV_MODE_FLAG_SAFETY_ARMED,
+    MAV_PARAM_TYPE_INT32,
+    MAV_PARAM_TYPE_REAL32,
+    MAV_STATE_ACTIVE,
+    MAV_TYPE_GCS,
+    MAV_TYPE_QUADROTOR,
+)
 from fuzzoff.modes import nav_state_to_custom_mode
 
 Sender = tuple[int, int]
@@ -56,15 +67,6 @@ Sender = tuple[int, int]
 DEFAULT_START_US = 1_735_689_600_000_000
 """2025-01-01 00:00:00 UTC: the wall clock of the first record."""
 
-MAV_AUTOPILOT_PX4 = 12
-MAV_TYPE_GCS = 6
-MAV_AUTOPILOT_INVALID = 8
-MAV_TYPE_QUADROTOR = 2
-MAV_MODE_FLAG_CUSTOM_MODE_ENABLED = 1
-MAV_MODE_FLAG_SAFETY_ARMED = 128
-MAV_STATE_ACTIVE = 4
-MAV_PARAM_TYPE_INT32 = 6
-MAV_PARAM_TYPE_REAL32 = 9
 FIRMWARE_VERSION_TYPE_OFFICIAL = 255
 
 FLOAT_PARAMS = frozenset({"COM_OF_LOSS_T", "COM_OBC_LOSS_T", "COM_RC_LOSS_T", "COM_DL_LOSS_T"})
@@ -120,6 +122,31 @@ def _param_bytes(name: str, value: float) -> tuple[float, int]:
         (as_float,) = struct.unpack("<f", struct.pack("<i", int(value)))
         return as_float, MAV_PARAM_TYPE_INT32
     return float(value), MAV_PARAM_TYPE_REAL32
+
+
+def _command_message(event: Command) -> Any:
+    """The MAVLink message ``event.message`` names (COMMAND_LONG when it names none)."""
+    p = event.params
+    if event.message == "SET_MODE":  # DO_SET_MODE's base mode, main and sub mode
+        base, main, sub = (int(v) for v in p[:3])
+        custom = (main & 0xFF) << 16 | (sub & 0xFF) << 24
+        return mavlink.MAVLink_set_mode_message(event.target_system, base, custom)
+    if event.message == "COMMAND_INT":
+        return mavlink.MAVLink_command_int_message(
+            event.target_system,
+            event.target_component,
+            0,  # frame: MAV_FRAME_GLOBAL, unused by mode and arming commands
+            event.command,
+            0,
+            0,
+            *p[:4],
+            int(p[4]),
+            int(p[5]),
+            p[6],
+        )
+    return mavlink.MAVLink_command_long_message(
+        event.target_system, event.target_component, event.command, 0, *p
+    )
 
 
 class _Writer:
@@ -231,10 +258,7 @@ class _Writer:
             )
             return [self.link(self.sender_of(event)).pack(msg)]
         if isinstance(event, Command):
-            p = event.params
-            msg = mavlink.MAVLink_command_long_message(
-                event.target_system, event.target_component, event.command, 0, *p
-            )
+            msg = _command_message(event)
             return [self.link(self.sender_of(event)).pack(msg)]
         if isinstance(event, VehicleStatus):
             self.last_status[self.vehicle_sysid(event)] = event

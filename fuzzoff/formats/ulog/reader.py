@@ -43,8 +43,9 @@ from fuzzoff.recording import (
     SourceProblem,
 )
 
-LOADED_TOPICS: tuple[str, ...] = (*TOPICS, *EXTRA_TOPICS)
-PLOT_LOADED_TOPICS: tuple[str, ...] = (*LOADED_TOPICS, *GPS_TOPICS)
+LOADED_TOPICS: tuple[str, ...] = (*TOPICS, *EXTRA_TOPICS, *GPS_TOPICS)
+"""The topics read; the GPS ones only date the log (``start_time_s``), none of their rows is
+an event or counted as a message."""
 CHUNK_ROWS = 4096
 """Rows turned into Python values at a time (bounds memory on long logs)."""
 
@@ -150,8 +151,7 @@ class UlogSource(Source):
             raise self._failed
         if self._loaded is None:
             try:
-                topics = PLOT_LOADED_TOPICS if self.plot_data else LOADED_TOPICS
-                self._loaded = load(self.path, topics)
+                self._loaded = load(self.path, LOADED_TOPICS)
             except SourceError as exc:
                 self._failed = exc
                 raise
@@ -180,7 +180,9 @@ class UlogSource(Source):
         datasets = self._datasets()
         status = next((d for d in datasets if d.name == "vehicle_status"), None)
         self._identity(ulog, info, status)
-        info.message_count = sum(len(d.data["timestamp"]) for d in datasets)
+        info.message_count = sum(
+            len(d.data["timestamp"]) for d in datasets if d.name not in GPS_TOPICS
+        )
         for d in datasets:
             spec = TOPICS.get(d.name)
             if spec is None:
@@ -255,8 +257,8 @@ class UlogSource(Source):
         ranks = {name: rank for rank, name in enumerate(specs, start=10)}
         topics: list[_Stream] = []
         datasets = self._datasets()
-        if self.plot_data:
-            self.set_start(_utc_start(datasets, t0))
+        self.set_start(_utc_start(datasets, t0))
+        self.aside.read((int(ulog.last_timestamp) - t0) / 1e6)  # the last row, event or not
         for d in datasets:
             spec = specs.get(d.name)
             if spec is None:
@@ -264,8 +266,11 @@ class UlogSource(Source):
             rank = ranks[d.name] * 256 + d.multi_id
             topic = d.name if d.multi_id == 0 else f"{d.name}_{d.multi_id}"
             keep = None
-            if spec.kind == ev.VehiclePosition.kind and not self.plot_data:
+            if spec.kind == ev.VehiclePosition.kind:
                 keep = _one_per_period(d.data["timestamp"], POSITION_PERIOD_S)
+                if self.aside.plot is not None:
+                    others = _others(keep, len(d.data["timestamp"]))
+                    self._plot(_stream(d.data, topic, rank, t0, spec.decode, context, others))
             topics.append(_stream(d.data, topic, rank, t0, spec.decode, context, keep))
         legacy = _legacy_flags(datasets)
         if legacy is not None:
@@ -279,6 +284,13 @@ class UlogSource(Source):
             # A layout no release has (a damaged format record that still parsed).
             where = f"the event after the first {self._yielded}"
             raise SourceError(self.path, f"cannot decode the data ({exc!r})", where) from None
+
+    def _plot(self, thinned: _Stream) -> None:
+        """Hand the positions thinned out of the events to the plots (``aside.plot``)."""
+        assert self.aside.plot is not None
+        for event in thinned.events:
+            if isinstance(event, ev.VehiclePosition):
+                self.aside.plot.position(event)
 
     def _merge(self, streams: list[_Stream]) -> Iterator[ev.Event]:
         """The streams' events by (time, rank, index), as ``heapq.merge`` of the keyed streams.
@@ -614,3 +626,8 @@ def _chunks(
         decode(Chunk(cols, sel, topic, t0), context)  # one event per row
         for sel in selections
     )
+
+
+def _others(rows: Any, n: int) -> Any:
+    """The rows of a topic of ``n`` rows that are not in ``rows``."""
+    return np.setdiff1d(np.arange(n), rows, assume_unique=True)

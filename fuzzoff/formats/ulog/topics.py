@@ -1,5 +1,9 @@
 """uORB topics in a ULog -> normalised events, one decoder per topic (formats.md 2.2, 8.1).
 
+A topic whose event is plain copies of its columns is one line of ``DECODERS`` (``copied``:
+event field -> column); a decoder of its own is written only where a release spells a field
+otherwise, a value is computed from several columns, or the context is needed.
+
 A decoder sees a ``Chunk``: a slice of a topic's numpy columns (as pyulog returns them) turned
 into Python lists, and yields events. Field layouts differ between releases; decoders go by
 field names, so one decoder reads every release's layout (``ignore_*`` and boolean control
@@ -250,69 +254,44 @@ def rates(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
         )
 
 
-def thrust(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
-    for t, w, ts, xyz in zip(c.t, c.where, c.ts, c.vec("xyz", 3), strict=True):
-        yield ev.ThrustSetpoint(t=t, where=w, sender_time_us=ts, origin=VEHICLE, xyz=xyz)
+Column = Callable[[Chunk], Iterable[Any]]
+"""One event field's values for a chunk's rows, read from the topic's columns."""
 
 
-def torque(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
-    for t, w, ts, xyz in zip(c.t, c.where, c.ts, c.vec("xyz", 3), strict=True):
-        yield ev.TorqueSetpoint(t=t, where=w, sender_time_us=ts, origin=VEHICLE, xyz=xyz)
+def floats(name: str) -> Column:
+    return lambda c: c.f(name)
 
 
-def motors(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
-    control = c.vec("control", c.width("control"))
-    for t, w, ts, values, flags in zip(
-        c.t, c.where, c.ts, control, c.i("reversible_flags"), strict=True
-    ):
-        yield ev.ActuatorMotors(
-            t=t, where=w, sender_time_us=ts, origin=VEHICLE, control=values, reversible_flags=flags
-        )
+def ints(name: str) -> Column:
+    return lambda c: c.i(name)
 
 
-def servos(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
-    for t, w, ts, values in zip(
-        c.t, c.where, c.ts, c.vec("control", c.width("control")), strict=True
-    ):
-        yield ev.ActuatorServos(t=t, where=w, sender_time_us=ts, origin=VEHICLE, control=values)
+def bools(name: str) -> Column:
+    return lambda c: c.b(name)
 
 
-def rover_position(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
-    for t, w, ts, pos, start, cruise, arrival, yaw in zip(
-        c.t,
-        c.where,
-        c.ts,
-        c.vec("position_ned", 2),
-        c.vec("start_ned", 2),
-        c.f("cruising_speed"),
-        c.f("arrival_speed"),
-        c.f("yaw"),
-        strict=True,
-    ):
-        yield ev.RoverPositionSetpoint(
-            t=t,
-            where=w,
-            sender_time_us=ts,
-            origin=VEHICLE,
-            position_ned=pos,
-            start_ned=start,
-            cruising_speed=cruise,
-            arrival_speed=arrival,
-            yaw=yaw,
-        )
+def vector(name: str, size: int) -> Column:
+    """``name[0..size)`` as tuples."""
+    return lambda c: c.vec(name, size)
 
 
-def _plain(cls: type[ev.Event], names: tuple[str, ...]) -> Decoder:
+def array(name: str) -> Column:
+    """``name[...]`` as tuples as long as the layout's array."""
+    return lambda c: c.vec(name, c.width(name))
+
+
+def copied(cls: type[ev.Event], **fields: Column) -> Decoder:
+    """The decoder of a topic whose event is plain copies of its columns: event field ->
+    where its values come from. A topic whose fields need more (another release's
+    spelling, values computed from several columns, the context) has a decoder of its own."""
+    names = tuple(fields)
+    columns = tuple(fields.values())
+
     def decode(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
-        columns = [c.f(name) for name in names]
-        for t, w, ts, *values in zip(c.t, c.where, c.ts, *columns, strict=True):
-            yield cls(
-                t=t,
-                where=w,
-                sender_time_us=ts,
-                origin=VEHICLE,
-                **dict(zip(names, values, strict=True)),
-            )
+        rows = zip(*(column(c) for column in columns), strict=True)
+        fields = map(dict, map(zip, repeat(names), rows))  # each row's fields, made in C
+        for t, w, ts, row in zip(c.t, c.where, c.ts, fields, strict=True):
+            yield cls(t=t, where=w, sender_time_us=ts, origin=VEHICLE, **row)
 
     return decode
 
@@ -333,35 +312,6 @@ def steering(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
             origin=VEHICLE,
             normalized_steering_angle=angle,
             normalized_speed_diff=diff,
-        )
-
-
-def triplet(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
-    for t, w, ts, prev, cur, nxt, kind, pos, vel, yaw in zip(
-        c.t,
-        c.where,
-        c.ts,
-        c.b("previous.valid"),
-        c.b("current.valid"),
-        c.b("next.valid"),
-        c.i("current.type"),
-        c.b("current.position_valid"),
-        c.b("current.velocity_valid"),
-        c.b("current.yaw_valid"),
-        strict=True,
-    ):
-        yield ev.PositionSetpointTriplet(
-            t=t,
-            where=w,
-            sender_time_us=ts,
-            origin=VEHICLE,
-            previous_valid=prev,
-            current_valid=cur,
-            next_valid=nxt,
-            current_type=kind,
-            current_position_valid=pos,
-            current_velocity_valid=vel,
-            current_yaw_valid=yaw,
         )
 
 
@@ -523,29 +473,6 @@ def command(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
         )
 
 
-def ack(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
-    for t, w, ts, cmd, result, tsys, tcomp in zip(
-        c.t,
-        c.where,
-        c.ts,
-        c.i("command"),
-        c.i("result"),
-        c.i("target_system"),
-        c.i("target_component"),
-        strict=True,
-    ):
-        yield ev.CommandAck(
-            t=t,
-            where=w,
-            sender_time_us=ts,
-            origin=VEHICLE,
-            command=cmd,
-            result=result,
-            target_system=tsys,
-            target_component=tcomp,
-        )
-
-
 @dataclass(frozen=True, slots=True)
 class TopicSpec:
     kind: str
@@ -562,20 +489,54 @@ DECODERS: dict[str, Decoder] = {
     "trajectory_setpoint": trajectory,
     "vehicle_attitude_setpoint": attitude,
     "vehicle_rates_setpoint": rates,
-    "vehicle_thrust_setpoint": thrust,
-    "vehicle_torque_setpoint": torque,
-    "actuator_motors": motors,
-    "actuator_servos": servos,
-    "rover_position_setpoint": rover_position,
-    "rover_speed_setpoint": _plain(ev.RoverSpeedSetpoint, ("speed_body_x", "speed_body_y")),
-    "rover_attitude_setpoint": _plain(ev.RoverAttitudeSetpoint, ("yaw_setpoint",)),
-    "rover_rate_setpoint": _plain(ev.RoverRateSetpoint, ("yaw_rate_setpoint",)),
-    "rover_throttle_setpoint": _plain(
-        ev.RoverThrottleSetpoint, ("throttle_body_x", "throttle_body_y")
+    "vehicle_thrust_setpoint": copied(ev.ThrustSetpoint, xyz=vector("xyz", 3)),
+    "vehicle_torque_setpoint": copied(ev.TorqueSetpoint, xyz=vector("xyz", 3)),
+    "actuator_motors": copied(
+        ev.ActuatorMotors, control=array("control"), reversible_flags=ints("reversible_flags")
+    ),
+    "actuator_servos": copied(ev.ActuatorServos, control=array("control")),
+    "rover_position_setpoint": copied(
+        ev.RoverPositionSetpoint,
+        position_ned=vector("position_ned", 2),
+        start_ned=vector("start_ned", 2),
+        cruising_speed=floats("cruising_speed"),
+        arrival_speed=floats("arrival_speed"),
+        yaw=floats("yaw"),
+    ),
+    "rover_speed_setpoint": copied(
+        ev.RoverSpeedSetpoint,
+        speed_body_x=floats("speed_body_x"),
+        speed_body_y=floats("speed_body_y"),
+    ),
+    "rover_attitude_setpoint": copied(
+        ev.RoverAttitudeSetpoint, yaw_setpoint=floats("yaw_setpoint")
+    ),
+    "rover_rate_setpoint": copied(
+        ev.RoverRateSetpoint, yaw_rate_setpoint=floats("yaw_rate_setpoint")
+    ),
+    "rover_throttle_setpoint": copied(
+        ev.RoverThrottleSetpoint,
+        throttle_body_x=floats("throttle_body_x"),
+        throttle_body_y=floats("throttle_body_y"),
     ),
     "rover_steering_setpoint": steering,
-    "position_setpoint_triplet": triplet,
-    "vehicle_command_ack": ack,
+    "position_setpoint_triplet": copied(
+        ev.PositionSetpointTriplet,
+        previous_valid=bools("previous.valid"),
+        current_valid=bools("current.valid"),
+        next_valid=bools("next.valid"),
+        current_type=ints("current.type"),
+        current_position_valid=bools("current.position_valid"),
+        current_velocity_valid=bools("current.velocity_valid"),
+        current_yaw_valid=bools("current.yaw_valid"),
+    ),
+    "vehicle_command_ack": copied(
+        ev.CommandAck,
+        command=ints("command"),
+        result=ints("result"),
+        target_system=ints("target_system"),
+        target_component=ints("target_component"),
+    ),
     "vehicle_status": vehicle_status,
     "vehicle_control_mode": control_mode_status,
     "failsafe_flags": failsafe_flags,

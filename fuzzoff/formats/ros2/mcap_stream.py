@@ -26,7 +26,7 @@ from mcap.stream_reader import (
 )
 
 from fuzzoff.events import Event
-from fuzzoff.formats.mcap.order import ChunkOrder
+from fuzzoff.formats.ros2.order import ChunkOrder
 from fuzzoff.formats.ros2msgs.decode import Decoder, Ros2Decoding
 from fuzzoff.recording import SourceProblem
 

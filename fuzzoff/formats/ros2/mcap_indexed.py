@@ -28,7 +28,7 @@ from mcap.reader import SeekingReader
 from mcap.records import Chunk, ChunkIndex, Message, MessageIndex
 from mcap.stream_reader import get_chunk_data_stream
 
-from fuzzoff.formats.mcap.stream import MAX_CHUNK_INFLATION
+from fuzzoff.formats.ros2.mcap_stream import MAX_CHUNK_INFLATION
 
 SHARE = 0.5
 """The indexes are used when the chosen channels hold less than this share of the messages;

@@ -1,0 +1,94 @@
+"""Record the ROS 2 bridge corpus: px4_ros_com's offboard_control flown on real PX4 over DDS.
+
+Run from the repository root with a Python that has the ``ros2live`` extra (cyclonedds), as
+root (each flight runs in its own network namespace, ``fuzzoff.sitl.ros2.netns``):
+
+    python corpora/ros2bridge/record.py [PROGRAM-BUNDLE ...]
+
+(when none is named: every run of ``RUNS``). Each run boots a fresh PX4 with the Micro
+XRCE-DDS Agent (``../shared/px4-sitl/``) and leaves beside this file:
+
+- ``PROGRAM-BUNDLE-mcap/``, ``PROGRAM-BUNDLE-sqlite3/``: the bag of the flight, as
+  ``ros2 bag record`` writes it, in both storages (``fuzzoff.sitl.ros2.bag``);
+- ``PROGRAM-BUNDLE.ulg``: PX4's own log from boot to exit, cut to the topics fuzzoff reads;
+- an entry in ``runs.json``: PX4's answers (acks, mode changes on the node's clock, counted
+  from its start), each topic's message count and the QoS its writers offered.
+
+The expected findings are written separately (``expected.py``).
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import sys
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent.parent))
+
+from pyulog import ULog  # noqa: E402
+
+from fuzzoff.formats.ulog.reader import LOADED_TOPICS  # noqa: E402
+from fuzzoff.sitl.ros2.netns import run_flight  # noqa: E402
+
+RUNS: tuple[tuple[str, str], ...] = (
+    ("example", "1.16.2-ros2"),
+    ("example", "1.18.0-beta1-head"),
+    ("example_stops", "1.16.2-ros2"),
+    ("example_stops", "1.18.0-beta1-head"),
+    ("example_lands", "1.16.2-ros2"),
+    ("example_lands_through", "1.18.0-beta1-head"),
+    ("example_no_setpoint", "1.16.2-ros2"),
+    ("example_arm_lost", "1.16.2-ros2"),
+    ("example_late_bag", "1.16.2-ros2"),
+    ("example_in_only", "1.16.2-ros2"),
+    ("example_agent_restart", "1.16.2-ros2"),
+)
+"""(program of ``fuzzoff.sitl.ros2.programs``, bundle): one PX4 boot each."""
+MAX_BYTES = 1_000_000
+LEFT_OUT = frozenset({"vehicle_local_position"})
+"""Left out of a ULog that is over 1 MB (as ``corpora/sitl/record_mavsdk.py`` does): PX4 logs it
+at 100 Hz; the bags keep it."""
+
+
+def cut_more(ulog: Path) -> None:
+    log = ULog(str(ulog), message_name_filter_list=sorted(set(LOADED_TOPICS) - LEFT_OUT))
+    log.write_ulog(str(ulog))
+
+
+def record(program: str, bundle_name: str) -> dict[str, object]:
+    stem = f"{program}-{bundle_name}"
+    for old in (HERE / f"{stem}-mcap", HERE / f"{stem}-sqlite3"):
+        shutil.rmtree(old, ignore_errors=True)
+    done = run_flight(HERE, [program, bundle_name, stem])
+    if done.returncode != 0:
+        raise SystemExit(f"{stem}: the flight failed:\n{done.stdout}\n{done.stderr}")
+    summary_file = HERE / f"{stem}.json"
+    summary: dict[str, object] = json.loads(summary_file.read_text())
+    summary_file.unlink()
+    ulog = HERE / f"{stem}.ulg"
+    if ulog.stat().st_size >= MAX_BYTES:
+        cut_more(ulog)
+        summary["ulog_left_out"] = sorted(LEFT_OUT)
+    for path in HERE.glob(f"{stem}*"):
+        for file in [path] if path.is_file() else path.iterdir():
+            if file.stat().st_size >= MAX_BYTES:
+                raise SystemExit(f"{file}: over 1 MB; shorten the program or cut the ULog more")
+    return summary
+
+
+def main(names: list[str]) -> int:
+    runs_file = HERE / "runs.json"
+    runs = json.loads(runs_file.read_text()) if runs_file.exists() else {}
+    chosen = [r for r in RUNS if not names or f"{r[0]}-{r[1]}" in names]
+    for program, bundle_name in chosen:
+        print(f"{program} on {bundle_name} ...", flush=True)
+        summary = record(program, bundle_name)
+        runs[f"{program}-{bundle_name}"] = summary
+        runs_file.write_text(json.dumps(runs, indent=1, sort_keys=True) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main(sys.argv[1:]))

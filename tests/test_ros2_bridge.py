@@ -1,0 +1,223 @@
+"""PX4's ROS 2 bridge without DDS: the names of a release's topics, the example's behaviour,
+and the bags the recorder writes (``fuzzoff/sitl/ros2``). The live flight, which needs the
+bundles and cyclonedds, is in ``test_ros2_live.py``."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from rosbags.interfaces import (
+    Nodetype,
+    Qos,
+    QosDurability,
+    QosHistory,
+    QosLiveliness,
+    QosReliability,
+    QosTime,
+)
+from rosbags.rosbag2 import Reader
+
+from fuzzoff.formats import px4_msgs
+from fuzzoff.sitl.ros2.bag import Record, write_bag
+from fuzzoff.sitl.ros2.example import (
+    VEHICLE_CMD_COMPONENT_ARM_DISARM,
+    VEHICLE_CMD_DO_SET_MODE,
+    OffboardControl,
+    Plan,
+)
+from fuzzoff.sitl.ros2.names import BridgeTopic, NamesError, bridge_topic
+from tests.helpers import run_cli
+
+
+def test_a_release_names_its_versioned_topics_as_its_bridge_does() -> None:
+    assert bridge_topic("1.16.2", "VehicleStatus").dds_topic == "rt/fmu/out/vehicle_status_v1"
+    assert bridge_topic("1.16.2", "VehicleCommandAck").ros_topic == "/fmu/out/vehicle_command_ack"
+    head = bridge_topic("1.18.0", "VehicleCommandAck")
+    assert head.ros_topic == "/fmu/out/vehicle_command_ack_v1"
+    assert bridge_topic("1.18.0", "VehicleStatus").ros_topic == "/fmu/out/vehicle_status_v4"
+    setpoint = bridge_topic("1.16.2", "TrajectorySetpoint")
+    assert setpoint.dds_topic == "rt/fmu/in/trajectory_setpoint"
+    assert setpoint.dds_type == "px4_msgs::msg::dds_::TrajectorySetpoint_"
+    assert setpoint.ros_type == "px4_msgs/msg/TrajectorySetpoint"
+    with pytest.raises(NamesError):
+        bridge_topic("1.16.2", "NoSuchMessage")
+
+
+class _Sink:
+    def __init__(self, name: str, sent: list[tuple[str, dict[str, Any]]]) -> None:
+        self.name = name
+        self.sent = sent
+
+    def publish(self, **values: Any) -> None:
+        self.sent.append((self.name, values))
+
+
+def _node(plan: Plan | None = None) -> tuple[OffboardControl, list[tuple[str, dict[str, Any]]]]:
+    sent: list[tuple[str, dict[str, Any]]] = []
+    names = ("OffboardControlMode", "TrajectorySetpoint", "VehicleCommand")
+    return OffboardControl({n: _Sink(n, sent) for n in names}, plan or Plan()), sent
+
+
+def test_the_example_switches_and_arms_on_its_eleventh_tick_and_keeps_streaming() -> None:
+    node, sent = _node()
+    for i in range(30):
+        node.tick(i * 0.1)
+    commands = [v for name, v in sent if name == "VehicleCommand"]
+    assert [c["command"] for c in commands] == [
+        VEHICLE_CMD_DO_SET_MODE,
+        VEHICLE_CMD_COMPONENT_ARM_DISARM,
+    ]
+    assert (commands[0]["param1"], commands[0]["param2"]) == (1.0, 6.0)
+    assert all(c["target_system"] == 1 and c["from_external"] for c in commands)
+    order = [name for name, _ in sent]
+    # ten mode + setpoint pairs, then the two commands before the eleventh pair
+    assert order[20:24] == [
+        "VehicleCommand",
+        "VehicleCommand",
+        "OffboardControlMode",
+        "TrajectorySetpoint",
+    ]
+    setpoints = [v for name, v in sent if name == "TrajectorySetpoint"]
+    assert len(setpoints) == 30 and setpoints[-1]["position"] == [0.0, 0.0, -5.0]
+    assert all(v["position"] for name, v in sent if name == "OffboardControlMode")
+
+
+def test_the_hazard_plan_stops_the_stream_after_the_arm() -> None:
+    node, sent = _node(Plan(stop_after_arm_s=2.0))
+    for i in range(60):
+        node.tick(i * 0.1)
+    setpoints = [v for name, v in sent if name == "TrajectorySetpoint"]
+    assert len(setpoints) == 10 + 20
+    assert node.stopped and node.notes[-1][1] == "the node stops publishing"
+
+
+QOS = Qos(
+    QosHistory.UNKNOWN,
+    0,
+    QosReliability.BEST_EFFORT,
+    QosDurability.TRANSIENT_LOCAL,
+    QosTime(2147483647, 4294967295),
+    QosTime(2147483647, 4294967295),
+    QosLiveliness.AUTOMATIC,
+    QosTime(2147483647, 4294967295),
+    False,
+)
+
+
+def _cdr(topic: BridgeTopic, **values: Any) -> bytes:
+    store = px4_msgs.typestore_for(topic.ros_type, topic.msgdef)
+    cls = store.types[topic.ros_type]
+    fields: list[tuple[str, Any]] = store.fielddefs[topic.ros_type][1]
+    init: dict[str, Any] = {}
+    for name, (nodetype, details) in fields:
+        if name in values:
+            init[name] = values[name]
+        elif nodetype == Nodetype.ARRAY:
+            init[name] = np.zeros(details[1], dtype=np.float32)
+        else:
+            init[name] = False if details[0] == "bool" else 0
+    return bytes(store.serialize_cdr(cls(**init), topic.ros_type))
+
+
+def _records() -> list[Record]:
+    mode = bridge_topic("1.16.2", "OffboardControlMode")
+    status = bridge_topic("1.16.2", "VehicleStatus")
+    t0 = 1_790_000_000_000_000_000
+    out = [Record(status, _cdr(status, nav_state=4, arming_state=1), t0)]
+    out += [
+        Record(mode, _cdr(mode, position=True, timestamp=1), t0 + i * 100_000_000)
+        for i in range(1, 30)
+    ]
+    return out
+
+
+@pytest.mark.parametrize("storage", ["mcap", "sqlite3"])
+def test_a_recorded_bag_holds_the_bytes_times_schemas_and_offered_qos(
+    storage: str, tmp_path: Path
+) -> None:
+    records = _records()
+    bag = write_bag(tmp_path / "flight", records, {"/fmu/out/vehicle_status_v1": [QOS]}, storage)  # type: ignore[arg-type]
+    with Reader(bag) as reader:
+        by_topic = {c.topic: c for c in reader.connections}
+        assert set(by_topic) == {"/fmu/in/offboard_control_mode", "/fmu/out/vehicle_status_v1"}
+        status = by_topic["/fmu/out/vehicle_status_v1"]
+        assert status.msgtype == "px4_msgs/msg/VehicleStatus"
+        assert "MESSAGE_VERSION = 1" in status.msgdef.data
+        assert status.ext.offered_qos_profiles == [QOS]  # type: ignore[union-attr]
+        got = [(c.topic, t, bytes(d)) for c, t, d in reader.messages()]
+    assert got == [(r.topic.ros_topic, r.received_ns, r.data) for r in records]
+
+
+def test_both_storages_of_one_flight_lint_alike(tmp_path: Path) -> None:
+    reports = []
+    for storage in ("mcap", "sqlite3"):
+        bag = write_bag(tmp_path / storage, _records(), {}, storage)  # type: ignore[arg-type]
+        out = run_cli(["lint", str(bag), "--format", "json"])
+        (report,) = json.loads(out.stdout)["files"]
+        reports.append([(f["code"], f["time_s"]) for f in report["findings"]])
+    assert reports[0] == reports[1]
+
+
+def test_the_landing_plan_sends_nav_land_once_and_streams_on() -> None:
+    node, sent = _node(Plan(land_after_arm_s=1.0))
+    for i in range(40):
+        node.tick(i * 0.1)
+    commands = [v["command"] for name, v in sent if name == "VehicleCommand"]
+    assert commands == [176, 400, 21]
+    assert len([v for name, v in sent if name == "TrajectorySetpoint"]) == 40
+
+
+def test_an_arm_from_a_new_publisher_leaves_the_streaming_ones_alone() -> None:
+    made: list[tuple[str, dict[str, Any]]] = []
+    node, sent = _node(Plan(arm_from_new_publisher=True, setpoints_before_switch=0))
+    node.new_sink = lambda message: _Sink(message, made)
+    node.tick(0.0)
+    assert [v["command"] for _, v in sent if "command" in v] == [VEHICLE_CMD_DO_SET_MODE]
+    assert [v["command"] for _, v in made] == [VEHICLE_CMD_COMPONENT_ARM_DISARM]
+    # the switch and the arm come before the first setpoint of the tick
+    assert [name for name, _ in sent] == [
+        "VehicleCommand",
+        "OffboardControlMode",
+        "TrajectorySetpoint",
+    ]
+
+
+def test_the_agent_pid_is_read_from_what_run_px4_says(tmp_path: Path) -> None:
+    from fuzzoff.sitl.ros2 import agent
+
+    console = tmp_path / "console.log"
+    console.write_text("INFO boot\nrun-px4.sh: agent PID 4242 (udp4 port 8888), log x\n")
+    assert agent.started_pid(console) == 4242
+    console.write_text("INFO boot\n")
+    with pytest.raises(agent.AgentError):
+        agent.started_pid(console)
+
+
+def test_a_replay_plan_is_the_bags_inputs_to_px4_from_their_first_message(
+    tmp_path: Path,
+) -> None:
+    from fuzzoff.sitl.ros2.replay import load_plan, plan_from_bag, save_plan
+
+    bag = Path(__file__).parent.parent / "corpora" / "ros2bridge" / "example-1.16.2-ros2-sqlite3"
+    plan = plan_from_bag(bag, "1.16.2")
+    assert {m.topic for m in plan.messages} == {
+        "/fmu/in/offboard_control_mode",
+        "/fmu/in/trajectory_setpoint",
+        "/fmu/in/vehicle_command",
+    }
+    assert plan.messages[0].offset_s == 0.0
+    offsets = [m.offset_s for m in plan.messages]
+    assert offsets == sorted(offsets) and 12.0 < offsets[-1] < 15.0
+    with Reader(bag) as reader:
+        sent = [bytes(d) for c, _, d in reader.messages() if c.topic.startswith("/fmu/in/")]
+    assert [m.data for m in plan.messages] == sent
+    assert load_plan(save_plan(plan, tmp_path / "plan.json")) == plan
+
+
+def test_a_ros2_replay_takes_a_bag_folder() -> None:
+    out = run_cli(["sitl", "replay", "flight.tlog", "--transport", "ros2", "--release", "1.16.2"])
+    assert out.returncode == 2 and "a ROS 2 replay takes a bag folder" in out.stderr
