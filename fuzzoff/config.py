@@ -33,7 +33,7 @@ from fuzzoff.profiles import (
     px4_profile_for,
     vehicle_type_for,
 )
-from fuzzoff.releases import PX4Profile
+from fuzzoff.releases import PX4Profile, Release
 
 
 class ConfigError(ValueError):
@@ -53,8 +53,6 @@ KNOWN_KEYS = {
     "per-file-ignores",
 }
 
-_RELEASE = re.compile(r"^v?(\d+)\.(\d+)(?:\.(\d+))?")
-
 
 def did_you_mean(word: str, choices: Iterable[str]) -> str:
     """`` (did you mean X?)`` for the closest choice, or nothing."""
@@ -73,13 +71,12 @@ def user_px4_profile(text: str) -> tuple[PX4Profile, str | None]:
     known = releases.names()
     if name in known:
         return px4_profile_for(name), None
-    match = _RELEASE.match(name)
-    if match is None:
+    release = releases.version_of(name)
+    if release is None:
         raise ProfileError(
             f"unknown PX4 version {text!r}{did_you_mean(name, known)}: give a release "
             f"such as 1.15.4, or one of {', '.join(known)}"
         )
-    release = (int(match.group(1)), int(match.group(2)))
     shown = f"{release[0]}.{release[1]}"
     newest, oldest = releases.newest_listed(), releases.oldest_listed()
     if release > newest:
@@ -242,6 +239,12 @@ class Settings:
         if origin == "--param":
             return "set with --param"
         return f"set in {Path(origin).name}"
+
+    @property
+    def release(self) -> Release | None:
+        """The record of the ``--px4`` profile (None: detect from each recording). ``px4`` was
+        resolved once, when the settings were read; this only looks the record up."""
+        return None if self.px4 is None else releases.get(self.px4)
 
     def resolved_for(self, recording: str | Path) -> Settings:
         """``for_recording``, resolved once: a lint given these settings does not look for a
