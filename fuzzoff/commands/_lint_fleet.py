@@ -83,10 +83,10 @@ def run_fleet(args: argparse.Namespace, settings: Settings) -> int:
     for fmt, output in reports:
         if fmt != PARQUET:
             check_output(output, local)
-    # every local recording's configuration checked, and its notes printed, before any work;
-    # the tasks resolve each again where they run (a fetched URL's copy is judged with the
-    # command's own: fleet.task)
-    resolve_recordings(settings, local)
+    # each local recording's settings resolved once, its notes printed, before any work; a
+    # URL's fetched copy is judged with the command's own (fleet.task)
+    resolved = dict(resolve_recordings(settings, local))
+    plan = [(t, resolved.get(t, settings)) for t in targets]
     lint: Lint = lint_file
     if any(fmt == "html" for fmt, _ in reports):
         from fuzzoff.engine import lint_file_with_timelines
@@ -111,8 +111,7 @@ def run_fleet(args: argparse.Namespace, settings: Settings) -> int:
             advance(outcome)
 
         outcomes = lint_all(
-            targets,
-            settings,
+            plan,
             scheduler=args.scheduler,
             jobs=args.jobs,
             timeout_s=args.timeout,
