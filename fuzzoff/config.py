@@ -17,7 +17,7 @@ import math
 import os
 import re
 import tomllib
-from collections.abc import Iterable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from difflib import get_close_matches
 from pathlib import Path
@@ -34,11 +34,8 @@ from fuzzoff.profiles import (
     vehicle_type_for,
 )
 from fuzzoff.releases import PX4Profile
-
-
-class ConfigError(ValueError):
-    """A usage error in the configuration or the command line (exit status 2)."""
-
+from fuzzoff.usage import ConfigError as ConfigError
+from fuzzoff.usage import did_you_mean as did_you_mean
 
 KNOWN_KEYS = {
     "px4",
@@ -54,12 +51,6 @@ KNOWN_KEYS = {
 }
 
 _RELEASE = re.compile(r"^v?(\d+)\.(\d+)(?:\.(\d+))?")
-
-
-def did_you_mean(word: str, choices: Iterable[str]) -> str:
-    """`` (did you mean X?)`` for the closest choice, or nothing."""
-    close = get_close_matches(word, list(choices), n=1, cutoff=0.6)
-    return f" (did you mean {close[0]}?)" if close else ""
 
 
 def user_px4_profile(text: str) -> tuple[PX4Profile, str | None]:
