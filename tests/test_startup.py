@@ -92,3 +92,43 @@ def test_the_package_api_is_there_when_used() -> None:
     assert callable(fuzzoff.lint_file)
     assert fuzzoff.Settings(px4="1.15").px4 == "1.15"
     assert set(fuzzoff.__all__) <= set(dir(fuzzoff))
+
+
+NOT_FOR_A_ULOG_LINT = (
+    "rosbags",
+    "mcap",
+    "mcap_ros2",
+    "pymavlink",
+    "rich",
+    "hypothesis",
+    "dask",
+    "distributed",
+    "pyarrow",
+    "fsspec",
+    "fuzzoff.fuzz",
+    "fuzzoff.sitl",
+    "fuzzoff.fleet.",
+    "fuzzoff.report.html",
+    "fuzzoff.report.sarif",
+    "fuzzoff.report.junit",
+    "fuzzoff.report.terminal",
+    "fuzzoff.formats.tlog.",
+    "fuzzoff.formats.mcap.",
+    "fuzzoff.formats.rosbag1.",
+    "fuzzoff.formats.rosbag2.",
+)
+"""What a JSON lint of one ULog (a pre-commit hook's run) never reaches: the other formats'
+readers and libraries, the fuzz, fleet and SITL machinery, the other reports."""
+
+
+def test_a_one_file_lint_loads_only_its_reader_and_its_report() -> None:
+    ulog = ROOT / "corpora" / "real" / "sample_log_small.ulg"
+    code = (
+        "import io, contextlib\n"
+        "from fuzzoff.cli import main\n"
+        "with contextlib.redirect_stdout(io.StringIO()):\n"
+        f"    main(['lint', {str(ulog)!r}, '--format', 'json'])\n"
+    )
+    modules = loaded_after(code)
+    assert "pyulog" in modules and "fuzzoff.report.json_report" in modules
+    assert heavy(modules, NOT_FOR_A_ULOG_LINT) == []
