@@ -16,7 +16,6 @@ import functools
 import math
 import os
 import re
-import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from difflib import get_close_matches
@@ -275,6 +274,8 @@ def find_config(start: Path) -> Path | None:
 
 
 def _load_toml(path: Path) -> dict[str, Any]:
+    import tomllib  # only where a configuration file is found
+
     try:
         with path.open("rb") as fh:
             return tomllib.load(fh)
