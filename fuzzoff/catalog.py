@@ -23,12 +23,9 @@ from __future__ import annotations
 import functools
 import json
 import os
-import tempfile
-import tomllib
 import zlib
 from collections.abc import Iterable
 from dataclasses import dataclass, field
-from importlib import resources
 from pathlib import Path
 from typing import Any, Literal, get_args
 
@@ -164,8 +161,10 @@ class Rule:
 
 
 def _catalog_dir() -> Path:
-    """``rules/`` beside the package in a checkout, or ``fuzzoff/_catalog`` in a wheel."""
-    packaged = Path(str(resources.files("fuzzoff"))) / "_catalog"
+    """``rules/`` beside the package in a checkout, or ``fuzzoff/_catalog`` in a wheel. Found
+    from ``__file__``, as ``importlib.resources.files`` would for a package on disk, without
+    importing ``importlib.resources`` (and through it zipfile and tempfile) on every start."""
+    packaged = Path(__file__).resolve().parent / "_catalog"
     if packaged.is_dir():
         return packaged
     return Path(__file__).resolve().parent.parent / "rules"
@@ -218,6 +217,8 @@ def _pages(directory: Path, cache: Path | None) -> dict[str, dict[str, Any]]:
                 return pages
         except (OSError, ValueError, KeyError, TypeError):
             pass
+    import tomllib  # only when the JSON copy is stale: most runs never parse a page
+
     pages = {}
     for path in paths:
         with path.open("rb") as fh:
@@ -229,6 +230,8 @@ def _pages(directory: Path, cache: Path | None) -> dict[str, dict[str, Any]]:
 
 def _write(cache: Path, data: dict[str, Any]) -> None:
     """Replace ``cache`` at once (a concurrent reader sees the old copy or the new one)."""
+    import tempfile  # only when the copy is written again
+
     try:
         text = json.dumps(data)
         cache.parent.mkdir(parents=True, exist_ok=True)

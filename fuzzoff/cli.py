@@ -14,9 +14,9 @@ import sys
 from collections.abc import Sequence
 from typing import Any
 
-from fuzzoff import __version__
+from fuzzoff._version import __version__
 from fuzzoff.commands import SUMMARIES, add_command
-from fuzzoff.config import ConfigError, did_you_mean
+from fuzzoff.usage import ConfigError, did_you_mean
 
 
 class UsageError(Exception):

@@ -7,7 +7,6 @@ from __future__ import annotations
 import math
 import os
 import re
-import tomllib
 from collections.abc import Mapping
 from dataclasses import replace
 from difflib import get_close_matches
@@ -96,6 +95,8 @@ def user_vehicle_type(text: str) -> str:
 
 
 def load_toml(path: Path) -> dict[str, Any]:
+    import tomllib  # only where a configuration file is found
+
     try:
         with path.open("rb") as fh:
             return tomllib.load(fh)
