@@ -6,6 +6,7 @@ not, and the recordings of each kept under 1 MB.
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pytest
@@ -94,3 +95,64 @@ def test_thinning_cuts_the_fast_topics_and_keeps_the_stream_whole(tmp_path: Path
     assert thin.stat().st_size < source.stat().st_size
     lint = run_cli(["lint", str(thin), "--format", "json"])
     assert lint.returncode == run_cli(["lint", str(source), "--format", "json"]).returncode
+
+
+SITL = CORPORA / "sitl"
+
+
+def _phases(path: Path) -> list[str]:
+    """The VTOL phases a recording's statuses go through, in order, each once per stretch."""
+    from fuzzoff.events import VehicleStatus
+    from fuzzoff.formats import open_source
+
+    seen: list[str] = []
+    with open_source(path) as source:
+        for event in source.events():
+            phase = event.vtol_phase if isinstance(event, VehicleStatus) else None
+            if phase is not None and (not seen or seen[-1] != phase):
+                seen.append(phase)
+    return seen
+
+
+@pytest.mark.parametrize("suffix", [".ulg", ".tlog"])
+def test_a_real_vtols_phase_is_read_at_each_moment(suffix: str) -> None:
+    """PX4 1.17's standard VTOL: MC takeoff, transition to FW in OFFBOARD and back (ULog
+    vehicle_status, tlog EXTENDED_SYS_STATE.vtol_state)."""
+    phases = _phases(SITL / f"vtol_offboard-1.17.0{suffix}")
+    assert phases == ["mc", "transition", "fw", "transition", "mc"]
+
+
+def test_px4s_own_transition_setpoints_are_not_the_clients() -> None:
+    """During a transition PX4's transition flight task writes trajectory_setpoint (velocity)
+    in OFFBOARD: the ULog of a clean VTOL flight on position setpoints has no OFB401."""
+    out = run_cli(["lint", str(SITL / "vtol_offboard-1.17.0.ulg"), "--format", "json"])
+    codes = {f["code"] for f in json.loads(out.stdout)["files"][0]["findings"]}
+    assert "OFB401" not in codes
+    assert out.returncode == 0
+
+
+def test_a_rovers_tlog_says_rover_but_not_which_kind_and_its_ulog_says_ackermann() -> None:
+    """PX4 sends HEARTBEAT type 10 for every rover: the tlog's kind is assumed and said
+    (OFB003); the ULog's rover topics tell the Ackermann drive."""
+    tlog = run_cli(
+        ["lint", str(SITL / "rover_offboard-1.18.0-beta1-head.tlog"), "--format", "json"]
+    )
+    (report,) = json.loads(tlog.stdout)["files"]
+    assumed = [f for f in report["findings"] if f["code"] == "OFB003"]
+    assert assumed and "not which kind" in assumed[0]["message"]
+    ulog = run_cli(["lint", str(SITL / "rover_offboard-1.18.0-beta1-head.ulg")])
+    assert "rover-ackermann detected" in ulog.stdout
+
+
+@pytest.mark.parametrize(
+    ("stem", "vehicle"),
+    [
+        ("hex_offboard-1.17.0", "mc detected"),
+        ("hex_offboard-1.18.0-beta1-head", "mc detected"),
+        ("vtol_offboard-1.18.0-beta1-head", "vtol detected"),
+    ],
+)
+def test_each_real_vehicle_is_detected_from_its_recordings(stem: str, vehicle: str) -> None:
+    for suffix in (".tlog", ".ulg"):
+        out = run_cli(["lint", str(SITL / f"{stem}{suffix}")])
+        assert vehicle in out.stdout.splitlines()[0]

@@ -58,7 +58,8 @@ def run_scenario(
 ) -> Outcome:
     """Fly scenario ``name`` on its own vehicle, or on ``vehicle`` (``--vehicle``)."""
     scenario = SCENARIOS[name]
-    env = airframes.boot_env(build, vehicle or scenario.vehicle, env)
+    airframe = airframes.airframe_for(vehicle or scenario.vehicle)
+    env = airframes.boot_env(build, airframe.vehicle, env)
     params = {**scenario.params, **(params or {})}
     out_dir.mkdir(parents=True, exist_ok=True)
     stem = f"{name}-{build.release}"
@@ -78,7 +79,12 @@ def run_scenario(
     finally:
         session.px4.cleanup()
     outcome.verdict = compare(
-        tlog, _release_for_model(build.release), outcome.ulog, params, COMPANION_SYSID
+        tlog,
+        _release_for_model(build.release),
+        outcome.ulog,
+        params,
+        COMPANION_SYSID,
+        airframe.fuzzoff_vehicle,
     )
     return outcome
 
