@@ -14,7 +14,7 @@ import json
 import sys
 from collections import Counter
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -30,6 +30,8 @@ class Row:
     loud_on_clean: int
     hazards: int
     caught: int
+    gate: str = "-"
+    """The gate model against PX4's ULog on the row's SITL runs: items agreed / judged."""
 
 
 def _expected(path: Path) -> dict[str, Any]:
@@ -63,17 +65,47 @@ def examples_row() -> Row:
     )
 
 
-def sitl_row() -> Row:
+VEHICLE_ROWS = {
+    "quad": "quadrotor (`sihsim_quadx`)",
+    "hex": "hexacopter (`sihsim_hex`)",
+    "vtol": "standard VTOL (`sihsim_standard_vtol`): MC, transition to FW in OFFBOARD, FW",
+    "rover-ackermann": "Ackermann rover (`sihsim_rover_ackermann`)",
+}
+"""The SITL vehicles, one row each (``fuzzoff.sitl.airframes``)."""
+
+
+def _vehicle_of(spec: dict[str, Any]) -> str:
+    from fuzzoff.sitl.scenarios import SCENARIOS
+
+    scenario = SCENARIOS.get(spec["recording"].split("-")[0])
+    return scenario.vehicle if scenario is not None else "quad"  # MAVSDK: the quadrotor
+
+
+def sitl_rows(gate: Counter[tuple[str, str, bool | None]]) -> list[Row]:
+    """One row per vehicle flown: ``sitl_row`` of its recordings, with its gate agreement."""
+    specs = [_expected(p) for p in sorted((CORPORA / "sitl").glob("*.expected.json"))]
+    rows = []
+    for vehicle, what in VEHICLE_ROWS.items():
+        mine = [s for s in specs if _vehicle_of(s) == vehicle]
+        if mine:
+            agree = sum(n for (v, _, ok), n in gate.items() if v == vehicle and ok)
+            judged = sum(n for (v, _, ok), n in gate.items() if v == vehicle and ok is not None)
+            rows.append(replace(sitl_row(mine, what), gate=f"{agree}/{judged}"))
+    return rows
+
+
+def sitl_row(specs: list[dict[str, Any]], vehicle: str) -> Row:
     """PX4 SITL's own ULogs and the offboard link's tlogs; a hazard is caught when one of
     the codes its expected file names is an error."""
-    specs = [_expected(p) for p in sorted((CORPORA / "sitl").glob("*.expected.json"))]
     clean = [s for s in specs if s["kind"] == "clean"]
     hazards = [s for s in specs if s["kind"] == "hazard"]
     releases = sorted({s["px4_release"] for s in specs}, key=_release_key)
+    mavsdk = any(s["recording"].startswith("mavsdk") for s in specs)
     return Row(
         "`corpora/sitl/`",
-        f"real PX4 SITL {', '.join(releases)}: its ULog and the tlog of its offboard link,"
-        " flown by pymavlink scenario programs and real MAVSDK 3 and 4",
+        f"{vehicle}, real PX4 SITL {', '.join(releases)}: its ULog and the tlog of its offboard"
+        " link, flown by pymavlink scenario programs"
+        + (" and real MAVSDK 3 and 4" if mavsdk else ""),
         len(clean),
         sum(map(_loud, clean)),
         len(hazards),
@@ -102,23 +134,26 @@ def _release_key(release: str) -> tuple[tuple[int, ...], str]:
     return tuple(int(p) for p in release.split("-")[0].split(".")), release
 
 
-def gate_agreement() -> Counter[tuple[str, bool | None]]:
-    """(kind, agree) over every recorded SITL exchange: the model run on the client's tlog
-    against PX4's ULog, as ``tests/test_sitl.py`` judges each."""
+def gate_agreement() -> Counter[tuple[str, str, bool | None]]:
+    """(vehicle, kind, agree) over every recorded SITL exchange: the model run on the
+    client's tlog against PX4's ULog, as ``tests/test_sitl.py`` judges each."""
+    from fuzzoff.sitl.airframes import DEFAULT, airframe_for
     from fuzzoff.sitl.link import COMPANION_SYSID
     from fuzzoff.sitl.verdict import compare
 
     sitl = CORPORA / "sitl"
     runs: dict[str, Any] = json.loads((sitl / "runs.json").read_text())
-    counts: Counter[tuple[str, bool | None]] = Counter()
+    counts: Counter[tuple[str, str, bool | None]] = Counter()
     for stem, run in sorted(runs.items()):
         tlog, ulog = sitl / f"{stem}.tlog", sitl / f"{stem}.ulg"
         if not (tlog.exists() and ulog.exists()):
             continue
         release = run["release"].split("-")[0]
-        verdict = compare(tlog, release, ulog, run.get("params") or {}, COMPANION_SYSID)
+        flown = run.get("vehicle", DEFAULT)
+        vehicle = airframe_for(flown).fuzzoff_vehicle
+        verdict = compare(tlog, release, ulog, run.get("params") or {}, COMPANION_SYSID, vehicle)
         for item in verdict.items:
-            counts[(_kind(item.what), item.agree)] += 1
+            counts[(flown, _kind(item.what), item.agree)] += 1
     return counts
 
 
@@ -139,17 +174,17 @@ GATE_KINDS = {
 }
 
 
-def render(rows: Iterable[Row], gate: Counter[tuple[str, bool | None]]) -> str:
+def render(rows: Iterable[Row], by_vehicle: Counter[tuple[str, str, bool | None]]) -> str:
     lines = [
         "| recordings | what | clean | warning or error on a clean one | hazards | hazard"
-        " given as an error |",
-        "| --- | --- | --- | --- | --- | --- |",
+        " given as an error | gate model agrees with PX4 |",
+        "| --- | --- | --- | --- | --- | --- | --- |",
     ]
     rows = list(rows)
     for r in rows:
         lines.append(
             f"| {r.recordings} | {r.what} | {r.clean} | {r.loud_on_clean} | {r.hazards} |"
-            f" {r.caught} |"
+            f" {r.caught} | {r.gate} |"
         )
     total = Row(
         "all",
@@ -159,9 +194,14 @@ def render(rows: Iterable[Row], gate: Counter[tuple[str, bool | None]]) -> str:
         sum(r.hazards for r in rows),
         sum(r.caught for r in rows),
     )
+    gate: Counter[tuple[str, bool | None]] = Counter()
+    for (_, kind, agree), n in by_vehicle.items():
+        gate[(kind, agree)] += n
+    agreed = sum(n for (_, ok), n in gate.items() if ok)
+    judged = sum(n for (_, ok), n in gate.items() if ok is not None)
     lines.append(
         f"| **all** | | **{total.clean}** | **{total.loud_on_clean}** | **{total.hazards}** |"
-        f" **{total.caught}** |"
+        f" **{total.caught}** | **{agreed}/{judged}** |"
     )
     lines += ["", "| the gate model against PX4 SITL | agree | differ | not judged |"]
     lines.append("| --- | --- | --- | --- |")
@@ -174,7 +214,8 @@ def render(rows: Iterable[Row], gate: Counter[tuple[str, bool | None]]) -> str:
 
 
 def table() -> str:
-    return render([examples_row(), sitl_row(), tlog_row()], gate_agreement())
+    gate = gate_agreement()
+    return render([examples_row(), *sitl_rows(gate), tlog_row()], gate)
 
 
 if __name__ == "__main__":

@@ -411,6 +411,24 @@ PX4_SETPOINTS: tuple[type[Event], ...] = (
 NAV_STATE_OFFBOARD = 14
 
 
+VtolPhase = Literal["mc", "fw", "transition"]
+"""A VTOL flies as a multicopter, as a fixed-wing, or is between the two: PX4's ``vehicle_status``
+``vehicle_type`` with ``in_transition_mode``, MAVLink ``EXTENDED_SYS_STATE.vtol_state``."""
+
+
+def vtol_phase_of(vehicle_type: int | None, in_transition: bool | None) -> VtolPhase | None:
+    """The phase from PX4's ``vehicle_status`` of a VTOL (``vehicle_type`` 1 rotary, 2 fixed)."""
+    if in_transition:
+        return "transition"
+    if vehicle_type == 1:
+        return "mc"
+    return "fw" if vehicle_type == 2 else None
+
+
+MAV_VTOL_STATE_PHASE: dict[int, VtolPhase] = {1: "transition", 2: "transition", 3: "mc", 4: "fw"}
+"""``EXTENDED_SYS_STATE.vtol_state`` (0 undefined: not a VTOL) -> the phase."""
+
+
 @dataclass(frozen=True, slots=True, kw_only=True)
 class VehicleStatus(Event):
     """Mode and arming as reported (``vehicle_status``, HEARTBEAT, ``/mavros/state``).
@@ -430,6 +448,8 @@ class VehicleStatus(Event):
     failsafe: bool | None = None
     vehicle_type: int | None = None
     is_vtol: bool | None = None
+    vtol_phase: VtolPhase | None = None
+    """A VTOL's phase at this moment (None: not a VTOL, or not recorded)."""
     origin: Origin = "vehicle"
 
     @property

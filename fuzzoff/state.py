@@ -28,6 +28,7 @@ from fuzzoff.events import (
     MavlinkTarget,
     Parameter,
     VehicleStatus,
+    VtolPhase,
 )
 
 STALE_STATUS_S = 0.05
@@ -58,6 +59,8 @@ class VehicleState:
     """The nav_state of the newest recorded status, without the acks applied: what PX4 had
     switched to (its own flight tasks write the setpoint topics until that status)."""
     armed: bool | None = None
+    vtol_phase: VtolPhase | None = None
+    """A VTOL's phase as last recorded (None: not a VTOL, or no phase recorded)."""
     params: dict[str, float] = field(default_factory=dict)
     control_mode: ControlMode | LegacyControlMode | None = None
     failsafe_flags: FailsafeFlags | None = None
@@ -115,6 +118,8 @@ class VehicleState:
             self.nav_state = self.status_nav_state = event.nav_state
         if event.armed is not None:
             self.armed = event.armed
+        if event.vtol_phase is not None:
+            self.vtol_phase = event.vtol_phase
 
     def _control_mode(self, event: Event) -> None:
         assert isinstance(event, ControlMode)

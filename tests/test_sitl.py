@@ -18,6 +18,7 @@ os.environ.setdefault("MAVLINK20", "1")
 import itertools
 
 from fuzzoff.sitl import bundle
+from fuzzoff.sitl.airframes import DEFAULT, airframe_for
 from fuzzoff.sitl.clock import PX4Clock
 from fuzzoff.sitl.link import COMPANION_SYSID, open_tlog
 from fuzzoff.sitl.replay import plan_from_tlog, readdress
@@ -158,6 +159,7 @@ def test_the_gate_model_agrees_with_the_recorded_px4_run(stem: str) -> None:
         SITL / f"{stem}.ulg",
         run.get("params") or {},
         COMPANION_SYSID,
+        airframe_for(run.get("vehicle", DEFAULT)).fuzzoff_vehicle,
     )
     assert verdict.items, "nothing compared"
     differ = [

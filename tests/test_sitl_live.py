@@ -18,7 +18,12 @@ from pathlib import Path
 import pytest
 
 from fuzzoff.sitl import bundle
-from fuzzoff.sitl.scenarios import scenarios_for
+from fuzzoff.sitl.scenarios import (
+    SCENARIOS,
+    VEHICLE_RELEASES,
+    scenarios_for,
+    vehicle_scenarios,
+)
 from tests.helpers import CORPORA, run_cli_process
 
 RELEASES = bundle.releases()
@@ -131,5 +136,52 @@ def test_px4_and_the_gate_model_agree_on_a_scenario(
             str(save),
         ],
         timeout=400,
+    )
+    assert out.returncode == 0, out.stdout + out.stderr
+
+
+def _vehicle_matrix() -> list[object]:
+    """Every other vehicle's scenario on each bundle that has its airframe; a bundle that has
+    it but cannot fly it (main's rover) is skipped with the reason (``airframes.why_not``)."""
+    from fuzzoff.sitl.airframes import airframe_for, why_not
+
+    cases: list[object] = []
+    for release in RELEASES:
+        if release not in VEHICLE_RELEASES:
+            continue
+        build = bundle.find_build(release, None)
+        for name in vehicle_scenarios():
+            reason = why_not(build, airframe_for(SCENARIOS[name].vehicle))
+            if reason is not None and "no SIH airframe" not in reason and "without" not in reason:
+                marks = [pytest.mark.skip(reason=reason)]
+            elif reason is not None:
+                continue  # the build lacks the vehicle altogether: nothing to say per run
+            else:
+                marks = []
+            cases.append(pytest.param(release, name, id=f"{name}-{release}", marks=marks))
+    return cases
+
+
+@needs_bundles
+@pytest.mark.skipif(not MATRIX, reason="the vehicles' matrix runs with make test-sitl")
+@pytest.mark.parametrize(("release", "scenario"), _vehicle_matrix())
+def test_px4_and_the_gate_model_agree_on_another_vehicle(
+    release: str, scenario: str, tmp_path: Path
+) -> None:
+    """Issue 33: the hexacopter, standard VTOL and Ackermann rover scenarios, each on its own
+    SIH airframe, compared with the gate model for that vehicle."""
+    out = run_cli_process(
+        [
+            "sitl",
+            "run",
+            scenario,
+            "--release",
+            release,
+            "--instance",
+            str(_instance()),
+            "--save-dir",
+            str(tmp_path / "run"),
+        ],
+        timeout=600,
     )
     assert out.returncode == 0, out.stdout + out.stderr

@@ -472,6 +472,8 @@ def main() -> None:
     for case in cases():
         tlog = write_tlog(HERE / f"{case.name}.tlog", case.events)
         other: list[Planted] = [("OFB701", "info", SWITCH), *OTHER_RULES.get(case.name, [])]
+        if case.vehicle.startswith("rover"):
+            other.append(("OFB003", "info", None))  # HEARTBEAT type 10: the rover's kind unsaid
         write_spec(case.name, tlog.name, case, case.findings + other, [], True)
         if case.bag:
             bag = write_rosbag1(HERE / f"{case.name}.bag", case.events)

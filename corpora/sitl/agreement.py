@@ -15,6 +15,7 @@ import json
 from collections import defaultdict
 from pathlib import Path
 
+from fuzzoff.sitl.airframes import AIRFRAMES, DEFAULT, airframe_for
 from fuzzoff.sitl.link import COMPANION_SYSID
 from fuzzoff.sitl.verdict import compare
 
@@ -31,41 +32,52 @@ GROUPS = {
 
 def main() -> None:
     runs = json.loads((HERE / "runs.json").read_text())
-    table: dict[str, dict[str, list[int]]] = defaultdict(lambda: defaultdict(lambda: [0, 0]))
-    offsets: dict[str, list[float]] = defaultdict(list)
+    table: dict[tuple[str, str], dict[str, list[int]]] = defaultdict(
+        lambda: defaultdict(lambda: [0, 0])
+    )
+    offsets: dict[tuple[str, str], list[float]] = defaultdict(list)
     differ: list[str] = []
     for stem, run in sorted(runs.items()):
         tlog, ulog = HERE / f"{stem}.tlog", HERE / f"{stem}.ulg"
         if not (tlog.exists() and ulog.exists()):
             continue
         release = run["release"]
+        flown = run.get("vehicle", DEFAULT)
+        vehicle = airframe_for(flown).fuzzoff_vehicle
         verdict = compare(
-            tlog, release.split("-")[0], ulog, run.get("params") or {}, COMPANION_SYSID
+            tlog, release.split("-")[0], ulog, run.get("params") or {}, COMPANION_SYSID, vehicle
         )
         for item in verdict.items:
             if item.agree is None:
                 continue
             group = GROUPS.get(item.what, "requests" if item.what.startswith("switch") else "other")
-            cell = table[release][group]
+            cell = table[(release, flown)][group]
             cell[0] += 1
             cell[1] += int(item.agree)
             if item.what == "loss time" and "ms from PX4's flag" in item.note:
-                offsets[release].append(float(item.note.split()[1]))
+                offsets[(release, flown)].append(float(item.note.split()[1]))
             if not item.agree:
                 differ.append(
                     f"{stem}: {item.what} at {item.t:.2f} s: PX4 {item.px4}; model {item.model}"
                 )
     columns = ["requests", "loss time", "failsafe action", "automatic return", "other"]
-    print("| PX4 | " + " | ".join(columns) + " | model - PX4 flag (ms) |")
-    print("| --- |" + " --- |" * (len(columns) + 1))
-    for release in sorted(table, key=lambda r: tuple(int(n) for n in r.split("-")[0].split("."))):
+    print("| PX4 | vehicle | " + " | ".join(columns) + " | model - PX4 flag (ms) |")
+    print("| --- | --- |" + " --- |" * (len(columns) + 1))
+    order = list(AIRFRAMES)
+    for key in sorted(
+        table,
+        key=lambda k: (
+            tuple(int(n) for n in k[0].split("-")[0].split(".")),
+            k[0],
+            order.index(k[1]),
+        ),
+    ):
         cells = [
-            f"{table[release][c][1]}/{table[release][c][0]}" if table[release][c][0] else "-"
-            for c in columns
+            f"{table[key][c][1]}/{table[key][c][0]}" if table[key][c][0] else "-" for c in columns
         ]
-        spread = offsets[release]
+        spread = offsets[key]
         span = f"{min(spread):+.0f} to {max(spread):+.0f}" if spread else "-"
-        print(f"| {release} | " + " | ".join(cells) + f" | {span} |")
+        print(f"| {key[0]} | {key[1]} | " + " | ".join(cells) + f" | {span} |")
     print()
     for line in differ:
         print(f"- {line}")

@@ -20,7 +20,7 @@ import json
 import sys
 from pathlib import Path
 
-from fuzzoff.sitl import bundle
+from fuzzoff.sitl import airframes, bundle
 from fuzzoff.sitl.link import LinkError
 from fuzzoff.sitl.scenarios import SCENARIOS, scenarios_for
 from fuzzoff.sitl.session import Session
@@ -28,14 +28,16 @@ from fuzzoff.sitl.trim import trim
 
 HERE = Path(__file__).resolve().parent
 RUNS = HERE / "runs.json"
+THIN_S = 0.1
 
 
 def record(release: str, instance: int, name: str) -> dict[str, object]:
     scenario = SCENARIOS[name]
     build = bundle.find_build(release, None)
+    env = airframes.boot_env(build, scenario.vehicle)
     stem = f"{name}-{build.release}"
     tlog = HERE / f"{stem}.tlog"
-    session = Session(build, instance)
+    session = Session(build, instance, env=env)
     with session:
         result = session.run(
             name, scenario.program, tlog, manual=scenario.manual, params=scenario.params
@@ -43,12 +45,15 @@ def record(release: str, instance: int, name: str) -> dict[str, object]:
         session.finish(result)
     if result.ulog is None:
         raise LinkError(f"{stem}: PX4 wrote no ULog")
-    trim(result.ulog, HERE / f"{stem}.ulg")
+    # the other vehicles' runs are longer (a VTOL's climb, transition and cruise): thin PX4's
+    # fastest topics to 10 Hz to keep the ULog under 1 MB
+    trim(result.ulog, HERE / f"{stem}.ulg", None if scenario.vehicle == "quad" else THIN_S)
     session.px4.cleanup()
     return {
         "recording": stem,
         "scenario": name,
         "release": build.release,
+        "vehicle": scenario.vehicle,
         "ready_s": round(session.ready_s, 1),
         "error": result.error,
         "params": result.params,

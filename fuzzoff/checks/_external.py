@@ -3,7 +3,8 @@
 A ULog logs PX4's own setpoints next to the external controller's, so a logged (origin
 ``vehicle``) setpoint counts as external only in offboard as the recorded status says it (not
 at an accepted ack: PX4 1.16 and 1.17 ack a switch from the MAVLink receiver before Commander
-makes it, and PX4's flight task still writes ``trajectory_setpoint`` until the status changes)
+makes it, and PX4's flight task still writes ``trajectory_setpoint`` until the status changes),
+not while a VTOL is in transition (PX4's transition flight task writes it then, in OFFBOARD too)
 and only when the declared first true field selects its topic
 (fuzzoff/tables/control_mode.py). Messages recorded on their way to the vehicle (origin
 ``sent``: ROS 2 ``/fmu/in``, MAVLink) are always external.
@@ -34,6 +35,8 @@ def from_external(ctx: CheckContext, event: Event) -> bool:
         return False
     if state.mode_recorded and state.status_nav_state != NAV_STATE_OFFBOARD:
         return False  # accepted, but PX4 has not switched yet: its own flight task writes
+    if state.vtol_phase == "transition":
+        return False  # a VTOL between MC and FW: PX4's transition flight task writes
     row = ctx.row_for(state.declared_flag)
     return row is not None and event.kind in row.allowed
 

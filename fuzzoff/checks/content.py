@@ -124,7 +124,15 @@ class TrajectoryContent(Check):
         self.mismatch = Episodes(ctx, "OFB401")
         self.all_nan = Episodes(ctx, "OFB402")
         self.axis = Episodes(ctx, "OFB403")
-        self.multicopter = ctx.profile.vehicle in ("mc", "vtol")
+        self.vehicle = ctx.profile.vehicle
+
+    @property
+    def multicopter(self) -> bool:
+        """Flying as a multicopter now: a VTOL by its recorded phase (in FW flight PX4's
+        fixed-wing controllers take the setpoint, not the multicopter position controller)."""
+        if self.vehicle == "vtol":
+            return self.ctx.state.vtol_phase != "fw"
+        return self.vehicle == "mc"
 
     def on_event(self, event: Event) -> None:
         assert isinstance(event, TrajectorySetpoint)

@@ -30,6 +30,12 @@ def add_parser(sub: Any) -> None:
     actions.required = True
     run = actions.add_parser("run", help="fly a scenario program on a PX4 SITL")
     run.add_argument("scenario", metavar="SCENARIO", help="a name from 'fuzzoff sitl list'")
+    run.add_argument(
+        "--vehicle",
+        metavar="V",
+        help="the SIH airframe to fly the scenario on (quad, hex, fw, tailsitter, vtol,"
+        " rover-ackermann; default: the scenario's own)",
+    )
     replay = actions.add_parser("replay", help="replay a tlog (or its reproducer) on a PX4 SITL")
     replay.add_argument(
         "path", metavar="FILE", help="a .tlog, a reproducer's .expected.json; a bag with ros2"
@@ -73,6 +79,11 @@ def _list() -> int:
     for s in SCENARIOS.values():
         kind = "clean" if s.kind == "clean" else f"hazard ({s.hazard})"
         lines.append(f"  {s.name:<26} {s.summary}; {kind}")
+    from fuzzoff.sitl.airframes import AIRFRAMES
+
+    lines.append("vehicles (--vehicle):")
+    for a in AIRFRAMES.values():
+        lines.append(f"  {a.vehicle:<26} PX4_SIM_MODEL={a.model}, judged as {a.fuzzoff_vehicle}")
     from fuzzoff.sitl.ros2.programs import PROGRAMS
 
     lines.append("ROS 2 programs (--transport ros2):")
@@ -119,7 +130,7 @@ def run_command(args: argparse.Namespace) -> int:
     try:
         if args.action == "run":
             outcome = run.run_scenario(
-                args.scenario, build, args.instance, save_dir, params, env, log
+                args.scenario, build, args.instance, save_dir, params, env, log, args.vehicle
             )
         else:
             recording, params, manual = _recording(Path(args.path), params)

@@ -11,7 +11,12 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from fuzzoff.mavlink_ids import MAV_FRAME_LOCAL_NED
+from fuzzoff.mavlink_ids import (
+    MAV_CMD_DO_VTOL_TRANSITION,
+    MAV_FRAME_LOCAL_NED,
+    MAV_VTOL_STATE_FW,
+    MAV_VTOL_STATE_MC,
+)
 from fuzzoff.sitl.link import Ack, Link, LinkError
 
 POSITION = 0x0DF8
@@ -104,6 +109,12 @@ class Driver:
         return self.note(
             f"switch to {label} (main {main}, sub {sub})", self.link.set_custom_mode(main, sub)
         )
+
+    def transition(self, to_fw: bool) -> Ack | None:
+        """DO_VTOL_TRANSITION to fixed-wing (or back to multicopter) flight."""
+        state = MAV_VTOL_STATE_FW if to_fw else MAV_VTOL_STATE_MC
+        ack = self.link.command(MAV_CMD_DO_VTOL_TRANSITION, state)
+        return self.note(f"VTOL transition to {'FW' if to_fw else 'MC'}", ack)
 
     def arm(self) -> Ack | None:
         return self.note("arm", self.link.arm(True))

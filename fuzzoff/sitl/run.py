@@ -15,7 +15,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from fuzzoff.sitl import bundle, replay
+from fuzzoff.sitl import airframes, bundle, replay
 from fuzzoff.sitl.driver import Driver, Step
 from fuzzoff.sitl.link import COMPANION_SYSID, Link, LinkError
 from fuzzoff.sitl.recorder import TlogRecorder
@@ -54,8 +54,12 @@ def run_scenario(
     params: dict[str, float] | None = None,
     env: dict[str, str] | None = None,
     log: Log = print,
+    vehicle: str | None = None,
 ) -> Outcome:
+    """Fly scenario ``name`` on its own vehicle, or on ``vehicle`` (``--vehicle``)."""
     scenario = SCENARIOS[name]
+    airframe = airframes.airframe_for(vehicle or scenario.vehicle)
+    env = airframes.boot_env(build, airframe.vehicle, env)
     params = {**scenario.params, **(params or {})}
     out_dir.mkdir(parents=True, exist_ok=True)
     stem = f"{name}-{build.release}"
@@ -75,7 +79,12 @@ def run_scenario(
     finally:
         session.px4.cleanup()
     outcome.verdict = compare(
-        tlog, _release_for_model(build.release), outcome.ulog, params, COMPANION_SYSID
+        tlog,
+        _release_for_model(build.release),
+        outcome.ulog,
+        params,
+        COMPANION_SYSID,
+        airframe.fuzzoff_vehicle,
     )
     return outcome
 

@@ -43,6 +43,8 @@ class Scenario:
     hazard_until: tuple[int, int] | None = None
     """The first PX4 release (major, minor) that does what the program means: there the run is
     context (a client relying on that release), not a hazard."""
+    vehicle: str = "quad"
+    """The SIH airframe it flies (``fuzzoff.sitl.airframes``; ``sitl run --vehicle`` overrides)."""
 
 
 def _offboard_takeoff(d: Driver, z: float = ALT, climb_s: float = 6.0) -> None:
@@ -193,6 +195,79 @@ def hold_with_unknown_sub_mode(d: Driver) -> None:
     d.land_and_wait()
 
 
+VTOL_MC_ALT = -20.0
+"""A standard VTOL climbs this high in MC before the transition (NED)."""
+VTOL_FW_POINT = (400.0, 0.0, -30.0)
+"""Where it flies in FW: far enough that it is still on its way when the run ends."""
+VTOL_FW_S = 15.0
+
+
+def _vtol_to_fw(d: Driver) -> None:
+    """MC offboard takeoff to 20 m, then DO_VTOL_TRANSITION to FW while in OFFBOARD, streaming
+    a full position setpoint (1.14-1.17 fly FW offboard only on all three components)."""
+    _offboard_takeoff(d, VTOL_MC_ALT, climb_s=10.0)
+    d.stream(d.position(0, 0, VTOL_MC_ALT), 0.5)
+    d.require(d.transition(to_fw=True), "DO_VTOL_TRANSITION to FW")
+    d.stream(d.position(*VTOL_FW_POINT), VTOL_FW_S)
+
+
+def _vtol_back_and_land(d: Driver) -> None:
+    d.transition(to_fw=False)
+    d.stream(d.position(*VTOL_FW_POINT), 6.0)
+    d.land_and_wait(60.0)
+
+
+def vtol_offboard(d: Driver) -> None:
+    _vtol_to_fw(d)
+    _vtol_back_and_land(d)
+
+
+def vtol_loss(d: Driver) -> None:
+    """A 2 s stream stop in each phase: hovering in MC, then cruising in FW."""
+    _offboard_takeoff(d, VTOL_MC_ALT, climb_s=10.0)
+    d.note("stream stops (MC)")
+    d.wait(2.0)
+    d.note("stream resumes (MC)")
+    d.stream(d.position(0, 0, VTOL_MC_ALT), 3.0)
+    d.require(d.transition(to_fw=True), "DO_VTOL_TRANSITION to FW")
+    d.stream(d.position(*VTOL_FW_POINT), 10.0)
+    d.note("stream stops (FW)")
+    d.wait(2.0)
+    d.note("stream resumes (FW)")
+    d.stream(d.position(*VTOL_FW_POINT), 4.0)
+    _vtol_back_and_land(d)
+
+
+def _rover_start(d: Driver) -> None:
+    d.stream(d.position(0, 0, 0), 1.5)
+    d.require(d.set_mode(NAV_OFFBOARD, "OFFBOARD"), "switch to OFFBOARD")
+    d.stream(d.position(0, 0, 0), 0.5)
+    d.require(d.arm(), "arm in OFFBOARD")
+
+
+def _rover_stop(d: Driver) -> None:
+    d.stream(d.velocity(0, 0, 0), 2.0)
+    d.disarm()
+    d.wait(0.5)
+
+
+def rover_offboard(d: Driver) -> None:
+    _rover_start(d)
+    d.stream(d.position(10, 0, 0), 10.0)
+    d.stream(d.velocity(1.0, 1.0, 0), 5.0)
+    _rover_stop(d)
+
+
+def rover_loss(d: Driver) -> None:
+    _rover_start(d)
+    d.stream(d.position(10, 0, 0), 6.0)
+    d.note("stream stops")
+    d.wait(3.0)
+    d.note("stream resumes")
+    d.stream(d.position(10, 0, 0), 4.0)
+    _rover_stop(d)
+
+
 SCENARIOS: dict[str, Scenario] = {
     s.name: s
     for s in (
@@ -317,6 +392,46 @@ SCENARIOS: dict[str, Scenario] = {
             "a mode request PX4 cannot honour: the vehicle stays in OFFBOARD",
             ("OFB205",),
         ),
+        Scenario(
+            "hex_offboard",
+            "hexacopter: stream, switch, arm, climb to 2.5 m, fly 3 m and back, land",
+            clean_offboard,
+            "clean",
+            vehicle="hex",
+        ),
+        Scenario(
+            "vtol_offboard",
+            "standard VTOL: offboard takeoff in MC to 20 m, DO_VTOL_TRANSITION to FW in OFFBOARD,"
+            " FW position setpoints, back to MC, land",
+            vtol_offboard,
+            "clean",
+            vehicle="vtol",
+        ),
+        Scenario(
+            "vtol_loss",
+            "standard VTOL: the stream stops 2 s hovering in MC, then 2 s cruising in FW",
+            vtol_loss,
+            "hazard",
+            "stream lost in OFFBOARD in each VTOL phase (failsafe, then back to OFFBOARD)",
+            ("OFB103",),
+            vehicle="vtol",
+        ),
+        Scenario(
+            "rover_offboard",
+            "Ackermann rover: offboard position setpoint 10 m north, then velocity, stop, disarm",
+            rover_offboard,
+            "clean",
+            vehicle="rover-ackermann",
+        ),
+        Scenario(
+            "rover_loss",
+            "Ackermann rover: driving to a position setpoint, the stream stops 3 s and resumes",
+            rover_loss,
+            "hazard",
+            "stream lost in OFFBOARD (failsafe, then back to OFFBOARD)",
+            ("OFB103",),
+            vehicle="rover-ackermann",
+        ),
     )
 }
 
@@ -340,6 +455,18 @@ RELEASE_DEPENDENT = (
 )
 
 
+VEHICLE_RELEASES = ("1.17.0", "1.17.0-ros2-rover", "1.18.0-beta1-head", "main-2026-08-13")
+"""The bundles the other vehicles' scenarios run on (the hexacopter and the rover came with
+1.17.0's SIH; the rover flies only where the bundle has its module: ``airframes.why_not``)."""
+
+
 def scenarios_for(release: str) -> list[str]:
-    """The scenarios the matrix runs on ``release``."""
-    return list(SCENARIOS) if release in EVERY_SCENARIO_ON else list(RELEASE_DEPENDENT)
+    """The multicopter scenarios the matrix runs on ``release``."""
+    if release in EVERY_SCENARIO_ON:
+        return [name for name, s in SCENARIOS.items() if s.vehicle == "quad"]
+    return list(RELEASE_DEPENDENT)
+
+
+def vehicle_scenarios() -> list[str]:
+    """The scenarios of the other vehicles (run where ``airframes.why_not`` allows)."""
+    return [name for name, s in SCENARIOS.items() if s.vehicle != "quad"]

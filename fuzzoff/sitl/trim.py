@@ -3,18 +3,47 @@
 pyulog loads only ``fuzzoff.formats.ulog.reader.LOADED_TOPICS`` and writes them back with
 ``ULog.write_ulog``: header, info, parameters and logged messages (PX4's own texts, such as
 "Disarming denied: not landed") are kept, as ``corpora/real/cut.py`` does for public logs.
+A long flight (a VTOL's transition and cruise) also thins PX4's fastest estimator and
+controller topics (``FAST_TOPICS``, 50-250 Hz) to one sample per ``thin_s``; the keep-alive,
+setpoint, mode and command topics are always kept whole.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 from pyulog import ULog
 
 from fuzzoff.formats.ulog.reader import LOADED_TOPICS
 
+FAST_TOPICS = frozenset(
+    {
+        "vehicle_local_position",
+        "vehicle_rates_setpoint",
+        "vehicle_thrust_setpoint",
+        "vehicle_torque_setpoint",
+        "vehicle_attitude_setpoint",
+    }
+)
 
-def trim(source: Path, target: Path) -> Path:
+
+def _thinned(timestamps: np.ndarray, every_us: int) -> np.ndarray:
+    """Indices keeping the first sample of each ``every_us`` slot (and the last sample)."""
+    slots = timestamps.astype(np.int64) // every_us
+    keep = np.flatnonzero(np.diff(slots, prepend=-1) != 0)
+    if len(timestamps) and keep[-1] != len(timestamps) - 1:
+        keep = np.append(keep, len(timestamps) - 1)
+    return keep
+
+
+def trim(source: Path, target: Path, thin_s: float | None = None) -> Path:
     log = ULog(str(source), message_name_filter_list=list(LOADED_TOPICS))
+    if thin_s is not None:
+        every_us = round(thin_s * 1e6)
+        for dataset in log.data_list:
+            if dataset.name in FAST_TOPICS and len(dataset.data["timestamp"]):
+                keep = _thinned(dataset.data["timestamp"], every_us)
+                dataset.data = {k: v[keep] for k, v in dataset.data.items()}
     log.write_ulog(str(target))
     return target

@@ -91,13 +91,14 @@ class Verdict:
 
 
 def model_rows(
-    tlog: Path, release: str, params: dict[str, float]
+    tlog: Path, release: str, params: dict[str, float], vehicle: str = "mc"
 ) -> tuple[list[dict[str, Any]], list[str]]:
-    """The gate model's timeline for the autopilot in ``tlog`` (``fuzzoff gate``'s rows)."""
+    """The gate model's timeline for the autopilot in ``tlog`` (``fuzzoff gate``'s rows), for
+    the vehicle PX4 flew (``fuzzoff.sitl.airframes``: a rover disarms anywhere)."""
     from fuzzoff.gate_timeline import gate_report
 
-    overrides: dict[str, Any] = {"px4": release, "vehicle": "mc"}
-    if params:  # as `fuzzoff gate --px4 RELEASE --vehicle mc --param NAME=VALUE...` has them
+    overrides: dict[str, Any] = {"px4": release, "vehicle": vehicle}
+    if params:  # as `fuzzoff gate --px4 RELEASE --vehicle V --param NAME=VALUE...` has them
         overrides["params"] = {name.upper(): float(value) for name, value in params.items()}
     settings = load_settings(Path.cwd(), overrides, per_recording=True)
     report, rows = gate_report(str(tlog), settings, controllers=False)
@@ -157,6 +158,7 @@ def compare(
     ulog: Path | None = None,
     params: dict[str, float] | None = None,
     client_sysid: int | None = None,
+    vehicle: str = "mc",
 ) -> Verdict:
     params = params or {}
     view = read_tlog(tlog)
@@ -165,7 +167,7 @@ def compare(
         verdict.problems.append(f"{tlog}: no TIMESYNC or SYSTEM_TIME from PX4: times unknown")
         return verdict
     offset = view.offset
-    rows, problems = model_rows(tlog, release, params)
+    rows, problems = model_rows(tlog, release, params, vehicle)
     verdict.problems += problems
     for r in rows:
         r["px4_t"] = r["time_s"] + offset

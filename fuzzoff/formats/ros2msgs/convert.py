@@ -304,6 +304,11 @@ def _status(fields: frozenset[str], vehicle: str, origin: Origin) -> Builder:
             failsafe=m.failsafe,
             vehicle_type=m.vehicle_type,
             is_vtol=m.is_vtol,
+            vtol_phase=(
+                ev.vtol_phase_of(m.vehicle_type, getattr(m, "in_transition_mode", None))
+                if m.is_vtol
+                else None
+            ),
         )
 
     return build

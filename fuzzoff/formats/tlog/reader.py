@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any, BinaryIO
 
 from fuzzoff.events import (
+    MAV_VTOL_STATE_PHASE,
     NOWHERE,
     Command,
     CommandAck,
@@ -31,6 +32,7 @@ from fuzzoff.events import (
     VehicleInfo,
     VehiclePosition,
     VehicleStatus,
+    VtolPhase,
     Where,
 )
 from fuzzoff.findings import RecordingStats
@@ -47,7 +49,7 @@ from fuzzoff.mavlink_ids import (
     MAV_TYPE_GCS,
 )
 from fuzzoff.modes import custom_mode_to_nav_state, nav_state_name, split_custom_mode
-from fuzzoff.profiles import MAV_TYPE_VEHICLE
+from fuzzoff.profiles import MAV_TYPE_VEHICLE, ROVER_ASSUMED
 from fuzzoff.recording import (
     POSITION_PERIOD_S,
     RecordingInfo,
@@ -146,6 +148,13 @@ def param_value(value: float, param_type: int) -> float:
     return float(value)
 
 
+ROVER_KIND_UNSAID = (
+    f"a rover (HEARTBEAT type 10, MAV_TYPE_GROUND_ROVER) but not which kind (assumed"
+    f" {ROVER_ASSUMED}; set --vehicle rover-ackermann, rover-differential or rover-mecanum)"
+)
+"""PX4 sends type 10 for its Ackermann, differential and mecanum rovers alike."""
+
+
 def _text(raw: Any) -> str:
     if isinstance(raw, bytes):
         return raw.split(b"\x00", 1)[0].decode("utf-8", errors="replace")
@@ -210,6 +219,8 @@ class TlogSource(Source):
                     autopilots.add(sender)
                 if sender in autopilots and info.vehicle_type is None:
                     info.vehicle_type = MAV_TYPE_VEHICLE.get(msg.type)
+                    if info.vehicle_type == ROVER_ASSUMED:
+                        info.vehicle_assumed = ROVER_KIND_UNSAID
             elif msgid == AUTOPILOT_VERSION and sender[1] == MAV_COMP_ID_AUTOPILOT1:
                 autopilots.add(sender)
                 if info.px4_version is None:
@@ -388,6 +399,9 @@ class _Decoder:
             EXTENDED_SYS_STATE: self._extended_sys_state,
         }
         self.landed: dict[int, bool | None] = {}
+        self.vtol_phase: dict[int, VtolPhase | None] = {}
+        """The newest ``EXTENDED_SYS_STATE.vtol_state`` per system, given to its HEARTBEAT's
+        status (PX4 sends both about once a second)."""
         """Vehicle sysid -> on the ground, as last said (events only on a change)."""
         self.manual: dict[int, bool] = {}
         """Vehicle sysid -> manual control present, as last said (events only on a change)."""
@@ -592,6 +606,7 @@ class _Decoder:
                 nav_state=nav_state,
                 mode=nav_state_name(nav_state),
                 armed=bool(m.base_mode & MAV_MODE_FLAG_SAFETY_ARMED),
+                vtol_phase=self.vtol_phase.get(sysid),
             )
         )
         return out
@@ -688,6 +703,7 @@ class _Decoder:
         if not self._from_autopilot(m):
             return self._ignore(m, "not from an autopilot")
         sysid = m.get_srcSystem()
+        self.vtol_phase[sysid] = MAV_VTOL_STATE_PHASE.get(getattr(m, "vtol_state", 0))
         state = m.landed_state
         landed = (
             None if state == MAV_LANDED_STATE_UNDEFINED else state == MAV_LANDED_STATE_ON_GROUND

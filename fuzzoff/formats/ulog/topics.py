@@ -341,7 +341,7 @@ def _intentions(c: Chunk, ctx: Context) -> list[int | None]:
 def vehicle_status(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
     arming = c.i("arming_state")
     armed = [a in (2, 3) if ctx.legacy_arming else a == 2 for a in arming]
-    for t, w, ts, nav, arm, intention, failsafe, vtype, vtol in zip(
+    for t, w, ts, nav, arm, intention, failsafe, vtype, vtol, transition in zip(
         c.t,
         c.where,
         c.ts,
@@ -351,6 +351,7 @@ def vehicle_status(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
         c.ob("failsafe"),
         _vehicle_types(c),
         c.ob("is_vtol"),
+        c.ob("in_transition_mode"),
         strict=True,
     ):
         yield ev.VehicleStatus(
@@ -365,6 +366,7 @@ def vehicle_status(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
             failsafe=failsafe,
             vehicle_type=vtype,
             is_vtol=vtol,
+            vtol_phase=ev.vtol_phase_of(vtype, transition) if vtol else None,
         )
 
 

@@ -1,0 +1,93 @@
+"""Which vehicle a SITL run flies: PX4's SIH airframes, and whether a build can fly each.
+
+PX4 picks the simulated airframe at boot from ``PX4_SIM_MODEL`` (the name of a file under
+``etc/init.d-posix/airframes/``, after its number). A build can fly an airframe when it ships
+that file and, for a rover, was built with the rover's module (``bin/commands.txt``); a few
+builds have an airframe that does not fly, each said here with the reason.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from fuzzoff.sitl import bundle
+
+
+@dataclass(frozen=True, slots=True)
+class Airframe:
+    vehicle: str
+    """What ``--vehicle`` takes."""
+    model: str
+    """``PX4_SIM_MODEL``: the SIH airframe."""
+    fuzzoff_vehicle: str
+    """The vehicle type the gate model and the rules judge it as (``fuzzoff profiles``)."""
+    module: str | None = None
+    """A PX4 module the build needs beside the airframe file."""
+
+
+AIRFRAMES: dict[str, Airframe] = {
+    a.vehicle: a
+    for a in (
+        Airframe("quad", "sihsim_quadx", "mc"),
+        Airframe("hex", "sihsim_hex", "mc"),
+        Airframe("fw", "sihsim_airplane", "fw"),
+        Airframe("tailsitter", "sihsim_xvert", "vtol"),
+        Airframe("vtol", "sihsim_standard_vtol", "vtol"),
+        Airframe("rover-ackermann", "sihsim_rover_ackermann", "rover-ackermann", "rover_ackermann"),
+    )
+}
+DEFAULT = "quad"
+
+DOES_NOT_FLY: dict[tuple[str, str], str] = {
+    (
+        "main",
+        "sihsim_rover_ackermann",
+    ): "the Ackermann rover on main (2026-08-13) stalls PX4's simulated clock after the arm"
+    " (SIH lockstep waits for actuator outputs the rover controller sends at 100 Hz: 40 ms of"
+    " PX4 time in 60 s); fly it on 1.17.0-ros2-rover or 1.18.0-beta1-head"
+}
+"""(bundle name prefix, airframe) -> why that build cannot fly it, though it has it."""
+
+
+class AirframeError(bundle.BundleError):
+    """A vehicle the build cannot fly: one line for the user."""
+
+
+def airframe_for(vehicle: str) -> Airframe:
+    try:
+        return AIRFRAMES[vehicle]
+    except KeyError:
+        raise AirframeError(
+            f"--vehicle {vehicle}: no such SITL vehicle; one of {', '.join(AIRFRAMES)}"
+        ) from None
+
+
+def why_not(build: bundle.Build, airframe: Airframe) -> str | None:
+    """Why ``build`` cannot fly ``airframe`` (None: it can)."""
+    folder = build.folder / "etc" / "init.d-posix" / "airframes"
+    if not any(p.name.endswith("_" + airframe.model) for p in folder.glob("*")):
+        return f"PX4 {build.release} has no SIH airframe {airframe.model}"
+    if airframe.module is not None:
+        commands = build.folder / "bin" / "commands.txt"
+        text = commands.read_text(errors="replace") if commands.exists() else ""
+        names = set(text.split())
+        if not {airframe.module, f"px4-{airframe.module}"} & names:
+            return f"PX4 {build.release} was built without the {airframe.module} module"
+    for (prefix, model), reason in DOES_NOT_FLY.items():
+        if model == airframe.model and build.folder.name.startswith(prefix):
+            return reason
+    return None
+
+
+def boot_env(
+    build: bundle.Build, vehicle: str, env: dict[str, str] | None = None
+) -> dict[str, str]:
+    """``env`` with what makes PX4 boot ``vehicle`` (``PX4_SIM_MODEL``); ``AirframeError``
+    when the build cannot fly it. The default quadrotor adds nothing (PX4's own default)."""
+    airframe = airframe_for(vehicle)
+    reason = why_not(build, airframe)
+    if reason is not None:
+        raise AirframeError(f"--vehicle {vehicle}: {reason}")
+    if vehicle == DEFAULT:
+        return dict(env or {})
+    return {**(env or {}), "PX4_SIM_MODEL": airframe.model}

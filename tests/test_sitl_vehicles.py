@@ -1,0 +1,158 @@
+"""Issue 33: the other vehicles PX4 flies offboard, on the SITL bundles (no PX4 started here).
+
+Which vehicle a run boots (``--vehicle``, ``PX4_SIM_MODEL``), which builds can fly it and why
+not, and the recordings of each kept under 1 MB.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from fuzzoff.sitl import airframes, bundle
+from fuzzoff.sitl.scenarios import SCENARIOS, scenarios_for, vehicle_scenarios
+from tests.helpers import run_cli
+
+CORPORA = Path(__file__).resolve().parents[1] / "corpora"
+
+
+def _bundle(root: Path, name: str, models: list[str], modules: list[str]) -> bundle.Build:
+    folder = root / name
+    (folder / "bin").mkdir(parents=True)
+    (folder / "bin" / "px4").write_bytes(b"")
+    (folder / "bin" / "commands.txt").write_text("".join(f"px4-{m}\n" for m in modules))
+    frames = folder / "etc" / "init.d-posix" / "airframes"
+    frames.mkdir(parents=True)
+    for number, model in enumerate(models, 10040):
+        (frames / f"{number}_{model}").write_text("")
+    return bundle.Build(folder, name)
+
+
+def test_a_vehicle_boots_its_sih_airframe_and_the_quad_changes_nothing(tmp_path: Path) -> None:
+    build = _bundle(tmp_path, "1.17.0", ["sihsim_quadx", "sihsim_standard_vtol"], ["commander"])
+    assert airframes.boot_env(build, "vtol") == {"PX4_SIM_MODEL": "sihsim_standard_vtol"}
+    assert airframes.boot_env(build, "quad", {"PX4_SIM_SPEED_FACTOR": "2"}) == {
+        "PX4_SIM_SPEED_FACTOR": "2"
+    }
+
+
+def test_a_build_without_the_airframe_or_the_rover_module_says_why(tmp_path: Path) -> None:
+    old = _bundle(tmp_path, "1.16.2", ["sihsim_quadx"], ["commander"])
+    with pytest.raises(airframes.AirframeError, match="no SIH airframe sihsim_hex"):
+        airframes.boot_env(old, "hex")
+    plain = _bundle(tmp_path, "1.17.0", ["sihsim_rover_ackermann"], ["commander"])
+    with pytest.raises(airframes.AirframeError, match="without the rover_ackermann module"):
+        airframes.boot_env(plain, "rover-ackermann")
+    rover = _bundle(tmp_path, "1.18.0-beta1-head", ["sihsim_rover_ackermann"], ["rover_ackermann"])
+    assert airframes.boot_env(rover, "rover-ackermann")["PX4_SIM_MODEL"] == "sihsim_rover_ackermann"
+
+
+def test_mains_rover_is_refused_with_the_reason(tmp_path: Path) -> None:
+    main = _bundle(tmp_path, "main-2026-08-13", ["sihsim_rover_ackermann"], ["rover_ackermann"])
+    with pytest.raises(airframes.AirframeError, match="stalls PX4's simulated clock"):
+        airframes.boot_env(main, "rover-ackermann")
+
+
+def test_sitl_run_names_an_unknown_vehicle_in_one_line() -> None:
+    out = run_cli(["sitl", "run", "clean_offboard", "--release", "1.17.0", "--vehicle", "blimp"])
+    assert out.returncode == 2
+    assert "--vehicle blimp: no such SITL vehicle" in out.stderr
+    assert len(out.stderr.strip().splitlines()) == 1
+
+
+def test_sitl_list_shows_the_vehicles_and_their_airframes() -> None:
+    out = run_cli(["sitl", "list"]).stdout
+    assert "rover-ackermann" in out and "PX4_SIM_MODEL=sihsim_standard_vtol" in out
+    assert "vtol_offboard" in out and "rover_loss" in out
+
+
+def test_the_multicopter_matrix_keeps_its_scenarios_and_the_others_fly_their_vehicle() -> None:
+    assert all(SCENARIOS[name].vehicle == "quad" for name in scenarios_for("1.16.2"))
+    assert {SCENARIOS[name].vehicle for name in vehicle_scenarios()} == {
+        "hex",
+        "vtol",
+        "rover-ackermann",
+    }
+
+
+def test_thinning_cuts_the_fast_topics_and_keeps_the_stream_whole(tmp_path: Path) -> None:
+    from pyulog import ULog
+
+    from fuzzoff.sitl.trim import trim
+
+    source = CORPORA / "sitl" / "hold_with_unknown_sub_mode-1.18.0-beta1-head.ulg"
+    thin = trim(source, tmp_path / "thin.ulg", thin_s=0.1)
+
+    def counts(path: Path) -> dict[str, int]:
+        return {d.name: len(d.data["timestamp"]) for d in ULog(str(path)).data_list}
+
+    before, after = counts(source), counts(thin)
+    assert after["offboard_control_mode"] == before["offboard_control_mode"]
+    assert after["trajectory_setpoint"] == before["trajectory_setpoint"]
+    assert after["vehicle_local_position"] < before["vehicle_local_position"] / 5
+    assert thin.stat().st_size < source.stat().st_size
+    lint = run_cli(["lint", str(thin), "--format", "json"])
+    assert lint.returncode == run_cli(["lint", str(source), "--format", "json"]).returncode
+
+
+SITL = CORPORA / "sitl"
+
+
+def _phases(path: Path) -> list[str]:
+    """The VTOL phases a recording's statuses go through, in order, each once per stretch."""
+    from fuzzoff.events import VehicleStatus
+    from fuzzoff.formats import open_source
+
+    seen: list[str] = []
+    with open_source(path) as source:
+        for event in source.events():
+            phase = event.vtol_phase if isinstance(event, VehicleStatus) else None
+            if phase is not None and (not seen or seen[-1] != phase):
+                seen.append(phase)
+    return seen
+
+
+@pytest.mark.parametrize("suffix", [".ulg", ".tlog"])
+def test_a_real_vtols_phase_is_read_at_each_moment(suffix: str) -> None:
+    """PX4 1.17's standard VTOL: MC takeoff, transition to FW in OFFBOARD and back (ULog
+    vehicle_status, tlog EXTENDED_SYS_STATE.vtol_state)."""
+    phases = _phases(SITL / f"vtol_offboard-1.17.0{suffix}")
+    assert phases == ["mc", "transition", "fw", "transition", "mc"]
+
+
+def test_px4s_own_transition_setpoints_are_not_the_clients() -> None:
+    """During a transition PX4's transition flight task writes trajectory_setpoint (velocity)
+    in OFFBOARD: the ULog of a clean VTOL flight on position setpoints has no OFB401."""
+    out = run_cli(["lint", str(SITL / "vtol_offboard-1.17.0.ulg"), "--format", "json"])
+    codes = {f["code"] for f in json.loads(out.stdout)["files"][0]["findings"]}
+    assert "OFB401" not in codes
+    assert out.returncode == 0
+
+
+def test_a_rovers_tlog_says_rover_but_not_which_kind_and_its_ulog_says_ackermann() -> None:
+    """PX4 sends HEARTBEAT type 10 for every rover: the tlog's kind is assumed and said
+    (OFB003); the ULog's rover topics tell the Ackermann drive."""
+    tlog = run_cli(
+        ["lint", str(SITL / "rover_offboard-1.18.0-beta1-head.tlog"), "--format", "json"]
+    )
+    (report,) = json.loads(tlog.stdout)["files"]
+    assumed = [f for f in report["findings"] if f["code"] == "OFB003"]
+    assert assumed and "not which kind" in assumed[0]["message"]
+    ulog = run_cli(["lint", str(SITL / "rover_offboard-1.18.0-beta1-head.ulg")])
+    assert "rover-ackermann detected" in ulog.stdout
+
+
+@pytest.mark.parametrize(
+    ("stem", "vehicle"),
+    [
+        ("hex_offboard-1.17.0", "mc detected"),
+        ("hex_offboard-1.18.0-beta1-head", "mc detected"),
+        ("vtol_offboard-1.18.0-beta1-head", "vtol detected"),
+    ],
+)
+def test_each_real_vehicle_is_detected_from_its_recordings(stem: str, vehicle: str) -> None:
+    for suffix in (".tlog", ".ulg"):
+        out = run_cli(["lint", str(SITL / f"{stem}{suffix}")])
+        assert vehicle in out.stdout.splitlines()[0]
