@@ -334,6 +334,18 @@ def test_ofb203_the_stream_resuming_after_a_loss_until_px4_returns_is_info() -> 
     assert found.severity is Severity.INFO and found.time_s == pytest.approx(5.001)
 
 
+def test_ofb203_px4s_offboard_again_after_a_landing_disarm_is_no_run_up() -> None:
+    """Issue 28 miss 1: a stream through AUTO_LAND; PX4 disarms after the landing and its
+    status shows OFFBOARD again (the user intention, disarmed): the armed stretch fought the
+    land task, whatever status follows the disarm."""
+    events = [status(0.0, OFFBOARD), *ocm(every(0.0, 9.0, 0.1))]
+    events += _repeat(0.0, 9.0, 10.0, position=(0.0, 0.0, -5.0))
+    events += [status(2.02, 18), status(8.05, OFFBOARD, armed=False)]
+    (found,) = codes(lint_events(events), "OFB203")
+    assert found.severity is Severity.ERROR and "AUTO_LAND" in found.summary
+    assert found.time_s == pytest.approx(2.1) and found.end_s == pytest.approx(8.0)
+
+
 def test_ofb203_an_external_mode_is_the_companions_own() -> None:
     """px4-ros2-interface-lib modes publish their setpoints while PX4 runs them (EXTERNAL1)."""
     events = [status(0.0, 23), *_repeat(0.0, 5.0, 20.0, velocity=(1.0, 0.0, 0.0))]

@@ -20,7 +20,7 @@ of these topics lacks) and OFB701 (the loss parameters assumed, at the offboard 
 * ``switch_rejected``: the ack says TEMPORARILY_REJECTED: OFB201, and OFB202 as the gate model
   expected PX4 1.15 to accept a switch after 2 s of stream.
 * ``wrong_release_payload``: the good flight whose VehicleControlMode payloads are 1.15's while
-  the embedded definitions are 1.18's (profile main): OFB001 at its first message (never
+  the embedded definitions are 1.18's (profile 1.18): OFB001 at its first message (never
   decoded half-right); exit status 2, the other topics' findings kept.
 * ``truncated``: the stream-lost flight cut in its last chunk: OFB001 (no footer), exit status
   2; the findings of the readable part (OFB101, OFB103) are kept.
@@ -148,7 +148,7 @@ def main() -> None:
         [finding("OFB001", "error", 0.25), *CONTEXT],
         exit_status=2,
         complete=False,
-        px4="main",
+        px4="1.18",
     )
 
     path = write_mcap(HERE / "truncated.mcap", lost.events(), release=RELEASE, chunk_size=2048)

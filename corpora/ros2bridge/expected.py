@@ -29,6 +29,8 @@ RECORDINGS = ("-mcap", "-sqlite3", ".ulg")
 NOT_IN_ULOG = {
     "OFB203": "a ULog's trajectory_setpoint holds PX4's own setpoints in its own modes beside"
     " the client's, so OFB203 is not checkable there (OFB002 says so); the bags show it",
+    "OFB208": "a command that never reached PX4 leaves no trace in its ULog (its vehicle_command"
+    " holds what PX4 received); the bags show it",
 }
 """Hazard code -> why PX4's ULog cannot show it."""
 

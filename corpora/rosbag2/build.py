@@ -7,7 +7,7 @@ against the rule texts. Every flight is on a multicopter; each carries the conte
 (OFB305 needs estimator flags these topics lack) and OFB701 (loss parameters assumed) at the
 offboard request.
 
-* ``good_flight_sqlite3``: PX4 1.18 (profile main; versioned topics ``vehicle_status_v4``,
+* ``good_flight_sqlite3``: PX4 1.18 (profile 1.18; versioned topics ``vehicle_status_v4``,
   ``vehicle_command_ack_v1``), the good flight; nothing else.
 * ``stream_lost_mcap``: mcap storage, PX4 1.15, the program stalls 3.55 s in offboard and the
   status shows POSCTL from 7.0 s: OFB101 error and OFB103 at 7.01 s.
@@ -71,7 +71,7 @@ def fresh(name: str) -> Path:
 
 def main() -> None:
     write_rosbag2(fresh("good_flight_sqlite3"), Flight().events(), release="main")
-    write_expected("good_flight_sqlite3", context(), px4="main", exit_status=0)
+    write_expected("good_flight_sqlite3", context(), px4="1.18", exit_status=0)
 
     lost = Flight(gaps=[(6.0, 9.5)], lost_mode_at=7.0)
     write_rosbag2(fresh("stream_lost_mcap"), lost.events(), storage="mcap", release="1.15")

@@ -102,6 +102,16 @@ class Flight:
         return sorted(out, key=lambda e: e.t)
 
 
+def arm_lost(events: list[Event]) -> list[Event]:
+    """The flight whose ARM never reached PX4: no ack for it, the vehicle stays disarmed."""
+    out: list[Event] = []
+    for event in events:
+        if isinstance(event, CommandAck) and event.command == 400:
+            continue
+        out.append(replace(event, armed=False) if isinstance(event, VehicleStatus) else event)
+    return out
+
+
 def climb(t: float) -> list[Event]:
     """Position control: up to 5 m, then a slow circle (the content changes every message)."""
     z = -min(5.0, max(0.5, 2.0 * (t - SWITCH_T)))
@@ -458,6 +468,25 @@ def mcap_cases() -> list[Case]:
             Flight({"body_rate": True}, yaw_nan).events(),
             [("OFB408", "error", 4.0)],
             [],
+        )
+    )
+    # OFB208 (command-unanswered): the ARM never reaches PX4 (issue 28 miss 3): no ack, the
+    # vehicle stays disarmed in OFFBOARD
+    cases.append(
+        Case(
+            "ofb208_command_unanswered",
+            arm_lost(Flight(POSITION, climb).events()),
+            # and the gate model, which took the arm, disagrees with the disarmed status
+            [("OFB208", "error", ARM_T), ("OFB202", "warning", 3.6)],
+            [],
+        )
+    )
+    cases.append(
+        Case(
+            "good_ofb208_command_unanswered",
+            Flight(POSITION, climb).events(),
+            [],
+            ["OFB208"],
         )
     )
     # -- scripts/add_rule.py adds a new rule's cases above this line

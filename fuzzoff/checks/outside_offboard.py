@@ -9,7 +9,8 @@ vehicle in another mode. While disarmed nothing flies them, and the stream that 
 offboard request (the switch needs it: px4_ros_com publishes from its first cycle) or that
 resumes after a loss until PX4 returns to OFFBOARD by itself lasts only until PX4 switches: both
 are ``info``. An armed stretch is judged when its fate is known: a request or the entry into
-OFFBOARD while the keep-alive stream that carried it is unbroken makes it a run-up (``info``); a
+OFFBOARD while the keep-alive stream that carried it is unbroken makes it a run-up (``info``),
+an entry while disarmed does not (PX4 shows OFFBOARD again as it disarms after a landing); a
 break of that stream (a keep-alive gap PX4 takes for a loss: the loss timeout or more), a disarm
 or the end of the recording before either makes it an ``error`` (a request that finds the stream
 already broken is no run-up either). An external mode (nav_state EXTERNAL1-8, a ROS 2 mode of
@@ -78,7 +79,7 @@ class SetpointsOutsideOffboard(Check):
             return
         if self._owned():
             if self.run is not None:  # _settle's own test, without the call on every message
-                self._settle(entered=self.ctx.in_offboard, t=event.t)
+                self._settle(entered=self._entered(), t=event.t)
             return
         if isinstance(event, Command):
             request = event.is_offboard_switch or (event.is_arm and self.ctx.offboard_selected())
@@ -120,7 +121,7 @@ class SetpointsOutsideOffboard(Check):
             setpoints = [e for e in setpoints if e.origin == "sent"]
         if self._owned():
             if self.run is not None:
-                self._settle(entered=self.ctx.in_offboard, t=setpoints[0].t)
+                self._settle(entered=self._entered(), t=setpoints[0].t)
             return
         self._add(setpoints[0], len(setpoints), setpoints[-1])
         run = self.run
@@ -136,6 +137,12 @@ class SetpointsOutsideOffboard(Check):
         if self.ctx.in_offboard:
             return True
         return state.mode_recorded and state.nav_state in EXTERNAL_MODES
+
+    def _entered(self) -> bool:
+        """Does the stretch end by entering OFFBOARD? Only armed: after a disarm (PX4 shows
+        OFFBOARD again as it disarms after a landing, its user intention) the armed stretch
+        ended with the disarm, not with a run-up."""
+        return self.ctx.in_offboard and is_armed(self.ctx)
 
     def _keepalive(self, t: float) -> None:
         last = self.last_keepalive

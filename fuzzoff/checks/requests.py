@@ -9,6 +9,10 @@ receiver's ACCEPTED and then Commander's verdict a few ms later): an ack within
 never the receiver's, and a ROS 2 command does not pass the MAVLink receiver: then the next
 ack belongs to the next command. The finding carries the gate
 model's reason for the rejection, or says that the model expected acceptance.
+
+An arm is an offboard request when OFFBOARD is selected, or when a switch to OFFBOARD went
+within ``ACK_WAIT_S`` before it and no ack rejected that: a client sends the two at once and
+PX4's status shows OFFBOARD only after it answered both (issue 28 miss 2).
 """
 
 from __future__ import annotations
@@ -52,6 +56,9 @@ class RequestRejected(Check):
         self.seen_ack = False
         self.unconfirmed = False
         """A request the model accepts could not be confirmed: there are no acks."""
+        self.switch: tuple[Command, bool] | None = None
+        """The latest mode switch, and whether it can still be a switch to OFFBOARD (it is one
+        and no ack rejected it)."""
         self.verdicts: dict[int, GateTransition] = {}
         """The gate's answer to a command, keyed by the command's id: the engine dispatches the
         gate's transitions before the event that caused them."""
@@ -67,8 +74,10 @@ class RequestRejected(Check):
             what = None
             if event.is_offboard_switch:
                 what = "switch to OFFBOARD"
-            elif event.is_arm and self.ctx.offboard_selected():
+            elif event.is_arm and (self.ctx.offboard_selected() or self._switching(event.t)):
                 what = "arm in OFFBOARD"
+            if event.is_mode_switch:
+                self.switch = (event, event.is_offboard_switch)
             if what is None and not (event.is_mode_switch or event.is_arm or event.is_disarm):
                 return
             queue = self.requests.setdefault(event.command, [])
@@ -78,6 +87,14 @@ class RequestRejected(Check):
         elif isinstance(event, CommandAck):
             self.seen_ack = True
             self._ack(event)
+
+    def _switching(self, t: float) -> bool:
+        """Is a switch to OFFBOARD on its way (sent within ``ACK_WAIT_S``, not rejected)? An arm
+        sent right after it is meant for OFFBOARD whatever the recorded status still shows: a
+        client sends both at once (px4_ros_com's examples 0.4 ms apart) and PX4's status
+        follows some 10 ms later, its answer to the arm before or after it."""
+        switch = self.switch
+        return switch is not None and switch[1] and t - switch[0].t <= ACK_WAIT_S
 
     def _ack(self, ack: CommandAck) -> None:
         queue = self.requests.get(ack.command)
@@ -160,6 +177,8 @@ class RequestRejected(Check):
     def _judge(self, request: _Request) -> None:
         ack = request.ack
         assert ack is not None
+        if not ack.accepted and self.switch is not None and self.switch[0] is request.command:
+            self.switch = (request.command, False)
         if ack.accepted or request.what is None:
             return
         verdict = request.verdict

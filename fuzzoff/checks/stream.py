@@ -435,7 +435,7 @@ class StreamBeforeRequest(Check):
         elif not fresh:
             stream = f"{t - last:.2f} s after the last keep-alive{accepted}"
         else:
-            stream = f"after {t - (run_start or t):.2f} s of keep-alive"
+            stream = f"after {t - (t if run_start is None else run_start):.2f} s of keep-alive"
         short = f"{what} {stream} (docs: {self.min_stream:g} s of it)"
         if brief:
             short += f"; {px4_label(self.ctx)} {brief}"

@@ -32,6 +32,11 @@ from fuzzoff.modes import nav_state_name
 NO_STREAM_SWITCH = "1.14+: no stream needed while disarmed, checked at arming"
 SAME_ITERATION_S = 0.012
 """A request and a flag logged this close were handled in one Commander iteration (10 ms)."""
+UNANSWERED_S = 0.1
+"""A request not answered yet when the flag turns available, this close to it, is handled by
+Commander after that check pass: its ack dates the handling (the ULog dates the command on
+receipt; PX4 1.16.2 handled an arm sent 0.4 ms before the first keep-alive 17 ms later, with
+the signal, in corpora/ros2bridge/example_no_setpoint)."""
 
 Before = tuple[int | None, bool | None]
 """(user intention, armed) before a request."""
@@ -83,6 +88,7 @@ class Requests:
         elif cmd.command == MAV_CMD_COMPONENT_ARM_DISARM:
             target = None
         else:
+            s.compare.unjudged = cmd
             return True
         before = (s.user_intention, s.armed)
         address = command_addressing(s.release, cmd, s.rx.own_system, s.rx.own_component)
@@ -156,16 +162,20 @@ class Requests:
 
     def rejudge(self, t: float) -> None:
         """A switch or arm the model rejected for want of a signal, logged in the same
-        Commander iteration as PX4's flag turning available: Commander had the keep-alive the
-        logger missed (its forced check pass runs before it handles the command, 2.1.3; the
-        ULog dates the command on receipt and the flag on publication). Judged again."""
+        Commander iteration as PX4's flag turning available, or not answered yet when it turns:
+        Commander had the keep-alive the logger missed (its forced check pass runs before it
+        handles the command, 2.1.3; the ULog dates the command on receipt and the flag on
+        publication). Judged again."""
         s = self.s
         rejected, self.rejected_unseen = self.rejected_unseen, None
         if rejected is None:
             return
         cmd, target, before = rejected
-        if t - cmd.t > SAME_ITERATION_S or s.armed is None:
+        late = t - cmd.t
+        if s.armed is None or late > UNANSWERED_S:
             return
+        if late > SAME_ITERATION_S and s.compare.answered_between(cmd.command, cmd.t, t):
+            return  # answered before the flag turned: Commander judged it without the signal
         decision = self._decide(cmd, target, s.armed)
         if not decision.accepted:
             return
@@ -313,6 +323,7 @@ class Requests:
             return
         if s.armed is not True:
             s.armed_now(t)
+            s.unshown_arming = (t, True)
             note = f" ({decision.reason})" if decision.reason else ""
             s.emit(t, "arm_accepted", f"armed{note}", decision.spec, unverified=decision.unverified)
             self.mode.refresh(t, cause=None)
@@ -333,6 +344,7 @@ class Requests:
             return
         if s.armed is not False:
             s.disarmed_now()
+            s.unshown_arming = (t, False)
             note = f" ({decision.reason})" if decision.reason else ""
             s.emit(t, "disarmed", f"disarm requested{note}", decision.spec)
             self.mode.refresh(t)

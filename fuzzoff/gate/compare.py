@@ -84,6 +84,16 @@ class Comparator:
         self.ack_wait: AckWait | None = None
         self.last_command_t = -INF
         self.last_status: VehicleStatus | None = None
+        self.last_ack_t: dict[int, float] = {}
+        """The time of each command id's latest recorded ack."""
+        self.unjudged: Command | None = None
+        """The latest recorded command the model does not judge (NAV_LAND, RTL, ...): a mode
+        the recording shows right after it is its doing, adopted from the recording."""
+
+    def unjudged_before(self, t: float) -> Command | None:
+        """The unjudged command a recorded change at ``t`` follows, if recent."""
+        cmd = self.unjudged
+        return cmd if cmd is not None and 0.0 <= t - cmd.t <= COMMAND_WINDOW else None
 
     def sampled_keepalive(self) -> None:
         self.slack = self.base_slack + SAMPLED_SLACK
@@ -154,7 +164,12 @@ class Comparator:
         self.decisions[cmd.command] = Decided(cmd.t, decision, cmd, before, target, alternative)
         self.last_command_t = cmd.t
 
+    def answered_between(self, command: int, start: float, end: float) -> bool:
+        """Was an ack of ``command`` recorded at or after ``start`` and before ``end``?"""
+        return start <= self.last_ack_t.get(command, -INF) < end
+
     def ack(self, ack: CommandAck) -> None:
+        self.last_ack_t[ack.command] = ack.t
         decided = self.decisions.get(ack.command)
         if decided is None or ack.t - decided.t > DECISION_MAX_AGE:
             return

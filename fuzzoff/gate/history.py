@@ -19,6 +19,7 @@ from fuzzoff.gate.signal import INF
 from fuzzoff.gate.state import GateState
 from fuzzoff.gate.verdict import UnseenStream
 from fuzzoff.modes import nav_state_name
+from fuzzoff.tables.answered import command_name
 
 
 class RecordedHistory:
@@ -45,6 +46,8 @@ class RecordedHistory:
             return True
         s.compare.remember(status)
         self.unseen.lost_in(status)
+        if s.unshown_arming is not None and status.armed is s.unshown_arming[1]:
+            s.unshown_arming = None
         if status.armed is not None and s.armed is None:
             state = "armed" if status.armed else "disarmed"
             self.requests.resolve(status.t, status.armed, f"recorded: {state} at {status.t:.2f} s")
@@ -165,15 +168,47 @@ class RecordedHistory:
             s.terminated = intention == TERMINATION
             s.fallback = None
             changed.append(f"intention {nav_state_name(intention)}")
+        unshown = s.unshown_arming
+        if silent and unshown is not None and status.armed is not None:
+            s.unshown_arming = None
+            if changed and changed[0] in ("armed", "disarmed") and status.armed is not unshown[1]:
+                self._arming_contradicted(t, status, unshown)
+                changed = changed[1:]
         if changed and silent:
+            after = s.compare.unjudged_before(t)
+            why = (
+                "no command for it in the recording"
+                if after is None
+                else f"after {command_name(after.command)} at {after.t:.2f} s, a command the "
+                "model does not judge"
+            )
             s.emit(
                 t,
                 "mode",
-                "from the recording (no command for it in the recording): " + ", ".join(changed),
+                f"from the recording ({why}): " + ", ".join(changed),
                 "12",
                 cause=status,
             )
         self.mode.refresh(t, cause=status)
+
+    def _arming_contradicted(
+        self, t: float, status: VehicleStatus, unshown: tuple[float, bool]
+    ) -> None:
+        """The recording shows the other arming state than the model took on a command, and
+        never showed the model's: PX4 did not do what the model predicted (the command never
+        reached it, or it refused it without an ack). A disagreement, not a silent change."""
+        at, armed = unshown
+        model = "armed" if armed else "disarmed"
+        recorded = "disarmed" if armed else "armed"
+        self.s.emit(
+            t,
+            "disagreement",
+            f"recorded: {recorded} at {t:.2f} s, never {model} since the "
+            f"{'arm' if armed else 'disarm'} request at {at:.2f} s; model: {model}",
+            "12",
+            cause=status,
+            recorded_nav_state=status.nav_state,
+        )
 
     # -- a difference that outlasts the slack
 

@@ -94,6 +94,9 @@ class GateState:
     flag_pending: tuple[float, bool, FailsafeFlags] | None = None
     """A recorded verdict that differs from the model, waiting for the slack (time, recorded
     value, event)."""
+    unshown_arming: tuple[float, bool] | None = None
+    """The model's own arming change on a recorded command (time, armed) that no recorded
+    status has shown yet: a recording that then shows the other state contradicts it."""
     follows_flag: bool = False
     """Without the stream: PX4's verdict has been seen, and the signal follows it from then
     on (the mode history no longer decides it)."""

@@ -53,6 +53,16 @@ def folders() -> tuple[str, ...]:
     return tuple(out)
 
 
+def first_release_of(folder: str) -> str:
+    """The oldest release whose messages ``folder`` holds: the release a recording fitting only
+    that folder is called (``main`` holds 1.18's layouts: a bag of the 1.18 head is 1.18, as
+    its ULog says; main's own bags cannot be told from it by their messages)."""
+    for release in releases.RELEASES:
+        if release.msg_folder == folder:
+            return release.name
+    return folder
+
+
 @cache
 def definition(release: str, message: str) -> str | None:
     """The ``.msg`` text of ``message`` in ``release``, or None where that release lacks it."""
@@ -71,6 +81,11 @@ def message_version(text: str) -> int:
     """``MESSAGE_VERSION`` of a definition (0 when it has none)."""
     match = _VERSION.search(text)
     return int(match.group(1)) if match else 0
+
+
+def declares_version(text: str) -> bool:
+    """Does the definition declare ``MESSAGE_VERSION`` (PX4 1.16+ on versioned messages)?"""
+    return _VERSION.search(text) is not None
 
 
 @cache

@@ -297,6 +297,10 @@ class Ros2Decoding:
     """How many messages of each of ``unknown`` the recording holds, where the reader counted."""
     evidence: set[str] | None = None
     """Releases every definition seen so far fits (for profile detection)."""
+    by_text: set[str] | None = None
+    """Releases whose ``.msg`` text declares ``MESSAGE_VERSION`` as the recording's embedded
+    definitions do (or lack it as they do): where layouts are equal, the text tells 1.15 from
+    1.16+."""
     topic_fits: dict[str, set[str]] = field(default_factory=dict)
     """Per PX4 topic, the releases its name and its embedded definition fit (a definition
     fuzzoff chose for a bag without one is no evidence of what the sender was built with)."""
@@ -360,7 +364,9 @@ class Ros2Decoding:
                     f"{topic}: embedded definition not usable ({why}); bundled px4_msgs used"
                 )
                 return decoder
-            self._note_evidence(message, definition, decoder.topic)
+            self._note_evidence(
+                message, definition, decoder.topic, embedded if fmt == "msg" else None
+            )
             decoder.use(definition)
         return decoder
 
@@ -376,12 +382,21 @@ class Ros2Decoding:
             self._topic_fits(decoder.topic, fits)
             self.name_fits[decoder.topic] = fits
 
-    def _note_evidence(self, message: str, definition: Definition, topic: str = "") -> None:
+    def _note_evidence(
+        self, message: str, definition: Definition, topic: str = "", text: str | None = None
+    ) -> None:
+        """Narrow the releases to those whose bundled ``message`` has this layout. A ``.msg``
+        text (``text``, the recording's own) also tells where layouts are equal: 1.16 added
+        ``MESSAGE_VERSION`` to the messages it versions (``by_text``, a preference only)."""
         fits = {
             r
             for r in px4_msgs.releases_with(message)
             if bundled_layout(message, r) == definition.layout
         }
+        if text is not None:
+            declared = _declared_version(text)
+            same = {r for r in fits if _declared_version(_bundled_text(r, message)) == declared}
+            self.by_text = same if self.by_text is None else self.by_text & same
         self.evidence = fits if self.evidence is None else self.evidence & fits
         if topic:
             self._topic_fits(topic, fits)
@@ -469,19 +484,28 @@ class Ros2Decoding:
         self._note_evidence(decoder.message, chosen)
         return chosen, ""
 
+    def _fits(self) -> set[str] | None:
+        """The releases every layout and topic name fits, narrowed by the definitions' text
+        where that leaves any (a recording whose programs mix px4_msgs keeps its layouts')."""
+        if self.evidence and self.by_text and self.evidence & self.by_text:
+            return self.evidence & self.by_text
+        return self.evidence
+
     def detected_release(self) -> str | None:
         """The one release every embedded or chosen definition and every PX4 topic name fits,
         if exactly one."""
-        if self.evidence and len(self.evidence) == 1:
-            return next(iter(self.evidence))
+        fits = self._fits()
+        if fits and len(fits) == 1:
+            return next(iter(fits))
         return None
 
     def fitting_releases(self) -> list[str]:
         """The releases (oldest first) the definitions and topic names fit, where they narrow
         it to several: the release is then not known, but it is one of these."""
-        if not self.evidence or len(self.evidence) == 1:
+        fits = self._fits()
+        if not fits or len(fits) == 1:
             return []
-        return [r for r in px4_msgs.folders() if r in self.evidence]
+        return [r for r in px4_msgs.folders() if r in fits]
 
     def vehicle_from(self, decoder: Decoder | None, raw: bytes | memoryview) -> str | None:
         """The vehicle type one ``VehicleStatus`` payload names (None for anything else)."""
@@ -553,3 +577,16 @@ class Ros2Decoding:
 
 Decoder = TopicDecoder | MavrosTopicDecoder
 """What readers hold per connection: ``event(raw, t)``, plus counts for the problems."""
+
+
+def _bundled_text(release: str, message: str) -> str:
+    text = px4_msgs.definition(release, message)
+    assert text is not None
+    return text
+
+
+def _declared_version(text: str) -> int | None:
+    """The ``MESSAGE_VERSION`` a ``.msg`` text declares at its top level (None: it declares
+    none; the nested definitions a recorder appends after ``===`` lines are not its own)."""
+    own = text.split("\n===", 1)[0]
+    return px4_msgs.message_version(own) if px4_msgs.declares_version(own) else None

@@ -112,9 +112,8 @@ PROGRAMS: dict[str, Program] = {
             Plan(arm_from_new_publisher=True),
             6.0,
             "hazard",
-            ("OFB201",),
+            ("OFB208",),
             hazard="an ARM PX4 never answered: the vehicle stays disarmed",
-            missed="issue 28 miss 3",
         ),
         Program(
             "example_late_bag",
@@ -134,7 +133,6 @@ PROGRAMS: dict[str, Program] = {
             10.0,
             "clean",
             topics="in",
-            missed="issue 28 miss 5",
         ),
     )
 }
