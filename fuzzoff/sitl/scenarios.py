@@ -193,6 +193,18 @@ def hold_with_unknown_sub_mode(d: Driver) -> None:
     d.land_and_wait()
 
 
+def sticks_moved(d: Driver) -> None:
+    """A pilot takes over an OFFBOARD hover: the pitch stick moves steadily to 0.6 in 0.3 s
+    (2 per second) and back, the stream going on. 1.18 and main end OFFBOARD (Position, no
+    return); 1.17 keeps it (COM_RC_OVERRIDE 1, auto modes only)."""
+    _offboard_takeoff(d)
+    d.note("pitch stick 0 -> 0.6 in 0.3 s and back")
+    d.move_pitch_stick(d.position(0, 0, ALT), 0.6, 0.3)
+    d.move_pitch_stick(d.position(0, 0, ALT), 0.0, 0.3)
+    d.stream(d.position(0, 0, ALT), 4.0)
+    d.land_and_wait()
+
+
 SCENARIOS: dict[str, Scenario] = {
     s.name: s
     for s in (
@@ -317,6 +329,13 @@ SCENARIOS: dict[str, Scenario] = {
             "a mode request PX4 cannot honour: the vehicle stays in OFFBOARD",
             ("OFB205",),
         ),
+        Scenario(
+            "sticks_moved",
+            "offboard hover with a MAVLink joystick; the pitch stick ramps to 0.6 and back",
+            sticks_moved,
+            "clean",
+            manual=True,
+        ),
     )
 }
 
@@ -337,6 +356,7 @@ RELEASE_DEPENDENT = (
     "acceleration_only",
     "one_setpoint_then_switch",
     "switch_to_broadcast",
+    "sticks_moved",
 )
 
 
