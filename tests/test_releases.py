@@ -335,3 +335,29 @@ def test_fuzzoff_profiles_says_which_releases_were_seen_running() -> None:
     assert seen["1.17"][0] == "1.17.0" and seen["legacy"] == seen["1.13"] == []
     terminal = run_cli(["profiles"]).stdout
     assert "from the code only" in terminal and "1.18.0-beta1-head" in terminal
+
+
+# mode numbering (gate spec 16 S10) --------------------------------------------------------------
+
+
+@pytest.mark.parametrize("release", RELEASES, ids=NAMES)
+def test_guided_course_and_descend_sub_modes_follow_the_record(release: Release) -> None:
+    from fuzzoff.gate.requests import mode_request, switch_decision
+
+    def asks(sub: int) -> Command:
+        return Command(t=1.0, vehicle="1", command=176, params=(1.0, 4.0, float(sub), 0, 0, 0, 0))
+
+    course, why = mode_request(asks(19), release)
+    assert (course == 7) == release.guided_course_sub_mode
+    assert course is not None or "AUTO sub-mode 19" in str(why)
+    descend, why = mode_request(asks(20), release)
+    assert descend is None and ("not selectable" in str(why)) == release.descend_sub_mode
+    refused = switch_decision(release, asks(20), descend, True, True, 14)
+    assert not refused.accepted
+
+
+def test_a_heartbeat_in_guided_course_or_main_s_descend_is_named() -> None:
+    from fuzzoff.modes import custom_mode_to_nav_state, nav_state_name
+
+    assert nav_state_name(custom_mode_to_nav_state(4 << 16 | 19 << 24)) == "GUIDED_COURSE"
+    assert nav_state_name(custom_mode_to_nav_state(4 << 16 | 20 << 24)) == "DESCEND"
