@@ -361,3 +361,14 @@ def test_a_heartbeat_in_guided_course_or_main_s_descend_is_named() -> None:
 
     assert nav_state_name(custom_mode_to_nav_state(4 << 16 | 19 << 24)) == "GUIDED_COURSE"
     assert nav_state_name(custom_mode_to_nav_state(4 << 16 | 20 << 24)) == "DESCEND"
+
+
+@pytest.mark.parametrize(("px4", "own_docs"), [("1.17", True), ("1.18", False), ("main", True)])
+def test_ofb101_says_which_docs_ask_for_2_hz(px4: str, own_docs: bool) -> None:
+    """Gate spec 16 S12: the 1.18 docs give COM_OF_LOSS_T, main's say 2 Hz again."""
+    path = str(CORPORA / "tlog" / "stream_lost_in_offboard.tlog")
+    result = run_cli(["lint", path, "--px4", px4, "--format", "json"])
+    (file,) = json.loads(result.stdout)["files"]
+    (gap,) = [f for f in file["findings"] if f["code"] == "OFB101"][:1]
+    assert ("docs: keep-alive at > 2 Hz" in gap["message"]) == own_docs
+    assert ("1.18's give COM_OF_LOSS_T only" in gap["message"]) != own_docs
