@@ -329,7 +329,10 @@ V1_15 = replace(
 V1_16 = replace(
     V1_15,
     name="1.16",
-    covers="v1.16: acceleration needs attitude, 200 ms last-valid fallback, double mode ack",
+    covers=(
+        "v1.16: acceleration needs attitude, 200 ms last-valid fallback, two mode acks "
+        "(one on branch builds after 2026-05-19)"
+    ),
     minors=(16,),
     acceleration_needs_attitude=True,
     never_leaves_termination=True,
@@ -346,7 +349,10 @@ V1_16 = replace(
 V1_17 = replace(
     V1_16,
     name="1.17",
-    covers="v1.17: offboard loss without RC uses NAV_RCL_ACT, double mode ack",
+    covers=(
+        "v1.17: offboard loss without RC uses NAV_RCL_ACT, ALTITUDE_CRUISE, two mode acks "
+        "(one on branch builds after 2026-05-19: the recording's acks decide)"
+    ),
     minors=(17,),
     nav_rcl_fallback="before_degrade",
     altitude_cruise_mode=True,
