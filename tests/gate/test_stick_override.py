@@ -93,3 +93,19 @@ def test_no_override_while_the_loss_failsafe_runs_and_none_after_the_switch_back
     # the stream stops at 1 s: failsafe from about 2.1 s; the ramp at 2.5 s changes nothing
     run("1.18", [in_offboard(), *stream(0.0, 1.0), *ramp(2.5, 2.0)], model=gate, t_end=4.0)
     assert gate.user_intention == OFFBOARD
+
+
+def test_a_tlog_s_mavlink_joystick_is_read_as_px4_scales_it() -> None:
+    """MANUAL_CONTROL x, y, r in thousandths; z 0..1000 is throttle -1..1 (500: centred)."""
+    from fuzzoff.formats import open_source
+    from tests.helpers import CORPORA
+
+    with open_source(CORPORA / "sitl" / "sticks_moved-1.18.0-beta1-head.tlog") as source:
+        source.probe()
+        sticks = [e for e in source.events() if isinstance(e, ManualControl)]
+    assert len(sticks) > 100 and {e.vehicle for e in sticks} == {"7"}
+    assert max(e.pitch for e in sticks) == pytest.approx(0.6)
+    assert (
+        {e.roll for e in sticks} == {e.yaw for e in sticks} == {e.throttle for e in sticks} == {0.0}
+    )
+    assert all(e.sticks_moving is None for e in sticks)  # PX4's verdict is not in a tlog
