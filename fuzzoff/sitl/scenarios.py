@@ -336,6 +336,14 @@ SCENARIOS: dict[str, Scenario] = {
             "clean",
             manual=True,
         ),
+        Scenario(
+            "sticks_moved_override",
+            "as sticks_moved with COM_RC_OVERRIDE 3 (1.14-1.17: sticks also end OFFBOARD)",
+            sticks_moved,
+            "clean",
+            manual=True,
+            params={"COM_RC_OVERRIDE": 3.0},
+        ),
     )
 }
 
