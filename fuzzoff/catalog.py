@@ -32,7 +32,7 @@ from typing import Any, Literal, get_args
 from fuzzoff import releases
 from fuzzoff._version import __version__
 from fuzzoff.findings import Severity
-from fuzzoff.profiles import VEHICLE_TYPES
+from fuzzoff.profiles import VEHICLE_TYPES, seen_running_text
 
 PROJECT_URL = "https://github.com/fuzzoff/fuzzoff"
 """The project's home: its public repository. A placeholder until the repository's address is
@@ -395,7 +395,8 @@ def render_page(rule: Rule, *, test_stream: bool = False) -> str:
         lines += ["", "## Options", ""]
         for opt in rule.options:
             lines.append(f"- `{rule.code}.{opt.name}` (default `{opt.default}`): {opt.doc}")
-    lines += ["", "## Profiles", "", rule.profiles_text()]
+    lines += ["", "## Profiles", "", rule.profiles_text() + "."]
+    lines += ["", seen_running_text(rule.px4) + "."]
     lines += ["", "## References", ""]
     lines += [f"- {ref.markdown()}" for ref in rule.references]
     if test_stream and rule.stream_bad:

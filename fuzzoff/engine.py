@@ -10,6 +10,7 @@ from contextlib import AbstractContextManager, contextmanager
 from pathlib import Path
 from typing import Protocol, cast
 
+from fuzzoff import releases
 from fuzzoff.catalog import get_rule, sent_stream_rules
 from fuzzoff.checks import CheckContext, load_all
 from fuzzoff.checks.base import STREAM_TYPES, Check, StreamBatch
@@ -83,6 +84,12 @@ def resolve_profile(info: RecordingInfo, settings: Settings) -> Profile:
             detected_px4 = px4_profile_for(release)
         except ProfileError:
             detected_px4 = None
+    by_branch = releases.for_branch(info.px4_branch) if release else None
+    note = None
+    if by_branch is not None and detected_px4 in (by_branch.name, by_branch.reports_as):
+        detected_px4 = by_branch.name  # type: ignore[assignment]  # a record's name is one
+    elif detected_px4 is not None and settings.px4 is None:
+        note = _reported_alike_note(releases.get(detected_px4), info.px4_branch)
     fallback = DEFAULT_PX4
     if info.px4_candidates and DEFAULT_PX4 not in info.px4_candidates:
         fallback = px4_profile_for(info.px4_candidates[-1])  # the newest the recording fits
@@ -96,6 +103,22 @@ def resolve_profile(info: RecordingInfo, settings: Settings) -> Profile:
         px4_release=release,
         px4_forced=settings.px4 is not None,
         vehicle_forced=settings.vehicle is not None,
+        px4_note=note,
+    )
+
+
+def _reported_alike_note(release: releases.Release, branch: str | None) -> str | None:
+    """Where another record's builds report the same version (main reports 1.18.0 beta): which
+    one was assumed, and why."""
+    alike = releases.reported_alike(release)
+    if not alike:
+        return None
+    others = " and ".join(r.name for r in alike)
+    named = f" ({branch} says neither)" if branch else ""
+    other = alike[0].name
+    return (
+        f"{others} reports it too, no branch recorded{named}: {release.name} assumed, "
+        f"--px4 {other} for a build of {other}"
     )
 
 

@@ -503,6 +503,22 @@ negated), in PX4's order."""
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
+class ManualControl(Event):
+    """The sticks as PX4 reads them (MAVLink ``MANUAL_CONTROL`` sent to the vehicle, uORB
+    ``manual_control_setpoint``): ``roll``, ``pitch``, ``yaw`` and ``throttle`` in [-1, 1]
+    (throttle centred at 0, as PX4 keeps it); ``sticks_moving`` is PX4's own verdict where the
+    recording logs it (a ULog), None where it does not (gate spec 16 S1)."""
+
+    kind: ClassVar[str] = "manual_control"
+
+    roll: float = 0.0
+    pitch: float = 0.0
+    yaw: float = 0.0
+    throttle: float = 0.0
+    sticks_moving: bool | None = None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
 class LandDetected(Event):
     """The land detector's verdict, which PX4 reads when it judges a disarm request (gate spec
     13a: refused in flight). ``landed`` is what Commander tests, ``landed or maybe_landed``
@@ -677,6 +693,7 @@ ALL_EVENT_TYPES: tuple[type[Event], ...] = (
     VehicleStatus,
     VehicleControlModeStatus,
     FailsafeFlags,
+    ManualControl,
     LandDetected,
     Command,
     CommandAck,

@@ -211,6 +211,7 @@ class FileReport:
                 "px4_source": self.profile.px4_source,
                 "vehicle_source": self.profile.vehicle_source,
                 "px4_release": self.profile.px4_release,
+                **({"px4_note": self.profile.px4_note} if self.profile.px4_note else {}),
             },
             "complete": self.complete,
             "findings": [f.to_json() for f in self.findings],

@@ -13,6 +13,7 @@ NAV_STATE_NAMES: dict[int, str] = {
     4: "AUTO_LOITER",
     5: "AUTO_RTL",
     6: "POSITION_SLOW",
+    7: "GUIDED_COURSE",
     8: "ALTITUDE_CRUISE",
     9: "AUTO_LANDGPSFAIL",
     10: "ACRO",
@@ -47,6 +48,8 @@ _CUSTOM_TO_NAV: dict[tuple[int, int], int] = {
     (4, 8): 19,
     (4, 9): 20,
     (4, 10): 22,
+    (4, 19): 7,  # GUIDED_COURSE, 1.18+ (gate spec 16 S10)
+    (4, 20): 12,  # DESCEND as main reports it (16 S10); 1.18 and older report AUTO_LAND's
     (5, 0): 10,
     (6, 0): 14,
     (7, 0): 15,
@@ -62,6 +65,7 @@ _NAV_TO_CUSTOM: dict[int, tuple[int, int]] = {
     4: (4, 3),
     5: (4, 5),
     6: (3, 3),
+    7: (4, 19),
     10: (5, 0),
     12: (4, 6),
     13: (10, 0),

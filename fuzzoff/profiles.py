@@ -54,6 +54,25 @@ def px4_notes() -> dict[str, str]:
     return {r.name: r.covers for r in releases.RELEASES}
 
 
+def px4_seen_running() -> dict[str, tuple[str, ...]]:
+    """Profile name -> the PX4 SITL builds it was checked against live (empty: from the code
+    only), oldest first."""
+    return {r.name: releases.SEEN_RUNNING.get(r.name, ()) for r in releases.RELEASES}
+
+
+def seen_running_text(names: tuple[str, ...]) -> str:
+    """Which of ``names`` were seen running on PX4 and which are modelled from the code only."""
+    seen = px4_seen_running()
+    live = [f"{n} ({', '.join(seen[n])})" for n in names if seen.get(n)]
+    code = [n for n in names if not seen.get(n)]
+    parts = []
+    if live:
+        parts.append("Seen running (PX4 SITL builds): " + "; ".join(live))
+    if code:
+        parts.append("Modelled from the code only: " + ", ".join(code))
+    return ". ".join(parts)
+
+
 def vehicle_type_for(name: str) -> str:
     """Validate and normalise a vehicle type name (``rover`` alone means differential)."""
     text = name.strip().lower()
@@ -90,6 +109,8 @@ class Profile:
     px4_forced: bool = False
     """Set by the user (``--px4``, the config file), whatever the recording says."""
     vehicle_forced: bool = False
+    px4_note: str | None = None
+    """Why this record and not another that reports the same version (main and 1.18)."""
 
     @property
     def detected(self) -> bool:
@@ -117,11 +138,13 @@ class Profile:
     def describe(self) -> str:
         px4 = f"PX4 {self.px4}"
         named = px4_profile_for(self.px4_release) if self.px4_release else None
-        if named == self.px4:
+        if named == self.px4 or (named and self.release.reports_as == named):
             px4 += f" ({self.px4_release})"
         px4 += f" {SOURCE_WORDS[self.px4_source]}"
         if self.px4_forced and named not in (None, self.px4):
             px4 += f" (the recording says {self.px4_release})"
+        if self.px4_note:
+            px4 += f" ({self.px4_note})"
         return f"{px4}, {self.vehicle} {SOURCE_WORDS[self.vehicle_source]}"
 
 

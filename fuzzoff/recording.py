@@ -103,6 +103,9 @@ class RecordingInfo:
     format: str
     kinds: set[str] = field(default_factory=set)
     px4_version: str | None = None
+    px4_branch: str | None = None
+    """The source branch the build names (ULog ``ver_sw_branch``): tells main from the release
+    branch whose version main reports."""
     px4_candidates: list[str] = field(default_factory=list)
     """Where the recording does not name its release but narrows it (a ROS 2 recording's
     message definitions and topic names): the profiles it fits, oldest first."""

@@ -46,6 +46,11 @@ AlienCommandAnswer = Literal["ack_failed", "ignored"]
 DocsPage = Literal["002", "000"]
 """The PX4 docs page (seed) that states the offboard rules of a release."""
 
+StickOverride = Literal["none", "com_rc_override", "man_override_spd"]
+"""What ends OFFBOARD when the pilot moves the sticks (gate spec 16 S1): not modelled (before
+1.14), ``COM_RC_OVERRIDE`` bit 1 with ``COM_RC_STICK_OV`` (1.14-1.17, off by default), or
+``MAN_OVERRIDE_SPD`` (1.18, main: on by default)."""
+
 UlogEra = Literal["legacy", "1.13", "1.14", "1.15", "1.16", "1.17"]
 """The uORB logging formats a ULog of the release holds, oldest first (writers/ulog_formats)."""
 
@@ -118,6 +123,13 @@ class Release:
     """A MAVLink mode switch is acked twice: the receiver's ACCEPTED, then Commander's (4.3)."""
     altitude_cruise_mode: bool
     """DO_SET_MODE main mode 11 is ALTITUDE_CRUISE (nav_state 8, 4.1; seen on 1.17.0 SITL)."""
+    guided_course_sub_mode: bool
+    """AUTO sub-mode 19 is GUIDED_COURSE (16 S10, 1.18+)."""
+    descend_sub_mode: bool
+    """AUTO sub-mode 20 is DESCEND, shown but not selectable: a request for it is refused
+    (16 S10, main after 841bb40365)."""
+    stick_override: StickOverride
+    """What moving sticks do to OFFBOARD (16 S1)."""
     alien_command_answer: AlienCommandAnswer
     """A COMMAND_LONG / COMMAND_INT for another system or component (and for system 0 where
     ``handles_broadcast_command`` is False): acked FAILED (up to 1.15) or ignored, no ack (1.16+).
@@ -133,6 +145,9 @@ class Release:
     nav_rcl_fallback: NavRclFallback
     nav_rcl_hold_no_failsafe: bool
     """NAV_RCL_ACT 7 "Hold (no failsafe)" exists (5.1)."""
+    position_loss_action: bool
+    """COM_POS_FS_ACT (0 Descend, 1 Terminate) decides the end of the degradation chain: 1
+    skips Descend (16 S11, main)."""
     obl_rc_manual_is_stabilized: bool
     """COM_OBL_RC_ACT 2 is labelled Manual and selects Stabilized (5.1, 1.14-1.15)."""
 
@@ -153,6 +168,18 @@ class Release:
     """The docs still ask for a velocity estimate with the acceleration flag (gate spec D10)."""
     rover_setpoints: bool
     """The rover setpoint topics and their docs table exist (1.16+)."""
+    docs_say_2hz: bool
+    """The release's docs ask for a proof of life at 2 Hz; the 1.18 docs give COM_OF_LOSS_T
+    instead, main's say 2 Hz again (16 S12)."""
+
+    # -- identity and evidence
+    branches: tuple[str, ...]
+    """ULog ``ver_sw_branch`` values other than ``release/<name>`` that name this record,
+    whatever version the build reports (main reports the version of the release it is ahead
+    of)."""
+    reports_as: str | None
+    """The record whose version this one's builds report (main: ``1.18``): a recording that
+    names no branch (a tlog, a ULog without ``ver_sw_branch``) cannot tell them apart."""
 
     # -- message layouts
     msg_folder: str | None
@@ -208,12 +235,16 @@ LEGACY = Release(
     never_leaves_termination=False,
     acks_switch_twice=False,
     altitude_cruise_mode=False,
+    guided_course_sub_mode=False,
+    descend_sub_mode=False,
+    stick_override="none",
     alien_command_answer="ack_failed",
     handles_broadcast_command=False,
     old_code_unverified=True,
     loss_failsafe="state_machine_legacy",
     nav_rcl_fallback="none",
     nav_rcl_hold_no_failsafe=False,
+    position_loss_action=False,
     obl_rc_manual_is_stabilized=False,
     allocation_flag=False,
     setpoint_types_control_mode=False,
@@ -222,6 +253,9 @@ LEGACY = Release(
     docs_page=None,
     docs_acceleration_needs_velocity=False,
     rover_setpoints=False,
+    docs_say_2hz=True,
+    branches=(),
+    reports_as=None,
     msg_folder=None,
     ulog_era="legacy",
     armed_error_state=True,
@@ -272,9 +306,12 @@ V1_14 = replace(
     unsupported_main_mode="acked_no_change",
     loss_failsafe="framework",
     obl_rc_manual_is_stabilized=True,
+    stick_override="com_rc_override",
     msg_folder="1.14",
     ulog_era="1.14",
-    param_defaults=_params(COM_OF_LOSS_T=1.0, COM_DISARM_PRFLT=10.0),  # COM_OBL_ACT removed
+    param_defaults=_params(  # COM_OBL_ACT removed
+        COM_OF_LOSS_T=1.0, COM_DISARM_PRFLT=10.0, COM_RC_OVERRIDE=1.0, COM_RC_STICK_OV=30.0
+    ),
 )
 
 V1_15 = replace(
@@ -293,7 +330,10 @@ V1_15 = replace(
 V1_16 = replace(
     V1_15,
     name="1.16",
-    covers="v1.16: acceleration needs attitude, 200 ms last-valid fallback, double mode ack",
+    covers=(
+        "v1.16: acceleration needs attitude, 200 ms last-valid fallback, two mode acks "
+        "(one on branch builds after 2026-05-19)"
+    ),
     minors=(16,),
     acceleration_needs_attitude=True,
     never_leaves_termination=True,
@@ -310,7 +350,10 @@ V1_16 = replace(
 V1_17 = replace(
     V1_16,
     name="1.17",
-    covers="v1.17: offboard loss without RC uses NAV_RCL_ACT, double mode ack",
+    covers=(
+        "v1.17: offboard loss without RC uses NAV_RCL_ACT, ALTITUDE_CRUISE, two mode acks "
+        "(one on branch builds after 2026-05-19: the recording's acks decide)"
+    ),
     minors=(17,),
     nav_rcl_fallback="before_degrade",
     altitude_cruise_mode=True,
@@ -321,7 +364,10 @@ V1_17 = replace(
 V1_18 = replace(
     V1_17,
     name="1.18",
-    covers="v1.18: accepts_offboard_setpoints, thrust required for SET_ATTITUDE_TARGET, one ack",
+    covers=(
+        "v1.18 (release/1.18 to 83c4f4e580, beyond beta1): sticks end OFFBOARD "
+        "(MAN_OVERRIDE_SPD), thrust required for SET_ATTITUDE_TARGET, one ack, GUIDED_COURSE"
+    ),
     minors=(18,),
     attitude_flag_needs_attitude=True,
     yaw_sets_attitude_flags=True,
@@ -333,15 +379,46 @@ V1_18 = replace(
     nav_rcl_hold_no_failsafe=True,
     setpoint_types_control_mode=True,
     rover_drive_modes=True,
+    guided_course_sub_mode=True,
+    stick_override="man_override_spd",
+    docs_say_2hz=False,
+    # MAN_OVERRIDE_SPD replaces COM_RC_OVERRIDE and COM_RC_STICK_OV (16 S1)
+    param_defaults=_params(COM_OF_LOSS_T=1.0, COM_DISARM_PRFLT=10.0, MAN_OVERRIDE_SPD=1.0),
     msg_folder="main",  # release/1.18's px4_msgs: main's layouts (one folder, see msg_folder)
 )
 
 MAIN = replace(
     V1_18,
     name="main",
-    covers="main: PX4's development branch, modelled as v1.18.0-beta1 (as 1.18 today)",
+    covers=(
+        "main (PX4's development branch, at bb59c637cd of 2026-08-13): as 1.18, plus "
+        "COM_POS_FS_ACT in the loss chain, DESCEND shown as AUTO sub-mode 20; reports 1.18.0 beta"
+    ),
     minors=(),
+    descend_sub_mode=True,
+    position_loss_action=True,
+    docs_say_2hz=True,
+    branches=("main", "master"),
+    reports_as="1.18",
+    param_defaults=_params(
+        COM_OF_LOSS_T=1.0, COM_DISARM_PRFLT=10.0, MAN_OVERRIDE_SPD=1.0, COM_POS_FS_ACT=0.0
+    ),
 )
+
+SEEN_RUNNING: Mapping[str, tuple[str, ...]] = MappingProxyType(
+    {
+        "1.14": ("1.14.4",),
+        "1.15": ("1.15.4",),
+        "1.16": ("1.16.2", "1.16.2-ros2"),
+        "1.17": ("1.17.0", "1.17.0-ros2-rover"),
+        # alpha1 has none of 1.18's gate changes (gate spec 16): judged as 1.18 where it agrees
+        "1.18": ("1.18.0-beta1-head", "1.18.0-alpha1"),
+        "main": ("main-2026-08-13",),
+    }
+)
+"""Profile name -> the PX4 SITL builds (``../shared/px4-sitl``) the record was checked against
+live; a record not listed is modelled from the code only. Evidence, not behaviour: a new
+record starts unlisted."""
 
 RELEASES: tuple[Release, ...] = (LEGACY, V1_11, V1_13, V1_14, V1_15, V1_16, V1_17, V1_18, MAIN)
 """Oldest to newest, ``main`` last. Read it at call time (a test may extend it)."""
@@ -406,6 +483,26 @@ def named(text: str) -> Release | None:
         return get(name)
     version = version_of(name)
     return None if version is None else for_version(*version)
+
+
+def for_branch(branch: str | None) -> Release | None:
+    """The record a ULog's ``ver_sw_branch`` names (``main``, ``release/1.18``), None for a
+    branch no record names (a fork's, a tag's build: the version decides)."""
+    if not branch:
+        return None
+    for release in RELEASES:
+        if branch in release.branches or branch == f"release/{release.name}":
+            return release
+    return None
+
+
+def reported_alike(release: Release) -> tuple[Release, ...]:
+    """The other records whose builds report the same version as ``release`` (1.18 and main)."""
+    return tuple(
+        r
+        for r in RELEASES
+        if r is not release and (r.reports_as == release.name or r.name == release.reports_as)
+    )
 
 
 def newest_listed() -> tuple[int, int]:

@@ -4,10 +4,12 @@ test only) is a profile ``fuzzoff profiles`` lists and a lint judges with, nothi
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import subprocess
 import sys
 import textwrap
+from pathlib import Path
 
 import pytest
 
@@ -225,7 +227,7 @@ def test_a_new_record_is_a_profile_fuzzoff_profiles_lists() -> None:
     assert done.returncode == 0, done.stderr
     listed = [p["profile"] for p in json.loads(done.stdout)["px4"]]
     assert listed == [*NAMES[:-1], NEXT, NAMES[-1]]
-    made_up = {"profile": NEXT, "covers": f"v{NEXT}: made up by a test"}
+    made_up = {"profile": NEXT, "covers": f"v{NEXT}: made up by a test", "seen_running": []}
     assert made_up in json.loads(done.stdout)["px4"]
 
 
@@ -265,3 +267,108 @@ def test_a_recording_of_px4_1_18_is_judged_with_profile_1_18(name: str) -> None:
     result = run_cli(["lint", str(CORPORA / "sitl" / name), "--format", "json"])
     (file,) = json.loads(result.stdout)["files"]
     assert file["profile"]["px4"] == "1.18" and file["profile"]["px4_source"] == "recording"
+
+
+# main and 1.18 report the same version (gate spec 16) -----------------------------------------
+
+
+def _lint_profile(path: str, *extra: str) -> dict[str, object]:
+    (file,) = json.loads(run_cli(["lint", path, "--format", "json", *extra]).stdout)["files"]
+    profile: dict[str, object] = file["profile"]
+    return profile
+
+
+@pytest.mark.parametrize(
+    ("branch", "expected"), [("main", "main"), ("release/1.18", "1.18"), (None, "1.18")]
+)
+def test_a_ulog_of_px4_main_is_told_from_1_18_by_its_branch(
+    tmp_path: Path, branch: str | None, expected: str
+) -> None:
+    from fuzzoff.formats.ulog.writer import write_ulog
+
+    path = write_ulog(
+        tmp_path / "flight.ulg", stream(0.0, 2.0), px4_version="1.18.0-beta", px4_branch=branch
+    )
+    profile = _lint_profile(str(path))
+    assert profile["px4"] == expected and profile["px4_source"] == "recording"
+    assert profile["px4_release"] == "1.18.0-beta"
+    if branch is None:  # a build that names no branch: main reports the same version
+        assert "main reports it too" in str(profile["px4_note"])
+    else:
+        assert "px4_note" not in profile
+
+
+def test_a_tlog_reporting_1_18_is_judged_as_1_18_and_says_main_reports_the_same() -> None:
+    profile = _lint_profile(str(CORPORA / "sitl" / "clean_offboard-1.18.0-alpha1.tlog"))
+    assert profile["px4"] == "1.18"
+    assert "--px4 main for a build of main" in str(profile["px4_note"])
+    forced = _lint_profile(
+        str(CORPORA / "sitl" / "clean_offboard-1.18.0-alpha1.tlog"), "--px4", "main"
+    )
+    assert forced["px4"] == "main" and "px4_note" not in forced
+
+
+def test_main_and_1_18_are_two_records_main_written_as_what_main_changed() -> None:
+    v118, main = releases.get("1.18"), releases.get("main")
+    assert v118 != main
+    changed = {
+        f.name
+        for f in dataclasses.fields(Release)
+        if f.compare and getattr(v118, f.name) != getattr(main, f.name)
+    }
+    assert changed == {
+        "name",
+        "covers",
+        "minors",
+        "descend_sub_mode",
+        "position_loss_action",
+        "docs_say_2hz",
+        "branches",
+        "reports_as",
+    }
+
+
+def test_fuzzoff_profiles_says_which_releases_were_seen_running() -> None:
+    listed = json.loads(run_cli(["profiles", "--format", "json"]).stdout)["px4"]
+    seen = {p["profile"]: p["seen_running"] for p in listed}
+    assert seen["1.18"][0] == "1.18.0-beta1-head" and seen["main"] == ["main-2026-08-13"]
+    assert seen["1.17"][0] == "1.17.0" and seen["legacy"] == seen["1.13"] == []
+    terminal = run_cli(["profiles"]).stdout
+    assert "from the code only" in terminal and "1.18.0-beta1-head" in terminal
+
+
+# mode numbering (gate spec 16 S10) --------------------------------------------------------------
+
+
+@pytest.mark.parametrize("release", RELEASES, ids=NAMES)
+def test_guided_course_and_descend_sub_modes_follow_the_record(release: Release) -> None:
+    from fuzzoff.gate.requests import mode_request, switch_decision
+
+    def asks(sub: int) -> Command:
+        return Command(t=1.0, vehicle="1", command=176, params=(1.0, 4.0, float(sub), 0, 0, 0, 0))
+
+    course, why = mode_request(asks(19), release)
+    assert (course == 7) == release.guided_course_sub_mode
+    assert course is not None or "AUTO sub-mode 19" in str(why)
+    descend, why = mode_request(asks(20), release)
+    assert descend is None and ("not selectable" in str(why)) == release.descend_sub_mode
+    refused = switch_decision(release, asks(20), descend, True, True, 14)
+    assert not refused.accepted
+
+
+def test_a_heartbeat_in_guided_course_or_main_s_descend_is_named() -> None:
+    from fuzzoff.modes import custom_mode_to_nav_state, nav_state_name
+
+    assert nav_state_name(custom_mode_to_nav_state(4 << 16 | 19 << 24)) == "GUIDED_COURSE"
+    assert nav_state_name(custom_mode_to_nav_state(4 << 16 | 20 << 24)) == "DESCEND"
+
+
+@pytest.mark.parametrize(("px4", "own_docs"), [("1.17", True), ("1.18", False), ("main", True)])
+def test_ofb101_says_which_docs_ask_for_2_hz(px4: str, own_docs: bool) -> None:
+    """Gate spec 16 S12: the 1.18 docs give COM_OF_LOSS_T, main's say 2 Hz again."""
+    path = str(CORPORA / "tlog" / "stream_lost_in_offboard.tlog")
+    result = run_cli(["lint", path, "--px4", px4, "--format", "json"])
+    (file,) = json.loads(result.stdout)["files"]
+    (gap,) = [f for f in file["findings"] if f["code"] == "OFB101"][:1]
+    assert ("docs: keep-alive at > 2 Hz" in gap["message"]) == own_docs
+    assert ("1.18's give COM_OF_LOSS_T only" in gap["message"]) != own_docs

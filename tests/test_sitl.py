@@ -170,6 +170,33 @@ def test_the_gate_model_agrees_with_the_recorded_px4_run(stem: str) -> None:
     assert not differ, differ
 
 
+@pytest.mark.parametrize(
+    ("stem", "overrides"),
+    [
+        ("sticks_moved-1.18.0-beta1-head", 1),
+        ("sticks_moved-1.17.0", 0),
+        ("sticks_moved_override-1.17.0", 1),
+    ],
+)
+def test_the_sticks_end_offboard_on_px4_1_18_and_not_on_1_17_as_the_model_says(
+    stem: str, overrides: int
+) -> None:
+    """Gate spec 16 S1, seen live: a steady ramp of the pitch stick in an OFFBOARD hover; PX4
+    1.18 goes to Position (sticks_moving) and stays, 1.17.0 keeps OFFBOARD (COM_RC_OVERRIDE 1)
+    and goes to Position with COM_RC_OVERRIDE 3."""
+    run = RUNS[stem]
+    verdict = compare(
+        SITL / f"{stem}.tlog",
+        run["release"].split("-")[0],
+        SITL / f"{stem}.ulg",
+        run.get("params") or {},
+        COMPANION_SYSID,
+    )
+    items = [i for i in verdict.items if i.what == "stick override"]
+    assert len(items) == overrides and all(i.agree for i in items)
+    assert verdict.agree
+
+
 def test_the_proxy_forwards_both_ways_unchanged_and_records_them(tmp_path: Path) -> None:
     """Between a client and a PX4 (here two sockets speaking pymavlink): every datagram goes
     through as it was sent, and the tlog holds both directions once PX4's clock is known."""

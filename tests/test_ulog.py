@@ -24,6 +24,7 @@ from fuzzoff.events import (
     FailsafeFlags,
     LandDetected,
     LegacyControlMode,
+    ManualControl,
     Parameter,
     PositionSetpointTriplet,
     RatesSetpoint,
@@ -95,6 +96,18 @@ def flight(era: str) -> list[Event]:
         VehiclePosition(t=0.7, x=1.5, y=-2.0, z=0.25),
         VehiclePosition(t=1.75, x=NAN, y=NAN, z=-1.5),  # xy_valid false: x and y mean nothing
     ]
+    if modern:
+        out.append(
+            ManualControl(
+                t=0.8,
+                roll=0.25,
+                pitch=-0.5,
+                yaw=0.125,
+                throttle=0.0,
+                sticks_moving=True,
+                origin="vehicle",
+            )
+        )
     layout = "thrust_and_torque" if era in ("1.15", "1.17") else "actuator"
     if legacy:
         out.append(LegacyControlMode(t=1.0, ignore_thrust=True, ignore_acceleration_force=True))

@@ -6,7 +6,7 @@ For every run with a tlog and a ULog, ``fuzzoff.sitl.verdict.compare`` puts the 
 the client's tlog, for the run's release) beside PX4's ULog; this counts, per release, the
 switches and arms judged and agreed, the losses and their timing (PX4's flag against the
 model's instant: within one 10 Hz check period), the failsafe actions and the automatic
-returns, and lists every disagreement.
+returns, the sticks ending OFFBOARD (1.18+), and lists every disagreement.
 """
 
 from __future__ import annotations
@@ -27,6 +27,7 @@ GROUPS = {
     "offboard loss": "loss time",
     "failsafe action": "failsafe action",
     "automatic return": "automatic return",
+    "stick override": "stick override",
 }
 
 
@@ -60,7 +61,14 @@ def main() -> None:
                 differ.append(
                     f"{stem}: {item.what} at {item.t:.2f} s: PX4 {item.px4}; model {item.model}"
                 )
-    columns = ["requests", "loss time", "failsafe action", "automatic return", "other"]
+    columns = [
+        "requests",
+        "loss time",
+        "failsafe action",
+        "automatic return",
+        "stick override",
+        "other",
+    ]
     print("| PX4 | vehicle | " + " | ".join(columns) + " | model - PX4 flag (ms) |")
     print("| --- | --- |" + " --- |" * (len(columns) + 1))
     order = list(AIRFRAMES)

@@ -60,6 +60,14 @@ def gap_severity(gap: float, timeout: float) -> Severity:
     return Severity.INFO
 
 
+def _docs(ctx: CheckContext) -> str:
+    """Which docs ask for 2 Hz: the release's own, or (1.18, whose docs give COM_OF_LOSS_T
+    instead) the docs before and after it (gate spec 16 S12)."""
+    if ctx.profile.release.docs_say_2hz:
+        return "docs"
+    return "docs before 1.18 and on main (1.18's give COM_OF_LOSS_T only)"
+
+
 @dataclass(slots=True)
 class _Gap:
     start: float
@@ -233,7 +241,8 @@ class KeepaliveRate(Check):
         sampled = " (logged gap minus the logger's interval)" if ctx.info.sampled else ""
         head = (
             f"keep-alive gap of {gap.proven:.2f} s{sampled} {context}{mode_note(ctx)}; "
-            f"docs: keep-alive at > 2 Hz, gaps under {self.max_gap:.1f} s; {px4_label(ctx)}"
+            f"{_docs(ctx)}: keep-alive at > 2 Hz, gaps under {self.max_gap:.1f} s; "
+            f"{px4_label(ctx)}"
         )
         flown = gap.proven if gap.counts is None else min(gap.proven, gap.counts)
         severity = gap_severity(flown, timeout)

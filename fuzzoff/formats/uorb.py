@@ -109,6 +109,9 @@ TOPICS: dict[str, Topic] = {
         "VehicleLocalPosition", ev.VehiclePosition.kind, published=True
     ),
     "vehicle_command_mode_executor": Topic("VehicleCommand", ev.Command.kind),
+    # the sticks PX4 flies by and its sticks_moving verdict (gate spec 16 S1); read from a ULog
+    # only: a ROS 2 recording's manual_control_input is not modelled (docs/gate.md)
+    "manual_control_setpoint": Topic(None, ev.ManualControl.kind, log_interval_s=0.2),
 }
 """uORB topic name -> what it is, the one table of topics. The decoders stay per format
 (``ulog.topics`` turns numpy columns into events, ``ros2msgs.convert`` one decoded message at a

@@ -75,6 +75,17 @@ _OBL_RC_14 = {0: POSCTL, 1: ALTCTL, 2: STAB, 3: RTL, 4: LAND, 5: LOITER, 6: TERM
 _NAV_RCL = {1: LOITER, 2: RTL, 3: LAND, 5: TERMINATION}
 
 
+_CHAIN_NO_DESCEND = tuple(nav for nav in _CHAIN_14 if nav != DESCEND)
+
+
+def _chain(release: Release, params: dict[str, float]) -> tuple[int, ...]:
+    """The 1.14+ degradation chain; main's COM_POS_FS_ACT 1 (Terminate) skips Descend when
+    the position is lost (gate spec 16 S11)."""
+    if release.position_loss_action and params.get("COM_POS_FS_ACT", 0.0) == 1.0:
+        return _CHAIN_NO_DESCEND
+    return _CHAIN_14
+
+
 def _degrade(nav: int, est: Estimates, vehicle: str, chain: tuple[int, ...]) -> int:
     start = chain.index(nav) if nav in chain else 0
     for candidate in chain[start:]:
@@ -141,18 +152,21 @@ def _framework(
         note += " (out of range: treated as 0, Position)"
     if value == 2 and release.obl_rc_manual_is_stabilized:
         note += " (labelled Manual, selects Stabilized)"
+    chain = _chain(release, params)
+    if chain is _CHAIN_NO_DESCEND:
+        note += "; COM_POS_FS_ACT 1: Terminate instead of Descend"
     if release.nav_rcl_fallback == "none":
         if chosen == POSCTL and params.get("COM_POSCTL_NAVL", 0.0) == 1.0:
             final = _degrade(POSCTL, est, vehicle, (POSCTL, LAND, DESCEND, TERMINATION))
         else:
-            final = _degrade(chosen, est, vehicle, _CHAIN_14)
+            final = _degrade(chosen, est, vehicle, chain)
         return _finish(chosen, final, "5.1", False, note, rc)
     # 1.17: replace a stick mode by NAV_RCL_ACT first; 1.18 and main: after the stick chain.
     if not est.rc_recorded:
         note += f"; manual control assumed {'present' if rc else 'absent'} ({RC_PRESENT})"
     if release.nav_rcl_fallback == "before_degrade" and chosen in _STICK and not rc:
         return _replace(release, vehicle, params, est, chosen, note, rc)
-    final = _degrade(chosen, est, vehicle, _CHAIN_14)
+    final = _degrade(chosen, est, vehicle, chain)
     if release.nav_rcl_fallback == "after_degrade" and final in _STICK and not rc:
         return _replace(release, vehicle, params, est, final, note, rc)
     return _finish(chosen, final, "5.1", False, note, rc)
@@ -174,7 +188,7 @@ def _replace(
         if "Disarm" in label:
             return LossAction("DISARM", None, "5.1", note, disarm=True, replaced_from=stick)
         return LossAction("NONE", None, "5.1", note, unverified=unverified, replaced_from=stick)
-    final = _degrade(nav, est, vehicle, _CHAIN_14)
+    final = _degrade(nav, est, vehicle, _chain(release, params))
     return replace(_finish(nav, final, "5.1", unverified, note, rc), replaced_from=stick)
 
 

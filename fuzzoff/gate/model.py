@@ -24,6 +24,8 @@ deadline when it comes. The parts share one ``state.GateState``:
   controller runs on the setpoints;
 * ``effective.EffectiveMode``: the effective mode, and the loss action while the signal is lost;
 * ``commander.Requests``: Commander's answer to switch, arm and disarm requests;
+* ``sticks.StickOverride``: the pilot's sticks taking over OFFBOARD (1.14+ by parameter, 1.18+
+  by default);
 * ``history.RecordedHistory`` and ``acks.Acks``: the recorded mode history and acks against
   the prediction (``compare``): a difference that outlasts the evaluation slack becomes a
   ``disagreement`` and the model re-synchronises, so one difference is reported once.
@@ -43,6 +45,7 @@ from fuzzoff.events import (
     FailsafeFlags,
     LandDetected,
     LegacyControlMode,
+    ManualControl,
     Parameter,
     PositionSetpointTriplet,
     SetAttitudeTarget,
@@ -65,6 +68,7 @@ from fuzzoff.gate.receiver import ReceiverContext
 from fuzzoff.gate.setpoints import Controllers
 from fuzzoff.gate.signal import INF
 from fuzzoff.gate.state import GateState
+from fuzzoff.gate.sticks import StickOverride
 from fuzzoff.gate.transitions import GateTransition
 from fuzzoff.gate.verdict import RecordedFlag, UnseenStream
 from fuzzoff.gate.view import GateSnapshot
@@ -103,6 +107,7 @@ class GateModel:
         self.unseen = UnseenStream(s, self.mode)
         self.history = RecordedHistory(s, self.mode, self.keepalives, self.requests, self.unseen)
         self.acks = Acks(s, self.mode, self.requests)
+        self.sticks = StickOverride(s, self.mode)
         self._handlers: dict[type, Handler] = {
             ControlMode: self.keepalives.control_mode,
             LegacyControlMode: self.keepalives.legacy_control_mode,
@@ -118,6 +123,7 @@ class GateModel:
             Parameter: self._on_parameter,
             StatusText: self.unseen.status_text,
             LandDetected: self._on_land,
+            ManualControl: self.sticks.manual_control,
         }
         sig = s.signal
         self._timers: tuple[tuple[Callable[[], float], Callable[[float], None]], ...] = (

@@ -28,6 +28,10 @@ GATE_PARAMS: tuple[str, ...] = (
     "MAV_COMP_ID",
     "MPC_LAND_SPEED",
     "COM_DISARM_PRFLT",
+    "COM_RC_OVERRIDE",
+    "COM_RC_STICK_OV",
+    "MAN_OVERRIDE_SPD",
+    "COM_POS_FS_ACT",
     RC_PRESENT,
 )
 

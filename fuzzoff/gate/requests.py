@@ -47,6 +47,8 @@ MAIN_AUTO = 4
 MAIN_ALTITUDE_CRUISE = 11
 NAV_AUTO_MISSION = 3
 NAV_ALTITUDE_CRUISE = 8
+SUB_GUIDED_COURSE = 19
+SUB_DESCEND = 20
 
 
 def decode_mode(cmd: Command, release: Release | None = None) -> int | None:
@@ -58,7 +60,8 @@ def mode_request(cmd: Command, release: Release | None = None) -> tuple[int | No
     """(the nav_state a mode command asks for, None), or (None, why PX4 has no such mode) as
     Commander reads DO_SET_MODE (4.1, seen on 1.16.2-main SITL): AUTO with sub-mode 0 is Mission,
     an AUTO sub-mode Commander does not know is refused, ALTITUDE_CRUISE (main 11) exists from
-    1.17. Without ``release`` every mode fuzzoff knows counts."""
+    1.17, GUIDED_COURSE (AUTO 19) from 1.18, and main shows DESCEND as AUTO 20 but refuses a
+    request for it (16 S10). Without ``release`` every mode fuzzoff knows counts."""
     if cmd.command == VEHICLE_CMD_SET_NAV_STATE:
         return whole(cmd.params[0]), None
     if cmd.command != MAV_CMD_DO_SET_MODE:
@@ -75,6 +78,13 @@ def mode_request(cmd: Command, release: Release | None = None) -> tuple[int | No
         if release is None or release.altitude_cruise_mode:
             return NAV_ALTITUDE_CRUISE, None
         return None, f"main mode {main} (ALTITUDE_CRUISE, PX4 1.17 and later)"
+    course = main == MAIN_AUTO and sub == SUB_GUIDED_COURSE
+    if course and release is not None and not release.guided_course_sub_mode:
+        return None, f"AUTO sub-mode {sub} (GUIDED_COURSE, PX4 1.18 and later)"
+    if main == MAIN_AUTO and sub == SUB_DESCEND and release is not None:
+        if release.descend_sub_mode:  # shown as DESCEND, not selectable (16 S10)
+            return None, f"AUTO sub-mode {sub} (DESCEND: shown, not selectable on main)"
+        return None, f"AUTO sub-mode {sub}"
     nav = custom_mode_to_nav_state(main << 16 | sub << 24)
     if nav is not None:
         return nav, None

@@ -44,6 +44,8 @@ class Driver:
     link: Link
     manual: bool = False
     steps: list[Step] = field(default_factory=list)
+    pitch_stick: float = 0.0
+    """Where the joystick's pitch stick is (-1..1): what every joystick sample sends."""
     _next_manual: float = 0.0
 
     def now(self) -> float:
@@ -56,7 +58,7 @@ class Driver:
     def tick(self) -> None:
         """Send a joystick sample when one is due (a scenario with manual control)."""
         if self.manual and self.now() >= self._next_manual:
-            self.link.manual_control()
+            self.link.manual_control(x=round(self.pitch_stick * 1000))
             self._next_manual = self.now() + MANUAL_EVERY_S
 
     def wait(self, seconds: float) -> None:
@@ -71,6 +73,23 @@ class Driver:
             setpoint(self)
             self.tick()
             self.link.sleep_until(start + (i + 1) / hz, self.tick)
+
+    def move_pitch_stick(
+        self, setpoint: Setpoint, to: float, seconds: float, hz: float = 20.0
+    ) -> None:
+        """Move the joystick's pitch stick steadily to ``to`` over ``seconds`` (a sample at
+        ``hz``), the setpoint stream going on at 10 Hz: the way a pilot's stick moves, and the
+        way PX4 1.18's ``sticks_moving`` needs (a steady ramp, not a step)."""
+        start, begin = self.now(), self.pitch_stick
+        n = max(1, round(seconds * hz))
+        every = max(1, round(hz / 10.0))
+        for i in range(1, n + 1):
+            self.pitch_stick = begin + (to - begin) * i / n
+            self.link.manual_control(x=round(self.pitch_stick * 1000))
+            if i % every == 0:
+                setpoint(self)
+            self.link.sleep_until(start + i / hz)
+        self._next_manual = self.now() + MANUAL_EVERY_S
 
     def position(self, x: float, y: float, z: float, frame: int = MAV_FRAME_LOCAL_NED) -> Setpoint:
         def send(d: Driver) -> None:

@@ -268,6 +268,18 @@ def rover_loss(d: Driver) -> None:
     _rover_stop(d)
 
 
+def sticks_moved(d: Driver) -> None:
+    """A pilot takes over an OFFBOARD hover: the pitch stick moves steadily to 0.6 in 0.3 s
+    (2 per second) and back, the stream going on. 1.18 and main end OFFBOARD (Position, no
+    return); 1.17 keeps it (COM_RC_OVERRIDE 1, auto modes only)."""
+    _offboard_takeoff(d)
+    d.note("pitch stick 0 -> 0.6 in 0.3 s and back")
+    d.move_pitch_stick(d.position(0, 0, ALT), 0.6, 0.3)
+    d.move_pitch_stick(d.position(0, 0, ALT), 0.0, 0.3)
+    d.stream(d.position(0, 0, ALT), 4.0)
+    d.land_and_wait()
+
+
 SCENARIOS: dict[str, Scenario] = {
     s.name: s
     for s in (
@@ -432,6 +444,21 @@ SCENARIOS: dict[str, Scenario] = {
             ("OFB103",),
             vehicle="rover-ackermann",
         ),
+        Scenario(
+            "sticks_moved",
+            "offboard hover with a MAVLink joystick; the pitch stick ramps to 0.6 and back",
+            sticks_moved,
+            "clean",
+            manual=True,
+        ),
+        Scenario(
+            "sticks_moved_override",
+            "as sticks_moved with COM_RC_OVERRIDE 3 (1.14-1.17: sticks also end OFFBOARD)",
+            sticks_moved,
+            "clean",
+            manual=True,
+            params={"COM_RC_OVERRIDE": 3.0},
+        ),
     )
 }
 
@@ -452,6 +479,7 @@ RELEASE_DEPENDENT = (
     "acceleration_only",
     "one_setpoint_then_switch",
     "switch_to_broadcast",
+    "sticks_moved",
 )
 
 

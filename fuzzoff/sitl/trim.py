@@ -3,9 +3,11 @@
 pyulog loads only ``fuzzoff.formats.ulog.reader.LOADED_TOPICS`` and writes them back with
 ``ULog.write_ulog``: header, info, parameters and logged messages (PX4's own texts, such as
 "Disarming denied: not landed") are kept, as ``corpora/real/cut.py`` does for public logs.
-A long flight (a VTOL's transition and cruise) also thins PX4's fastest estimator and
-controller topics (``FAST_TOPICS``, 50-250 Hz) to one sample per ``thin_s``; the keep-alive,
-setpoint, mode and command topics are always kept whole.
+``vehicle_local_position``, which the 1.18 builds log at 100 Hz, is thinned to one sample per
+``POSITION_MIN_S`` (fuzzoff reads it for the vertical setpoint checks and the plots, at most
+10 Hz in a plain lint). A long flight (a VTOL's transition and cruise) thins PX4's fastest
+estimator and controller topics (``FAST_TOPICS``, 50-250 Hz) to one sample per ``thin_s``
+instead; the keep-alive, setpoint, mode and command topics are always kept whole.
 """
 
 from __future__ import annotations
@@ -26,6 +28,8 @@ FAST_TOPICS = frozenset(
         "vehicle_attitude_setpoint",
     }
 )
+POSITION_MIN_S = 0.02
+"""Without ``thin_s``: the slot ``vehicle_local_position`` keeps one sample of (50 Hz)."""
 
 
 def _thinned(timestamps: np.ndarray, every_us: int) -> np.ndarray:
@@ -39,11 +43,11 @@ def _thinned(timestamps: np.ndarray, every_us: int) -> np.ndarray:
 
 def trim(source: Path, target: Path, thin_s: float | None = None) -> Path:
     log = ULog(str(source), message_name_filter_list=list(LOADED_TOPICS))
-    if thin_s is not None:
-        every_us = round(thin_s * 1e6)
-        for dataset in log.data_list:
-            if dataset.name in FAST_TOPICS and len(dataset.data["timestamp"]):
-                keep = _thinned(dataset.data["timestamp"], every_us)
-                dataset.data = {k: v[keep] for k, v in dataset.data.items()}
+    topics = FAST_TOPICS if thin_s is not None else frozenset({"vehicle_local_position"})
+    every_us = round((thin_s if thin_s is not None else POSITION_MIN_S) * 1e6)
+    for dataset in log.data_list:
+        if dataset.name in topics and len(dataset.data["timestamp"]):
+            keep = _thinned(dataset.data["timestamp"], every_us)
+            dataset.data = {k: v[keep] for k, v in dataset.data.items()}
     log.write_ulog(str(target))
     return target

@@ -178,6 +178,7 @@ def compare(
         truth.modes = [Mode(m.t + offset, m.nav_state, m.armed, None) for m in truth.modes]
         truth.keepalives = [k + offset for k in truth.keepalives]
     _requests(verdict, truth, rows)
+    _stick_overrides(verdict, truth, rows)
     _losses(verdict, truth, rows, params.get("COM_OF_LOSS_T", 1.0), ulog is not None)
     _gate_disagreements(verdict, rows)
     verdict.items.sort(key=lambda i: i.t)
@@ -217,6 +218,41 @@ def _requests(verdict: Verdict, truth: Truth, rows: list[dict[str, Any]]) -> Non
         model = ("accepted" if model_ok else "rejected") + f": {row['message']}"
         agree = None if request.result is None else (request.result == 0) == model_ok
         verdict.items.append(Item(label, request.t, px4, model, agree))
+
+
+STICK_OVERRIDE = "stick override"
+NAV_POSCTL = 2
+OVERRIDE_PAIR_S = 0.5
+"""A model's stick override and PX4's leaving OFFBOARD for Position this close are one."""
+
+
+def _stick_overrides(verdict: Verdict, truth: Truth, rows: list[dict[str, Any]]) -> None:
+    """The sticks ending OFFBOARD (gate spec 16 S1): PX4's user intention going from OFFBOARD
+    to Position, armed, with no request in the second before (a loss failsafe leaves the
+    intention at OFFBOARD; a tlog's HEARTBEAT does not show it: judged from a ULog only),
+    against the model's stick override rows."""
+    if all(m.intention is None for m in truth.modes):
+        return
+    px4 = [
+        m.t
+        for prev, m in zip(truth.modes, truth.modes[1:], strict=False)
+        if prev.intention == NAV_OFFBOARD
+        and m.intention == NAV_POSCTL
+        and m.armed
+        and not any(0 <= m.t - r.t <= 1.0 for r in truth.requests)
+    ]
+    model = [r["px4_t"] for r in rows if r.get("reason") == STICK_OVERRIDE]
+    for t in px4:
+        near = [m for m in model if abs(m - t) <= OVERRIDE_PAIR_S]
+        if near:
+            model.remove(near[0])
+            verdict.items.append(
+                Item(STICK_OVERRIDE, t, "Position", "Position", True, f"{near[0] - t:+.3f} s")
+            )
+        else:
+            verdict.items.append(Item(STICK_OVERRIDE, t, "Position", "OFFBOARD stays", False))
+    for m in model:
+        verdict.items.append(Item(STICK_OVERRIDE, m, "OFFBOARD stays", "Position", False))
 
 
 def _px4_losses(truth: Truth, flagged: bool) -> list[float]:

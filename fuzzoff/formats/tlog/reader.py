@@ -9,6 +9,7 @@ is the autopilot's sysid as text. Setpoints and commands belong to the vehicle t
 
 from __future__ import annotations
 
+import math
 import struct
 from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
@@ -23,6 +24,7 @@ from fuzzoff.events import (
     Event,
     FailsafeFlags,
     LandDetected,
+    ManualControl,
     Parameter,
     SetActuatorControlTarget,
     SetAttitudeTarget,
@@ -129,7 +131,30 @@ _KIND_OF_ID: dict[int, tuple[str, ...]] = {
     AUTOPILOT_VERSION: (VehicleInfo.kind,),
     STATUSTEXT: (StatusText.kind,),
     EXTENDED_SYS_STATE: (LandDetected.kind,),
+    MANUAL_CONTROL: (ManualControl.kind,),
 }
+
+
+STICK_UNUSED = 32767
+"""MANUAL_CONTROL's INT16_MAX: the axis is not used."""
+
+
+def _stick(value: int, scale: float = 1000.0, offset: float = 0.0) -> float:
+    return math.nan if value == STICK_UNUSED else value / scale - offset
+
+
+def _sticks(m: Any, t: float, vehicle: str, where: Where) -> ManualControl:
+    """MANUAL_CONTROL as PX4's receiver scales it: x pitch, y roll, r yaw in [-1, 1] from
+    thousandths; z throttle 0..1000 -> [-1, 1] (PX4 keeps throttle centred)."""
+    return ManualControl(
+        t=t,
+        vehicle=vehicle,
+        where=where,
+        pitch=_stick(m.x),
+        roll=_stick(m.y),
+        yaw=_stick(m.r),
+        throttle=_stick(m.z, 500.0, 1.0),
+    )
 
 
 def decode_px4_version(flight_sw_version: int) -> str:
@@ -690,6 +715,7 @@ class _Decoder:
             sysid = int(vehicle)
             if sysid not in self.sys_status:
                 out.extend(self._manual(sysid, True, t, where))
+            out.append(_sticks(m, t, vehicle, where))
         return out
 
     def _position(self, m: Any, t: float, where: Where) -> Iterable[Event]:

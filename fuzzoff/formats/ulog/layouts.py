@@ -311,6 +311,31 @@ FORMATS: dict[str, list[tuple[str, list[str]]]] = {
             ],
         ),
     ],
+    "manual_control_setpoint": [
+        (
+            "1.14",
+            [
+                "uint64_t timestamp",
+                "uint64_t timestamp_sample",
+                "float roll",
+                "float pitch",
+                "float yaw",
+                "float throttle",
+                "float flaps",
+                "float aux1",
+                "float aux2",
+                "float aux3",
+                "float aux4",
+                "float aux5",
+                "float aux6",
+                "uint16_t buttons",
+                "bool valid",
+                "uint8_t data_source",
+                "bool sticks_moving",
+                "uint8_t[3] _padding0",
+            ],
+        ),
+    ],
     "vehicle_command": [
         (
             "legacy",

@@ -229,6 +229,8 @@ class UlogSource(Source):
     def _identity(self, ulog: Any, info: RecordingInfo, status: Any) -> None:
         release = ulog.msg_info_dict.get("ver_sw_release")
         info.px4_version = decode_release(int(release)) if isinstance(release, int) else None
+        branch = ulog.msg_info_dict.get("ver_sw_branch")
+        info.px4_branch = branch.strip() or None if isinstance(branch, str) else None
         params = dict(ulog.initial_parameters)
         from_params, why = vehicle_from_params(params)
         from_status = _vehicle_from_status(status) if status is not None else None

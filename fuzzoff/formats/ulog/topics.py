@@ -444,6 +444,33 @@ def land_detected(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
         yield ev.LandDetected(t=t, where=w, sender_time_us=ts, origin=VEHICLE, landed=value)
 
 
+def manual_control(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
+    """``manual_control_setpoint``: the sticks PX4 flies by (1.14+ names; throttle in [-1, 1])
+    and ManualControl's ``sticks_moving`` verdict where logged (gate spec 16 S1)."""
+    for t, w, ts, roll, pitch, yaw, throttle, moving in zip(
+        c.t,
+        c.where,
+        c.ts,
+        c.f("roll"),
+        c.f("pitch"),
+        c.f("yaw"),
+        c.f("throttle"),
+        c.ob("sticks_moving"),
+        strict=True,
+    ):
+        yield ev.ManualControl(
+            t=t,
+            where=w,
+            sender_time_us=ts,
+            origin=VEHICLE,
+            roll=roll,
+            pitch=pitch,
+            yaw=yaw,
+            throttle=throttle,
+            sticks_moving=moving,
+        )
+
+
 def command(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
     params = list(zip(*(c.f(f"param{k}") for k in range(1, 8)), strict=True))
     for t, w, ts, p, cmd, tsys, tcomp, ssys, scomp, external in zip(
@@ -545,6 +572,7 @@ DECODERS: dict[str, Decoder] = {
     "vehicle_status_flags": failsafe_flags,
     "vehicle_land_detected": land_detected,
     "vehicle_local_position": local_position,
+    "manual_control_setpoint": manual_control,
 }
 """uORB topic -> its decoder (what each topic is: ``uorb.TOPICS``)."""
 

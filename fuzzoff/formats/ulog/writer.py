@@ -113,6 +113,7 @@ class _Topics:
             ev.VehicleControlModeStatus: self._control_mode_status,
             ev.FailsafeFlags: self._failsafe_flags,
             ev.LandDetected: self._land_detected,
+            ev.ManualControl: self._manual_control,
             ev.VehiclePosition: self._local_position,
             ev.Command: self._command,
             ev.CommandAck: self._ack,
@@ -301,6 +302,13 @@ class _Topics:
         row: Row = {"landed": landed, "maybe_landed": landed, "ground_contact": landed}
         self._put("vehicle_land_detected", ts, row)
 
+    def _manual_control(self, e: ev.ManualControl, ts: int) -> None:
+        if not self._at_least("1.14"):
+            return  # older layouts name the sticks otherwise: not written
+        row: Row = {"roll": e.roll, "pitch": e.pitch, "yaw": e.yaw, "throttle": e.throttle}
+        row |= {"valid": True, "sticks_moving": bool(e.sticks_moving), "timestamp_sample": ts}
+        self._put("manual_control_setpoint", ts, row)
+
     def _local_position(self, e: ev.VehiclePosition, ts: int) -> None:
         xy = math.isfinite(e.x) and math.isfinite(e.y)
         row: Row = {"x": e.x if xy else 0.0, "y": e.y if xy else 0.0, "xy_valid": xy}
@@ -405,6 +413,7 @@ def write_ulog(
     vehicle_type: str | None = None,
     start_us: int = DEFAULT_START_US,
     subscribed: Iterable[str] = SUBSCRIBED,
+    px4_branch: str | None = None,
 ) -> Path:
     """Write ``events`` as a ULog of ``px4_version`` (None: no ``ver_sw_release`` at all).
 
@@ -417,6 +426,7 @@ def write_ulog(
     ``vehicle_type`` (or a ``VehicleInfo`` event) sets ``CA_AIRFRAME``/``MAV_TYPE``.
     ``subscribed``: topics whose format is written without data, as PX4's logger does for
     the topics of its profile (``()``: a logger that did not log the offboard stream).
+    ``px4_branch``: the build's ``ver_sw_branch`` (``main``, ``release/1.18``).
     """
     era = layout or era_for(px4_version)
     stream = list(events)
@@ -426,7 +436,7 @@ def write_ulog(
     topics = _Topics(era, start_us, vehicle_type)
     for event in stream:
         topics.add(event)
-    ulog = _new_ulog(px4_version, start_us)
+    ulog = _new_ulog(px4_version, start_us, px4_branch)
     initial = default_params(era, vehicle_type) | dict(params or {}) | topics.initial_params
     ulog._initial_parameters = dict(initial)
     ulog._changed_parameters = topics.changed_params
@@ -462,7 +472,7 @@ def write_ulog_columns(
     return _write(ulog, Path(path))
 
 
-def _new_ulog(px4_version: str | None, start_us: int) -> Any:
+def _new_ulog(px4_version: str | None, start_us: int, branch: str | None = None) -> Any:
     ulog = ULog(None)
     ulog._file_version = 1
     ulog._start_timestamp = start_us
@@ -473,6 +483,8 @@ def _new_ulog(px4_version: str | None, start_us: int) -> Any:
     }
     if px4_version is not None:
         info["ver_sw_release"] = ("uint32_t", ver_sw_release(px4_version))
+    if branch is not None:
+        info["ver_sw_branch"] = (f"char[{len(branch)}]", branch)
     for key, (kind, value) in info.items():
         ulog._msg_info_dict[key] = value
         ulog._msg_info_dict_types[key] = kind
