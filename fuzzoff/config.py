@@ -2,7 +2,9 @@
 
 Keys (ruff-like): ``px4``, ``vehicle``, ``select``, ``extend-select``, ``ignore``, ``fail-on``,
 ``severity`` (table code -> level), ``options`` (table code -> table of thresholds),
-``params`` (PX4 parameter overrides for the gate model), ``per-file-ignores`` (glob -> codes).
+``params`` (PX4 parameter overrides for the gate model), ``per-file-ignores`` (glob -> codes),
+``suppressions`` (recording -> list of ``{ code, from, to, reason }``: findings kept in the
+reports as suppressed, not failing the run).
 An unknown key, code or option is a usage error, never ignored.
 
 As in ruff, each recording is judged with the nearest configuration above it (a ``rover/``
@@ -25,7 +27,7 @@ from typing import Any
 
 from fuzzoff import releases
 from fuzzoff.catalog import expand_selectors, get_rule, load_catalog
-from fuzzoff.findings import Severity
+from fuzzoff.findings import Finding, Report, Severity
 from fuzzoff.gate.params import GATE_PARAMS
 from fuzzoff.profiles import (
     VEHICLE_TYPES,
@@ -51,7 +53,11 @@ KNOWN_KEYS = {
     "options",
     "params",
     "per-file-ignores",
+    "suppressions",
 }
+
+NEVER = "never"
+"""``fail-on = "never"`` (``--fail-on never``, ``--exit-zero``): no finding fails the run."""
 
 _RELEASE = re.compile(r"^v?(\d+)\.(\d+)(?:\.(\d+))?")
 
@@ -188,6 +194,39 @@ def glob_regex(pattern: str) -> re.Pattern[str]:
 
 
 @dataclass(frozen=True, slots=True)
+class ConfigSuppression:
+    """One ``suppressions`` entry: findings of ``codes`` in the recordings ``pattern`` names
+    (as ``per-file-ignores`` patterns match), starting within ``from_s``..``to_s`` seconds
+    (the whole recording when both are None), taken out of the findings that fail a run and
+    reported as suppressed, with ``reason``."""
+
+    pattern: str
+    folder: str
+    codes: frozenset[str]
+    reason: str
+    source: str
+    """The configuration file that holds it."""
+    from_s: float | None = None
+    to_s: float | None = None
+
+    def matches(self, recording: str | Path) -> bool:
+        return FileIgnore(self.pattern, self.folder, self.codes).matches(recording)
+
+    def covers(self, finding: Finding) -> bool:
+        """Is ``finding`` one this entry suppresses? A window takes the findings that start in
+        it; a whole-recording finding only an entry without a window."""
+        if finding.code not in self.codes:
+            return False
+        if self.from_s is None and self.to_s is None:
+            return True
+        if finding.time_s is None:
+            return False
+        low = -math.inf if self.from_s is None else self.from_s
+        high = math.inf if self.to_s is None else self.to_s
+        return low <= finding.time_s <= high
+
+
+@dataclass(frozen=True, slots=True)
 class Discovery:
     """What a run needs to find each recording's settings: the command line's values, laid over
     the nearest configuration above the recording (``Settings.for_recording``)."""
@@ -218,6 +257,16 @@ class Settings:
     """What the user should hear about their settings (``--px4 1.12`` is judged as ``1.13``)."""
     discovery: Discovery | None = None
     """Set for a command-line run: each recording then takes its nearest configuration."""
+    exit_zero: bool = False
+    """``--exit-zero`` or ``fail-on = "never"``: findings never make the exit status 1 (the
+    reports still judge them at ``fail_on``); input that could not be read still gives 2."""
+    suppressions: tuple[ConfigSuppression, ...] = ()
+
+    def exit_status(self, report: Report) -> int:
+        """The run's exit status: 0 passed, 1 findings at or above ``fail_on`` (never with
+        ``exit_zero``), 2 input not read completely."""
+        status = report.exit_status(self.fail_on)
+        return 0 if status == 1 and self.exit_zero else status
 
     def enabled(self, code: str) -> bool:
         if code in self.ignore:
@@ -263,6 +312,9 @@ class Settings:
         )
         if ignored - settings.ignore:
             settings = replace(settings, ignore=settings.ignore | ignored)
+        mine = tuple(s for s in settings.suppressions if s.matches(recording))
+        if mine != settings.suppressions:
+            settings = replace(settings, suppressions=mine)
         return settings
 
 
@@ -405,17 +457,21 @@ def settings_from_table(
         )
     if table.get("fail-on") is not None:
         fail_on = _text(table["fail-on"], "fail-on", where, "warning")
-        try:
-            settings = replace(settings, fail_on=Severity.parse(fail_on))
-        except ValueError as exc:
-            raise ConfigError(f"{where}: fail-on: {exc}") from None
+        if fail_on.strip().lower() == NEVER:
+            settings = replace(settings, exit_zero=True)
+        else:
+            try:
+                settings = replace(settings, fail_on=Severity.parse(fail_on), exit_zero=False)
+            except ValueError as exc:
+                raise ConfigError(f"{where}: fail-on: {exc}, or never") from None
     if table.get("severity") is not None:
         levels = dict(settings.severity)
         for selector, level in _table(table["severity"], "severity", where).items():
             try:
                 sev = Severity.parse(str(level))
             except ValueError as exc:
-                raise ConfigError(f"{where}: severity.{selector}: {exc}") from None
+                at = f"--severity {selector}" if cli else f"{where}: severity.{selector}"
+                raise ConfigError(f"{at}: {exc}") from None
             for code in _codes([selector], "severity", where):
                 levels[code] = sev
         settings = replace(settings, severity=levels)
@@ -458,7 +514,71 @@ def settings_from_table(
         settings = replace(
             settings, per_file_ignores=(*settings.per_file_ignores, *_file_ignores(table, where))
         )
+    if table.get("suppressions") is not None:
+        if cli:
+            raise ConfigError("suppressions are read from a configuration file only")
+        settings = replace(
+            settings, suppressions=(*settings.suppressions, *_suppressions(table, where))
+        )
     return settings
+
+
+_SUPPRESSION_KEYS = {"code", "from", "to", "reason"}
+_SUPPRESSION_EXAMPLE = '[{ code = "OFB101", from = 12.0, to = 15.5, reason = "bench test" }]'
+
+
+def _suppressions(table: Mapping[str, Any], where: str) -> list[ConfigSuppression]:
+    """``suppressions = { "RECORDING" = [{ code, from, to, reason }, ...] }``: a recording's
+    path relative to the file's folder (or a pattern, as ``per-file-ignores``); ``code`` a code
+    or prefix; ``from`` and ``to`` seconds from the recording's first message (optional: the
+    whole recording); ``reason`` required, since it is what the reports show."""
+    folder = str(Path(where).parent)
+    out = []
+    for pattern, entries in _table(table["suppressions"], "suppressions", where).items():
+        at = f"{where}: suppressions.{pattern!r}"
+        try:
+            glob_regex(pattern.removeprefix("!"))
+        except (ValueError, re.error) as exc:
+            raise ConfigError(f"{at}: bad pattern: {exc}") from None
+        if isinstance(entries, dict):
+            entries = [entries]
+        if not isinstance(entries, list) or not all(isinstance(e, dict) for e in entries):
+            raise ConfigError(f"{at} must be a list of tables, e.g. {_SUPPRESSION_EXAMPLE}")
+        for entry in entries:
+            unknown = sorted(set(entry) - _SUPPRESSION_KEYS)
+            if unknown:
+                raise ConfigError(
+                    f"{at}: unknown key {unknown[0]}{did_you_mean(unknown[0], _SUPPRESSION_KEYS)}"
+                    f"; known: code, from, to, reason"
+                )
+            if "code" not in entry:
+                raise ConfigError(f"{at}: each suppression names its code: {_SUPPRESSION_EXAMPLE}")
+            reason = entry.get("reason")
+            if not isinstance(reason, str) or not reason.strip():
+                raise ConfigError(
+                    f"{at}: each suppression gives its reason (the reports show it): "
+                    f"{_SUPPRESSION_EXAMPLE}"
+                )
+            window = [_seconds(entry.get(k), f"{at}: {k}") for k in ("from", "to")]
+            if window[0] is not None and window[1] is not None and window[0] > window[1]:
+                raise ConfigError(f"{at}: from ({window[0]}) is after to ({window[1]})")
+            codes = _codes(
+                [entry["code"]] if isinstance(entry["code"], str) else entry["code"], "code", at
+            )
+            out.append(
+                ConfigSuppression(
+                    pattern, folder, frozenset(codes), reason.strip(), where, window[0], window[1]
+                )
+            )
+    return out
+
+
+def _seconds(value: Any, where: str) -> float | None:
+    if value is None:
+        return None
+    if not isinstance(value, (int, float)) or isinstance(value, bool) or not math.isfinite(value):
+        raise ConfigError(f"{where} must be a number of seconds")
+    return float(value)
 
 
 def _file_ignores(table: Mapping[str, Any], where: str) -> list[FileIgnore]:
@@ -483,12 +603,20 @@ def load_settings(
     overrides: Mapping[str, Any] | None = None,
     *,
     per_recording: bool = False,
+    config: Path | None = None,
 ) -> Settings:
     """Settings from the nearest config file, then ``overrides`` (the command line) on top.
 
     ``per_recording`` (command-line runs): ``Settings.for_recording`` then looks for each
-    recording's own nearest configuration, as ruff does for each source file."""
+    recording's own nearest configuration, as ruff does for each source file. ``config``
+    (``--config FILE``, as ruff's): that file for every recording, none searched for."""
     clean = {k: v for k, v in (overrides or {}).items() if v is not None}
+    if config is not None:
+        if not config.is_file():
+            raise ConfigError(f"--config {config}: no such file")
+        if config.name == "pyproject.toml" and "fuzzoff" not in _load_toml(config).get("tool", {}):
+            raise ConfigError(f"--config {config}: no [tool.fuzzoff] table in it")
+        return _settings_from(config.resolve(), clean)
     settings = _settings_from(find_config((start or Path.cwd()).resolve()), clean)
     if per_recording:
         settings = replace(settings, discovery=Discovery(tuple(sorted(clean.items()))))
@@ -523,7 +651,12 @@ def _nearest_settings(run: Settings, discovery: Discovery, recording: Path) -> S
             found = discovery.cache.get(str(config))
             if found is None:
                 found = _settings_from(config, dict(discovery.overrides))
-                found = replace(found, fail_on=run.fail_on, notes=_fail_on_note(found, run))
+                found = replace(
+                    found,
+                    fail_on=run.fail_on,
+                    exit_zero=run.exit_zero,
+                    notes=_fail_on_note(found, run),
+                )
                 discovery.cache[str(config)] = found
         discovery.cache[folder] = found
     return found

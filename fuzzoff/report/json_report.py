@@ -32,10 +32,16 @@ SCHEMA_FILE = Path(__file__).parent / "schemas" / "lint-report.schema.json"
 
 
 def file_dict(file: FileReport) -> dict[str, Any]:
-    """One recording: ``FileReport.to_json``, each finding with its SARIF fingerprint."""
+    """One recording: ``FileReport.to_json``, each finding with its SARIF fingerprint, and the
+    findings a suppression took out (``suppressed``), each with its ``suppression``."""
     data: dict[str, Any] = clean(file.to_json())
     for finding, mark in zip(data["findings"], marks(file.findings), strict=True):
         finding["fingerprint"] = mark
+    held = [finding for finding, _ in file.suppressed]
+    data["suppressed"] = [
+        {**clean(finding.to_json()), "fingerprint": mark, "suppression": why.to_json()}
+        for (finding, why), mark in zip(file.suppressed, marks(held), strict=True)
+    ]
     return data
 
 

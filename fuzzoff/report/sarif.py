@@ -184,7 +184,7 @@ def sarif_log(report: Report, settings: Settings, root: Path | None = None) -> d
             {
                 # input that could not be read completely: the analysis did not complete
                 "executionSuccessful": report.complete,
-                "exitCode": report.exit_status(settings.fail_on),
+                "exitCode": settings.exit_status(report),
                 "toolExecutionNotifications": notifications,
                 "properties": {"fail_on": settings.fail_on.label, "complete": report.complete},
             }
