@@ -108,7 +108,7 @@ def user_px4_profile(text: str) -> tuple[PX4Profile, str | None]:
 
 def user_vehicle_type(text: str) -> str:
     """A vehicle type the user names. ``rover`` alone is refused: the rover kinds take
-    setpoints differently (gate spec 10), and a guess would judge the wrong one."""
+    setpoints differently (gate.md#rover), and a guess would judge the wrong one."""
     if text.strip().lower() == "rover":
         rovers = ", ".join(v for v in VEHICLE_TYPES if v.startswith("rover"))
         raise ProfileError(f"vehicle type 'rover' names no rover kind: give one of {rovers}")

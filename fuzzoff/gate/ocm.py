@@ -1,6 +1,6 @@
 """``offboard_control_mode`` flags as a small bit mask (cheap to build once per message).
 
-Bits follow PX4's priority order (gate spec section 7): the lowest set bit is the "first true
+Bits follow PX4's priority order (gate.md#control-mode): the lowest set bit is the "first true
 flag" that selects the controller chain.
 """
 

@@ -1,4 +1,4 @@
-"""Proof of life: when is the offboard signal available, per profile (gate spec section 2).
+"""Proof of life: when is the offboard signal available, per profile (gate.md#signal).
 
 Each model keeps only the newest keep-alive and computes the time of its loss arithmetically
 (no per-tick loop):

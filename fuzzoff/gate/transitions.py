@@ -36,7 +36,7 @@ class GateTransition(Event):
     """One change the gate model predicts, at ``t``, caused by ``cause`` (None for a timeout).
 
     ``spec`` names the section of px4-offboard-gate.md the transition implements;
-    ``unverified`` marks behaviour the spec lists as unverified (section 15).
+    ``unverified`` marks behaviour not verified on PX4 (gate.md#unverified).
     """
 
     kind: ClassVar[str] = "gate"
