@@ -167,3 +167,12 @@ def test_show_settings_names_what_a_recording_is_judged_with(tmp_path: Path) -> 
     folder = run_cli(["lint", "--show-settings", "."], tmp_path)
     assert folder.returncode == 0  # one recording found under it
     assert run_cli(["lint", "--show-settings", "nothing.tlog"], tmp_path).returncode == 2
+
+
+def test_gate_takes_config_too(tmp_path: Path) -> None:
+    gap_recording(tmp_path / "gap.tlog")
+    (tmp_path / "alt.toml").write_text("params = { COM_OF_LOSS_T = 0.5 }\n")
+    plain = run_cli(["gate", "gap.tlog"], tmp_path).stdout
+    faster = run_cli(["gate", "gap.tlog", "--config", "alt.toml"], tmp_path).stdout
+    assert "1.00-1.10 s after the newest keep-alive" in plain
+    assert "0.50-0.60 s after the newest keep-alive" in faster

@@ -20,6 +20,7 @@ from typing import Any
 from fuzzoff import __version__
 from fuzzoff.commands import add_command
 from fuzzoff.commands._common import (
+    add_config_option,
     add_profile_options,
     check_output,
     existing_paths,
@@ -43,6 +44,7 @@ def add_parser(sub: Any) -> None:
     )
     parser.add_argument("path", metavar="PATH", help="a recording (any supported format)")
     add_profile_options(parser)
+    add_config_option(parser)
     parser.add_argument("--format", choices=("terminal", "json"), default="terminal")
     parser.add_argument("--output", "-o", metavar="FILE", help="write the timeline here")
     parser.add_argument(
