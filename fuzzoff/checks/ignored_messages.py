@@ -1,7 +1,7 @@
 """OFB608: MAVLink setpoint messages the profile's PX4 has no handler for.
 
-PX4 1.14 removed the MAVLink receiver's handler of ``SET_ACTUATOR_CONTROL_TARGET`` (#139, gate
-spec 6.6): MAVSDK's ``set_actuator_control`` and MAVROS ``actuator_control`` still send it (two
+PX4 1.14 removed the MAVLink receiver's handler of ``SET_ACTUATOR_CONTROL_TARGET`` (#139,
+gate.md#receiver): MAVSDK's ``set_actuator_control`` and MAVROS ``actuator_control`` still send it (two
 groups at MAVSDK's 20 Hz: 40 messages a second), and PX4 ignores every one: no setpoint, no
 keep-alive. The rule's profiles (1.14+) say where; on 1.13 and older PX4 handles the message.
 

@@ -56,7 +56,8 @@ def mask_of(event: ControlMode) -> int:
 
 
 def legacy_mask(event: LegacyControlMode) -> int:
-    """A legacy ``ignore_*`` control mode as the flags it leaves enabled (spec 7, legacy)."""
+    """A legacy ``ignore_*`` control mode as the flags it leaves enabled (gate.md#control-mode,
+    legacy)."""
     return (
         (0 if event.ignore_position else POSITION)
         | (0 if event.ignore_velocity else VELOCITY)

@@ -236,7 +236,7 @@ class AgeSignal(Signal):
 
 
 class LegacySignal(Signal):
-    """Two flags: lost (500 ms) and loss timeout (500 ms + ``COM_OF_LOSS_T``), spec 2.3."""
+    """Two flags: lost (500 ms) and loss timeout (500 ms + ``COM_OF_LOSS_T``), gate.md#signal."""
 
     spec = "2.3"
 
