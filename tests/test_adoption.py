@@ -11,6 +11,7 @@ from typing import Any
 
 from tests.helpers import CORPORA, run_cli
 from tests.report_fixtures import gap_recording
+from tests.test_sarif import multitool, validate
 
 OLD_FLIGHTS = ["stream_lost_in_offboard.tlog", "keepalive_gap_0_7s.tlog", "good_offboard.tlog"]
 
@@ -176,3 +177,22 @@ def test_gate_takes_config_too(tmp_path: Path) -> None:
     faster = run_cli(["gate", "gap.tlog", "--config", "alt.toml"], tmp_path).stdout
     assert "1.00-1.10 s after the newest keep-alive" in plain
     assert "0.50-0.60 s after the newest keep-alive" in faster
+
+
+def test_sarif_keeps_a_suppressed_finding_as_suppressed(tmp_path: Path) -> None:
+    """Code scanning would take a finding that left the SARIF for fixed: it stays, suppressed."""
+    (tmp_path / "flights").mkdir()
+    gap_recording(tmp_path / "flights" / "gap.tlog")
+    (tmp_path / "pyproject.toml").write_text(SUPPRESS)
+    result = run_cli(["lint", "flights", "--select", "OFB101", "--format", "sarif"], tmp_path)
+    assert result.returncode == 0
+    run = json.loads(result.stdout)["runs"][0]
+    (held,) = [r for r in run["results"] if r.get("suppressions")]
+    assert held["ruleId"] == "OFB101"
+    assert held["suppressions"] == [
+        {"kind": "external", "justification": "config: bench test, props off"}
+    ]
+    assert run["invocations"][0]["exitCode"] == 0
+    sarif = tmp_path / "suppressed.sarif"
+    sarif.write_text(result.stdout, encoding="utf-8")
+    assert validate(multitool(), [sarif], tmp_path / "validation.sarif") == []

@@ -162,6 +162,14 @@ def sarif_log(report: Report, settings: Settings, root: Path | None = None) -> d
         ref = {**location, "index": len(artifacts) - 1}
         for finding, mark in zip(file.findings, marks(file.findings), strict=True):
             results.append(result(finding, index[finding.code], ref, mark))
+        # a suppressed finding (configuration or baseline) stays a result, marked suppressed:
+        # code scanning then shows it as such instead of taking it for fixed
+        held = [finding for finding, _ in file.suppressed]
+        for (finding, why), mark in zip(file.suppressed, marks(held), strict=True):
+            item = result(finding, index[finding.code], ref, mark)
+            justification = printable(f"{why.kind}: {why.reason}", CI_TEXT_LIMIT)
+            item["suppressions"] = [{"kind": "external", "justification": justification}]
+            results.append(item)
         notifications.extend(
             {
                 "level": "error",
