@@ -159,6 +159,23 @@ class Rule:
         veh = "all" if self.vehicles == VEHICLE_TYPES else ", ".join(self.vehicles)
         return f"PX4 {px4}; vehicles {veh}"
 
+    def profiles_short(self) -> str:
+        """``profiles_text`` for a table row: a run of profiles up to the newest as ``1.13+``
+        (as the rule pages' front matter writes it)."""
+        names = releases.names()
+        px4 = ", ".join(self.px4)
+        if self.px4 == names:
+            px4 = "all"
+        elif self.px4 and self.px4 == names[names.index(self.px4[0]) :]:
+            px4 = f"{self.px4[0]}+"
+        rovers = tuple(v for v in VEHICLE_TYPES if v.startswith("rover"))
+        veh = ", ".join(self.vehicles)
+        if self.vehicles == VEHICLE_TYPES:
+            return f"PX4 {px4}"
+        if self.vehicles == rovers:
+            veh = "rovers"
+        return f"PX4 {px4}; {veh}"
+
 
 def _catalog_dir() -> Path:
     """``rules/`` beside the package in a checkout, or ``fuzzoff/_catalog`` in a wheel. Found

@@ -714,7 +714,7 @@ def timeline_loss_timeout(
     An engine that copies the gate's final ``loss_timeout`` and ``recorded_params`` onto the
     timeline gives the recording's own value; without them the value is ``--param`` /
     configuration, else the profile's default (what the gate model starts from). Before 1.11
-    the timeout is a fixed 500 ms whatever COM_OF_LOSS_T says (gate spec 2.3).
+    the timeout is a fixed 500 ms whatever COM_OF_LOSS_T says (gate.md#signal).
     """
     recorded = timeline.recorded_params
     value = timeline.loss_timeout

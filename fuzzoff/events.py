@@ -520,8 +520,9 @@ class ManualControl(Event):
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class LandDetected(Event):
-    """The land detector's verdict, which PX4 reads when it judges a disarm request (gate spec
-    13a: refused in flight). ``landed`` is what Commander tests, ``landed or maybe_landed``
+    """The land detector's verdict, which PX4 reads when it judges a disarm request
+    (gate.md#seen-on-px4:
+    refused in flight). ``landed`` is what Commander tests, ``landed or maybe_landed``
     (ULog ``vehicle_land_detected``), or MAVLink ``EXTENDED_SYS_STATE.landed_state`` ON_GROUND
     (IN_AIR, TAKEOFF and LANDING are not landed; UNDEFINED is ``None``)."""
 

@@ -134,6 +134,29 @@ class Finding:
         }
 
 
+@dataclass(frozen=True, slots=True)
+class Suppression:
+    """Why a finding was taken out of the ones that fail a run: an entry of the
+    configuration's ``suppressions`` or the ``--baseline`` file (``kind``)."""
+
+    kind: str
+    """``config`` or ``baseline``."""
+    reason: str
+    source: str
+    """The configuration file or the baseline."""
+    from_s: float | None = None
+    to_s: float | None = None
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "kind": self.kind,
+            "reason": self.reason,
+            "source": self.source,
+            "from": self.from_s,
+            "to": self.to_s,
+        }
+
+
 class RecordingStats(TypedDict, total=False):
     """What a reader counted while it read (``Source.stats``); each format fills its own keys."""
 
@@ -197,6 +220,9 @@ class FileReport:
     it; empty in a plain lint)."""
     loss_timeouts: dict[str, tuple[float, str]] = field(default_factory=dict)
     """Per vehicle of ``timelines``, the loss timeout the gate used and where it came from."""
+    suppressed: list[tuple[Finding, Suppression]] = field(default_factory=list)
+    """Findings a suppression took out of ``findings`` (``fuzzoff.suppress``): the reports
+    show them apart, and they fail no run."""
 
     def to_json(self) -> dict[str, Any]:
         return {

@@ -1,6 +1,6 @@
 """The gate model's timeline of a recording as rows, for ``fuzzoff gate`` and the SITL
-verdict: each row a model transition (time, what, message, gate-spec section, unverified or not)
-or a recorded mode change, in time order."""
+verdict: each row a model transition (time, what, message, its docs/gate.md section, unverified
+or not) or a recorded mode change, in time order."""
 
 from __future__ import annotations
 
@@ -11,6 +11,7 @@ from fuzzoff.config import Settings
 from fuzzoff.engine import lint_file
 from fuzzoff.findings import FileReport
 from fuzzoff.gate import GateTransition
+from fuzzoff.gate.sections import link
 from fuzzoff.modes import nav_state_name
 from fuzzoff.timeline import Timeline
 
@@ -23,7 +24,7 @@ def _transition_row(tr: GateTransition) -> Row:
         "source": "model",
         "what": tr.what,
         "message": tr.message,
-        "spec": tr.spec,
+        "see": link(tr.spec),
         "unverified": tr.unverified,
         "nav_state": tr.nav_state,
         "mode": nav_state_name(tr.nav_state) if tr.nav_state is not None else None,
@@ -42,7 +43,7 @@ def _recorded_row(t: float, nav: int | None, armed: bool | None) -> Row:
         "source": "recorded",
         "what": "recorded",
         "message": f"{nav_state_name(nav)}{arming}",
-        "spec": None,
+        "see": None,
         "unverified": False,
         "nav_state": nav,
         "mode": nav_state_name(nav) if nav is not None else None,

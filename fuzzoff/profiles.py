@@ -1,4 +1,4 @@
-"""PX4 version profiles and vehicle types (gate spec section 0, rules.md "Profile").
+"""PX4 version profiles and vehicle types (docs/gate.md, docs/rules).
 
 A profile is the pair (PX4 profile, vehicle type). ``--px4`` takes a release such as ``1.15.4``
 and maps it to the modelled profile; the report always says whether it was detected. What each

@@ -3,7 +3,8 @@
 Each record answers questions about behaviour ("does Commander accept a switch to OFFBOARD while
 disarmed without a stream?"), never "is this release at least 1.14?": code asks
 ``release.accepts_disarmed_switch``, and a new PX4 release is one new record here (plus its
-``px4_msgs`` folder), each field written down once, beside the gate spec section it comes from.
+``px4_msgs`` folder), each field written down once, beside the docs/gate.md
+section it comes from.
 
 A record is found once, where a model or a check is built (``get``, ``Profile.release``), never per
 event. The table is read at call time (``names``, ``get``, ``RELEASES``), so a record added here is
@@ -24,21 +25,21 @@ PX4Profile = Literal["legacy", "1.11", "1.13", "1.14", "1.15", "1.16", "1.17", "
 """The names of the modelled releases (``--px4`` values), oldest first."""
 
 LossSignal = Literal["fixed", "age", "hysteresis", "tick"]
-"""How PX4 decides the offboard signal is lost (gate spec 2.1-2.3)."""
+"""How PX4 decides the offboard signal is lost (gate.md#signal)."""
 
 LossFailsafe = Literal["state_machine_legacy", "state_machine", "framework"]
-"""What picks the action on offboard loss (gate spec 5.3, 5.2, 5.1)."""
+"""What picks the action on offboard loss (gate.md#loss)."""
 
 NavRclFallback = Literal["none", "before_degrade", "after_degrade"]
 """Where a stick mode chosen on offboard loss without manual control becomes NAV_RCL_ACT
-(gate spec 5.1): never, before the PosCtrl -> AltCtrl -> Stab chain, or after it."""
+(gate.md#loss): never, before the PosCtrl -> AltCtrl -> Stab chain, or after it."""
 
 UnsupportedModeAnswer = Literal["rejected_unverified", "acked_no_change", "rejected"]
-"""Commander's answer to DO_SET_MODE with a custom main mode it does not know (gate spec 4.1)."""
+"""Commander's answer to DO_SET_MODE with a custom main mode it does not know (gate.md#requests)."""
 
 ControlModeLayout = Literal["ignore_fields", "actuator", "thrust_and_torque"]
 """OffboardControlMode's fields: legacy ``ignore_*``, 1.13's booleans with one ``actuator``,
-1.15's ``thrust_and_torque`` and ``direct_actuator`` (gate spec 7)."""
+1.15's ``thrust_and_torque`` and ``direct_actuator`` (gate.md#control-mode)."""
 
 AlienCommandAnswer = Literal["ack_failed", "ignored"]
 """What PX4's MAVLink receiver does with a command it is not addressed by (4.4)."""
@@ -63,7 +64,7 @@ def _params(**values: float) -> Mapping[str, float]:
 class Release:
     """A modelled PX4 release: its name, the versions it covers and how its offboard gate behaves.
 
-    Field docs name the gate spec section (``../shared/spec/px4-offboard-gate.md``) or the docs
+    Field docs name the docs/gate.md section (or PX4's source at a tag) or the docs
     seed they come from.
     """
 
@@ -165,7 +166,8 @@ class Release:
     docs_page: DocsPage | None
     """The docs page of OffboardControlMode's table and the MAVLink rules (None: no page)."""
     docs_acceleration_needs_velocity: bool
-    """The docs still ask for a velocity estimate with the acceleration flag (gate spec D10)."""
+    """The docs still ask for a velocity estimate with the acceleration flag
+    (gate.md#docs-vs-code)."""
     rover_setpoints: bool
     """The rover setpoint topics and their docs table exist (1.16+)."""
     docs_say_2hz: bool

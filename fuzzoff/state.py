@@ -38,7 +38,7 @@ ack and its new vehicle_status: 7 ms later on 1.16.2 SITL), not a switch back.""
 
 DOUBLE_ACK_WINDOW_S = 0.1
 """A second ack for the same command within this window replaces a first that was ACCEPTED
-(gate spec 4.3: PX4 1.16/1.17's receiver acks ACCEPTED, Commander's verdict follows)."""
+(gate.md#acks: PX4 1.16/1.17's receiver acks ACCEPTED, Commander's verdict follows)."""
 
 
 @dataclass(slots=True)

@@ -2,7 +2,7 @@
 
 ``POSITION_TARGET_TYPEMASK`` (SET_POSITION_TARGET_LOCAL_NED and _GLOBAL_INT): a set bit
 ignores the field. Bits 12-14 are not MAVLink's: PX4 reads them as a fixed-wing "setpoint type"
-(gate spec 6.2). ``ATTITUDE_TARGET_TYPEMASK`` (SET_ATTITUDE_TARGET, gate spec 6.4).
+(gate.md#receiver). ``ATTITUDE_TARGET_TYPEMASK`` (SET_ATTITUDE_TARGET, gate.md#receiver).
 """
 
 from __future__ import annotations

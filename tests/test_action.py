@@ -8,6 +8,7 @@ from __future__ import annotations
 import json
 import shutil
 import subprocess
+import sys
 from pathlib import Path
 
 from tests.action_runner import ACTION, ACTIONLINT, actionlint, run_step
@@ -104,3 +105,26 @@ def test_a_recording_it_cannot_read_gives_status_2(tmp_path: Path) -> None:
     )
     assert run.returncode == 0 and run.outputs["status"] == "2"
     assert "flight.tlog" in run.stderr
+
+
+def test_annotations_and_a_baseline(tmp_path: Path) -> None:
+    """Each finding printed as a workflow command; a baseline's findings fail nothing."""
+    _logs(tmp_path, "stream_lost_in_offboard.tlog")
+    off = {"paths": "logs/", "sarif": "false", "html": "false"}
+    run = run_step("lint", off, tmp_path, tmp_path)
+    assert run.outputs["status"] == "1"
+    commands = [line for line in run.stdout.splitlines() if line.startswith("::")]
+    assert any(
+        line.startswith("::error file=logs/stream_lost_in_offboard.tlog,") for line in commands
+    )
+    subprocess.run(
+        [sys.executable, "-m", "fuzzoff.cli", "lint", "logs/", "--write-baseline", "base.json"],
+        cwd=tmp_path,
+        capture_output=True,
+        check=True,
+    )
+    again = run_step("lint", {**off, "baseline": "base.json"}, tmp_path, tmp_path)
+    assert again.outputs["status"] == "0", again.stdout + again.stderr
+    assert not [line for line in again.stdout.splitlines() if line.startswith("::")]
+    quiet = run_step("lint", {**off, "annotations": "false"}, tmp_path, tmp_path)
+    assert not [line for line in quiet.stdout.splitlines() if line.startswith("::")]

@@ -102,7 +102,7 @@ def proven_gap(ctx: CheckContext, event: Event, gap: float) -> float:
 
 
 def loss_timeout(ctx: CheckContext) -> float:
-    """The gap after which the profile's PX4 declares the offboard signal lost (gate spec 2):
+    """The gap after which the profile's PX4 declares the offboard signal lost (gate.md#signal):
     the gate model's own value (legacy's fixed 500 ms, else the effective COM_OF_LOSS_T)."""
     return ctx.gate.loss_timeout
 
@@ -140,7 +140,8 @@ class RecordedSwitches:
     Where no commands are recorded (MAVROS bags: services are not recorded) the recorded entry
     into OFFBOARD is the request. But PX4 enters OFFBOARD by itself twice:
 
-    * after a loss failsafe it returns when the stream resumes (gate spec 5.1, D9): an entry
+    * after a loss failsafe it returns when the stream resumes (gate.md#loss, #docs-vs-code): an
+      entry
       that follows an exit made while the keep-alive was older than the loss timeout (less the
       10 Hz evaluation slack) is that return;
     * when it disarms after a landing (an auto land, a Return), its mode goes back to the

@@ -1,7 +1,8 @@
 """OFB401-OFB403, OFB405-OFB408: what the setpoint messages carry.
 
 Seed 000 "Мультикоптери" and "Універсальний апарат" (002 "旋翼机", "Generic Vehicle"); the
-per-axis validity of OFB403 is the code's rule (gate spec section 8, D13). OFB405/OFB406 also
+per-axis validity of OFB403 is the code's rule (gate.md#multicopter, #docs-vs-code).
+OFB405/OFB406 also
 judge MAVLink ``SET_ATTITUDE_TARGET`` where its ``type_mask`` uses the field.
 """
 
@@ -94,7 +95,7 @@ def _selected(finite: tuple[tuple[bool, bool, bool], ...]) -> str | None:
 
 
 def axis_problems(sp: TrajectorySetpoint) -> list[str]:
-    """What PX4's position controller rejects (gate spec section 8, ``_inputValid``)."""
+    """What PX4's position controller rejects (gate.md#multicopter, ``_inputValid``)."""
     return _axis_problems(finiteness(sp))
 
 
@@ -220,7 +221,7 @@ class TrajectoryContent(Check):
 
 
 def _invalid_effect(ctx: CheckContext) -> str:
-    """What mc_pos_control does with invalid input (gate spec section 8)."""
+    """What mc_pos_control does with invalid input (gate.md#multicopter)."""
     if ctx.profile.release.reuses_last_valid_setpoint:
         return (
             f"PX4 {ctx.profile.px4} reuses the last valid setpoint for 200 ms, then flies a "

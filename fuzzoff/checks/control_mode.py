@@ -153,7 +153,7 @@ class DeclaredSetpointMissing(Check):
 
     ROS 2: per the first true field of ``OffboardControlMode``; a setpoint published once before
     counts (it stays on the topic). MAVLink (no ``OffboardControlMode`` in the recording): PX4's
-    receiver forwards a setpoint only while the vehicle is in OFFBOARD (gate spec 6.1), so only a
+    receiver forwards a setpoint only while the vehicle is in OFFBOARD (gate.md#receiver), so only a
     setpoint it takes at or after the switch counts."""
 
     codes = ("OFB303",)
@@ -300,7 +300,7 @@ class DeclaredSetpointMissing(Check):
 
     @staticmethod
     def _taken(event: MavlinkTarget, rx: ReceiverContext) -> bool:
-        """Does PX4's receiver publish a setpoint for it (gate spec 6.1-6.4)?"""
+        """Does PX4's receiver publish a setpoint for it (gate.md#receiver)?"""
         mask, axes, _, _ = receive(event, rx)
         return mask != DROPPED and (axes != 0 or isinstance(event, SetAttitudeTarget))
 
@@ -354,7 +354,7 @@ class ControlModeChanged(Check):
     """OFB304: the first true field PX4 receives changes while in offboard (info).
 
     On ROS 2 (and in a ULog) that is ``OffboardControlMode`` as recorded; over MAVLink there is
-    none, and PX4's receiver sets the flags from each setpoint's type mask (gate spec 6), so
+    none, and PX4's receiver sets the flags from each setpoint's type mask (gate.md#receiver), so
     the same flight judged from its tlog and from its ULog (which logs the receiver's
     ``offboard_control_mode``) tells the same changes. Changes less than ``stretch_s`` apart are
     one finding: a stream that interleaves setpoint types switches the flags with every

@@ -2,7 +2,7 @@
 
 On the v1.16.x and v1.17.0 tags PX4's MAVLink receiver answers a ``COMMAND_LONG``/``COMMAND_INT``
 ``DO_SET_MODE`` with its own ACCEPTED and then passes the command on to Commander, whose verdict
-follows 4-9 ms later as a second ``COMMAND_ACK`` (gate spec 4.3, §16 S2: PX4 PR #27343 removed the
+follows 4-9 ms later as a second ``COMMAND_ACK`` (gate.md#acks, #drift: PX4 PR #27343 removed the
 first one on 1.18 and on the 1.16/1.17 branches after 2026-05-19). ``SET_MODE`` and a ROS 2
 ``VehicleCommand`` get Commander's ack only. The recording's own acks are the evidence, not the
 version string: a switch answered once is never judged.

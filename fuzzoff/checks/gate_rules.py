@@ -1,4 +1,4 @@
-"""Rules read straight off the gate model (gate spec sections 5 and 12).
+"""Rules read straight off the gate model (gate.md#loss, #history).
 
 * OFB202 gate-model-disagrees: the model's ``disagreement`` transitions (recorded mode or ack vs
   the prediction, judged with the profile's evaluation slack, see ``fuzzoff.gate.compare``); the

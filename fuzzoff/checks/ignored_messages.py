@@ -1,9 +1,10 @@
 """OFB608: MAVLink setpoint messages the profile's PX4 has no handler for.
 
-PX4 1.14 removed the MAVLink receiver's handler of ``SET_ACTUATOR_CONTROL_TARGET`` (#139, gate
-spec 6.6): MAVSDK's ``set_actuator_control`` and MAVROS ``actuator_control`` still send it (two
-groups at MAVSDK's 20 Hz: 40 messages a second), and PX4 ignores every one: no setpoint, no
-keep-alive. The rule's profiles (1.14+) say where; on 1.13 and older PX4 handles the message.
+PX4 1.14 removed the MAVLink receiver's handler of ``SET_ACTUATOR_CONTROL_TARGET`` (#139,
+gate.md#receiver): MAVSDK's ``set_actuator_control`` and MAVROS ``actuator_control`` still
+send it (two groups at MAVSDK's 20 Hz: 40 messages a second), and PX4 ignores every one: no
+setpoint, no keep-alive. The rule's profiles (1.14+) say where; on 1.13 and older PX4 handles
+the message.
 
 The keep-alive rules see what this leaves: OFB101 the gap in the keep-alive (and how many of
 these messages came in it), OFB103 the loss failsafe, OFB102 and OFB201 a switch refused for

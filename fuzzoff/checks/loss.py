@@ -1,12 +1,12 @@
 """OFB103: the keep-alive stopped in offboard for longer than the loss timeout.
 
-Driven by the gate model's ``failsafe`` transitions (gate spec 5); where the gate did not see the
+Driven by the gate model's ``failsafe`` transitions (gate.md#loss); where the gate did not see the
 vehicle in offboard but the recording does (a MAVROS bag has no mode commands to model), the same
 timeout is applied to the recorded mode so the loss is still reported. Where the recording shows
 what the vehicle did next, the finding compares it with the model's action.
 
 Times quoted: the model's loss as the gate dates it (PX4's own flag where the recording holds
-it, else the window of PX4's 10 Hz check pass, gate spec 2.1.3); the recorded change as the
+it, else the window of PX4's 10 Hz check pass, gate.md#check-timing); the recorded change as the
 recording shows it: the first status with the new mode, or, where the mode is sampled over a
 link (1 Hz HEARTBEAT, ``/mavros/state``), between the last sample still in OFFBOARD and that one.
 """
@@ -168,7 +168,7 @@ class OffboardLoss(Check):
             stopped = "no keep-alive"
         elif self.lost is not None and self.lost.t - self.last < timeout - TIME_EPSILON_S:
             # lost sooner than a timeout after the newest keep-alive: not silence but, e.g., an
-            # old timestamp (gate spec 2.1.1) or a declaration without a flag
+            # old timestamp (gate.md#signal) or a declaration without a flag
             why = self.lost.reason or _inner(self.lost.message)
             stopped = f"the keep-alive kept arriving but PX4 no longer counts it ({why})"
         else:

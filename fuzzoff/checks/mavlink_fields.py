@@ -6,7 +6,7 @@ tables are in ``fuzzoff.tables.mavlink``. Every setpoint the recording shows on 
 vehicle is judged, in any mode: a message PX4 drops is also a keep-alive that never counted.
 
 OFB609 covers PX4 legacy and 1.11, which no seed documents field by field: it follows the legacy
-receiver (gate spec 6.3-6.5) and reports what it drops or does not forward.
+receiver (gate.md#receiver) and reports what it drops or does not forward.
 """
 
 from __future__ import annotations
@@ -234,7 +234,7 @@ class PositionTargetFields(Check):
             f"the PX4 {px4} docs support only {frames_text(docs)} for {for_what} on a "
             f"{self.vehicle_label}"
         )
-        # In BODY_NED the receiver always drops the position (gate spec 6.2).
+        # In BODY_NED the receiver always drops the position (gate.md#receiver).
         body_position = event.kind == tm.LOCAL and frame == 8 and "position" in usable
         if frame in receiver and not body_position:
             return {
@@ -316,7 +316,7 @@ class PositionTargetFields(Check):
     def _global_partial_position(
         self, event: PositionTarget, head: str, selected: tm.Combo
     ) -> dict[str, Offence] | None:
-        """GLOBAL_INT (gate spec 6.3): the receiver takes the position only whole; an ignore bit
+        """GLOBAL_INT (gate.md#receiver): the receiver takes the position only whole; an ignore bit
         on any of lat, lon or alt drops all three. With no velocity or acceleration left the
         message is dropped silently (no setpoint, no keep-alive); otherwise only the rest is
         flown. The legacy and 1.11 handlers are OFB609's."""
@@ -359,7 +359,8 @@ class PositionTargetFields(Check):
         selected: tm.Combo,
         usable: tm.Combo,
     ) -> dict[str, Offence] | None:
-        """BODY_NED (gate spec 6.2, D17): the receiver always ignores the position and takes a
+        """BODY_NED (gate.md#receiver, #docs-vs-code): the receiver always ignores the position
+        and takes a
         velocity or acceleration only with all three components; with nothing left it drops the
         message. Frames the docs do not list for the combination are OFB601's."""
         frame = event.coordinate_frame
@@ -387,7 +388,7 @@ class PositionTargetFields(Check):
         }
 
     def _mc_axes(self, event: PositionTarget, rx: ReceiverContext) -> dict[str, Offence]:
-        """What PX4's multicopter position controller rejects (gate spec 8, ``_inputValid``)
+        """What PX4's multicopter position controller rejects (gate.md#multicopter, ``_inputValid``)
         in the setpoint the receiver makes of the message: each axis needs a finite position,
         velocity or acceleration, and x and y of each must be both finite or both NaN. Dropped
         messages are the other verdicts' (or OFB607's)."""
@@ -482,7 +483,7 @@ class PositionTargetFields(Check):
 
 LEGACY_SETPOINT_TYPES = {0x1000: "takeoff", 0x2000: "land"}
 """Setpoint-type values the legacy receiver classifies as LOITER (it tests ``mask & 0x3000``
-first, gate spec 6.5, D14)."""
+first, gate.md#receiver, #docs-vs-code)."""
 
 
 def _nonfinite(names: tuple[str, ...], values: tuple[float, ...]) -> list[str]:
@@ -490,8 +491,8 @@ def _nonfinite(names: tuple[str, ...], values: tuple[float, ...]) -> list[str]:
 
 
 class LegacySetpointDropped(Check):
-    """OFB609: what the legacy / 1.11 MAVLink receiver drops or does not forward (gate spec
-    6.3 legacy, 6.4 legacy, 6.5). Addressing is OFB607's."""
+    """OFB609: what the legacy / 1.11 MAVLink receiver drops or does not forward
+    (gate.md#receiver). Addressing is OFB607's."""
 
     codes = ("OFB609",)
     wants = (SetPositionTargetLocal, SetPositionTargetGlobal, SetAttitudeTarget)

@@ -1,7 +1,7 @@
 """OFB606 (SET_ATTITUDE_TARGET type_mask) and OFB607 (setpoints addressed to another vehicle).
 
 OFB606 follows seed 000 "MAVLink Offboard Control" / seed 002 "MAVLink 消息": attitude or body
-rates, each with thrust. OFB607 follows PX4's receiver (gate spec 6.1): a setpoint whose
+rates, each with thrust. OFB607 follows PX4's receiver (gate.md#receiver): a setpoint whose
 ``target_system`` is neither the vehicle's system id nor 0, or whose ``target_component`` is
 neither its component id nor 0, is dropped, keep-alive included. The vehicle's ids are what the
 recording shows: the system id its own messages come from (HEARTBEAT and the rest), or the

@@ -1,7 +1,7 @@
 """OFB006: the companion's px4_msgs do not match the PX4 it talks to (ROS 2 recordings).
 
 From 1.16 PX4 names a ROS 2 topic after its message's version (``/fmu/out/vehicle_status_v1``
-on 1.16 and 1.17, ``_v4`` on 1.18: gate spec §16 S9), and the uXRCE-DDS bridge takes a message
+on 1.16 and 1.17, ``_v4`` on 1.18: gate.md#drift), and the uXRCE-DDS bridge takes a message
 only under its own name and type. A recording says which px4_msgs each side was built with:
 the names and embedded definitions of the companion's ``/fmu/in`` topics, and those of PX4's
 ``/fmu/out`` topics (the reader's ``RecordingInfo.px4_msgs_fits``).

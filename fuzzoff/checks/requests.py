@@ -3,7 +3,7 @@
 Acks carry the command's id but not its parameters, so they are paired with the commands of
 that id in the order sent (PX4 answers in order): a switch to OFFBOARD followed at once by a
 switch to another mode gets the first ack, the other switch the second. The last ack of a
-command decides where PX4 sends two (gate spec 4.3: 1.16/1.17 answer a mode switch with the
+command decides where PX4 sends two (gate.md#acks: 1.16/1.17 answer a mode switch with the
 receiver's ACCEPTED and then Commander's verdict a few ms later): an ack within
 ``DOUBLE_ACK_WINDOW_S`` of an ACCEPTED one replaces it. A first ack that is not ACCEPTED is
 never the receiver's, and a ROS 2 command does not pass the MAVLink receiver: then the next

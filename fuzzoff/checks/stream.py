@@ -1,7 +1,8 @@
 """OFB101, OFB102, OFB105: the keep-alive stream's rate and its run-up to an offboard request.
 
 Seed 000 "Опис": a > 2 Hz proof of life, running for a second before an offboard request. The
-messages say both what the docs require and what the profile's PX4 does (gate spec 2, 3, D1/D2),
+messages say both what the docs require and what the profile's PX4 does (gate.md#signal,
+#before-switch, #docs-vs-code),
 and the severity is what PX4 does (rules.md): a gap PX4 takes for a loss is an error, one of
 80 % of the loss timeout or more a warning, a shorter one (the docs' 2 Hz only) info.
 """
@@ -106,7 +107,7 @@ class KeepaliveRate(Check):
         self.left_at: Event | None = None
         """The ack of a switch away from OFFBOARD that ended the window while no keep-alive
         came: judged once no second ack can undo it (1.16/1.17 ack a switch twice, and only
-        the last, Commander's, decides: gate spec 4.3)."""
+        the last, Commander's, decides: gate.md#acks)."""
         self.count_ignored = ignores(ctx)
         self.ignored: list[tuple[float, str]] = []
         """(time, message name) of each message PX4 ignores since the newest keep-alive."""

@@ -1,9 +1,9 @@
 """OFB106: the ``OffboardControlMode.timestamp`` a ROS 2 sender writes: zero, backwards, lagging.
 
-From 1.14 PX4 judges the keep-alive's age by this field, rewritten on receipt (gate spec
-2.1.1): zero becomes the receive time, anything else ``min(value - time_offset, now)``. So a
+From 1.14 PX4 judges the keep-alive's age by this field, rewritten on receipt (gate.md#signal):
+zero becomes the receive time, anything else ``min(value - time_offset, now)``. So a
 clock that lags by more than the loss timeout makes a fresh stream look lost; 1.13 ignores the
-field (gate spec 2.2). The recording clock is relative, so the lag is measured against the
+field (gate.md#signal). The recording clock is relative, so the lag is measured against the
 freshest sender-to-recording offset seen so far.
 """
 

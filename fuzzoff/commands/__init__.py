@@ -15,6 +15,7 @@ SUMMARIES: dict[str, str] = {
     "fuzz": "search setpoint streams for hazards the rules miss (seeded, shrunk)",
     "gate": "the gate model's timeline for a recording, beside the recorded mode",
     "lint": "lint recordings (tlog, ULog, MCAP, ROS 2 and ROS 1 bags)",
+    "mcp": "serve lint, gate, rule and profiles to a coding assistant (MCP over stdio)",
     "profiles": "list the modelled PX4 versions and vehicle types",
     "replay": "re-check a fuzz reproducer, or replay it to a live PX4 (--to udp:HOST:14580)",
     "rule": "show a rule's documentation, or list all rules",

@@ -8,6 +8,7 @@ import math
 import os
 import sys
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -40,9 +41,41 @@ def add_rule_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--ignore", metavar="CODES", help="comma-separated codes or prefixes")
     parser.add_argument(
         "--fail-on",
-        choices=("error", "warning", "info"),
-        help="lowest severity that makes the exit status 1 (default warning)",
+        choices=("error", "warning", "info", "never"),
+        help="lowest severity that makes the exit status 1 (default warning; never: report only)",
     )
+    parser.add_argument(
+        "--exit-zero",
+        action="store_true",
+        help="findings never make the exit status 1 (an unreadable recording still gives 2)",
+    )
+    parser.add_argument(
+        "--severity",
+        action="append",
+        default=[],
+        metavar="CODE=LEVEL",
+        help="a rule's severity (repeatable; codes or prefixes), e.g. OFB102=error",
+    )
+
+
+def add_config_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--config",
+        metavar="FILE",
+        help="settings from this fuzzoff.toml or pyproject.toml for every recording "
+        "(none searched for)",
+    )
+
+
+def parse_severities(values: list[str]) -> dict[str, str]:
+    """``--severity OFB102=error`` (repeatable) as the configuration's ``severity`` table."""
+    levels: dict[str, str] = {}
+    for item in values:
+        code, sep, level = item.partition("=")
+        if not sep or not code.strip() or not level.strip():
+            raise ConfigError(f"--severity {item!r}: expected CODE=LEVEL, e.g. OFB102=error")
+        levels[code.strip().upper()] = level.strip()
+    return levels
 
 
 def add_output_options(parser: argparse.ArgumentParser, formats: tuple[str, ...] = FORMATS) -> None:
@@ -180,7 +213,18 @@ def settings_from_args(args: argparse.Namespace) -> Settings:
     params = parse_params(getattr(args, "param", []) or [])
     if params:
         overrides["params"] = params
-    settings = load_settings(Path.cwd(), overrides, per_recording=True)
+    severities = parse_severities(getattr(args, "severity", []) or [])
+    if severities:
+        overrides["severity"] = severities
+    config = getattr(args, "config", None)
+    settings = load_settings(
+        Path.cwd(),
+        overrides,
+        per_recording=config is None,
+        config=None if config is None else Path(config),
+    )
+    if getattr(args, "exit_zero", False):
+        settings = replace(settings, exit_zero=True)
     print_notes(settings)
     return settings
 

@@ -21,7 +21,12 @@ from fuzzoff.commands._common import (
     resolve_recordings,
     write_stdout,
 )
-from fuzzoff.commands._lint_output import print_problems, write_report
+from fuzzoff.commands._lint_output import (
+    check_baseline,
+    print_problems,
+    settle,
+    write_report,
+)
 from fuzzoff.config import ConfigError, Settings
 from fuzzoff.engine import lint_file
 from fuzzoff.findings import Report
@@ -63,6 +68,8 @@ def run_fleet(args: argparse.Namespace, settings: Settings) -> int:
     for fmt, output in reports:
         if fmt != PARQUET:
             check_output(output, local)
+    check_output(args.write_baseline, local)
+    baseline = check_baseline(args)
     # each local recording's settings resolved once, its notes printed, before any work; a
     # URL's fetched copy is judged with the command's own (fleet.task)
     resolved = dict(resolve_recordings(settings, local))
@@ -101,6 +108,7 @@ def run_fleet(args: argparse.Namespace, settings: Settings) -> int:
             on_outcome=on_outcome,
         )
     report = Report([o.report for o in outcomes if o.report is not None])
+    settings = settle(args, report, settings, settings.resolved_for, baseline)
     for fmt, output in reports:
         if fmt == PARQUET and writer is not None:
             writer.flush()
@@ -112,7 +120,7 @@ def run_fleet(args: argparse.Namespace, settings: Settings) -> int:
         else:
             write_report(args, report, settings, fmt, output)
     print_problems(report, settings)
-    return report.exit_status(settings.fail_on)
+    return settings.exit_status(report)
 
 
 @contextmanager

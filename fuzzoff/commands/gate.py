@@ -1,11 +1,11 @@
 """``fuzzoff gate PATH``: the gate model's timeline beside the recorded mode.
 
-Each row is a model transition (time, what, message, gate-spec section, ``U`` for behaviour the
-spec lists as unverified) or a recorded mode change (``recorded``). A loss whose time is PX4's
-10 Hz check window is dated at the window's end, ``earliest_s`` its start; ``seen_in`` names
-where the recording shows PX4's own timing when the model took it from there. Rows where the
-recording and the model differ beyond the profile's evaluation slack are ``disagreement`` rows
-naming both.
+Each row is a model transition (time, what, message, the docs/gate.md section that explains it,
+``U`` for behaviour not verified on PX4) or a recorded mode change (``recorded``). A loss whose
+time is PX4's 10 Hz check window is dated at the window's end, ``earliest_s`` its start;
+``seen_in`` names where the recording shows PX4's own timing when the model took it from
+there. Rows where the recording and the model differ beyond the profile's evaluation slack are
+``disagreement`` rows naming both.
 Exit status: 0 the model and the recording agree (or the recording has no mode), 1 they
 disagree somewhere, 2 usage error or the recording could not be read completely.
 """
@@ -20,6 +20,7 @@ from typing import Any
 from fuzzoff import __version__
 from fuzzoff.commands import add_command
 from fuzzoff.commands._common import (
+    add_config_option,
     add_profile_options,
     check_output,
     existing_paths,
@@ -29,6 +30,9 @@ from fuzzoff.commands._common import (
 from fuzzoff.findings import FileReport
 from fuzzoff.gate_timeline import Row, gate_report
 from fuzzoff.report.sanitize import escape_bidi, printable
+
+SEE = 21
+"""Width of the ``see`` column: the longest section, ``gate.md#before-switch``."""
 
 
 def add_parser(sub: Any) -> None:
@@ -40,6 +44,7 @@ def add_parser(sub: Any) -> None:
     )
     parser.add_argument("path", metavar="PATH", help="a recording (any supported format)")
     add_profile_options(parser)
+    add_config_option(parser)
     parser.add_argument("--format", choices=("terminal", "json"), default="terminal")
     parser.add_argument("--output", "-o", metavar="FILE", help="write the timeline here")
     parser.add_argument(
@@ -57,15 +62,15 @@ def _terminal(report: FileReport, rows: dict[str, list[Row]]) -> str:
             f"vehicle {printable(vehicle) or '(default)'}"
             + ("" if has_recorded else " (the recording has no mode: model only)")
         )
-        lines.append(f"{'time s':>9}  {'model':<18} {'spec':<5} {'':1} {'recorded':<14} message")
+        lines.append(f"{'time s':>9}  {'model':<18} {'see':<{SEE}} {'':1} {'recorded':<14} message")
         for r in vrows:
             mark = "U" if r["unverified"] else ""
             if r["source"] == "recorded":
-                line = f"{r['time_s']:9.3f}  {'':<18} {'':<5} {'':1} {r['message']:<14}"
+                line = f"{r['time_s']:9.3f}  {'':<18} {'':<{SEE}} {'':1} {r['message']:<14}"
             else:
-                spec = r["spec"] or ""
+                see = (r["see"] or "").removeprefix("docs/")
                 what = r["what"].upper() if r["what"] == "disagreement" else r["what"]
-                line = f"{r['time_s']:9.3f}  {what:<18} {spec:<5} {mark:1} {'':<14} "
+                line = f"{r['time_s']:9.3f}  {what:<18} {see:<{SEE}} {mark:1} {'':<14} "
                 line += printable(r["message"], 200)
             lines.append(line.rstrip())
         differ = [r for r in vrows if r["what"] == "disagreement"]
@@ -76,7 +81,7 @@ def _terminal(report: FileReport, rows: dict[str, list[Row]]) -> str:
             lines.append("  the recorded mode history agrees with the model")
     if any(r["unverified"] for vrows in rows.values() for r in vrows):
         lines.append("")
-        lines.append("U = behaviour the gate spec lists as unverified (docs/gate.md)")
+        lines.append("U = behaviour not verified on PX4 yet (docs/gate.md#unverified)")
     for problem in report.problems:
         lines.append(f"incomplete: {printable(problem)}")
     return "\n".join(lines) + "\n"

@@ -11,6 +11,7 @@ from typing import Any
 
 from fuzzoff.commands import add_command
 from fuzzoff.commands._common import (
+    add_config_option,
     add_fleet_options,
     add_profile_options,
     add_report_options,
@@ -21,8 +22,15 @@ from fuzzoff.commands._common import (
     resolve_recordings,
     settings_from_args,
 )
-from fuzzoff.commands._lint_output import print_problems, write_report
-from fuzzoff.config import ConfigError
+from fuzzoff.commands._lint_output import (
+    add_adoption_options,
+    check_baseline,
+    print_problems,
+    settle,
+    show_settings,
+    write_report,
+)
+from fuzzoff.config import ConfigError, Settings
 from fuzzoff.engine import Lint, Watch, lint_each, lint_file, lint_file_with_timelines
 from fuzzoff.fleet import is_url
 from fuzzoff.report import FORMATS
@@ -39,6 +47,8 @@ def add_parser(sub: Any) -> None:
     )
     add_profile_options(parser)
     add_rule_options(parser)
+    add_config_option(parser)
+    add_adoption_options(parser)
     add_report_options(parser, (*FORMATS, "parquet"))
     parser.add_argument("--jobs", "-j", type=int, default=1, help="lint files in N processes")
     parser.add_argument(
@@ -85,6 +95,8 @@ def _watching(args: argparse.Namespace) -> Iterator[Watch | None]:
 
 def run(args: argparse.Namespace) -> int:
     settings = settings_from_args(args)
+    if args.show_settings is not None:
+        return show_settings(args.show_settings, settings)
     if args.jobs < 1:
         raise ConfigError("--jobs must be at least 1")
     # As ruff: no path means the current folder.
@@ -95,17 +107,24 @@ def run(args: argparse.Namespace) -> int:
         return run_fleet(args, settings)
     paths = recordings_named(args.paths)
     targets = report_targets(args.format, args.output)
-    for _, output in targets:
+    for output in [*(out for _, out in targets), args.write_baseline]:
         check_output(output, paths)
+    baseline = check_baseline(args)
     plan = resolve_recordings(settings, paths)
     # One lint for every report asked for, with the timelines the HTML report plots
     lint: Lint = lint_file_with_timelines if any(f == "html" for f, _ in targets) else lint_file
     with _watching(args) as watch:
         report = lint_each(plan, lint=lint, jobs=args.jobs, watch=watch)
+    resolved = dict(plan)
+
+    def settings_for(path: str) -> Settings:
+        return resolved.get(path) or settings.resolved_for(path)
+
+    settings = settle(args, report, settings, settings_for, baseline)
     for fmt, output in targets:
         write_report(args, report, settings, fmt, output)
     print_problems(report, settings)  # OFB004's lines (nothing lost) unless it is silenced
-    return report.exit_status(settings.fail_on)
+    return settings.exit_status(report)
 
 
 def _fleet_wanted(args: argparse.Namespace) -> bool:

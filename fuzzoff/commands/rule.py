@@ -90,8 +90,11 @@ def _draw_list(console: Console, rules: list[Rule]) -> None:
     from fuzzoff.report.terminal import table_box
 
     table = Table(show_edge=False, box=table_box(console))
-    for column in ("code", "name", "severity", "profiles"):
-        table.add_column(column, overflow="fold")  # a narrow screen folds a name, never cuts it
+    # code, name and severity are never broken (a name cut mid-word reads as two); the
+    # profiles wrap between words, and fit beside the longest name in 80 columns
+    for column in ("code", "name", "severity"):
+        table.add_column(column, no_wrap=True)
+    table.add_column("profiles", overflow="fold")
     for r in rules:
-        table.add_row(r.code, r.name, r.severity.label, r.profiles_text())
+        table.add_row(r.code, r.name, r.severity.label, r.profiles_short())
     console.print(table)

@@ -2,7 +2,9 @@
 
 Keys (ruff-like): ``px4``, ``vehicle``, ``select``, ``extend-select``, ``ignore``, ``fail-on``,
 ``severity`` (table code -> level), ``options`` (table code -> table of thresholds),
-``params`` (PX4 parameter overrides for the gate model), ``per-file-ignores`` (glob -> codes).
+``params`` (PX4 parameter overrides for the gate model), ``per-file-ignores`` (glob -> codes),
+``suppressions`` (recording -> list of ``{ code, from, to, reason }``: findings kept in the
+reports as suppressed, not failing the run).
 An unknown key, code or option is a usage error, never ignored.
 
 As in ruff, each recording is judged with the nearest configuration above it (a ``rover/``
@@ -20,9 +22,10 @@ from __future__ import annotations
 from fuzzoff.config.discovery import NearestConfig, find_config, load_settings
 from fuzzoff.config.errors import ConfigError, did_you_mean
 from fuzzoff.config.globs import FileIgnore, glob_regex
-from fuzzoff.config.settings import Discovery, Settings
+from fuzzoff.config.settings import ConfigSuppression, Discovery, Settings
 from fuzzoff.config.table import (
     KNOWN_KEYS,
+    NEVER,
     read_config_table,
     settings_from_table,
     user_px4_profile,
@@ -31,7 +34,9 @@ from fuzzoff.config.table import (
 
 __all__ = [
     "KNOWN_KEYS",
+    "NEVER",
     "ConfigError",
+    "ConfigSuppression",
     "Discovery",
     "FileIgnore",
     "NearestConfig",

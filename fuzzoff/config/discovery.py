@@ -10,6 +10,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+from fuzzoff.config.errors import ConfigError
 from fuzzoff.config.settings import Settings
 from fuzzoff.config.table import load_toml, read_config_table, settings_from_table
 
@@ -36,12 +37,20 @@ def load_settings(
     overrides: Mapping[str, Any] | None = None,
     *,
     per_recording: bool = False,
+    config: Path | None = None,
 ) -> Settings:
     """Settings from the nearest config file, then ``overrides`` (the command line) on top.
 
     ``per_recording`` (command-line runs): ``Settings.for_recording`` then looks for each
-    recording's own nearest configuration, as ruff does for each source file."""
+    recording's own nearest configuration, as ruff does for each source file. ``config``
+    (``--config FILE``, as ruff's): that file for every recording, none searched for."""
     clean = {k: v for k, v in (overrides or {}).items() if v is not None}
+    if config is not None:
+        if not config.is_file():
+            raise ConfigError(f"--config {config}: no such file")
+        if config.name == "pyproject.toml" and "fuzzoff" not in load_toml(config).get("tool", {}):
+            raise ConfigError(f"--config {config}: no [tool.fuzzoff] table in it")
+        return _settings_from(config.resolve(), clean)
     settings = _settings_from(find_config((start or Path.cwd()).resolve()), clean)
     if per_recording:
         settings = replace(settings, discovery=NearestConfig(tuple(sorted(clean.items()))))
@@ -85,7 +94,12 @@ class NearestConfig:
                 found = self.cache.get(str(config))
                 if found is None:
                     found = _settings_from(config, dict(self.overrides))
-                    found = replace(found, fail_on=run.fail_on, notes=_fail_on_note(found, run))
+                    found = replace(
+                        found,
+                        fail_on=run.fail_on,
+                        exit_zero=run.exit_zero,
+                        notes=_fail_on_note(found, run),
+                    )
                     self.cache[str(config)] = found
             self.cache[folder] = found
         return found

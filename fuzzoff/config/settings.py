@@ -3,6 +3,7 @@ recording is judged with (``for_recording``)."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -11,7 +12,7 @@ from typing import Any, Protocol
 from fuzzoff import releases
 from fuzzoff.catalog import get_rule
 from fuzzoff.config.globs import FileIgnore
-from fuzzoff.findings import Severity
+from fuzzoff.findings import Finding, Report, Severity
 from fuzzoff.releases import PX4Profile, Release
 
 
@@ -20,6 +21,39 @@ class Discovery(Protocol):
     above it, the command line on top): ``config.discovery.NearestConfig``."""
 
     def settings_for(self, run: Settings, recording: Path) -> Settings: ...
+
+
+@dataclass(frozen=True, slots=True)
+class ConfigSuppression:
+    """One ``suppressions`` entry: findings of ``codes`` in the recordings ``pattern`` names
+    (as ``per-file-ignores`` patterns match), starting within ``from_s``..``to_s`` seconds
+    (the whole recording when both are None), taken out of the findings that fail a run and
+    reported as suppressed, with ``reason``."""
+
+    pattern: str
+    folder: str
+    codes: frozenset[str]
+    reason: str
+    source: str
+    """The configuration file that holds it."""
+    from_s: float | None = None
+    to_s: float | None = None
+
+    def matches(self, recording: str | Path) -> bool:
+        return FileIgnore(self.pattern, self.folder, self.codes).matches(recording)
+
+    def covers(self, finding: Finding) -> bool:
+        """Is ``finding`` one this entry suppresses? A window takes the findings that start in
+        it; a whole-recording finding only an entry without a window."""
+        if finding.code not in self.codes:
+            return False
+        if self.from_s is None and self.to_s is None:
+            return True
+        if finding.time_s is None:
+            return False
+        low = -math.inf if self.from_s is None else self.from_s
+        high = math.inf if self.to_s is None else self.to_s
+        return low <= finding.time_s <= high
 
 
 @dataclass(frozen=True, slots=True)
@@ -45,6 +79,16 @@ class Settings:
     discovery: Discovery | None = None
     """Set for a command-line run: each recording then takes its nearest configuration
     (``config.discovery.NearestConfig``)."""
+    exit_zero: bool = False
+    """``--exit-zero`` or ``fail-on = "never"``: findings never make the exit status 1 (the
+    reports still judge them at ``fail_on``); input that could not be read still gives 2."""
+    suppressions: tuple[ConfigSuppression, ...] = ()
+
+    def exit_status(self, report: Report) -> int:
+        """The run's exit status: 0 passed, 1 findings at or above ``fail_on`` (never with
+        ``exit_zero``), 2 input not read completely."""
+        status = report.exit_status(self.fail_on)
+        return 0 if status == 1 and self.exit_zero else status
 
     def enabled(self, code: str) -> bool:
         if code in self.ignore:
@@ -96,4 +140,7 @@ class Settings:
         )
         if ignored - settings.ignore:
             settings = replace(settings, ignore=settings.ignore | ignored)
+        mine = tuple(s for s in settings.suppressions if s.matches(recording))
+        if mine != settings.suppressions:
+            settings = replace(settings, suppressions=mine)
         return settings

@@ -17,7 +17,7 @@ from fuzzoff import releases
 from fuzzoff.catalog import expand_selectors, get_rule, load_catalog
 from fuzzoff.config.errors import ConfigError, did_you_mean
 from fuzzoff.config.globs import FileIgnore, glob_regex
-from fuzzoff.config.settings import Settings
+from fuzzoff.config.settings import ConfigSuppression, Settings
 from fuzzoff.findings import Severity
 from fuzzoff.gate.params import GATE_PARAMS
 from fuzzoff.profiles import (
@@ -39,7 +39,11 @@ KNOWN_KEYS = {
     "options",
     "params",
     "per-file-ignores",
+    "suppressions",
 }
+
+NEVER = "never"
+"""``fail-on = "never"`` (``--fail-on never``, ``--exit-zero``): no finding fails the run."""
 
 
 def user_px4_profile(text: str) -> tuple[PX4Profile, str | None]:
@@ -218,17 +222,21 @@ def settings_from_table(
         )
     if table.get("fail-on") is not None:
         fail_on = _text(table["fail-on"], "fail-on", where, "warning")
-        try:
-            settings = replace(settings, fail_on=Severity.parse(fail_on))
-        except ValueError as exc:
-            raise ConfigError(f"{where}: fail-on: {exc}") from None
+        if fail_on.strip().lower() == NEVER:
+            settings = replace(settings, exit_zero=True)
+        else:
+            try:
+                settings = replace(settings, fail_on=Severity.parse(fail_on), exit_zero=False)
+            except ValueError as exc:
+                raise ConfigError(f"{where}: fail-on: {exc}, or never") from None
     if table.get("severity") is not None:
         levels = dict(settings.severity)
         for selector, level in _table(table["severity"], "severity", where).items():
             try:
                 sev = Severity.parse(str(level))
             except ValueError as exc:
-                raise ConfigError(f"{where}: severity.{selector}: {exc}") from None
+                at = f"--severity {selector}" if cli else f"{where}: severity.{selector}"
+                raise ConfigError(f"{at}: {exc}") from None
             for code in _codes([selector], "severity", where):
                 levels[code] = sev
         settings = replace(settings, severity=levels)
@@ -271,6 +279,12 @@ def settings_from_table(
         settings = replace(
             settings, per_file_ignores=(*settings.per_file_ignores, *_file_ignores(table, where))
         )
+    if table.get("suppressions") is not None:
+        if cli:
+            raise ConfigError("suppressions are read from a configuration file only")
+        settings = replace(
+            settings, suppressions=(*settings.suppressions, *_suppressions(table, where))
+        )
     return settings
 
 
@@ -289,3 +303,61 @@ def _file_ignores(table: Mapping[str, Any], where: str) -> list[FileIgnore]:
         chosen = _codes(codes, f"per-file-ignores.{pattern!r}", where)
         out.append(FileIgnore(pattern, folder, frozenset(chosen)))
     return out
+
+
+_SUPPRESSION_KEYS = {"code", "from", "to", "reason"}
+_SUPPRESSION_EXAMPLE = '[{ code = "OFB101", from = 12.0, to = 15.5, reason = "bench test" }]'
+
+
+def _suppressions(table: Mapping[str, Any], where: str) -> list[ConfigSuppression]:
+    """``suppressions = { "RECORDING" = [{ code, from, to, reason }, ...] }``: a recording's
+    path relative to the file's folder (or a pattern, as ``per-file-ignores``); ``code`` a code
+    or prefix; ``from`` and ``to`` seconds from the recording's first message (optional: the
+    whole recording); ``reason`` required, since it is what the reports show."""
+    folder = str(Path(where).parent)
+    out = []
+    for pattern, entries in _table(table["suppressions"], "suppressions", where).items():
+        at = f"{where}: suppressions.{pattern!r}"
+        try:
+            glob_regex(pattern.removeprefix("!"))
+        except (ValueError, re.error) as exc:
+            raise ConfigError(f"{at}: bad pattern: {exc}") from None
+        if isinstance(entries, dict):
+            entries = [entries]
+        if not isinstance(entries, list) or not all(isinstance(e, dict) for e in entries):
+            raise ConfigError(f"{at} must be a list of tables, e.g. {_SUPPRESSION_EXAMPLE}")
+        for entry in entries:
+            unknown = sorted(set(entry) - _SUPPRESSION_KEYS)
+            if unknown:
+                raise ConfigError(
+                    f"{at}: unknown key {unknown[0]}{did_you_mean(unknown[0], _SUPPRESSION_KEYS)}"
+                    f"; known: code, from, to, reason"
+                )
+            if "code" not in entry:
+                raise ConfigError(f"{at}: each suppression names its code: {_SUPPRESSION_EXAMPLE}")
+            reason = entry.get("reason")
+            if not isinstance(reason, str) or not reason.strip():
+                raise ConfigError(
+                    f"{at}: each suppression gives its reason (the reports show it): "
+                    f"{_SUPPRESSION_EXAMPLE}"
+                )
+            window = [_seconds(entry.get(k), f"{at}: {k}") for k in ("from", "to")]
+            if window[0] is not None and window[1] is not None and window[0] > window[1]:
+                raise ConfigError(f"{at}: from ({window[0]}) is after to ({window[1]})")
+            codes = _codes(
+                [entry["code"]] if isinstance(entry["code"], str) else entry["code"], "code", at
+            )
+            out.append(
+                ConfigSuppression(
+                    pattern, folder, frozenset(codes), reason.strip(), where, window[0], window[1]
+                )
+            )
+    return out
+
+
+def _seconds(value: Any, where: str) -> float | None:
+    if value is None:
+        return None
+    if not isinstance(value, (int, float)) or isinstance(value, bool) or not math.isfinite(value):
+        raise ConfigError(f"{where} must be a number of seconds")
+    return float(value)

@@ -1,6 +1,6 @@
 """What the gate model predicts that the stream did not intend, and which rules explain it.
 
-A *hazard* is a ``GateTransition`` of one of these kinds (gate spec section in brackets):
+A *hazard* is a ``GateTransition`` of one of these kinds (the docs/gate.md section in brackets):
 
 * ``request_rejected`` / ``arm_rejected``: the stream asked for OFFBOARD or to arm in it (4.1, 4.2);
 * ``failsafe``: the loss failsafe ran (5), and ``disarmed`` by it (not by a disarm command);
@@ -25,6 +25,7 @@ from dataclasses import dataclass
 from fuzzoff.catalog import HAZARD_KINDS, CatalogError, Rule, load_catalog
 from fuzzoff.events import Command
 from fuzzoff.gate import GateTransition
+from fuzzoff.gate.sections import cite
 
 HOLD_S = 0.2
 """A controller hazard must last this long (PX4 1.16's last-valid reuse window)."""
@@ -100,7 +101,8 @@ class Hazard:
     """The mode the vehicle is in after it (a failsafe's action), where the model says."""
 
     def describe(self) -> str:
-        return f"{self.kind} at {self.t:.3f} s ({self.message}; gate spec {self.spec})"
+        see = cite(self.spec)
+        return f"{self.kind} at {self.t:.3f} s ({self.message}" + (f"; {see})" if see else ")")
 
 
 def hazards(transitions: Sequence[GateTransition], t_end: float) -> list[Hazard]:

@@ -1,4 +1,5 @@
-"""Invariants of the gate spec, checked on the gate model running over a scenario's sent stream.
+"""Invariants of the gate model (docs/fuzz.md), checked on the gate model running over a
+scenario's sent stream.
 
 0. The model's timeline never goes back in time (transitions in time order).
 1. No OFFBOARD while the signal is lost, armed, on 1.14+ (5.1), longer than one Commander

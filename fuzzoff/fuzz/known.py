@@ -14,7 +14,8 @@ _MAV = r"silent hazard \((mavlink|mavros), "
 
 KNOWN: dict[str, str] = {
     _MAV + r"PX4 1\.11\): setpoint_dropped .*GLOBAL_INT handler \(unverified\)": (
-        "PX4 1.11's SET_POSITION_TARGET_GLOBAL_INT handler is unverified (gate spec 6.3): the "
-        "gate model takes it as a keep-alive without a setpoint, OFB609 says so as a warning"
+        "PX4 1.11's SET_POSITION_TARGET_GLOBAL_INT handler is unverified "
+        "(docs/gate.md#unverified): the gate model takes it as a keep-alive without a setpoint, "
+        "OFB609 says so as a warning"
     ),
 }

@@ -19,7 +19,7 @@
   itself), OFB002, OFB003 and OFB004 are left out: they describe the file, not the stream. So is a
   finding about a stretch that runs into that edge (its ``end_s``): the cut closed the stretch,
   and its verdict (OFB105's percentiles, say) is on the part the cut left.
-* ``gate_invariants_hold`` (e): invariants of the gate spec, on the sent stream (see
+* ``gate_invariants_hold`` (e): invariants of the gate model, on the sent stream (see
   ``fuzz.invariants``).
 * ``runs_match_single_messages`` (f): the checks that take the stream as runs
   (``on_batch``) report exactly what they report when given one message at a time.
@@ -386,7 +386,7 @@ PROPERTIES: dict[str, PropertySpec] = {
         PropertySpec(
             "invariants",
             gate_invariants_hold,
-            "the gate model keeps the gate spec's invariants",
+            "the gate model keeps its invariants (docs/fuzz.md)",
         ),
         PropertySpec(
             "runs",

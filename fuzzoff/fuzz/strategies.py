@@ -60,7 +60,7 @@ def gate_params(draw: st.DrawFn, px4: PX4Profile) -> dict[str, float]:
         params["COM_OBL_RC_ACT"] = float(draw(st.integers(0, 7)))
     if draw(st.booleans()):
         params["FUZZOFF_RC_PRESENT"] = float(draw(st.integers(0, 1)))
-    del px4  # every profile reads the same names (defaults differ, gate spec 13)
+    del px4  # every profile reads the same names (defaults differ, gate.md#params)
     return params
 
 
@@ -211,7 +211,7 @@ _COMMON_TRIPLES = st.sampled_from([(True, True, True), (False, False, False)])
 
 _T, _F = True, False
 TRICKY_PATTERNS = (
-    NanPattern((_T, _F, _T), (_F, _T, _F), (_F, _F, _F), _T),  # x/y not paired (gate spec 8)
+    NanPattern((_T, _F, _T), (_F, _T, _F), (_F, _F, _F), _T),  # x/y unpaired (gate.md#multicopter)
     NanPattern((_F, _F, _T), (_T, _T, _F), (_F, _F, _F), _T),  # altitude + horizontal velocity
     NanPattern((_T, _T, _F), (_F, _F, _F), (_F, _F, _F), _T),  # no vertical setpoint
     NanPattern((_F, _F, _F), (_F, _F, _F), (_T, _T, _T), _F),  # acceleration only

@@ -135,7 +135,7 @@ def echo(
     transport: TransportName,
 ) -> list[ev.Event]:
     """The vehicle's answers the gate model predicts: a COMMAND_ACK per command (two for a
-    MAVLink mode switch on 1.16/1.17, gate spec 4.3), and for MAVROS the state at 1 Hz and at
+    MAVLink mode switch on 1.16/1.17, gate.md#acks), and for MAVROS the state at 1 Hz and at
     each change."""
     profile = Profile(px4=px4, vehicle=vehicle, px4_detected=True, vehicle_detected=True)
     vid = "1" if transport == "mavlink" else ""

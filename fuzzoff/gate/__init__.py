@@ -2,8 +2,8 @@
 
 ``GateModel(profile, params).feed(event)`` returns the transitions the event causes (after the
 model has advanced its clock to ``event.t``, which may itself time out the signal);
-``finish(t_end)`` flushes timeouts up to the end of the recording. See px4-offboard-gate.md and
-docs/gate.md ("Code layout"). ``model`` is the façade; its parts, sharing one ``state.GateState``:
+``finish(t_end)`` flushes timeouts up to the end of the recording. See docs/gate.md (its
+sections and "Code layout"). ``model`` is the façade; its parts, sharing one ``state.GateState``:
 ``keepalive`` (keep-alives and the loss window, 2), ``verdict`` (PX4's recorded verdict on the
 signal), ``mavlink`` (the MAVLink receiver, 6) and ``setpoints`` (controllers, 7-10),
 ``effective`` (the effective mode and loss action, 5), ``commander`` (requests, 4 and 13a),

@@ -1,4 +1,4 @@
-"""The recorded acks against the model's decisions (gate spec 4.3): one part of ``GateModel``.
+"""The recorded acks against the model's decisions (gate.md#acks): one part of ``GateModel``.
 
 ``Acks`` hands each recorded ``COMMAND_ACK`` to the comparison (``compare``), which waits
 ``ACK_WINDOW`` for a second ack of the same command (PX4 1.16/1.17 ack a mode switch twice) and

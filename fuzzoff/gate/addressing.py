@@ -1,7 +1,7 @@
 """Whether a MAVLink command reaches Commander: PX4's receiver checks its address first.
 
 Seen on running PX4 SITL (1.14.4, 1.15.4, 1.16.2, 1.17.0, the 1.18 beta head and main, 2026-12;
-gate spec 13a): a COMMAND_LONG or COMMAND_INT for another system or another component is never
+gate.md#seen-on-px4): a COMMAND_LONG or COMMAND_INT for another system or another component is never
 handled; up to 1.15 the receiver answers it with FAILED, from 1.16 it drops it without an ack.
 One with ``target_system`` 0 is treated the same way up to 1.17 and handled from 1.18. SET_MODE
 has no component: for system 0 or the vehicle's it is handled on every release, for another

@@ -1,5 +1,5 @@
-"""Commander's requests: mode switches, arming and disarming (gate spec 4, 13a): one part of
-``GateModel``.
+"""Commander's requests: mode switches, arming and disarming (gate.md#requests, #seen-on-px4):
+one part of ``GateModel``.
 
 ``Requests`` judges each recorded command the way Commander would (``requests`` holds the
 decisions per release) and applies the outcome: the user intention and the arming state change,

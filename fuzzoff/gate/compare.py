@@ -4,7 +4,8 @@ A recorded ``VehicleStatus`` agrees with the model when its nav_state equals the
 equals the model's previous nav_state and the model changed less than the slack ago (the
 recording lags), or the model reaches it within the slack (the recording leads: a loss whose
 time the recording does not show is dated at the end of its window, PX4's 10 Hz check pass of
-unknown phase, gate spec 2.1.3, and the slack covers the window). Otherwise the difference waits
+unknown phase, gate.md#check-timing, and the slack covers the window). Otherwise the difference
+waits
 ``slack``; if it is still there it is confirmed once per episode (until the two agree again).
 
 A mode that reached the recording over a link (HEARTBEAT, ``/mavros/state``) may also lag by
@@ -37,7 +38,7 @@ NOT_OFFBOARD = "no OFFBOARD on either side: other modes' own rules are not model
 """Said of a difference that does not concern the offboard gate (a ``mode`` row, not OFB202)."""
 SAMPLED_SLACK = 0.1
 """Extra slack when the keep-alive is a logged, subsampled copy (ULog logs
-``offboard_control_mode`` at 10 Hz, gate spec 13a)."""
+``offboard_control_mode`` at 10 Hz, gate.md#seen-on-px4)."""
 
 
 @dataclass(slots=True)

@@ -1,4 +1,4 @@
-"""Which controllers run in offboard (gate spec sections 7-10).
+"""Which controllers run in offboard (gate.md#control-mode to #rover).
 
 * ``control_flags``: ``offboard_control_mode`` -> ``vehicle_control_mode`` flags (section 7);
 * ``mc_axes``: what the multicopter position controller does with a trajectory setpoint, per

@@ -1,4 +1,4 @@
-"""The effective mode and the loss action (gate spec 5): one part of ``GateModel``.
+"""The effective mode and the loss action (gate.md#loss): one part of ``GateModel``.
 
 ``EffectiveMode`` works out the nav_state PX4 flies after anything that can change it: the user
 intention, or, while the intention is OFFBOARD and the signal is lost, the action the loss
@@ -23,7 +23,8 @@ _RESUME_SPEC: dict[LossFailsafe, str] = {
     "state_machine": "5.2",
     "state_machine_legacy": "5.3",
 }
-"""The spec section of the return to OFFBOARD when the signal comes back, by loss failsafe."""
+"""The section number (``gate.sections``) of the return to OFFBOARD when the signal comes back,
+by loss failsafe."""
 
 
 class EffectiveMode:

@@ -1,7 +1,7 @@
-"""What the gate knows about the vehicle's estimates and manual control (gate spec 2.1, 5).
+"""What the gate knows about the vehicle's estimates and manual control (gate.md#signal, #loss).
 
 Taken from ``FailsafeFlags`` events where the recording has them; a field the recording does not
-carry (``None``) keeps its last value, and every field starts valid ("assume valid", spec 2.1).
+carry (``None``) keeps its last value, and every field starts valid (gate.md#signal).
 Manual control (RC or joystick) starts from the ``FUZZOFF_RC_PRESENT`` assumption.
 """
 

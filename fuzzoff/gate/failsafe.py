@@ -1,8 +1,8 @@
-"""What the vehicle does when the offboard signal is lost, per profile (gate spec section 5).
+"""What the vehicle does when the offboard signal is lost, per profile (gate.md#loss).
 
 ``loss_action(release, vehicle, params, est, stage)`` gives the action the failsafe selects at that
 moment. Mode requirements used for the degradation chains are fuzzoff's approximation of PX4's
-mode requirements (the spec gives the chains, not every requirement): results that depend on
+mode requirements (gate.md#loss gives the chains, not every requirement): results that depend on
 them are marked ``unverified``.
 """
 

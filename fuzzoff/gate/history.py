@@ -1,4 +1,4 @@
-"""The recorded mode history against the prediction (gate spec 12): one part of ``GateModel``.
+"""The recorded mode history against the prediction (gate.md#history): one part of ``GateModel``.
 
 ``RecordedHistory`` starts the model from the recording's first status (a recording may start
 mid-flight), adopts what the recording shows with no recorded command for it (an RC switch, an

@@ -1,4 +1,4 @@
-"""The keep-alives and the loss of the offboard signal (gate spec 2): one part of ``GateModel``.
+"""The keep-alives and the loss of the offboard signal (gate.md#signal): one part of ``GateModel``.
 
 ``KeepAlives`` takes every keep-alive (``OffboardControlMode``, its legacy form, and the MAVLink
 setpoints ``mavlink.MavlinkSetpoints`` passes on), says when the signal becomes available,

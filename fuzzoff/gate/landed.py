@@ -1,4 +1,4 @@
-"""Is the vehicle on the ground, as PX4 asks when it judges a disarm request (gate spec 13a)?
+"""Is the vehicle on the ground, as PX4 asks when it judges a disarm request (gate.md#seen-on-px4)?
 
 Commander refuses a disarm that is not forced (param2 21196) unless the land detector says
 ``landed`` or ``maybe_landed`` (or the vehicle drives on the ground): "Disarming denied: not

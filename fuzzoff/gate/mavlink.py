@@ -1,4 +1,4 @@
-"""MAVLink setpoints as PX4's receiver takes them (gate spec 6): one part of ``GateModel``.
+"""MAVLink setpoints as PX4's receiver takes them (gate.md#receiver): one part of ``GateModel``.
 
 ``MavlinkSetpoints`` runs each SET_POSITION_TARGET_* / SET_ATTITUDE_TARGET through the receiver
 model (``receiver.receive``): a dropped message is a ``setpoint_dropped`` transition (once per run

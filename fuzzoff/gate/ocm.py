@@ -1,6 +1,6 @@
 """``offboard_control_mode`` flags as a small bit mask (cheap to build once per message).
 
-Bits follow PX4's priority order (gate spec section 7): the lowest set bit is the "first true
+Bits follow PX4's priority order (gate.md#control-mode): the lowest set bit is the "first true
 flag" that selects the controller chain.
 """
 
@@ -56,7 +56,8 @@ def mask_of(event: ControlMode) -> int:
 
 
 def legacy_mask(event: LegacyControlMode) -> int:
-    """A legacy ``ignore_*`` control mode as the flags it leaves enabled (spec 7, legacy)."""
+    """A legacy ``ignore_*`` control mode as the flags it leaves enabled (gate.md#control-mode,
+    legacy)."""
     return (
         (0 if event.ignore_position else POSITION)
         | (0 if event.ignore_velocity else VELOCITY)

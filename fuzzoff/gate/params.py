@@ -1,4 +1,4 @@
-"""PX4's defaults for the parameters the gate reads, per profile (gate spec section 13).
+"""PX4's defaults for the parameters the gate reads, per profile (gate.md#params).
 
 Precedence (lowest to highest): these defaults, the recording's ``Parameter`` events, the
 user's overrides (``--param`` / ``[tool.fuzzoff] params``).

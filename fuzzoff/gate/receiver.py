@@ -1,5 +1,5 @@
 """PX4's MAVLink receiver: which setpoint messages it accepts, and the keep-alive they produce
-(gate spec section 6).
+(gate.md#receiver).
 
 ``receive(msg, ctx)`` returns ``(ocm_mask, axes, reason, spec)``: ``ocm_mask`` is the
 ``offboard_control_mode`` flag mask the receiver publishes (``DROPPED`` when the message is

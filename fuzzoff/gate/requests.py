@@ -1,4 +1,5 @@
-"""Mode-switch, arming and disarming requests: accepted or rejected, and why (gate spec 4, 13a).
+"""Mode-switch, arming and disarming requests: accepted or rejected, and why (gate.md#requests,
+#seen-on-px4).
 
 ``mode_request`` turns a command into the nav_state it asks for (or why the release has none);
 ``switch_decision``, ``arm_decision`` and ``disarm_decision`` return ``Decision`` (accepted,

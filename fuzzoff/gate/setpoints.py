@@ -1,4 +1,5 @@
-"""Which controller runs on the offboard setpoints (gate spec 7-10): one part of ``GateModel``.
+"""Which controller runs on the offboard setpoints (gate.md#control-mode to #rover): one part of
+``GateModel``.
 
 ``Controllers`` hands the setpoints PX4's controllers read (``TrajectorySetpoint``, legacy's
 ``position_setpoint_triplet``, and what ``mavlink.MavlinkSetpoints`` passes on) to the

@@ -1,4 +1,4 @@
-"""Proof of life: when is the offboard signal available, per profile (gate spec section 2).
+"""Proof of life: when is the offboard signal available, per profile (gate.md#signal).
 
 Each model keeps only the newest keep-alive and computes the time of its loss arithmetically
 (no per-tick loop):
@@ -236,7 +236,7 @@ class AgeSignal(Signal):
 
 
 class LegacySignal(Signal):
-    """Two flags: lost (500 ms) and loss timeout (500 ms + ``COM_OF_LOSS_T``), spec 2.3."""
+    """Two flags: lost (500 ms) and loss timeout (500 ms + ``COM_OF_LOSS_T``), gate.md#signal."""
 
     spec = "2.3"
 

@@ -59,7 +59,7 @@ class GateState:
     (``failsafe_flags.offboard_control_signal_lost``) where the recording has it; else it is
     taken as present, and lost only where PX4's own failsafe is recorded."""
     tick_based: bool
-    """1.14+: OffboardChecks at 10 Hz (gate spec 2.1)."""
+    """1.14+: OffboardChecks at 10 Hz (gate.md#signal)."""
     recorded_params: dict[str, float] = field(default_factory=dict)
     """The recording's ``Parameter`` events, as recorded (also those not applied)."""
 

@@ -1,4 +1,4 @@
-"""Which controller runs in offboard, tracked over time (gate spec sections 7-10).
+"""Which controller runs in offboard, tracked over time (gate.md#control-mode to #rover).
 
 ``ControllerTracker`` keeps what the controllers see (the OCM flags, the newest trajectory
 setpoint's per-axis content, the last valid setpoint for the 1.16+ 200 ms reuse) and reports a

@@ -35,8 +35,9 @@ not show (``reason`` names both outcomes)."""
 class GateTransition(Event):
     """One change the gate model predicts, at ``t``, caused by ``cause`` (None for a timeout).
 
-    ``spec`` names the section of px4-offboard-gate.md the transition implements;
-    ``unverified`` marks behaviour the spec lists as unverified (section 15).
+    ``spec`` numbers the part of PX4's behaviour the transition implements, which
+    ``gate.sections`` maps to a section of docs/gate.md (``5.1`` -> gate.md#loss);
+    ``unverified`` marks behaviour not verified on PX4 (gate.md#unverified).
     """
 
     kind: ClassVar[str] = "gate"

@@ -1,4 +1,5 @@
-"""Renderers: terminal (rich), JSON, SARIF, JUnit and HTML. Machine formats return text.
+"""Renderers: terminal (rich), JSON, SARIF, JUnit, HTML, GitHub workflow commands, reviewdog's
+rdjson, GitLab Code Quality and JSON lines. Machine formats return text.
 
 One module per format writes both what ``fuzzoff lint`` reports (a ``Report``) and what
 ``fuzzoff fuzz`` reports (a ``CampaignReport``); a renderer only renders: the commands run the
@@ -27,6 +28,10 @@ RENDERERS: dict[str, str] = {
     "sarif": "fuzzoff.report.sarif:render",
     "junit": "fuzzoff.report.junit:render",
     "html": "fuzzoff.report.html:render",
+    "github": "fuzzoff.report.github:render",
+    "rdjson": "fuzzoff.report.rdjson:render",
+    "gitlab": "fuzzoff.report.gitlab:render",
+    "json-lines": "fuzzoff.report.json_lines:render",
 }
 """``--format`` name -> ``module:function`` for the formats written as one text document."""
 

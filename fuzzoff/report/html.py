@@ -15,6 +15,7 @@ from __future__ import annotations
 import datetime
 from collections import Counter
 from html import escape
+from pathlib import Path
 
 from markdown_it import MarkdownIt
 
@@ -175,6 +176,36 @@ def _findings_table(markers: list[Marker], timed: set[str]) -> str:
     )
 
 
+SUPPRESSED_COLUMNS = ("time", "rule", "severity", "vehicle", "message", "suppressed by")
+
+
+def _suppressed_table(file: FileReport) -> str:
+    """The findings a suppression took out (issue 30): shown, never dropped silently."""
+    if not file.suppressed:
+        return ""
+    rows = []
+    for f, why in file.suppressed:
+        sev = f.severity.label
+        by = f"{why.kind} ({Path(why.source).name}): {why.reason}"
+        if why.from_s is not None or why.to_s is not None:
+            low = "start" if why.from_s is None else f"{why.from_s:g} s"
+            high = "end" if why.to_s is None else f"{why.to_s:g} s"
+            by += f", {low} to {high}"
+        rows.append(
+            f'<tr class="suppressed"><td>{e(_time(f))}</td>'
+            f'<td><a href="#rule-{e(f.code)}">{e(f.code)}</a></td><td class="sev">{sev}</td>'
+            f"<td>{e(f.vehicle)}</td><td>{e(f.message)}</td><td>{e(by)}</td></tr>"
+        )
+    head = "".join(f"<th>{name}</th>" for name in SUPPRESSED_COLUMNS)
+    return (
+        f"<h3>Suppressed ({len(file.suppressed)})</h3>"
+        '<p class="none">Findings the configuration\'s <code>suppressions</code> or the '
+        "<code>--baseline</code> took out: they fail no run.</p>"
+        f'<table class="findings suppressed"><thead><tr>{head}</tr></thead>'
+        f"<tbody>{''.join(rows)}</tbody></table>"
+    )
+
+
 def _file_section(index: int, file: FileReport) -> str:
     timelines = file.timelines
     markers = [Marker(f"{index}-{i}", f) for i, f in enumerate(file.findings)]
@@ -183,7 +214,7 @@ def _file_section(index: int, file: FileReport) -> str:
         f'<section class="file" id="file-{index}"><h2>{e(file.path)}</h2>'
         f"{_summary(file, timelines)}<h3>Timeline</h3>"
         f"{_plots(index, file, markers, timelines)}"
-        f"<h3>Findings</h3>{_findings_table(markers, timed)}</section>"
+        f"<h3>Findings</h3>{_findings_table(markers, timed)}{_suppressed_table(file)}</section>"
     )
 
 
@@ -297,7 +328,9 @@ HELP = (
 
 def render(report: Report, settings: Settings) -> str:
     sections = "".join(_file_section(i, f) for i, f in enumerate(report.files))
-    codes = sorted({f.code for f in report.findings})
+    codes = sorted(
+        {f.code for f in report.findings} | {f.code for x in report.files for f, _ in x.suppressed}
+    )
     rules = [r for r in (_rule(c) for c in codes) if r is not None]
     articles = "".join(rule_article(r) for r in rules)
     rules_section = f'<section id="rules"><h2>Rules</h2>{articles}</section>' if rules else ""

@@ -46,7 +46,7 @@ TEXT_LIMIT = 300
 KEEPALIVE_RATE_S = 0.5
 """The 2 Hz minimum rate of the offboard docs (rules.md OFB101)."""
 LEGACY_LOSS_S = 0.5
-"""PX4 before 1.11 loses the signal after a fixed 500 ms (gate spec 2.3)."""
+"""PX4 before 1.11 loses the signal after a fixed 500 ms (gate.md#signal)."""
 
 RAMP_STEPS = 16
 RAMP_MIN_S = 0.1
@@ -110,7 +110,7 @@ def loss_line(seconds: float, source: str, profile: Profile, recorded: float | N
     """The loss-timeout line and its words, as the version's code means COM_OF_LOSS_T.
 
     Before 1.11 the loss comes after a fixed 500 ms and COM_OF_LOSS_T is an extra wait before
-    the loss action (gate spec 2.3). From 1.11 it is the timeout itself, and 0 means the signal
+    the loss action (gate.md#signal). From 1.11 it is the timeout itself, and 0 means the signal
     counts as lost at once: nothing to draw on a log axis, and in a recording that names no
     release (the profile assumed) it usually means an older firmware, where 0 was the default.
     """

@@ -5,31 +5,51 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 from typing import Any
 
 from fuzzoff import __version__
 from fuzzoff.config import Settings
-from fuzzoff.findings import Report
+from fuzzoff.findings import FileReport, Report
 from fuzzoff.report import CampaignReport
 from fuzzoff.report.sanitize import escape_bidi
+from fuzzoff.report.sarif import marks
 
 
-def _clean(value: Any) -> Any:
+def clean(value: Any) -> Any:
     """JSON has no NaN or infinity: write them as null."""
     if isinstance(value, float) and not math.isfinite(value):
         return None
     if isinstance(value, dict):
-        return {k: _clean(v) for k, v in value.items()}
+        return {k: clean(v) for k, v in value.items()}
     if isinstance(value, list | tuple):
-        return [_clean(v) for v in value]
+        return [clean(v) for v in value]
     return value
+
+
+SCHEMA_FILE = Path(__file__).parent / "schemas" / "lint-report.schema.json"
+"""The JSON Schema of this report, shipped in the package (docs/reports.md links it)."""
+
+
+def file_dict(file: FileReport) -> dict[str, Any]:
+    """One recording: ``FileReport.to_json``, each finding with its SARIF fingerprint, and the
+    findings a suppression took out (``suppressed``), each with its ``suppression``."""
+    data: dict[str, Any] = clean(file.to_json())
+    for finding, mark in zip(data["findings"], marks(file.findings), strict=True):
+        finding["fingerprint"] = mark
+    held = [finding for finding, _ in file.suppressed]
+    data["suppressed"] = [
+        {**clean(finding.to_json()), "fingerprint": mark, "suppression": why.to_json()}
+        for (finding, why), mark in zip(file.suppressed, marks(held), strict=True)
+    ]
+    return data
 
 
 def report_dict(report: Report) -> dict[str, Any]:
     return {
         "tool": "fuzzoff",
         "version": __version__,
-        "files": [_clean(f.to_json()) for f in report.files],
+        "files": [file_dict(f) for f in report.files],
     }
 
 

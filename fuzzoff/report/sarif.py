@@ -82,6 +82,18 @@ def fingerprint(finding: Finding) -> str:
     return hashlib.sha256(key.encode()).hexdigest()[:32]
 
 
+def marks(findings: list[Finding]) -> list[str]:
+    """Each finding's ``partialFingerprints`` value: its ``fingerprint``, with ``:N`` on the
+    Nth repeat of the same one in a recording (two findings of one rule at one time)."""
+    seen: Counter[str] = Counter()
+    out = []
+    for finding in findings:
+        key = fingerprint(finding)
+        out.append(key + (f":{seen[key]}" if seen[key] else ""))
+        seen[key] += 1
+    return out
+
+
 def message_text(finding: Finding) -> str:
     where = []
     if finding.time_s is not None:
@@ -110,7 +122,7 @@ def region(finding: Finding) -> dict[str, int]:
 
 
 def result(
-    finding: Finding, rule_index: int, artifact: dict[str, Any], occurrence: int
+    finding: Finding, rule_index: int, artifact: dict[str, Any], mark: str
 ) -> dict[str, Any]:
     props: dict[str, Any] = {"vehicle": finding.vehicle}
     if finding.time_s is not None:
@@ -123,7 +135,6 @@ def result(
             props["index"] = finding.where.index
         if finding.where.offset is not None:
             props["byte_offset"] = finding.where.offset
-    mark = fingerprint(finding) + (f":{occurrence}" if occurrence else "")
     return {
         "ruleId": finding.code,
         "ruleIndex": rule_index,
@@ -149,11 +160,16 @@ def sarif_log(report: Report, settings: Settings, root: Path | None = None) -> d
         location: dict[str, Any] = {"uri": uri, **({"uriBaseId": base} if base else {})}
         artifacts.append({"location": location, "properties": {"format": file.format}})
         ref = {**location, "index": len(artifacts) - 1}
-        seen: Counter[str] = Counter()
-        for finding in file.findings:
-            key = fingerprint(finding)
-            results.append(result(finding, index[finding.code], ref, seen[key]))
-            seen[key] += 1
+        for finding, mark in zip(file.findings, marks(file.findings), strict=True):
+            results.append(result(finding, index[finding.code], ref, mark))
+        # a suppressed finding (configuration or baseline) stays a result, marked suppressed:
+        # code scanning then shows it as such instead of taking it for fixed
+        held = [finding for finding, _ in file.suppressed]
+        for (finding, why), mark in zip(file.suppressed, marks(held), strict=True):
+            item = result(finding, index[finding.code], ref, mark)
+            justification = printable(f"{why.kind}: {why.reason}", CI_TEXT_LIMIT)
+            item["suppressions"] = [{"kind": "external", "justification": justification}]
+            results.append(item)
         notifications.extend(
             {
                 "level": "error",
@@ -176,7 +192,7 @@ def sarif_log(report: Report, settings: Settings, root: Path | None = None) -> d
             {
                 # input that could not be read completely: the analysis did not complete
                 "executionSuccessful": report.complete,
-                "exitCode": report.exit_status(settings.fail_on),
+                "exitCode": settings.exit_status(report),
                 "toolExecutionNotifications": notifications,
                 "properties": {"fail_on": settings.fail_on.label, "complete": report.complete},
             }

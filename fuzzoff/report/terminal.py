@@ -164,11 +164,19 @@ def print_file(
     _print_findings(console, shown, several, verbose)
     if not shown:
         console.print(Text("  no findings", style="green"))
+    if file.suppressed and not quiet:
+        kinds = Counter(why.kind for _, why in file.suppressed)
+        said = ", ".join(f"{n} by the {kind}" for kind, n in sorted(kinds.items()))
+        console.print(Text(f"  {len(file.suppressed)} suppressed ({said})", style="dim"))
     console.print()
 
 
 def print_summary(
-    console: Console, report: Report, fail_on: Severity, verbose: bool = False
+    console: Console,
+    report: Report,
+    fail_on: Severity,
+    verbose: bool = False,
+    exit_zero: bool = False,
 ) -> None:
     counts = Counter(f.severity for f in report.findings)
     table = Table(title="fuzzoff summary", box=table_box(console), show_edge=False)
@@ -177,19 +185,25 @@ def print_summary(
     table.add_column("warnings", justify="right", style=STYLE[Severity.WARNING])
     table.add_column("info", justify="right", style=STYLE[Severity.INFO])
     table.add_column("unreadable", justify="right")
+    suppressed = sum(len(f.suppressed) for f in report.files)
+    if suppressed:
+        table.add_column("suppressed", justify="right", style="dim")
     table.add_row(
         str(len(report.files)),
         str(counts[Severity.ERROR]),
         str(counts[Severity.WARNING]),
         str(counts[Severity.INFO]),
         str(sum(1 for f in report.files if not f.complete)),
+        *([str(suppressed)] if suppressed else []),
     )
     console.print(table)
     status = report.exit_status(fail_on)
     verdict = VERDICT[status]
     if status == 1:
         verdict += f" (findings at or above {fail_on.label})"
-    style = "bold green" if status == 0 else "bold red"
+        if exit_zero:
+            verdict += "; exit status 0 (--exit-zero)"
+    style = "bold green" if status == 0 else ("bold yellow" if exit_zero else "bold red")
     console.print(Text(f"result: {verdict}", style=style))
     if report.findings and not verbose:
         hint = "--verbose shows each finding in full; fuzzoff rule CODE explains a rule, with a fix"
@@ -224,6 +238,7 @@ def print_report(
     quiet: bool = False,
     statistics: bool = False,
     verbose: bool = False,
+    exit_zero: bool = False,
 ) -> None:
     """The whole terminal report; ``quiet`` keeps only findings at the fail level, no summary;
     ``verbose`` adds each finding's whole message, time window and byte offset."""
@@ -233,7 +248,7 @@ def print_report(
     for file in report.files:
         print_file(console, file, fail_on, quiet, verbose)
     if not quiet:
-        print_summary(console, report, fail_on, verbose)
+        print_summary(console, report, fail_on, verbose, exit_zero)
 
 
 def _property_line(r: PropertyResult) -> str:

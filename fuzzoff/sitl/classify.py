@@ -10,7 +10,7 @@
   kinds, frames and masks, the gaps of 0.2 s or more, the parameters): a live campaign sends
   one stream of each shape, since each costs seconds of real time;
 - ``edge_note``: a keep-alive gap within one 10 Hz check period of the loss timeout, where
-  PX4's outcome depends on the phase of its own check (gate spec 2.1.3) and the model fixes it.
+  PX4's outcome depends on the phase of its own check (gate.md#check-timing) and the model fixes it.
 """
 
 from __future__ import annotations

@@ -27,12 +27,12 @@ from fuzzoff.modes import custom_mode_to_nav_state, nav_state_name
 from fuzzoff.sitl.truth import Mode, Truth, read_tlog, read_truth
 
 CHECK_PERIOD_S = 0.1
-"""Commander's health-check pass (gate spec 2.1.3)."""
+"""Commander's health-check pass (gate.md#check-timing)."""
 LOOP_S = 0.012
 """One Commander iteration (10 ms) and a logging tick: slack on each side of the window."""
 LOSS_TOLERANCE_S = 0.11
 """The model's loss instant may differ from PX4's flag by up to one check period and a loop
-(gate spec 2.1.3: at least 110 ms)."""
+(gate.md#check-timing: at least 110 ms)."""
 DECISION_S = 0.05
 """The model decides a request at the time the tlog recorded it; PX4 logs it when its receiver
 took it: a few milliseconds apart on the shifted clocks."""
@@ -383,7 +383,7 @@ def _preempted_loss(rows: list[dict[str, Any]], t: float, window: float) -> dict
     """A model loss without a failsafe because the recording's mode change came first: a
     ``mode`` row taken from the recording (no command for it) at most one check period and a
     loop before the model's ``signal_lost``. The model then follows the recording instead of
-    predicting the action (gate spec 2.1.3: PX4's check has its own phase), so neither the
+    predicting the action (gate.md#check-timing: PX4's check has its own phase), so neither the
     action nor the return can be judged."""
     for i, row in enumerate(rows):
         if row["what"] != "signal_lost" or abs(row["px4_t"] - t) > window:

@@ -3,8 +3,8 @@
 The first true field of ``OffboardControlMode`` selects a required estimate and the setpoint
 messages that may and must be published (seed 000 "The OffboardControlMode PX4 message" for
 1.15+, seed 002 "ROS 2 消息" for 1.13-1.14 with its single ``actuator`` field; rover table of
-seed 000 "Ровер" from 1.16). The legacy ``ignore_*`` semantics follow seed 003 and the gate
-spec section 7 (legacy). Everything version-dependent about the declaration lives here.
+seed 000 "Ровер" from 1.16). The legacy ``ignore_*`` semantics follow seed 003 and
+gate.md#control-mode (legacy). Everything version-dependent about the declaration lives here.
 """
 
 from __future__ import annotations
@@ -88,7 +88,7 @@ TABLE_002: dict[str, FlagRow] = {
     ),
 }
 
-# The 1.15 docs still asked for a velocity estimate with ``acceleration`` (gate spec D10).
+# The 1.15 docs still asked for a velocity estimate with ``acceleration`` (gate.md#docs-vs-code).
 TABLE_115: dict[str, FlagRow] = {
     **TABLE_000,
     "acceleration": _row("acceleration", "velocity", TRAJECTORY),
@@ -198,7 +198,7 @@ def describe_required(row: FlagRow) -> str:
 
 
 # ---------------------------------------------------------------------------------------------
-# Legacy (v1.5-v1.11) ``ignore_*`` semantics: seed 003, gate spec section 7 (legacy)
+# Legacy (v1.5-v1.11) ``ignore_*`` semantics: seed 003, gate.md#control-mode (legacy)
 
 
 @dataclass(frozen=True, slots=True)
@@ -239,8 +239,8 @@ def legacy_disabled_by_acceleration(mode: LegacyControlMode) -> tuple[str, ...]:
 
 
 def legacy_mode_from_mask(sp: SetPositionTargetLocal) -> LegacyControlMode:
-    """The ``offboard_control_mode`` a legacy receiver publishes for this message (gate spec
-    6.5): a group is ignored when ANY of its ignore bits is set."""
+    """The ``offboard_control_mode`` a legacy receiver publishes for this message
+    (gate.md#receiver): a group is ignored when ANY of its ignore bits is set."""
     mask = sp.type_mask
     return LegacyControlMode(
         t=sp.t,

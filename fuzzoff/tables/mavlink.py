@@ -10,7 +10,7 @@ A ``type_mask`` selects groups: position (bits 0-2), velocity (bits 3-5), accele
 of its components is used. Yaw (bit 10) and yaw rate (bit 11) may accompany any combination.
 Bits 12-14 carry the fixed-wing "setpoint type" values, which are not part of MAVLink.
 
-``RECEIVER_FRAMES`` is the one code fact kept here (gate spec 6.2, 6.3): the frames PX4's
+``RECEIVER_FRAMES`` is the one code fact kept here (gate.md#receiver): the frames PX4's
 receiver accepts in v1.12-main, so OFB601 can say where the docs and the code disagree.
 """
 
@@ -87,7 +87,7 @@ RECEIVER_FRAMES: dict[str, frozenset[int]] = {
     LOCAL: frozenset({1, 8}),
     GLOBAL: frozenset({5, 6, 11}),
 }
-"""Code, not docs (gate spec 6.2/6.3, v1.12-main): any other frame is dropped, no keep-alive."""
+"""Code, not docs (gate.md#receiver, v1.12-main): any other frame is dropped, no keep-alive."""
 
 Combo = frozenset[str]
 
@@ -269,8 +269,9 @@ def selected_groups(type_mask: int) -> Combo:
 
 
 def body_ned_groups(type_mask: int) -> Combo:
-    """What PX4's receiver keeps of a LOCAL_NED in MAV_FRAME_BODY_NED (gate spec 6.2, D17):
-    never the position; a velocity or acceleration only with all three components used."""
+    """What PX4's receiver keeps of a LOCAL_NED in MAV_FRAME_BODY_NED (gate.md#receiver,
+    #docs-vs-code): never the position; a velocity or acceleration only with all three components
+    used."""
     return frozenset(g for g in ("velocity", "acceleration") if not type_mask & GROUP_BITS[g])
 
 
@@ -301,7 +302,7 @@ def attitude_used(type_mask: int) -> bool:
 
 
 def rates_used(type_mask: int) -> bool:
-    """Body rates count as given when roll and pitch rate are used (gate spec 6.4)."""
+    """Body rates count as given when roll and pitch rate are used (gate.md#receiver)."""
     return not type_mask & (ROLL_RATE_IGNORE | PITCH_RATE_IGNORE)
 
 

@@ -49,7 +49,7 @@ def test_gate_json_timeline_agrees_with_recording(tmp_path: Path) -> None:
     (vehicle,) = file["vehicles"]
     rows = vehicle["timeline"]
     failsafe = [r for r in rows if r["what"] == "failsafe"]
-    assert [(r["action"], r["spec"]) for r in failsafe] == [("POSCTL", "5.1")]
+    assert [(r["action"], r["see"]) for r in failsafe] == [("POSCTL", "docs/gate.md#loss")]
     assert 4.0 <= failsafe[0]["time_s"] <= 4.12
     assert [r["what"] for r in rows if r["what"] == "offboard_resumed"] == ["offboard_resumed"]
     assert any(r["source"] == "recorded" and r["mode"] == "POSCTL" for r in rows)
@@ -61,7 +61,7 @@ def test_gate_terminal_states_the_difference(tmp_path: Path) -> None:
     result = run_cli(["gate", str(path)])
     assert result.returncode == 1
     assert "recorded: OFFBOARD at 5.01 s; model: POSCTL" in result.stdout
-    assert "5.1" in result.stdout and "failsafe" in result.stdout
+    assert "gate.md#loss" in result.stdout and "failsafe" in result.stdout
 
 
 def test_gate_param_override(tmp_path: Path) -> None:

@@ -380,7 +380,7 @@ def _local_position(fields: frozenset[str], vehicle: str, origin: Origin) -> Bui
 
 def _land_detected(fields: frozenset[str], vehicle: str, origin: Origin) -> Builder:
     """``VehicleLandDetected``: landed as Commander judges a disarm, ``landed`` or
-    ``maybe_landed`` (gate spec 13a), as from a ULog."""
+    ``maybe_landed`` (gate.md#seen-on-px4), as from a ULog."""
 
     def build(m: Any, t: float, where: Where, ts: int) -> Event:
         return ev.LandDetected(

@@ -436,7 +436,7 @@ def failsafe_flags(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
 
 def land_detected(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
     """``vehicle_land_detected``: Commander refuses a disarm unless ``landed`` or
-    ``maybe_landed`` (gate spec 13a)."""
+    ``maybe_landed`` (gate.md#seen-on-px4)."""
     for t, w, ts, landed, maybe in zip(
         c.t, c.where, c.ts, c.ob("landed"), c.ob("maybe_landed"), strict=True
     ):
