@@ -5,7 +5,7 @@ Both act on a lint's ``Report`` once it is made, whatever ran it (this process, 
 cluster): a suppressed finding leaves ``FileReport.findings``, so it fails no run, and joins
 ``FileReport.suppressed`` with why, so the JSON and HTML reports still show it. A baseline
 matches a finding by its recording and its SARIF fingerprint (rule, vehicle, topic and time
-window: ``report.sarif.marks``), which stays the same over re-lints and fuzzoff versions
+window: ``report.marks.marks``), which stays the same over re-lints and fuzzoff versions
 where the finding did not change.
 """
 
@@ -20,7 +20,7 @@ from typing import Any
 from fuzzoff import __version__
 from fuzzoff.config import ConfigError, Settings
 from fuzzoff.findings import FileReport, Finding, Report, Suppression
-from fuzzoff.report.sarif import marks
+from fuzzoff.report.marks import marks
 
 BASELINE_VERSION = 1
 

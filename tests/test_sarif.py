@@ -17,8 +17,9 @@ from fuzzoff.events import Where
 from fuzzoff.findings import FileReport, Finding, Report, Severity
 from fuzzoff.profiles import Profile
 from fuzzoff.report.junit import render as junit_render
+from fuzzoff.report.marks import fingerprint
 from fuzzoff.report.sanitize import printable
-from fuzzoff.report.sarif import fingerprint, sarif_log
+from fuzzoff.report.sarif import sarif_log
 from tests.helpers import ROOT, run_cli
 from tests.report_fixtures import gap_recording, hostile_report
 

@@ -17,8 +17,8 @@ from typing import Any
 from fuzzoff.config import Settings
 from fuzzoff.findings import Report, Severity
 from fuzzoff.report.located import Located, located
+from fuzzoff.report.marks import message_text
 from fuzzoff.report.sanitize import escape_bidi
-from fuzzoff.report.sarif import message_text
 
 SEVERITY = {Severity.ERROR: "critical", Severity.WARNING: "major", Severity.INFO: "info"}
 

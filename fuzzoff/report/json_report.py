@@ -12,8 +12,8 @@ from fuzzoff import __version__
 from fuzzoff.config import Settings
 from fuzzoff.findings import FileReport, Report
 from fuzzoff.report import CampaignReport
+from fuzzoff.report.marks import marks
 from fuzzoff.report.sanitize import escape_bidi
-from fuzzoff.report.sarif import marks
 
 
 def clean(value: Any) -> Any:

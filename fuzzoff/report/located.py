@@ -1,6 +1,6 @@
 """What the one-line-per-finding formats (``github``, ``rdjson``, ``gitlab``, ``json-lines``)
 share: each finding with its recording, its path as a CI service matches it against the
-repository, and its fingerprint (the SARIF one: ``sarif.marks``)."""
+repository, and its fingerprint (the SARIF one: ``marks.marks``)."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from fuzzoff.findings import FileReport, Finding, Report
-from fuzzoff.report.sarif import marks
+from fuzzoff.report.marks import marks
 
 
 @dataclass(frozen=True, slots=True)

@@ -18,8 +18,8 @@ from fuzzoff.catalog import PROJECT_URL, get_rule
 from fuzzoff.config import Settings
 from fuzzoff.findings import Report, Severity
 from fuzzoff.report.located import Located, located
+from fuzzoff.report.marks import message_text
 from fuzzoff.report.sanitize import CI_TEXT_LIMIT, escape_bidi, printable
-from fuzzoff.report.sarif import message_text
 
 SEVERITY = {Severity.ERROR: "ERROR", Severity.WARNING: "WARNING", Severity.INFO: "INFO"}
 SOURCE = {"name": "fuzzoff", "url": PROJECT_URL}

@@ -16,9 +16,7 @@ notification.
 
 from __future__ import annotations
 
-import hashlib
 import json
-from collections import Counter
 from pathlib import Path
 from typing import Any
 from urllib.parse import quote
@@ -28,6 +26,7 @@ from fuzzoff.catalog import PROJECT_URL, Rule, load_catalog, render_page
 from fuzzoff.config import Settings
 from fuzzoff.findings import Finding, Report, Severity
 from fuzzoff.report import CampaignReport
+from fuzzoff.report.marks import marks, message_text
 from fuzzoff.report.sanitize import CI_TEXT_LIMIT, escape_bidi, printable
 
 SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
@@ -71,43 +70,6 @@ def artifact_uri(path: str, root: Path) -> tuple[str, str | None]:
     except ValueError:
         return resolved.as_uri(), None
     return quote(relative.as_posix()), BASE_ID
-
-
-def fingerprint(finding: Finding) -> str:
-    """Stable over re-runs of the same recording: rule, vehicle, topic, time window (10 ms)."""
-    topic = finding.where.topic if finding.where is not None else ""
-    start = "file" if finding.time_s is None else f"{finding.time_s:.2f}"
-    end = "" if finding.end_s is None else f"{finding.end_s:.2f}"
-    key = "\0".join((finding.code, finding.vehicle, topic, start, end))
-    return hashlib.sha256(key.encode()).hexdigest()[:32]
-
-
-def marks(findings: list[Finding]) -> list[str]:
-    """Each finding's ``partialFingerprints`` value: its ``fingerprint``, with ``:N`` on the
-    Nth repeat of the same one in a recording (two findings of one rule at one time)."""
-    seen: Counter[str] = Counter()
-    out = []
-    for finding in findings:
-        key = fingerprint(finding)
-        out.append(key + (f":{seen[key]}" if seen[key] else ""))
-        seen[key] += 1
-    return out
-
-
-def message_text(finding: Finding) -> str:
-    where = []
-    if finding.time_s is not None:
-        when = f"at {finding.time_s:.3f} s"
-        if finding.end_s is not None:
-            when += f" to {finding.end_s:.3f} s"
-        where.append(when)
-    if finding.vehicle:
-        where.append(f"vehicle {finding.vehicle!r}")
-    if finding.where is not None and finding.where.topic:
-        where.append(f"on {finding.where}")
-    suffix = f" ({', '.join(where)})" if where else " (whole recording)"
-    # one line, no bidi overrides, bounded: CI views show it as the recording wrote it
-    return printable(finding.message + suffix, CI_TEXT_LIMIT)
 
 
 def region(finding: Finding) -> dict[str, int]:
