@@ -30,6 +30,14 @@ GROUPS = {
 }
 
 
+def _release_order(release: str) -> tuple[int, ...]:
+    """Releases by version; a build of main (``main-2026-08-13``) after them all."""
+    base = release.split("-")[0]
+    if not base.replace(".", "").isdigit():
+        return (999,)
+    return tuple(int(n) for n in base.split("."))
+
+
 def main() -> None:
     runs = json.loads((HERE / "runs.json").read_text())
     table: dict[str, dict[str, list[int]]] = defaultdict(lambda: defaultdict(lambda: [0, 0]))
@@ -66,7 +74,7 @@ def main() -> None:
     ]
     print("| PX4 | " + " | ".join(columns) + " | model - PX4 flag (ms) |")
     print("| --- |" + " --- |" * (len(columns) + 1))
-    for release in sorted(table, key=lambda r: tuple(int(n) for n in r.split("-")[0].split("."))):
+    for release in sorted(table, key=_release_order):
         cells = [
             f"{table[release][c][1]}/{table[release][c][0]}" if table[release][c][0] else "-"
             for c in columns
