@@ -130,8 +130,12 @@ def tlog_row() -> Row:
 
 
 def _release_key(release: str) -> tuple[tuple[int, ...], str]:
-    """Oldest first; a pre-release after its number's others by name (alpha before beta)."""
-    return tuple(int(p) for p in release.split("-")[0].split(".")), release
+    """Oldest first; a pre-release after its number's others by name (alpha before beta); a
+    build of main (``main-2026-08-13``) last."""
+    base = release.split("-")[0]
+    if not base.replace(".", "").isdigit():
+        return (999,), release
+    return tuple(int(p) for p in base.split(".")), release
 
 
 def gate_agreement() -> Counter[tuple[str, str, bool | None]]:

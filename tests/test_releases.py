@@ -372,3 +372,19 @@ def test_ofb101_says_which_docs_ask_for_2_hz(px4: str, own_docs: bool) -> None:
     (gap,) = [f for f in file["findings"] if f["code"] == "OFB101"][:1]
     assert ("docs: keep-alive at > 2 Hz" in gap["message"]) == own_docs
     assert ("1.18's give COM_OF_LOSS_T only" in gap["message"]) != own_docs
+
+
+@pytest.mark.parametrize(
+    ("name", "px4", "note"),
+    [
+        ("sticks_moved-main-2026-08-13.ulg", "main", False),  # ver_sw_branch main
+        ("sticks_moved-1.18.0-beta1-head.ulg", "1.18", False),  # ver_sw_branch release/1.18
+        ("sticks_moved-main-2026-08-13.tlog", "1.18", True),  # AUTOPILOT_VERSION only
+    ],
+)
+def test_px4_s_own_recordings_of_main_and_the_1_18_head_pick_their_record(
+    name: str, px4: str, note: bool
+) -> None:
+    profile = _lint_profile(str(CORPORA / "sitl" / name))
+    assert profile["px4"] == px4 and profile["px4_source"] == "recording"
+    assert ("px4_note" in profile) == note

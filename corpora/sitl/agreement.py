@@ -31,6 +31,14 @@ GROUPS = {
 }
 
 
+def _release_order(release: str) -> tuple[int, ...]:
+    """Releases by version; a build of main (``main-2026-08-13``) after them all."""
+    base = release.split("-")[0]
+    if not base.replace(".", "").isdigit():
+        return (999,)
+    return tuple(int(n) for n in base.split("."))
+
+
 def main() -> None:
     runs = json.loads((HERE / "runs.json").read_text())
     table: dict[tuple[str, str], dict[str, list[int]]] = defaultdict(
@@ -75,7 +83,7 @@ def main() -> None:
     for key in sorted(
         table,
         key=lambda k: (
-            tuple(int(n) for n in k[0].split("-")[0].split(".")),
+            _release_order(k[0]),
             k[0],
             order.index(k[1]),
         ),

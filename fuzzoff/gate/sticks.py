@@ -9,11 +9,12 @@ What PX4 does, per release (``Release.stick_override``), as seen on SITL (MAVLin
   a fast swing (the direction changes every sample or two) never count; a steady ramp does.
   Commander then makes Position the user intention of an armed multicopter (VTOL in hover) in
   OFFBOARD without an active failsafe: OFFBOARD ends and does not come back by itself. Seen on
-  the 1.18 head and main bundles.
+  the 1.18 head and main bundles (``corpora/sitl/sticks_moved-*``).
 * 1.14-1.17 (``COM_RC_OVERRIDE``, default 1 = auto modes only; bit 1 adds OFFBOARD): the sticks
   count as moving when one moves faster than ``COM_RC_STICK_OV`` percent per second (30).
   By default OFFBOARD stays (seen on 1.17.0); with bit 1 set Position takes over (seen on
-  1.17.0 with ``COM_RC_OVERRIDE`` 3).
+  1.17.0 with ``COM_RC_OVERRIDE`` 3, ``corpora/sitl/sticks_moved_override-1.17.0``). 1.14-1.16
+  follow the same parameters, not run with a joystick ramp.
 * Older releases: not modelled.
 
 PX4 low-pass filters the stick speed before comparing it; the filter's constant is not modelled:
