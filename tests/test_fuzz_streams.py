@@ -17,6 +17,7 @@ from fuzzoff.events import (
     Event,
     MavlinkTarget,
     RoverSteeringSetpoint,
+    SetPositionTargetGlobal,
     SetPositionTargetLocal,
 )
 from fuzzoff.findings import Finding
@@ -114,3 +115,49 @@ def test_a_mavlink_reproducer_addresses_px4_from_the_companions_own_system(
     assert len(sent) == 17 and set(sent) == {(245, 191, 1, 1)}
     assert spec["setup"]["companion"] == {"system": 245, "component": 191}
     assert spec["setup"]["autopilot"] == {"system": 1, "component": 1}
+
+
+def test_the_generator_holds_a_stream_long_enough_for_what_only_time_shows() -> None:
+    """Issue 33 item 5: OFB107 needs 10 s of one moving command; the generator's streams
+    lasted at most 6 s (plus stalls) and never reached it."""
+    from hypothesis import HealthCheck, Phase, find
+
+    quick = settings(
+        max_examples=400,
+        database=None,
+        deadline=None,
+        derandomize=True,
+        phases=[Phase.generate],
+        suppress_health_check=list(HealthCheck),
+    )
+    times = find(fs.keepalive_times(1.0), lambda ts: len(ts) > 1 and ts[-1] >= 10.0, settings=quick)
+    assert times[-1] >= 10.0
+    held = find(
+        scenarios(transport="ros2", vehicle="mc"),
+        lambda s: any(f.code == "OFB107" for f in run(s)),
+        settings=quick,
+    )
+    assert any(f.code == "OFB107" for f in run(held))
+
+
+@settings(max_examples=25, database=None, deadline=None, derandomize=True)
+@given(st.sampled_from(["fw", "vtol"]).flatmap(lambda v: scenarios(vehicle=v, transport="mavlink")))
+def test_a_fixed_wing_stream_sends_the_fixed_wing_setpoint_types(scenario: Scenario) -> None:
+    """Issue 33 item 5: per-vehicle setpoints; a fixed-wing program's position targets carry
+    the FW types (glide, takeoff, land, loiter) or a NaN altitude, and lint judges them."""
+    targets = [
+        e
+        for e in scenario.events
+        if isinstance(e, SetPositionTargetLocal | SetPositionTargetGlobal)
+    ]
+    assert all(e.type_mask in fs.FW_TYPE_MASKS for e in targets)
+    run(scenario)
+
+
+@settings(max_examples=25, database=None, deadline=None, derandomize=True)
+@given(scenarios(vehicle="rover-ackermann", transport="mavlink"))
+def test_a_rover_stream_stays_on_the_ground(scenario: Scenario) -> None:
+    for e in scenario.events:
+        if isinstance(e, SetPositionTargetLocal):
+            assert e.position[2] == 0.0 or math.isnan(e.position[2])
+            assert e.velocity[2] == 0.0

@@ -156,3 +156,14 @@ def test_each_real_vehicle_is_detected_from_its_recordings(stem: str, vehicle: s
     for suffix in (".tlog", ".ulg"):
         out = run_cli(["lint", str(SITL / f"{stem}{suffix}")])
         assert vehicle in out.stdout.splitlines()[0]
+
+
+def test_a_vtol_gliding_on_a_nan_altitude_in_fw_flight_is_not_a_copter_hold() -> None:
+    """The 1.18 head's standard VTOL in FW flight on position setpoints with z NaN glided
+    (it went down 29 m, then climbed back when z came again): OFB602's multicopter axis check
+    ("PX4 holds instead") does not apply in FW flight on 1.18."""
+    tlog = SITL / "vtol_fw_glide-1.18.0-beta1-head.tlog"
+    out = run_cli(["lint", str(tlog), "--format", "json"])
+    codes = {f["code"] for f in json.loads(out.stdout)["files"][0]["findings"]}
+    assert "OFB602" not in codes
+    assert out.returncode == 0

@@ -32,6 +32,7 @@ from fuzzoff.events import (
 from fuzzoff.findings import Severity, clip
 from fuzzoff.gate.estimates import Estimates
 from fuzzoff.gate.receiver import DROPPED, FLOAT_FIELDS, ReceiverContext, receive
+from fuzzoff.releases import Release
 from fuzzoff.tables import mavlink as tm
 
 VEHICLE_LABELS = {"copter": "multicopter/VTOL", "fixedwing": "fixed-wing", "rover": "rover"}
@@ -100,6 +101,12 @@ def set_components(event: PositionTarget, group: str) -> list[str]:
     return out
 
 
+def _fw_by_component(release: Release) -> bool:
+    """1.18 and later take a fixed-wing's offboard setpoint by component (gate spec 16 S7);
+    1.14-1.17 only with x, y and z all given (what a NaN z does there was not flown)."""
+    return not release.minors or min(release.minors) >= 18
+
+
 class PositionTargetFields(Check):
     codes = ("OFB601", "OFB602", "OFB603", "OFB604", "OFB605")
     wants = (SetPositionTargetLocal, SetPositionTargetGlobal)
@@ -142,8 +149,8 @@ class PositionTargetFields(Check):
     def _verdicts_by_key(self, events: list[Event]) -> list[Verdicts] | None:
         """What a message of each ``_KEY`` of the run commits, or None where that needs each
         message (fixed-wing ignored fields, a non-finite value for the axes)."""
-        if self.group == "fixedwing":
-            return None
+        if self.group == "fixedwing" or self.ctx.state.vtol_phase is not None:
+            return None  # a VTOL: per message, as its phase says (``_copter_axes``)
         if self.group == "copter" and self.rx is not None:
             if not all_finite(events):
                 return None
@@ -166,9 +173,17 @@ class PositionTargetFields(Check):
         judged = self.by_mask.get(key)
         if judged is None:
             judged = self.by_mask[key] = self._judge_mask(event)
-        if self.group == "copter" and self.rx is not None:
+        if self._copter_axes() and self.rx is not None:
             return [*judged, ("OFB602", self._mc_axes(event, self.rx))]
         return judged
+
+    def _copter_axes(self) -> bool:
+        """Does PX4's multicopter position controller take the setpoint now? Not a VTOL's in
+        FW flight: there the fixed-wing controllers do (1.18 glides on a NaN z, seen on the 1.18
+        head's standard VTOL, ``corpora/sitl/vtol_fw_glide-*``)."""
+        if self.group != "copter":
+            return False
+        return self.ctx.state.vtol_phase != "fw" or not _fw_by_component(self.ctx.profile.release)
 
     def on_event(self, event: Event) -> None:
         if event.origin != "sent" or not isinstance(
@@ -181,7 +196,7 @@ class PositionTargetFields(Check):
             judged = self.by_mask[key] = self._judge_mask(event)
         for code, offences in judged:
             self.episodes.update(code, event.kind, event.t, event.where, offences)
-        if self.group == "copter" and self.rx is not None:
+        if self._copter_axes() and self.rx is not None:
             offences = self._mc_axes(event, self.rx)
             self.episodes.update("OFB602", event.kind, event.t, event.where, offences)
         if self.group == "fixedwing":

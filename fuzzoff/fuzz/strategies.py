@@ -1,6 +1,7 @@
 """Hypothesis strategies, one per concept of a setpoint stream (composed in ``fuzz.streams``).
 
-Timing: ``rates``, ``jitters``, ``stalls``, ``bursts``, ``keepalive_times``, ``clock_skews``.
+Timing: ``rates``, ``jitters``, ``stalls``, ``bursts``, ``held_streams``, ``keepalive_times``,
+``clock_skews``.
 Declarations: ``control_modes``. Content: ``nan_patterns``, ``trajectory_setpoints``,
 ``quaternions``, ``attitude_setpoints``, ``rates_setpoints``, ``rover_setpoints``,
 ``frames``, ``type_masks``, ``mavlink_setpoints``. Commands: ``command_plans``. Parameters:
@@ -99,11 +100,16 @@ def bursts() -> st.SearchStrategy[list[tuple[float, int]]]:
 
 @st.composite
 def keepalive_times(draw: st.DrawFn, loss_timeout: float) -> list[float]:
-    """Sorted send times of the keep-alive: a rate with jitter, stalls and bursts."""
-    rate = draw(rates())
+    """Sorted send times of the keep-alive: a rate with jitter, stalls and bursts; now and
+    then a long held stream (``held_streams``)."""
+    held = draw(held_streams())
+    if held is not None:
+        duration, rate = held
+    else:
+        rate = draw(rates())
+        # Hypothesis favours the ends of a range: typical durations get their own share.
+        duration = draw(st.one_of(st.sampled_from([1.5, 2.5, 4.0, 6.0]), st.floats(0.0, 6.0)))
     period = 1.0 / rate
-    # Hypothesis favours the ends of a range: typical durations get their own share.
-    duration = draw(st.one_of(st.sampled_from([1.5, 2.5, 4.0, 6.0]), st.floats(0.0, 6.0)))
     jitter = draw(jitters())
     n = min(int(duration * rate) + 1, 400)
     offsets = draw(st.lists(st.floats(-1.0, 1.0), min_size=n, max_size=n)) if jitter else [0.0] * n
@@ -113,6 +119,23 @@ def keepalive_times(draw: st.DrawFn, loss_timeout: float) -> list[float]:
     for at, count in draw(bursts()):
         times += [at + 0.0002 * k for k in range(count)]
     return sorted(round(t, 4) for t in times)
+
+
+HELD_SECONDS = (12.0, 15.0, 20.0)
+"""Long enough that a command held unchanged reaches what only time shows (OFB107 asks for
+10 s of one moving command)."""
+HELD_RATES = (2.0, 5.0, 10.0, 20.0)
+"""At most 20 Hz, so that 20 s stay within the ``keepalive_times`` cap of 400 messages."""
+
+
+def held_streams() -> st.SearchStrategy[tuple[float, float] | None]:
+    """Mostly None (an ordinary stream); else (duration s, rate Hz) of a long held stream."""
+    return st.one_of(
+        st.none(),
+        st.none(),
+        st.none(),
+        st.tuples(st.sampled_from(HELD_SECONDS), st.sampled_from(HELD_RATES)),
+    )
 
 
 @dataclass(frozen=True, slots=True)
@@ -385,6 +408,57 @@ def frames(kind: str) -> st.SearchStrategy[int]:
 
 def type_masks() -> st.SearchStrategy[int]:
     return st.one_of(st.sampled_from(COMMON_TYPE_MASKS), st.integers(0, 0xFFFF))
+
+
+FW_TYPE_MASKS = (
+    292,  # glide: z, vz and az ignored (PX4 flies it with the throttle off)
+    0x1000 | 0b110111111000,  # takeoff
+    0x2000 | 0b110111111000,  # land
+    0x3000 | 0b110111111000,  # loiter
+    0b110111111000,  # position (1.14-1.17 need x, y and z all given)
+    0b110111000111,  # velocity (not flown in FW before 1.18)
+)
+"""What a fixed-wing program sends (PX4 answers each per release: gate spec section 16)."""
+
+
+def vehicle_setpoints(vehicle: str | None) -> st.SearchStrategy[tuple[str, dict[str, Any]]]:
+    """A MAVLink setpoint as a program for ``vehicle`` writes it: a fixed-wing's (or a VTOL's
+    in FW) setpoint types and NaN altitude, a rover's ground-plane setpoint (z 0 or NaN), else
+    any (``mavlink_setpoints``)."""
+    if vehicle in ("fw", "vtol"):
+        return mavlink_setpoints().flatmap(
+            lambda sp: st.builds(
+                _fw_shaped, st.just(sp), st.sampled_from(FW_TYPE_MASKS), st.booleans()
+            )
+        )
+    if vehicle is not None and vehicle.startswith("rover"):
+        return mavlink_setpoints().flatmap(
+            lambda sp: st.builds(_ground_shaped, st.just(sp), st.sampled_from([0.0, NAN]))
+        )
+    return mavlink_setpoints()
+
+
+def _fw_shaped(
+    sp: tuple[str, dict[str, Any]], mask: int, nan_z: bool
+) -> tuple[str, dict[str, Any]]:
+    kind, fields = sp
+    if kind == "set_attitude_target":
+        return sp
+    fields = {**fields, "type_mask": mask}
+    if nan_z and "position" in fields:  # 1.18 glides on a NaN z (and vz)
+        x, y, _ = fields["position"]
+        vx, vy, _ = fields["velocity"]
+        fields |= {"position": (x, y, NAN), "velocity": (vx, vy, NAN)}
+    return kind, fields
+
+
+def _ground_shaped(sp: tuple[str, dict[str, Any]], z: float) -> tuple[str, dict[str, Any]]:
+    kind, fields = sp
+    if "position" not in fields:
+        return sp
+    x, y, _ = fields["position"]
+    vx, vy, _ = fields["velocity"]
+    return kind, {**fields, "position": (x, y, z), "velocity": (vx, vy, 0.0)}
 
 
 @st.composite

@@ -337,9 +337,11 @@ _MAV_BUILD: dict[str, type[ev.MavlinkTarget]] = {
 
 
 @st.composite
-def mavlink_sent(draw: st.DrawFn, times: list[float], transport: TransportName) -> list[ev.Event]:
-    """MAVLink setpoints (each one a keep-alive) from the companion."""
-    kind, values = draw(fs.mavlink_setpoints())
+def mavlink_sent(
+    draw: st.DrawFn, times: list[float], transport: TransportName, vehicle: str | None = None
+) -> list[ev.Event]:
+    """MAVLink setpoints (each one a keep-alive) from the companion, shaped for ``vehicle``."""
+    kind, values = draw(fs.vehicle_setpoints(vehicle))
     if transport == "mavros" and "thrust" in values:
         # MAVROS clamps thrust to [0, 1] before it is sent (rosbag1/writer.py): what PX4 gets.
         thrust = float(values["thrust"])
@@ -384,7 +386,7 @@ def scenarios(
     if chosen == "ros2":
         sent = draw(ros2_sent(profile, vehicle, times))
     else:
-        sent = draw(mavlink_sent(times, chosen))
+        sent = draw(mavlink_sent(times, chosen, vehicle))
     plan = draw(fs.command_plans(duration, chosen == "ros2" and release.handles_set_nav_state))
     if chosen == "mavros":
         plan = replace(plan, acks=False)

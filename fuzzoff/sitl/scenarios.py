@@ -8,6 +8,7 @@ holds a *hazard* (``hazard`` names the error code fuzzoff should give, and why).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Literal
@@ -238,6 +239,18 @@ def vtol_loss(d: Driver) -> None:
     _vtol_back_and_land(d)
 
 
+def vtol_fw_glide(d: Driver) -> None:
+    """In FW flight, position setpoints with z NaN: 1.18 takes a fixed-wing's setpoint by
+    component and glides (throttle off) on a NaN altitude; then the full setpoint again."""
+    _vtol_to_fw(d)
+    x, y, _ = VTOL_FW_POINT
+    d.note("z NaN: glide")
+    d.stream(d.position(x, y, math.nan), 8.0)
+    d.note("z given again")
+    d.stream(d.position(*VTOL_FW_POINT), 4.0)
+    _vtol_back_and_land(d)
+
+
 def _rover_start(d: Driver) -> None:
     d.stream(d.position(0, 0, 0), 1.5)
     d.require(d.set_mode(NAV_OFFBOARD, "OFFBOARD"), "switch to OFFBOARD")
@@ -426,6 +439,13 @@ SCENARIOS: dict[str, Scenario] = {
             "hazard",
             "stream lost in OFFBOARD in each VTOL phase (failsafe, then back to OFFBOARD)",
             ("OFB103",),
+            vehicle="vtol",
+        ),
+        Scenario(
+            "vtol_fw_glide",
+            "standard VTOL in FW flight: position setpoints with z NaN (1.18: glide), then z again",
+            vtol_fw_glide,
+            "clean",
             vehicle="vtol",
         ),
         Scenario(
