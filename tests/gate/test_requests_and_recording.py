@@ -279,3 +279,34 @@ def test_4_1_disarmed_in_offboard_without_signal(px4: str, fallback: bool) -> No
     trs = run(px4, events, t_end=3.0, model=gate)
     assert bool(of("failsafe", trs)) is fallback
     assert (gate.nav_state != OFFBOARD) is fallback
+
+
+def test_12_a_recorded_disarm_against_the_models_own_arm_is_a_disagreement() -> None:
+    """The model took an ARM that PX4 never got (issue 28 miss 3): no status showed the vehicle
+    armed since, and later ones show it disarmed. Not 'no command for it': a disagreement."""
+    events = [
+        status(0.0, POSCTL, False),
+        *stream(0.0, 4.0),
+        switch_offboard(1.0),
+        arm(1.001),
+        CommandAck(t=1.01, command=176, result=0),
+        status(1.02, OFFBOARD, False),
+        status(3.0, OFFBOARD, False),
+    ]
+    out = run("1.16", events)
+    (differs,) = of("disagreement", out)
+    assert differs.t == 3.0 and "never armed since the arm request at 1.00 s" in differs.message
+    assert not any("no command for it" in tr.message for tr in out)
+
+
+def test_12_a_mode_change_after_a_command_the_model_does_not_judge_names_it() -> None:
+    events = [
+        in_offboard(0.0),
+        *stream(0.0, 3.0),
+        Command(t=2.0, command=21, params=(0.0,) * 7),
+        CommandAck(t=2.01, command=21, result=0),
+        status(2.02, 18, True),
+    ]
+    out = run("1.16", events)
+    assert any("after NAV_LAND (21) at 2.00 s" in tr.message for tr in of("mode", out))
+    assert not of("disagreement", out)
