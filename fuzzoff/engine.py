@@ -437,7 +437,7 @@ def lint_file(
     unreadable = get_rule("OFB001")
     try:
         source = open_source(path)
-        source.px4_hint = settings.px4
+        source.px4_hint = settings.release
         plot = source.aside.plot = PlotSamples() if plot_data else None
 
         def show() -> None:

@@ -7,7 +7,6 @@ PX4 profile does is its record in ``fuzzoff/releases.py`` (``Profile.release``).
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 
 from fuzzoff import releases
@@ -34,8 +33,6 @@ VEHICLE_NOTES: dict[str, str] = {
 DEFAULT_PX4: PX4Profile = "1.15"
 DEFAULT_VEHICLE = "mc"
 
-_RELEASE = re.compile(r"^v?(\d+)\.(\d+)(?:\.(\d+))?")
-
 
 class ProfileError(ValueError):
     """An unknown PX4 version or vehicle type (a usage error)."""
@@ -43,17 +40,12 @@ class ProfileError(ValueError):
 
 def px4_profile_for(version: str) -> PX4Profile:
     """Map a release (``1.15.4``, ``v1.17.0-beta1``) or a profile name to the modelled profile."""
-    text = version.strip()
-    known = releases.names()
-    if text in known:
-        return releases.names()[known.index(text)]
-    match = _RELEASE.match(text)
-    if match is None:
+    found = releases.named(version)
+    if found is None:
         raise ProfileError(
             f"unknown PX4 version {version!r}: give a release such as 1.15.4, "
-            f"or one of {', '.join(known)}"
+            f"or one of {', '.join(releases.names())}"
         )
-    found = releases.for_version(int(match.group(1)), int(match.group(2)))
     return found.name  # type: ignore[return-value]
 
 

@@ -19,6 +19,7 @@ from types import TracebackType
 
 from fuzzoff.events import Event, VehiclePosition
 from fuzzoff.findings import RecordingStats
+from fuzzoff.releases import Release
 
 
 def path_text(path: Path | str) -> str:
@@ -191,9 +192,10 @@ class Source(abc.ABC):
         self.on_progress: Callable[[], None] | None = None
         """Set by the caller that shows progress: a reader that reads a long stretch without
         an event (a tlog's garbage) calls it now and then."""
-        self.px4_hint: str | None = None
-        """The user's ``--px4`` profile, set before ``open()``: readers that must choose message
-        definitions the recording does not carry (Humble-era ROS 2 bags) start from it."""
+        self.px4_hint: Release | None = None
+        """The user's ``--px4`` release record, set before ``open()``: readers that must choose
+        message definitions the recording does not carry (Humble-era ROS 2 bags) start from
+        its ``msg_folder``."""
         self.aside = Aside()
         """What the reader read beside the events: the last message's time, and the plotted
         positions it thinned out (``aside.plot``, set before ``events()``)."""

@@ -14,6 +14,7 @@ This module imports nothing from fuzzoff: every layer may ask it.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from types import MappingProxyType
@@ -383,6 +384,28 @@ def for_version(major: int, minor: int) -> Release:
         if listed and minor < min(listed):
             return RELEASES[0]
     return RELEASES[0] if major < 1 else RELEASES[-1]
+
+
+_VERSION = re.compile(r"^v?(\d+)\.(\d+)(?:\.(\d+))?")
+"""A release as PX4 names it: ``1.15.4``, ``v1.17.0-beta1``, ``1.14``."""
+
+
+def version_of(text: str) -> tuple[int, int] | None:
+    """``(major, minor)`` of a release name (``v1.17.0-beta1`` -> ``(1, 17)``); None for text
+    that names no release."""
+    found = _VERSION.match(text.strip())
+    return None if found is None else (int(found.group(1)), int(found.group(2)))
+
+
+def named(text: str) -> Release | None:
+    """The record a profile name (``main``) or a release (``1.15.4``) stands for: the one
+    place a name is parsed (``--px4``, a recording's version, a reproducer's profile). None
+    when the text is neither."""
+    name = text.strip()
+    if name in names():
+        return get(name)
+    version = version_of(name)
+    return None if version is None else for_version(*version)
 
 
 def newest_listed() -> tuple[int, int]:

@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Any
 
 from fuzzoff import events as ev
+from fuzzoff import releases
 from fuzzoff.events import Event, event_to_dict
 from fuzzoff.formats import open_source
 from fuzzoff.recording import Source
@@ -184,7 +185,7 @@ def read_all(path: Path, px4: str | None = None) -> tuple[Source, list[Event]]:
     """Open, probe and read a recording the way the engine does."""
     source = open_source(path)
     if px4 is not None:
-        source.px4_hint = px4  # type: ignore[attr-defined]
+        source.px4_hint = releases.named(px4)  # as the engine sets it from --px4
     source.open()
     source.probe()
     events = list(source.events())

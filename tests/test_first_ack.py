@@ -114,3 +114,19 @@ def test_without_acks_the_rule_says_it_cannot_judge() -> None:
     assert codes(findings, "OFB207") == []
     (not_checkable,) = codes(findings, "OFB002")
     assert "OFB207" in not_checkable.message
+
+
+def test_a_retry_loop_that_stops_on_the_receivers_accepted_is_an_error() -> None:
+    """The switch sent again while no answer came (a lost ack), then acked ACCEPTED by the
+    receiver and rejected by Commander: no retry follows."""
+    events = [switch(1.0), switch(1.5), ack(1.503, ACCEPTED), ack(1.509, TEMPORARILY_REJECTED)]
+    (finding,) = ofb207([*events, Command(t=5.0, command=511, params=(0.0,) * 7)])
+    assert ofb207(events) == []  # the recording ends before next_step_s has passed
+    assert finding.severity is Severity.ERROR
+    assert finding.time_s == pytest.approx(1.509)
+    assert "sent 2 times" in finding.message and "stopped on the first ack" in finding.message
+
+
+def test_a_retry_loop_that_goes_on_retrying_is_right() -> None:
+    events = [switch(1.0), switch(1.5), ack(1.503, ACCEPTED), ack(1.509, TEMPORARILY_REJECTED)]
+    assert ofb207([*events, switch(2.0), Command(t=5.0, command=511, params=(0.0,) * 7)]) == []

@@ -65,6 +65,11 @@ def test_a_folder_format_is_asked_through_the_registry(
     ``detect_folder``: the search and detection know no format by name."""
     import fuzzoff.formats as formats
 
+    def fake_folder(path: Path) -> str:
+        if not (path / f"{path.name}.idx").is_file():
+            raise SourceError(path, "not a fake capture")
+        return "fake-folder"
+
     folder = tmp_path / "capture"
     folder.mkdir()
     (folder / "capture.idx").write_text("")
@@ -78,7 +83,7 @@ def test_a_folder_format_is_asked_through_the_registry(
         suffixes=(".idx",),
         written_suffix="",
         is_folder=lambda path, suffixes: (path / f"{path.name}.idx").is_file(),
-        detect_folder=lambda path: "fake-folder",
+        detect_folder=fake_folder,
     )
     monkeypatch.setattr(formats, "FOLDER_FORMATS", (fake, *formats.FOLDER_FORMATS))
     assert formats.is_bag_folder(folder)
@@ -86,7 +91,7 @@ def test_a_folder_format_is_asked_through_the_registry(
     assert formats.recordings_in([tmp_path]) == [folder]
     plain = tmp_path / "plain"
     plain.mkdir()
-    with pytest.raises(SourceError, match="a folder that is no recording fuzzoff reads"):
+    with pytest.raises(SourceError, match="not a fake capture"):  # the first folder format's
         detect_format(plain)
 
 

@@ -120,3 +120,23 @@ def test_a_folder_tree_deeper_than_pythons_recursion_limit_is_searched(tmp_path:
         for folder in reversed(folders):
             if folder.exists():
                 folder.rmdir()
+
+
+def test_a_fleet_lint_finds_the_recordings_as_a_plain_lint(tmp_path: Path) -> None:
+    """One search for both paths: a recording named twice, under a link and in a folder named
+    too, is linted once, where first named, whether or not the lint writes the Parquet dataset."""
+    pytest.importorskip("pyarrow")
+    folder = tmp_path / "flights"
+    folder.mkdir()
+    shutil.copy(GOOD, folder / "a.tlog")
+    shutil.copy(GAP, folder / "b.tlog")
+    (folder / "c.tlog").symlink_to("b.tlog")
+    named = [folder / "b.tlog", folder, folder / "c.tlog"]
+    plain = _linted(*named)
+    report = tmp_path / "fleet.json"
+    dataset = ["--format", "parquet", "-o", str(tmp_path / "dataset")]
+    json_report = ["--format", "json", "-o", str(report)]
+    result = run_cli(["lint", *map(str, named), "--no-progress", *json_report, *dataset])
+    assert result.returncode in (0, 1), result.stderr
+    fleet = [f["path"] for f in json.loads(report.read_text())["files"]]
+    assert plain == fleet == [str(folder / "b.tlog"), str(folder / "a.tlog")]

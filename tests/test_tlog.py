@@ -95,6 +95,7 @@ def flight() -> list[Event]:
             command=176,
             params=(1.0, 6.0, 0.0, 0.0, 0.0, 0.0, 0.0),
             from_external=True,
+            message="COMMAND_LONG",
             **SENT,
         ),
         CommandAck(
@@ -633,6 +634,7 @@ def _event(draw: st.DrawFn, t: float) -> Event:
             command=draw(st.integers(0, 0xFFFF)),
             params=params,
             from_external=True,
+            message="COMMAND_LONG",
             **draw(_sent()),
         )
     if kind == 4:

@@ -53,6 +53,14 @@ Failures the damage campaign found (shrunk by Hypothesis), kept here:
 * ``metadata_start_digit``: corpora/rosbag2/two_vehicles with one bit flipped in a digit of
   metadata.yaml's starting time: every time moved by that much in silence. Now OFB004, and the
   data files' own first time is used (the findings of the intact bag).
+
+Intact recordings under names that are not their format's (issue 26 item 3): a recording is
+read as what its content is, so each expects its undamaged findings and nothing else.
+
+* ``renamed.MCAP``, ``renamed.mcap.active``, ``renamed_mcap`` (``chunked.mcap``): read as a
+  damaged SQLite database (OFB001, exit 2, the flight's findings gone).
+* ``renamed.DB3`` (corpora/rosbag2/good_flight_sqlite3's database): "salvaged" row by row
+  (OFB001), the PX4 release assumed instead of read from its definitions.
 """
 
 from __future__ import annotations
@@ -269,6 +277,21 @@ def main() -> None:
         exit_status=bag_spec["exit_status"],
         profile=bag_spec["profile"],
         stderr=["metadata.yaml's starting time is", "the data files' times were used"],
+    )
+    for name in ("renamed.MCAP", "renamed.mcap.active", "renamed_mcap"):
+        shutil.copyfile(mcap, HERE / name)
+        case = name.replace(".", "_")
+        expected(case, name, MCAP_FINDINGS, profile=MCAP_PROFILE, clean=clean)
+    database = ROOT / "corpora" / "rosbag2" / "good_flight_sqlite3" / "good_flight_sqlite3.db3"
+    shutil.copyfile(database, HERE / "renamed.DB3")
+    sqlite_spec = intact("rosbag2/good_flight_sqlite3.expected.json")
+    expected(
+        "renamed_DB3",
+        "renamed.DB3",
+        sqlite_spec["findings"],
+        exit_status=sqlite_spec["exit_status"],
+        profile=sqlite_spec["profile"],
+        clean=clean,
     )
     for name, (damaged, says) in bag_cases(bag.read_bytes()).items():
         (HERE / f"{name}.bag").write_bytes(damaged)

@@ -86,6 +86,8 @@ class _Switch:
     first: CommandAck | None = None
     step: Command | None = None
     """The client's first command after the first ack, while the second may still come."""
+    attempts: int = 1
+    """How often the client sent this switch before an answer came (a retry on a lost ack)."""
 
 
 @dataclass(slots=True)
@@ -93,6 +95,7 @@ class _Rejected:
     cmd: Command
     first: CommandAck
     second: CommandAck
+    attempts: int = 1
 
 
 class FirstAckBelieved(Check):
@@ -128,7 +131,10 @@ class FirstAckBelieved(Check):
         if rejected is not None and not cmd.is_mode_switch:
             self._went_on(rejected, cmd)
         if self._through_receiver(cmd) and (switch is None or switch.first is None):
-            self.switches[client] = _Switch(cmd)
+            attempts = 1
+            if switch is not None and switch.cmd.params == cmd.params:
+                attempts = switch.attempts + 1
+            self.switches[client] = _Switch(cmd, attempts=attempts)
             if not self.ctx.has("command_ack"):
                 self.unanswered = True
 
@@ -153,7 +159,7 @@ class FirstAckBelieved(Check):
                     del self.switches[client]
                 return
             del self.switches[client]
-            self._judge(client, switch.cmd, switch.first, ack, switch.step)
+            self._judge(client, switch, ack)
             return
 
     def _expire(self, now: float) -> None:
@@ -165,16 +171,13 @@ class FirstAckBelieved(Check):
         ]:
             del self.switches[client]
         for client in [c for c, r in self.rejected.items() if now - r.second.t > self.next_step_s]:
-            del self.rejected[client]
+            rejected = self.rejected.pop(client)
+            if rejected.attempts > 1:
+                self._stopped(rejected)
 
-    def _judge(
-        self,
-        client: Client,
-        cmd: Command,
-        first: CommandAck,
-        second: CommandAck,
-        step: Command | None,
-    ) -> None:
+    def _judge(self, client: Client, switch: _Switch, second: CommandAck) -> None:
+        cmd, first, step = switch.cmd, switch.first, switch.step
+        assert first is not None
         what = switch_name(cmd)
         acks = (
             f"{what} at {cmd.t:.3f} s was acked twice, as {px4_label(self.ctx)}'s MAVLink "
@@ -213,7 +216,7 @@ class FirstAckBelieved(Check):
             )
             return
         if not second.accepted:
-            self.rejected[client] = _Rejected(cmd, first, second)
+            self.rejected[client] = _Rejected(cmd, first, second, switch.attempts)
 
     def _went_on(self, rejected: _Rejected, step: Command) -> None:
         what = switch_name(rejected.cmd)
@@ -232,7 +235,27 @@ class FirstAckBelieved(Check):
             f"({second.result_name})",
         )
 
+    def _stopped(self, rejected: _Rejected) -> None:
+        """A client that retried the switch while no answer came, and stopped once the
+        receiver's ACCEPTED came, although Commander's answer rejected it."""
+        what = switch_name(rejected.cmd)
+        second = rejected.second
+        self.ctx.report(
+            CODE,
+            f"{what} was sent {rejected.attempts} times before an answer came (a client that "
+            f"retries until it is accepted); the answer was the MAVLink receiver's ACCEPTED at "
+            f"{rejected.first.t:.3f} s, then Commander's {second.result_name} at "
+            f"{second.t:.3f} s, and the client retried no more (none within "
+            f"{self.next_step_s:g} s): it stopped on the first ack. Read the last ack of the "
+            "switch (1.16/1.17 tags send two) before the retry loop ends",
+            second.t,
+            second.where,
+            short=f"stopped retrying {what} on the receiver's ACCEPTED; Commander: "
+            f"{second.result_name}",
+        )
+
     def finish(self, t_end: float) -> None:
+        self._expire(t_end)
         if self.unanswered:
             self.ctx.cannot_check(
                 CODE,

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 from fuzzoff import releases
 from fuzzoff.checks.base import Check, CheckContext
-from fuzzoff.events import MAV_CMD_DO_SET_MODE, Command, Event, Where
+from fuzzoff.events import MAV_CMD_DO_SET_MODE, Command, Event, Where, whole
 from fuzzoff.findings import Severity
 from fuzzoff.gate.requests import mode_request, unknown_mode_decision
 from fuzzoff.modes import nav_state_name
@@ -29,7 +29,8 @@ class _Seen:
 
 
 def _whole_params(cmd: Command) -> tuple[int, int, int]:
-    base, main, sub = (int(p) if p == p else -1 for p in cmd.params[:3])
+    """Base, main and sub mode as whole numbers (-1 for a value that is none: NaN, inf)."""
+    base, main, sub = (-1 if (w := whole(p)) is None else w for p in cmd.params[:3])
     return base, main, sub
 
 

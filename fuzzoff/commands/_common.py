@@ -207,6 +207,45 @@ def resolve_recordings(settings: Settings, recordings: list[str]) -> list[tuple[
     return plan
 
 
+def recordings_named(paths: list[str]) -> list[str]:
+    """The recordings the command line names, found once, in order: a file as given, a bag
+    folder as one recording, other folders searched; each real file once however often it is
+    named; a URL (a fleet lint) expanded on this machine, its workers fetch it. A path that
+    does not exist, or a folder with nothing to lint, is a usage error before any work: passing
+    it would turn a CI job green without looking at a single flight."""
+    # here, not at the top: the commands that read no recording need not import the readers
+    from fuzzoff.fleet import is_url, require  # the fleet's dependencies are imported on use
+    from fuzzoff.formats import RECORDING_SUFFIXES, find_recordings, recordings_in
+
+    existing_paths([p for p in paths if not is_url(p)])
+    named: list[list[Path] | str] = []
+    for p in paths:
+        if is_url(p):
+            require("urls", "a URL")
+            named.append(p)
+            continue
+        found = find_recordings(Path(p))
+        if Path(p).is_dir() and not found:
+            suffixes = ", ".join(RECORDING_SUFFIXES)
+            raise ConfigError(f"no recordings in {p} (searched for {suffixes} and bag folders)")
+        named.append(found)
+    # each real file once (a link, ``./a`` and ``a``), where it is first named
+    first = recordings_in(f for item in named if not isinstance(item, str) for f in item)
+    k = 0
+    out: list[str] = []
+    for item in named:
+        if isinstance(item, str):
+            from fuzzoff.fleet.inputs import expand
+
+            out.extend(expand(item))
+            continue
+        for f in item:
+            if k < len(first) and f == first[k]:
+                out.append(str(f))
+                k += 1
+    return list(dict.fromkeys(out))
+
+
 def existing_paths(paths: list[str]) -> None:
     """Check each path names something: an empty one (an unset shell variable) would otherwise
     mean the current folder."""

@@ -16,7 +16,7 @@ from pathlib import Path
 
 from fuzzoff.commands._common import (
     check_output,
-    existing_paths,
+    recordings_named,
     report_targets,
     resolve_recordings,
     write_stdout,
@@ -26,30 +26,10 @@ from fuzzoff.config import ConfigError, Settings
 from fuzzoff.engine import lint_file
 from fuzzoff.findings import Report
 from fuzzoff.fleet import is_url, require
-from fuzzoff.fleet.inputs import expand
 from fuzzoff.fleet.lint_run import lint_all
 from fuzzoff.fleet.task import LINTED, SKIPPED, Lint, Outcome
-from fuzzoff.formats import RECORDING_SUFFIXES, find_recordings
 
 PARQUET = "parquet"
-
-
-def targets_of(paths: Sequence[str]) -> list[str]:
-    """The recordings named on the command line, as a plain lint finds them (local paths),
-    URLs expanded on this machine (the workers fetch them)."""
-    found: list[str] = []
-    for p in paths:
-        if is_url(p):
-            require("urls", "a URL")
-            found.extend(expand(p))
-            continue
-        existing_paths([p])
-        recordings = find_recordings(Path(p))
-        if Path(p).is_dir() and not recordings:
-            suffixes = ", ".join(RECORDING_SUFFIXES)
-            raise ConfigError(f"no recordings in {p} (searched for {suffixes} and bag folders)")
-        found.extend(str(f) for f in recordings)
-    return list(dict.fromkeys(found))
 
 
 def check_fleet_args(args: argparse.Namespace, reports: list[tuple[str, str | None]]) -> None:
@@ -78,15 +58,15 @@ def run_fleet(args: argparse.Namespace, settings: Settings) -> int:
     reports, stderr lines and exit status as a plain lint."""
     reports = report_targets(args.format, args.output)
     check_fleet_args(args, reports)
-    targets = targets_of(args.paths)
+    targets = recordings_named(args.paths)
     local = [t for t in targets if not is_url(t)]
     for fmt, output in reports:
         if fmt != PARQUET:
             check_output(output, local)
-    # every local recording's configuration checked, and its notes printed, before any work;
-    # the tasks resolve each again where they run (a fetched URL's copy is judged with the
-    # command's own: fleet.task)
-    resolve_recordings(settings, local)
+    # each local recording's settings resolved once, its notes printed, before any work; a
+    # URL's fetched copy is judged with the command's own (fleet.task)
+    resolved = dict(resolve_recordings(settings, local))
+    plan = [(t, resolved.get(t, settings)) for t in targets]
     lint: Lint = lint_file
     if any(fmt == "html" for fmt, _ in reports):
         from fuzzoff.engine import lint_file_with_timelines
@@ -111,8 +91,7 @@ def run_fleet(args: argparse.Namespace, settings: Settings) -> int:
             advance(outcome)
 
         outcomes = lint_all(
-            targets,
-            settings,
+            plan,
             scheduler=args.scheduler,
             jobs=args.jobs,
             timeout_s=args.timeout,

@@ -16,7 +16,7 @@ from fuzzoff.commands._common import (
     add_report_options,
     add_rule_options,
     check_output,
-    existing_paths,
+    recordings_named,
     report_targets,
     resolve_recordings,
     settings_from_args,
@@ -25,7 +25,6 @@ from fuzzoff.commands._lint_output import print_problems, write_report
 from fuzzoff.config import ConfigError
 from fuzzoff.engine import Lint, Watch, lint_each, lint_file, lint_file_with_timelines
 from fuzzoff.fleet import is_url
-from fuzzoff.formats import RECORDING_SUFFIXES, find_recordings, recordings_in
 from fuzzoff.report import FORMATS
 from fuzzoff.report.sanitize import printable
 
@@ -94,17 +93,7 @@ def run(args: argparse.Namespace) -> int:
         from fuzzoff.commands._lint_fleet import run_fleet
 
         return run_fleet(args, settings)
-    existing_paths(args.paths)
-    # A folder with nothing to lint is a mistake (a wrong path, a recording step that failed):
-    # passing it would turn a CI job green without looking at a single flight.
-    # Each folder is searched once, here; the linting takes the recordings found.
-    found = [(p, find_recordings(Path(p))) for p in args.paths]
-    empty = [p for p, recordings in found if Path(p).is_dir() and not recordings]
-    if empty:
-        suffixes = ", ".join(RECORDING_SUFFIXES)
-        raise ConfigError(f"no recordings in {empty[0]} (searched for {suffixes} and bag folders)")
-    # each real file once, in order, however often it is named (no folder is searched again)
-    paths = [str(f) for f in recordings_in(f for _, recordings in found for f in recordings)]
+    paths = recordings_named(args.paths)
     targets = report_targets(args.format, args.output)
     for _, output in targets:
         check_output(output, paths)

@@ -138,10 +138,11 @@ class _Start:
 class _Run:
     """One fleet run's futures, the start of each task, and the outcomes so far."""
 
-    def __init__(self, client: Any, targets: Sequence[str], settings: Settings) -> None:
+    def __init__(self, client: Any, targets: Sequence[str], settings: Sequence[Settings]) -> None:
         self.client = client
         self.targets = targets
         self.settings = settings
+        """Each target's settings, in the order of ``targets``."""
         self.id = uuid.uuid4().hex[:12]
         self.topic = f"fuzzoff-started-{self.id}"
         self.lock = threading.Lock()
@@ -189,7 +190,6 @@ class _Run:
         raised (a bug: the report names the exception)."""
         from distributed import KilledWorker
 
-        target = self.targets[index]
         after = self.elapsed(index)
         took = "" if after is None else f" after {after:.1f} s"
         if isinstance(exc, KilledWorker):
@@ -198,12 +198,13 @@ class _Run:
                 "(killed, out of memory, or a crash in a reader), and so did the next one "
                 "it was given to; the scheduler gave up on it"
             )
-            return self._failed(target, what, CRASHED, after)
+            return self._failed(index, what, CRASHED, after)
         what = f"the lint did not finish: fuzzoff failed{took} ({type(exc).__name__}: {exc})"
-        return self._failed(target, what, FAILED, after)
+        return self._failed(index, what, FAILED, after)
 
-    def _failed(self, target: str, what: str, status: str, after: float | None) -> Outcome:
-        report = failed_report(target, what, self.settings)
+    def _failed(self, index: int, what: str, status: str, after: float | None) -> Outcome:
+        target = self.targets[index]
+        report = failed_report(target, what, self.settings[index])
         return Outcome(target, report, status, seconds=after or 0.0)
 
     def timed_out(self, index: int, worker: str, timeout_s: float) -> Outcome:
@@ -211,13 +212,13 @@ class _Run:
             f"the lint did not finish within {timeout_s:g} s (--timeout): stopped by ending "
             f"its Dask worker {worker} (its nanny starts a new one)"
         )
-        return self._failed(self.targets[index], what, TIMED_OUT, timeout_s)
+        return self._failed(index, what, TIMED_OUT, timeout_s)
 
 
 def run_on_cluster(
     client: Any,
     targets: Sequence[str],
-    settings: Settings,
+    settings: Settings | Sequence[Settings],
     *,
     timeout_s: float = DEFAULT_TIMEOUT_S,
     lint: Lint = lint_file,
@@ -225,12 +226,14 @@ def run_on_cluster(
     record: bool = False,
     on_outcome: Callable[[Outcome], None] | None = None,
 ) -> list[Outcome]:
-    """Lint every target as its own task on ``client``'s cluster; the outcomes in the order of
+    """Lint every target as its own task on ``client``'s cluster, with ``settings`` (one for
+    all, or each target's own in the order of ``targets``); the outcomes in the order of
     ``targets``, each handed to ``on_outcome`` as it arrives. Results are gathered in batches
     as they finish; a watchdog thread stops the tasks that run past ``timeout_s``."""
     from distributed import as_completed
 
-    run = _Run(client, targets, settings)
+    each = [settings] * len(targets) if isinstance(settings, Settings) else list(settings)
+    run = _Run(client, targets, each)
     client.subscribe_topic(run.topic, run.on_start)
     known_arg: Any = frozenset(known)
     if known:  # once to every worker, not once per task
@@ -243,7 +246,7 @@ def run_on_cluster(
         tries[i] = tries.get(i, 0) + 1
         key = _key(run, i, tries[i])
         future = client.submit(
-            _run, i, targets[i], settings, run.topic, lint, known_arg, record, key=key, pure=False
+            _run, i, targets[i], each[i], run.topic, lint, known_arg, record, key=key, pure=False
         )
         futures[key] = future
         return future
@@ -340,4 +343,3 @@ async def _exit() -> None:
 def _still_on(client: Any, key: str, worker: str) -> bool:
     processing: dict[str, Any] = client.processing(workers=[worker])
     return key in processing.get(worker, ())
-

@@ -16,8 +16,7 @@ from fuzzoff.fleet.task import Lint, Outcome, lint_target
 
 
 def lint_all(
-    targets: Sequence[str],
-    settings: Settings,
+    plan: Sequence[tuple[str, Settings]],
     *,
     scheduler: str | None,
     jobs: int = 1,
@@ -27,9 +26,11 @@ def lint_all(
     record: bool = False,
     on_outcome: Callable[[Outcome], None] | None = None,
 ) -> list[Outcome]:
-    """Every target's outcome, in the order given: on the Dask cluster at ``scheduler``
-    (``local`` starts one with ``jobs`` worker processes, as many as ``--jobs`` would use),
-    else in ``jobs`` processes here."""
+    """Every target's outcome, in the order of ``plan`` (each target with the settings it is
+    judged with, resolved by the command): on the Dask cluster at ``scheduler`` (``local``
+    starts one with ``jobs`` worker processes, as many as ``--jobs`` would use), else in
+    ``jobs`` processes here."""
+    targets = [target for target, _ in plan]
     if scheduler is not None:
         from fuzzoff.fleet.cluster import DEFAULT_TIMEOUT_S, connect, run_on_cluster
 
@@ -37,25 +38,25 @@ def lint_all(
             return run_on_cluster(
                 client,
                 targets,
-                settings,
+                [settings for _, settings in plan],
                 timeout_s=timeout_s or DEFAULT_TIMEOUT_S,
                 lint=lint,
                 known=known,
                 record=record,
                 on_outcome=on_outcome,
             )
-    work = partial(_lint_here, settings=settings, lint=lint, record=record)
+    work = partial(_lint_here, lint=lint, record=record)
     outcomes: list[Outcome] = []
-    if jobs > 1 and len(targets) > 1:
+    if jobs > 1 and len(plan) > 1:
         with ProcessPoolExecutor(jobs, initializer=_know, initargs=(frozenset(known),)) as pool:
-            for outcome in pool.map(work, targets):
+            for outcome in pool.map(work, plan):
                 outcomes.append(outcome)
                 if on_outcome is not None:
                     on_outcome(outcome)
         return outcomes
     _know(frozenset(known))
-    for target in targets:
-        outcome = work(target)
+    for planned in plan:
+        outcome = work(planned)
         outcomes.append(outcome)
         if on_outcome is not None:
             on_outcome(outcome)
@@ -72,5 +73,6 @@ def _know(known: frozenset[str]) -> None:
     _KNOWN = known
 
 
-def _lint_here(target: str, *, settings: Settings, lint: Lint, record: bool) -> Outcome:
+def _lint_here(planned: tuple[str, Settings], *, lint: Lint, record: bool) -> Outcome:
+    target, settings = planned
     return lint_target(target, settings, lint=lint, known=_KNOWN, record=record)

@@ -65,11 +65,19 @@ def _claimed_by(folder: Path) -> Format | None:
 
 
 def _folder_format(folder: Path) -> str:
-    """The reported format of a folder that is one recording (``Format.detect_folder``)."""
-    fmt = _claimed_by(folder)
-    if fmt is None or fmt.detect_folder is None:
-        raise SourceError(folder, "a folder that is no recording fuzzoff reads (nor a ROS 2 bag)")
-    return fmt.detect_folder(folder)
+    """The reported format of a folder given as one recording (``Format.detect_folder``): the
+    format that claims it, else the first folder format that can read it (a bag folder whose
+    metadata.yaml is gone and whose data file is not named as rosbag2 names it, given by
+    itself rather than found by the search)."""
+    claimed = _claimed_by(folder)
+    refusal: SourceError | None = None
+    for fmt in (claimed,) if claimed is not None else FOLDER_FORMATS:
+        assert fmt.detect_folder is not None
+        try:
+            return fmt.detect_folder(folder)
+        except SourceError as exc:
+            refusal = refusal or exc
+    raise refusal or SourceError(folder, "a folder that is no recording fuzzoff reads")
 
 
 def open_source(path: Path, fmt: str | None = None) -> Source:

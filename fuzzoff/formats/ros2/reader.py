@@ -24,7 +24,6 @@ from rosbags.interfaces import MessageDefinitionFormat
 from rosbags.rosbag2 import Reader
 
 from fuzzoff.events import Event
-from fuzzoff.formats import px4_msgs
 from fuzzoff.formats.ros2 import mcap_check, mcap_indexed
 from fuzzoff.formats.ros2.mcap_stream import McapStream
 from fuzzoff.formats.ros2.storage import SUFFIX, Storage, data_files, storage_of
@@ -110,7 +109,7 @@ class Ros2Source(Source):
     # -- opening -----------------------------------------------------------------------------
 
     def open(self) -> None:
-        self.decoding.release = px4_msgs.release_for(self.px4_hint)
+        self.decoding.release = None if self.px4_hint is None else self.px4_hint.msg_folder
         self.decoding.thin_positions(POSITION_PERIOD_S, self.aside)
         if not self.path.exists():
             raise SourceError(self.path, "no such file or folder")

@@ -85,13 +85,13 @@ class BridgeFlight:
             self.build = bundle.find_build(release, None)
         self.log = log
         self.topics_in_only = program is not None and program.topics == "in"
+        release_name = self.build.profile_release  # no px4_msgs for it: fails before PX4 starts
+        self.received = [bridge_topic(release_name, m) for m in RECEIVED]
+        self.sent = [bridge_topic(release_name, m) for m in SENT]
         env = {"PX4_AGENT": str(bundle.default_root() / "agent"), "PX4_PARAM_SDLOG_MODE": "2"}
         self.px4 = bundle.start(self.build, 0, env)
         self.restart = AgentRestart(program, self.px4)
         self.participant = DomainParticipant(0)
-        release_name = self.build.profile_release
-        self.received = [bridge_topic(release_name, m) for m in RECEIVED]
-        self.sent = [bridge_topic(release_name, m) for m in SENT]
         recorded = self.sent + ([] if self.topics_in_only else self.received)
         self.recorder = Recorder(self.participant, recorded)
         self.watcher = Recorder(self.participant, self.received) if self.topics_in_only else None

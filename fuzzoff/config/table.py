@@ -1,29 +1,23 @@
-"""Settings: ``[tool.fuzzoff]`` of the nearest pyproject.toml or a fuzzoff.toml, then the CLI.
-
-Keys (ruff-like): ``px4``, ``vehicle``, ``select``, ``extend-select``, ``ignore``, ``fail-on``,
-``severity`` (table code -> level), ``options`` (table code -> table of thresholds),
-``params`` (PX4 parameter overrides for the gate model), ``per-file-ignores`` (glob -> codes).
-An unknown key, code or option is a usage error, never ignored.
-
-As in ruff, each recording is judged with the nearest configuration above it (a ``rover/``
-folder may carry its own ``fuzzoff.toml``); the command line applies on top of every one. A
-recording with no configuration above it takes the one found from the current folder.
-"""
+"""A configuration table (``[tool.fuzzoff]``, a ``fuzzoff.toml``, the command line's values)
+read and checked into ``Settings``: an unknown key, code or option is a usage error, never
+ignored; ``--px4`` and ``--vehicle`` become a release record's name and a vehicle type."""
 
 from __future__ import annotations
 
-import functools
 import math
 import os
 import re
 from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from difflib import get_close_matches
 from pathlib import Path
 from typing import Any
 
 from fuzzoff import releases
 from fuzzoff.catalog import expand_selectors, get_rule, load_catalog
+from fuzzoff.config.errors import ConfigError, did_you_mean
+from fuzzoff.config.globs import FileIgnore, glob_regex
+from fuzzoff.config.settings import Settings
 from fuzzoff.findings import Severity
 from fuzzoff.gate.params import GATE_PARAMS
 from fuzzoff.profiles import (
@@ -33,8 +27,6 @@ from fuzzoff.profiles import (
     vehicle_type_for,
 )
 from fuzzoff.releases import PX4Profile
-from fuzzoff.usage import ConfigError as ConfigError
-from fuzzoff.usage import did_you_mean as did_you_mean
 
 KNOWN_KEYS = {
     "px4",
@@ -49,8 +41,6 @@ KNOWN_KEYS = {
     "per-file-ignores",
 }
 
-_RELEASE = re.compile(r"^v?(\d+)\.(\d+)(?:\.(\d+))?")
-
 
 def user_px4_profile(text: str) -> tuple[PX4Profile, str | None]:
     """The profile for a PX4 version the user names, and a note when its name differs.
@@ -63,13 +53,12 @@ def user_px4_profile(text: str) -> tuple[PX4Profile, str | None]:
     known = releases.names()
     if name in known:
         return px4_profile_for(name), None
-    match = _RELEASE.match(name)
-    if match is None:
+    release = releases.version_of(name)
+    if release is None:
         raise ProfileError(
             f"unknown PX4 version {text!r}{did_you_mean(name, known)}: give a release "
             f"such as 1.15.4, or one of {', '.join(known)}"
         )
-    release = (int(match.group(1)), int(match.group(2)))
     shown = f"{release[0]}.{release[1]}"
     newest, oldest = releases.newest_listed(), releases.oldest_listed()
     if release > newest:
@@ -105,175 +94,7 @@ def user_vehicle_type(text: str) -> str:
         ) from None
 
 
-@dataclass(frozen=True, slots=True)
-class FileIgnore:
-    """One ``per-file-ignores`` entry: codes turned off in the recordings its glob matches.
-
-    As in ruff, a pattern without a slash matches a recording's name in any folder; one with a
-    slash matches its path relative to the configuration's folder (``*`` stays within a
-    folder, ``**`` spans folders); a leading ``!`` turns off the codes everywhere the rest of
-    the pattern does not match."""
-
-    pattern: str
-    folder: str
-    codes: frozenset[str]
-
-    def matches(self, recording: str | Path) -> bool:
-        negated = self.pattern.startswith("!")
-        pattern = self.pattern[1:] if negated else self.pattern
-        path = Path(os.path.abspath(recording))
-        if "/" not in pattern:
-            hit = glob_regex(pattern).fullmatch(path.name) is not None
-        else:
-            try:
-                relative = path.relative_to(os.path.abspath(self.folder)).as_posix()
-            except ValueError:
-                relative = path.as_posix()
-            target = path.as_posix() if pattern.startswith("/") else relative
-            hit = glob_regex(pattern.removeprefix("./")).fullmatch(target) is not None
-        return hit != negated
-
-
-@functools.lru_cache(maxsize=256)
-def glob_regex(pattern: str) -> re.Pattern[str]:
-    """A glob as a regular expression: ``*``/``?`` within one path part, ``**`` across parts,
-    ``[...]`` classes (``[!...]`` negated) and ``{a,b}`` alternatives."""
-    out: list[str] = []
-    i, depth = 0, 0
-    while i < len(pattern):
-        c = pattern[i]
-        if pattern.startswith("**/", i):
-            out.append("(?:.*/)?")
-            i += 3
-            continue
-        if pattern.startswith("**", i):
-            out.append(".*")
-            i += 2
-            continue
-        if c == "*":
-            out.append("[^/]*")
-        elif c == "?":
-            out.append("[^/]")
-        elif c == "[" and "]" in pattern[i + 2 :]:
-            end = pattern.index("]", i + 2)
-            body = pattern[i + 1 : end]
-            if body.startswith("!"):
-                body = "^" + body[1:]
-            out.append("[" + body.replace("\\", "\\\\") + "]")
-            i = end
-        elif c == "{":
-            out.append("(?:")
-            depth += 1
-        elif c == "}" and depth:
-            out.append(")")
-            depth -= 1
-        elif c == "," and depth:
-            out.append("|")
-        else:
-            out.append(re.escape(c))
-        i += 1
-    if depth:
-        raise ValueError(f"unclosed {{ in {pattern!r}")
-    return re.compile("".join(out))
-
-
-@dataclass(frozen=True, slots=True)
-class Discovery:
-    """What a run needs to find each recording's settings: the command line's values, laid over
-    the nearest configuration above the recording (``Settings.for_recording``)."""
-
-    overrides: tuple[tuple[str, Any], ...]
-    cache: dict[str, Settings] = field(default_factory=dict, compare=False, hash=False)
-
-
-@dataclass(frozen=True, slots=True)
-class Settings:
-    """Everything that changes what a lint run reports."""
-
-    px4: PX4Profile | None = None
-    """Profile forced by the user (None = detect)."""
-    vehicle: str | None = None
-    select: frozenset[str] = frozenset()
-    """Enabled codes (empty = every rule)."""
-    ignore: frozenset[str] = frozenset()
-    fail_on: Severity = Severity.WARNING
-    severity: Mapping[str, Severity] = field(default_factory=dict)
-    options: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
-    params: Mapping[str, float] = field(default_factory=dict)
-    config_file: str | None = None
-    per_file_ignores: tuple[FileIgnore, ...] = ()
-    param_origins: Mapping[str, str] = field(default_factory=dict)
-    """Parameter -> where its value was set: ``--param`` or the configuration file's path."""
-    notes: tuple[str, ...] = ()
-    """What the user should hear about their settings (``--px4 1.12`` is judged as ``1.13``)."""
-    discovery: Discovery | None = None
-    """Set for a command-line run: each recording then takes its nearest configuration."""
-
-    def enabled(self, code: str) -> bool:
-        if code in self.ignore:
-            return False
-        return not self.select or code in self.select
-
-    def option(self, code: str, name: str) -> Any:
-        """A rule threshold: the user's value, else the catalog default."""
-        value = self.options.get(code, {}).get(name)
-        if value is not None:
-            return value
-        return get_rule(code).option(name).default
-
-    def severity_of(self, code: str, default: Severity) -> Severity:
-        return self.severity.get(code, default)
-
-    def param_origin(self, name: str) -> str:
-        """How a report words where a parameter set by the user came from."""
-        origin = self.param_origins.get(name)
-        if origin is None:
-            return "set by the user"  # Settings(params=...) from the Python API
-        if origin == "--param":
-            return "set with --param"
-        return f"set in {Path(origin).name}"
-
-    def resolved_for(self, recording: str | Path) -> Settings:
-        """``for_recording``, resolved once: a lint given these settings does not look for a
-        configuration again (no ``discovery`` left to follow); the per-file ignores it applies
-        again add nothing."""
-        return replace(self.for_recording(recording), discovery=None)
-
-    def for_recording(self, recording: str | Path) -> Settings:
-        """The settings one recording is judged with: its nearest configuration (for a
-        command-line run), the command line on top, then the ``per-file-ignores`` it matches."""
-        settings = self
-        if self.discovery is not None:
-            settings = _nearest_settings(self, self.discovery, Path(recording))
-        ignored = frozenset(
-            code
-            for rule in settings.per_file_ignores
-            if rule.matches(recording)
-            for code in rule.codes
-        )
-        if ignored - settings.ignore:
-            settings = replace(settings, ignore=settings.ignore | ignored)
-        return settings
-
-
-def find_config(start: Path) -> Path | None:
-    """The nearest fuzzoff.toml, or pyproject.toml with a ``[tool.fuzzoff]`` table.
-
-    A pyproject.toml that cannot be read is an error, not skipped: it may hold the table, and
-    a parent folder's settings would silently take its place."""
-    for folder in [start, *start.parents]:
-        candidate = folder / "fuzzoff.toml"
-        if candidate.is_file():
-            return candidate
-        candidate = folder / "pyproject.toml"
-        if candidate.is_file():
-            tool = _load_toml(candidate).get("tool", {})
-            if isinstance(tool, dict) and "fuzzoff" in tool:
-                return candidate
-    return None
-
-
-def _load_toml(path: Path) -> dict[str, Any]:
+def load_toml(path: Path) -> dict[str, Any]:
     import tomllib  # only where a configuration file is found
 
     try:
@@ -288,7 +109,7 @@ def _load_toml(path: Path) -> dict[str, Any]:
 
 
 def read_config_table(path: Path) -> dict[str, Any]:
-    data = _load_toml(path)
+    data = load_toml(path)
     if path.name == "pyproject.toml":
         table = data.get("tool", {}).get("fuzzoff", {})
         return dict(table) if isinstance(table, dict) else {}
@@ -468,67 +289,3 @@ def _file_ignores(table: Mapping[str, Any], where: str) -> list[FileIgnore]:
         chosen = _codes(codes, f"per-file-ignores.{pattern!r}", where)
         out.append(FileIgnore(pattern, folder, frozenset(chosen)))
     return out
-
-
-def load_settings(
-    start: Path | None = None,
-    overrides: Mapping[str, Any] | None = None,
-    *,
-    per_recording: bool = False,
-) -> Settings:
-    """Settings from the nearest config file, then ``overrides`` (the command line) on top.
-
-    ``per_recording`` (command-line runs): ``Settings.for_recording`` then looks for each
-    recording's own nearest configuration, as ruff does for each source file."""
-    clean = {k: v for k, v in (overrides or {}).items() if v is not None}
-    settings = _settings_from(find_config((start or Path.cwd()).resolve()), clean)
-    if per_recording:
-        settings = replace(settings, discovery=Discovery(tuple(sorted(clean.items()))))
-    return settings
-
-
-def _settings_from(config: Path | None, overrides: Mapping[str, Any]) -> Settings:
-    settings = Settings()
-    if config is not None:
-        settings = settings_from_table(read_config_table(config), str(config), settings)
-        settings = replace(settings, config_file=str(config))
-    if overrides:
-        if "select" in overrides:
-            # as in ruff: --select names the rules outright, the file's ignore included
-            settings = replace(settings, ignore=frozenset())
-        settings = settings_from_table(overrides, "command line", settings)
-    return settings
-
-
-def _nearest_settings(run: Settings, discovery: Discovery, recording: Path) -> Settings:
-    """The settings of the nearest configuration above ``recording``; the run's own when there
-    is none, or when it is the run's. ``fail-on`` stays the run's: a run has one exit status."""
-    folder = os.path.abspath(recording)
-    if not os.path.isdir(folder):
-        folder = os.path.dirname(folder)
-    found = discovery.cache.get(folder)
-    if found is None:
-        config = find_config(Path(folder))
-        if config is None or str(config) == run.config_file:
-            found = run
-        else:
-            found = discovery.cache.get(str(config))
-            if found is None:
-                found = _settings_from(config, dict(discovery.overrides))
-                found = replace(found, fail_on=run.fail_on, notes=_fail_on_note(found, run))
-                discovery.cache[str(config)] = found
-        discovery.cache[folder] = found
-    return found
-
-
-def _fail_on_note(nested: Settings, run: Settings) -> tuple[str, ...]:
-    table = read_config_table(Path(nested.config_file or ""))
-    if "fail-on" not in table or nested.fail_on is run.fail_on:
-        return nested.notes
-    where = run.config_file or "the default"
-    return (
-        *nested.notes,
-        f"{nested.config_file}: fail-on is not used: one run has one exit status, set by "
-        f"--fail-on or the configuration of the folder fuzzoff runs in ({where}: "
-        f"{run.fail_on.label})",
-    )
