@@ -176,11 +176,8 @@ class Ros2Source(Source):
             self._probe_files()
         info.kinds = self.decoding.kinds()
         info.vehicles = self.decoding.vehicles()
-        detected = self.decoding.detected_release()
-        info.px4_version = None if detected is None else px4_msgs.first_release_of(detected)
-        info.px4_candidates = [
-            px4_msgs.first_release_of(f) for f in self.decoding.fitting_releases()
-        ]
+        info.px4_version = self.decoding.detected_release()
+        info.px4_candidates = self.decoding.fitting_releases()
         info.px4_msgs_fits = self.decoding.px4_msgs_fits()
         info.px4_msgs_conflicts = self.decoding.px4_msgs_conflicts()
         info.vehicle_type = self._vehicle

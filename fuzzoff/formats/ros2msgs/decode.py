@@ -493,10 +493,10 @@ class Ros2Decoding:
 
     def detected_release(self) -> str | None:
         """The one release every embedded or chosen definition and every PX4 topic name fits,
-        if exactly one."""
+        if exactly one (named as ``px4_msgs.first_release_of`` names its folder)."""
         fits = self._fits()
         if fits and len(fits) == 1:
-            return next(iter(fits))
+            return px4_msgs.first_release_of(next(iter(fits)))
         return None
 
     def fitting_releases(self) -> list[str]:
@@ -505,7 +505,7 @@ class Ros2Decoding:
         fits = self._fits()
         if not fits or len(fits) == 1:
             return []
-        return [r for r in px4_msgs.folders() if r in fits]
+        return [px4_msgs.first_release_of(r) for r in px4_msgs.folders() if r in fits]
 
     def vehicle_from(self, decoder: Decoder | None, raw: bytes | memoryview) -> str | None:
         """The vehicle type one ``VehicleStatus`` payload names (None for anything else)."""
