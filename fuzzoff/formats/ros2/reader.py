@@ -24,7 +24,6 @@ from rosbags.interfaces import MessageDefinitionFormat
 from rosbags.rosbag2 import Reader
 
 from fuzzoff.events import Event
-from fuzzoff.formats import px4_msgs
 from fuzzoff.formats.ros2 import mcap_check, mcap_indexed
 from fuzzoff.formats.ros2.mcap_stream import McapStream
 from fuzzoff.formats.ros2.storage import SUFFIX, Storage, data_files, storage_of
