@@ -113,6 +113,26 @@ def sitl_row(specs: list[dict[str, Any]], vehicle: str) -> Row:
     )
 
 
+def ros2bridge_row() -> Row:
+    """PX4 over its ROS 2 bridge: the companion's bags (mcap and sqlite3, bytes as received) and
+    PX4's ULog of each flight; a hazard is caught when one of the codes its expected file names
+    is an error (a ULog cannot show a command that never reached PX4 or the client's setpoints
+    through PX4's own modes; the agent restart needs the bag and the ULog together)."""
+    specs = [_expected(p) for p in sorted((CORPORA / "ros2bridge").glob("*.expected.json"))]
+    clean = [s for s in specs if s["kind"] == "clean"]
+    hazards = [s for s in specs if s["kind"] == "hazard"]
+    releases = sorted({s["px4_release"] for s in specs}, key=_release_key)
+    return Row(
+        "`corpora/ros2bridge/`",
+        f"real PX4 SITL {', '.join(releases)} over its ROS 2 bridge (uXRCE-DDS): the companion's"
+        " bags (mcap, sqlite3) and PX4's ULog, px4_ros_com's offboard_control reproduced",
+        len(clean),
+        sum(map(_loud, clean)),
+        len(hazards),
+        sum(bool(_errors(h) & set(h["hazard"])) for h in hazards),
+    )
+
+
 def tlog_row() -> Row:
     """PX4's MAVLink as it sends it (development dialect), from both ends of the link."""
     specs = [_expected(p) for p in sorted((CORPORA / "tlog").glob("px4_*.expected.json"))]
@@ -219,7 +239,7 @@ def render(rows: Iterable[Row], by_vehicle: Counter[tuple[str, str, bool | None]
 
 def table() -> str:
     gate = gate_agreement()
-    return render([examples_row(), *sitl_rows(gate), tlog_row()], gate)
+    return render([examples_row(), *sitl_rows(gate), ros2bridge_row(), tlog_row()], gate)
 
 
 if __name__ == "__main__":
