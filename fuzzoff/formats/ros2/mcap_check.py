@@ -52,13 +52,11 @@ def summary_damage(path: Path) -> Damage | None:
     summary, or no footer at its end: rosbags refuses such a file and the stream reader says
     why)."""
     size = path.stat().st_size
-    footer_at = size - len(MAGIC) - FOOTER_RECORD
     with path.open("rb") as fh:
-        fh.seek(max(footer_at, 0))
-        tail = fh.read()
-        if footer_at < len(MAGIC) or not tail.endswith(MAGIC) or tail[0] != Opcode.FOOTER:
+        found = _footer(fh, size)
+        if found is None:
             return None
-        footer = Footer.read(ReadDataStream(io.BytesIO(tail[9:])))
+        footer, footer_at = found
         if footer.summary_start == 0:
             return None
         if not len(MAGIC) < footer.summary_start <= footer_at:
@@ -161,14 +159,11 @@ def framing_damage(path: Path) -> Damage | None:
     """The first top-level record of the data section whose header no writer produces (an
     impossible type or length), or a data section that does not end in its DataEnd record;
     None for a file without a footer (rosbags refuses it; the stream reader says why)."""
-    size = path.stat().st_size
-    footer_at = size - len(MAGIC) - FOOTER_RECORD
     with path.open("rb") as fh:
-        fh.seek(max(footer_at, 0))
-        tail = fh.read()
-        if footer_at < len(MAGIC) or not tail.endswith(MAGIC) or tail[0] != Opcode.FOOTER:
+        found = _footer(fh, path.stat().st_size)
+        if found is None:
             return None
-        footer = Footer.read(ReadDataStream(io.BytesIO(tail[9:])))
+        footer, footer_at = found
         end = footer.summary_start if len(MAGIC) < footer.summary_start <= footer_at else footer_at
         at = len(MAGIC)
         fh.seek(at)
@@ -191,6 +186,17 @@ def framing_damage(path: Path) -> Damage | None:
             at += 9 + length
             fh.seek(at)
         return Damage("the data section has no DataEnd record", at, "length")
+
+
+def _footer(fh: BinaryIO, size: int) -> tuple[Footer, int] | None:
+    """The file's footer record and where it starts, or None when the file does not end in
+    one (then rosbags refuses the file and the stream reader says why)."""
+    footer_at = size - len(MAGIC) - FOOTER_RECORD
+    fh.seek(max(footer_at, 0))
+    tail = fh.read()
+    if footer_at < len(MAGIC) or not tail.endswith(MAGIC) or tail[0] != Opcode.FOOTER:
+        return None
+    return Footer.read(ReadDataStream(io.BytesIO(tail[9:]))), footer_at
 
 
 def _misplaced(opcode: int) -> bool:
