@@ -681,6 +681,117 @@ class Dropout(Event):
     origin: Origin = "vehicle"
 
 
+# ---------------------------------------------------------------------------------------------
+# External modes (px4-ros2-interface-lib and PX4's ModeManagement, PX4 1.15+): registration,
+# the arming-check exchange that keeps a registration alive, unregistration, and on 1.18 the
+# setpoint types an external mode asks for. Ids are as the messages carry them (-1: none).
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ExtComponentRequest(Event):
+    """``RegisterExtComponentRequest``: a companion asks PX4 to register an arming check, a
+    mode and / or a mode executor under ``name``; ``api_version`` is the request's
+    ``px4_ros2_api_version`` (the library's own ``LATEST_PX4_ROS2_API_VERSION``)."""
+
+    kind: ClassVar[str] = "ext_component_request"
+
+    request_id: int = 0
+    name: str = ""
+    api_version: int = 0
+    arming_check: bool = False
+    mode: bool = False
+    executor: bool = False
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ExtComponentReply(Event):
+    """``RegisterExtComponentReply``: PX4's answer; ``api_version`` is PX4's own
+    ``LATEST_PX4_ROS2_API_VERSION`` (1 up to 1.17, 2 on 1.18 and main), whatever the request
+    said."""
+
+    kind: ClassVar[str] = "ext_component_reply"
+
+    request_id: int = 0
+    name: str = ""
+    api_version: int = 0
+    success: bool = False
+    arming_check_id: int = -1
+    mode_id: int = -1
+    executor_id: int = -1
+    origin: Origin = "vehicle"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ArmingCheckRequest(Event):
+    """``ArmingCheckRequest``: PX4 asks every registered component for its checks (every
+    300 ms). ``registrations_mask`` (1.17+: ``valid_registrations_mask``) has a bit per
+    registration PX4 still counts as valid and responsive; None where the release lacks it."""
+
+    kind: ClassVar[str] = "arming_check_request"
+
+    request_id: int = 0
+    registrations_mask: int | None = None
+    origin: Origin = "vehicle"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ArmingCheckReply(Event):
+    """``ArmingCheckReply``: one registered component's answer to request ``request_id``."""
+
+    kind: ClassVar[str] = "arming_check_reply"
+
+    request_id: int = 0
+    registration_id: int = 0
+    can_arm_and_run: bool = True
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ExtComponentUnregister(Event):
+    """``UnregisterExtComponent``: the companion removes what it registered (ids from the
+    reply, -1 for none)."""
+
+    kind: ClassVar[str] = "ext_component_unregister"
+
+    name: str = ""
+    arming_check_id: int = -1
+    mode_id: int = -1
+    executor_id: int = -1
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class SetpointConfig(Event):
+    """``SetpointConfig`` (1.18+): an external mode says which setpoint type it will send."""
+
+    kind: ClassVar[str] = "setpoint_config"
+
+    setpoint_type: int = 0
+    source_id: int = 0
+    should_apply: bool = False
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class SetpointConfigReply(Event):
+    """``SetpointConfigReply`` (1.18+): PX4's answer to a ``SetpointConfig``."""
+
+    kind: ClassVar[str] = "setpoint_config_reply"
+
+    setpoint_type: int = 0
+    source_id: int = 0
+    result: int = 0
+    origin: Origin = "vehicle"
+
+
+EXTERNAL_MODE_TYPES: tuple[type[Event], ...] = (
+    ExtComponentRequest,
+    ExtComponentReply,
+    ArmingCheckRequest,
+    ArmingCheckReply,
+    ExtComponentUnregister,
+    SetpointConfig,
+    SetpointConfigReply,
+)
+
+
 KEEPALIVE_ROS: tuple[type[Event], ...] = (ControlMode, LegacyControlMode)
 KEEPALIVE_TYPES: tuple[type[Event], ...] = (*KEEPALIVE_ROS, *MAVLINK_SETPOINTS)
 
@@ -703,6 +814,7 @@ ALL_EVENT_TYPES: tuple[type[Event], ...] = (
     StatusText,
     VehiclePosition,
     Dropout,
+    *EXTERNAL_MODE_TYPES,
 )
 
 EVENT_BY_KIND: dict[str, type[Event]] = {cls.kind: cls for cls in ALL_EVENT_TYPES}

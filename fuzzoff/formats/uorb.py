@@ -112,6 +112,21 @@ TOPICS: dict[str, Topic] = {
     # the sticks PX4 flies by and its sticks_moving verdict (gate spec 16 S1); read from a ULog
     # only: a ROS 2 recording's manual_control_input is not modelled (docs/gate.md)
     "manual_control_setpoint": Topic(None, ev.ManualControl.kind, log_interval_s=0.2),
+    # external modes (1.15+; SetpointConfig 1.18+): not in PX4's default log profile, so a ULog
+    # has them only where the user added them (logger_topics.txt)
+    "register_ext_component_request": Topic(
+        "RegisterExtComponentRequest", ev.ExtComponentRequest.kind
+    ),
+    "register_ext_component_reply": Topic(
+        "RegisterExtComponentReply", ev.ExtComponentReply.kind, published=True
+    ),
+    "arming_check_request": Topic("ArmingCheckRequest", ev.ArmingCheckRequest.kind, published=True),
+    "arming_check_reply": Topic("ArmingCheckReply", ev.ArmingCheckReply.kind),
+    "unregister_ext_component": Topic("UnregisterExtComponent", ev.ExtComponentUnregister.kind),
+    "setpoint_config": Topic("SetpointConfig", ev.SetpointConfig.kind),
+    "setpoint_config_reply": Topic(
+        "SetpointConfigReply", ev.SetpointConfigReply.kind, published=True
+    ),
 }
 """uORB topic name -> what it is, the one table of topics. The decoders stay per format
 (``ulog.topics`` turns numpy columns into events, ``ros2msgs.convert`` one decoded message at a

@@ -63,9 +63,34 @@ def first_release_of(folder: str) -> str:
     return folder
 
 
+SEPARATOR = "=" * 80
+"""Between a message's definition and those of the px4_msgs types it nests, as ROS 2 embeds
+them (MCAP ``ros2msg`` schemas, rosbag2 ``message_definitions``)."""
+_NESTED = re.compile(r"^([A-Z][A-Za-z0-9]*)(?:\[\d*\])?\s", re.MULTILINE)
+
+
 @cache
 def definition(release: str, message: str) -> str | None:
-    """The ``.msg`` text of ``message`` in ``release``, or None where that release lacks it."""
+    """The ``.msg`` text of ``message`` in ``release``, or None where that release lacks it.
+
+    A message that nests other px4_msgs types (``ArmingCheckReply`` holds ``Event[5]``) comes
+    with their definitions after it, each under a ``MSG: px4_msgs/<Type>`` line, as ROS 2
+    embeds a definition: one text that a type store registers whole."""
+    text = _own(release, message)
+    if text is None:
+        return None
+    nested = [(name, _own(release, name)) for name in dict.fromkeys(_NESTED.findall(text))]
+    return text + "".join(
+        f"{SEPARATOR}\nMSG: {PACKAGE}/{name}\n{body}" for name, body in nested if body is not None
+    )
+
+
+def own_part(text: str) -> str:
+    """The message's own part of a ``definition`` (without the nested types after it)."""
+    return text.split(SEPARATOR, 1)[0]
+
+
+def _own(release: str, message: str) -> str | None:
     node = resources.files(__name__).joinpath(release, f"{message}.msg")
     if not node.is_file():
         return None
@@ -79,13 +104,13 @@ def releases_with(message: str) -> list[str]:
 
 def message_version(text: str) -> int:
     """``MESSAGE_VERSION`` of a definition (0 when it has none)."""
-    match = _VERSION.search(text)
+    match = _VERSION.search(own_part(text))
     return int(match.group(1)) if match else 0
 
 
 def declares_version(text: str) -> bool:
     """Does the definition declare ``MESSAGE_VERSION`` (PX4 1.16+ on versioned messages)?"""
-    return _VERSION.search(text) is not None
+    return _VERSION.search(own_part(text)) is not None
 
 
 @cache

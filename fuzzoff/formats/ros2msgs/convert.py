@@ -395,6 +395,133 @@ def _land_detected(fields: frozenset[str], vehicle: str, origin: Origin) -> Buil
     return build
 
 
+def _name(value: Any) -> str:
+    """A ``char[25]`` name (rosbags: a numpy uint8 array) as text, up to its first NUL."""
+    raw = bytes(value.tolist()) if hasattr(value, "tolist") else bytes(value)
+    return raw.split(b"\0", 1)[0].decode("utf-8", "replace")
+
+
+def _ext_request(fields: frozenset[str], vehicle: str, origin: Origin) -> Builder:
+    def build(m: Any, t: float, where: Where, ts: int) -> Event:
+        return ev.ExtComponentRequest(
+            t=t,
+            vehicle=vehicle,
+            where=where,
+            sender_time_us=ts,
+            origin=origin,
+            request_id=int(m.request_id),
+            name=_name(m.name),
+            api_version=int(m.px4_ros2_api_version),
+            arming_check=bool(m.register_arming_check),
+            mode=bool(m.register_mode),
+            executor=bool(m.register_mode_executor),
+        )
+
+    return build
+
+
+def _ext_reply(fields: frozenset[str], vehicle: str, origin: Origin) -> Builder:
+    def build(m: Any, t: float, where: Where, ts: int) -> Event:
+        return ev.ExtComponentReply(
+            t=t,
+            vehicle=vehicle,
+            where=where,
+            sender_time_us=ts,
+            origin=origin,
+            request_id=int(m.request_id),
+            name=_name(m.name),
+            api_version=int(m.px4_ros2_api_version),
+            success=bool(m.success),
+            arming_check_id=int(m.arming_check_id),
+            mode_id=int(m.mode_id),
+            executor_id=int(m.mode_executor_id),
+        )
+
+    return build
+
+
+def _check_request(fields: frozenset[str], vehicle: str, origin: Origin) -> Builder:
+    has_mask = "valid_registrations_mask" in fields
+
+    def build(m: Any, t: float, where: Where, ts: int) -> Event:
+        return ev.ArmingCheckRequest(
+            t=t,
+            vehicle=vehicle,
+            where=where,
+            sender_time_us=ts,
+            origin=origin,
+            request_id=int(m.request_id),
+            registrations_mask=int(m.valid_registrations_mask) if has_mask else None,
+        )
+
+    return build
+
+
+def _check_reply(fields: frozenset[str], vehicle: str, origin: Origin) -> Builder:
+    def build(m: Any, t: float, where: Where, ts: int) -> Event:
+        return ev.ArmingCheckReply(
+            t=t,
+            vehicle=vehicle,
+            where=where,
+            sender_time_us=ts,
+            origin=origin,
+            request_id=int(m.request_id),
+            registration_id=int(m.registration_id),
+            can_arm_and_run=bool(m.can_arm_and_run),
+        )
+
+    return build
+
+
+def _unregister(fields: frozenset[str], vehicle: str, origin: Origin) -> Builder:
+    def build(m: Any, t: float, where: Where, ts: int) -> Event:
+        return ev.ExtComponentUnregister(
+            t=t,
+            vehicle=vehicle,
+            where=where,
+            sender_time_us=ts,
+            origin=origin,
+            name=_name(m.name),
+            arming_check_id=int(m.arming_check_id),
+            mode_id=int(m.mode_id),
+            executor_id=int(m.mode_executor_id),
+        )
+
+    return build
+
+
+def _setpoint_config(fields: frozenset[str], vehicle: str, origin: Origin) -> Builder:
+    def build(m: Any, t: float, where: Where, ts: int) -> Event:
+        return ev.SetpointConfig(
+            t=t,
+            vehicle=vehicle,
+            where=where,
+            sender_time_us=ts,
+            origin=origin,
+            setpoint_type=int(m.type),
+            source_id=int(m.source_id),
+            should_apply=bool(m.should_apply),
+        )
+
+    return build
+
+
+def _setpoint_config_reply(fields: frozenset[str], vehicle: str, origin: Origin) -> Builder:
+    def build(m: Any, t: float, where: Where, ts: int) -> Event:
+        return ev.SetpointConfigReply(
+            t=t,
+            vehicle=vehicle,
+            where=where,
+            sender_time_us=ts,
+            origin=origin,
+            setpoint_type=int(m.type),
+            source_id=int(m.source_id),
+            result=int(m.result),
+        )
+
+    return build
+
+
 BUILDERS: dict[str, Callable[[frozenset[str], str, Origin], Builder]] = {
     "OffboardControlMode": _control_mode,
     "TrajectorySetpoint": _trajectory,
@@ -419,6 +546,13 @@ BUILDERS: dict[str, Callable[[frozenset[str], str, Origin], Builder]] = {
     "FailsafeFlags": _failsafe_flags,
     "VehicleLocalPosition": _local_position,
     "VehicleLandDetected": _land_detected,
+    "RegisterExtComponentRequest": _ext_request,
+    "RegisterExtComponentReply": _ext_reply,
+    "ArmingCheckRequest": _check_request,
+    "ArmingCheckReply": _check_reply,
+    "UnregisterExtComponent": _unregister,
+    "SetpointConfig": _setpoint_config,
+    "SetpointConfigReply": _setpoint_config_reply,
 }
 """px4_msgs message name -> builder factory (fields of the definition, vehicle, origin)."""
 

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from rosbags.interfaces import Nodetype
 
 from fuzzoff import events as ev
 from fuzzoff.formats import px4_msgs
@@ -45,10 +46,19 @@ _MESSAGE_OF: dict[type[ev.Event], str] = {
     ev.FailsafeFlags: "FailsafeFlags",
     ev.VehiclePosition: "VehicleLocalPosition",
     ev.LandDetected: "VehicleLandDetected",
+    ev.ExtComponentRequest: "RegisterExtComponentRequest",
+    ev.ExtComponentReply: "RegisterExtComponentReply",
+    ev.ArmingCheckRequest: "ArmingCheckRequest",
+    ev.ArmingCheckReply: "ArmingCheckReply",
+    ev.ExtComponentUnregister: "UnregisterExtComponent",
+    ev.SetpointConfig: "SetpointConfig",
+    ev.SetpointConfigReply: "SetpointConfigReply",
 }
 
 _NUMPY = {
     "bool": np.bool_,
+    "char": np.uint8,
+    "byte": np.uint8,
     "uint8": np.uint8,
     "int8": np.int8,
     "uint16": np.uint16,
@@ -94,7 +104,7 @@ def fields_of(release: str, message: str) -> list[Field]:
     if text is None:
         raise UnsupportedEvent(f"px4_msgs {release} has no {message}")
     out = []
-    for line in text.splitlines():
+    for line in px4_msgs.own_part(text).splitlines():
         line = line.split("#", 1)[0].strip()
         if not line or "=" in line:
             continue
@@ -193,6 +203,30 @@ def _event_values(event: ev.Event, message: str, names: set[str]) -> dict[str, A
             v[f"{name}_invalid"] = valid is False
     elif isinstance(event, ev.LandDetected):
         v["landed"] = v["maybe_landed"] = bool(event.landed)
+    elif isinstance(event, ev.ExtComponentRequest | ev.ExtComponentReply):
+        v.update(request_id=event.request_id, name=_name_bytes(event.name))
+        v["px4_ros2_api_version"] = event.api_version
+        if isinstance(event, ev.ExtComponentRequest):
+            v.update(register_arming_check=event.arming_check, register_mode=event.mode)
+            v["register_mode_executor"] = event.executor
+        else:
+            v.update(success=event.success, arming_check_id=event.arming_check_id)
+            v.update(mode_id=event.mode_id, mode_executor_id=event.executor_id)
+    elif isinstance(event, ev.ArmingCheckRequest):
+        v["request_id"] = event.request_id
+        v["valid_registrations_mask"] = event.registrations_mask or 0
+    elif isinstance(event, ev.ArmingCheckReply):
+        v.update(request_id=event.request_id, registration_id=event.registration_id)
+        v["can_arm_and_run"] = event.can_arm_and_run
+    elif isinstance(event, ev.ExtComponentUnregister):
+        v.update(name=_name_bytes(event.name), arming_check_id=event.arming_check_id)
+        v.update(mode_id=event.mode_id, mode_executor_id=event.executor_id)
+    elif isinstance(event, ev.SetpointConfig | ev.SetpointConfigReply):
+        v.update(type=event.setpoint_type, source_id=event.source_id)
+        if isinstance(event, ev.SetpointConfig):
+            v["should_apply"] = event.should_apply
+        else:
+            v["result"] = event.result
     elif isinstance(event, ev.VehiclePosition):
         xy, z = math.isfinite(event.x) and math.isfinite(event.y), math.isfinite(event.z)
         v.update(x=event.x if xy else 0.0, y=event.y if xy else 0.0, z=event.z if z else 0.0)
@@ -200,11 +234,20 @@ def _event_values(event: ev.Event, message: str, names: set[str]) -> dict[str, A
     return v
 
 
+def _name_bytes(name: str) -> list[int]:
+    """A name as the ``char[25]`` field holds it: UTF-8, NUL-padded (cut to 24 bytes)."""
+    raw = name.encode("utf-8")[:24]
+    return [*raw, *([0] * (25 - len(raw)))]
+
+
 def complete(given: dict[str, Any], release: str, message: str) -> dict[str, Any]:
     """Every wire field of ``release``'s ``message``: ``given`` values, else zero / NaN."""
     values: dict[str, Any] = {}
     for f in fields_of(release, message):
         value = given.get(f.name, _default(f))
+        if f.base not in _NUMPY:
+            values[f.name] = None  # a nested px4_msgs type: its zero value (rosbags_message)
+            continue
         if f.length is not None:
             value = _fit(tuple(value), f.length) if f.base.startswith("float") else list(value)
         values[f.name] = value
@@ -247,9 +290,26 @@ def rosbags_message(store: Any, msg: Px4Message) -> Any:
     kwargs = {}
     for f in fields_of(msg.release, msg.message):
         value = msg.values[f.name]
+        if f.base not in _NUMPY:
+            nested = _zero(store, px4_msgs.type_name(f.base))
+            kwargs[f.name] = [nested] * f.length if f.length else nested
+            continue
         if f.length is not None:
             value = np.array(value, dtype=_NUMPY[f.base])
         kwargs[f.name] = value
+    return cls(**kwargs)
+
+
+def _zero(store: Any, typename: str) -> Any:
+    """A message of a nested type with every field zero (``ArmingCheckReply.events``)."""
+    cls = store.types[typename]
+    kwargs: dict[str, Any] = {}
+    for name, (nodetype, details) in store.fielddefs[typename][1]:
+        if nodetype == Nodetype.ARRAY:
+            (_, (base, _)), count = details
+            kwargs[name] = np.zeros(count, dtype=_NUMPY[base])
+        else:
+            kwargs[name] = _NUMPY[details[0]](0)
     return cls(**kwargs)
 
 
