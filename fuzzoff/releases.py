@@ -157,6 +157,10 @@ class Release:
     """``flag_control_allocation_enabled`` is set with the rate controller (7, 1.15+)."""
     setpoint_types_control_mode: bool
     """The control flags come from ModeUtil/setpoint_types.cpp (7, main)."""
+    external_mode_api: int | None
+    """``LATEST_PX4_ROS2_API_VERSION``: the API version PX4's registration reply carries and
+    px4-ros2-interface-lib must have been built for (16 S8: 1 from 1.15, 2 on 1.18 and main);
+    None before external modes (1.14 and older)."""
     reuses_last_valid_setpoint: bool
     """mc_pos_control reuses the last valid setpoint for 200 ms before its failsafe (8, 1.16+)."""
     rover_drive_modes: bool
@@ -250,6 +254,7 @@ LEGACY = Release(
     obl_rc_manual_is_stabilized=False,
     allocation_flag=False,
     setpoint_types_control_mode=False,
+    external_mode_api=None,
     reuses_last_valid_setpoint=False,
     rover_drive_modes=False,
     docs_page=None,
@@ -324,6 +329,7 @@ V1_15 = replace(
     control_mode="thrust_and_torque",
     handles_set_nav_state=True,
     allocation_flag=True,
+    external_mode_api=1,
     docs_page="000",
     msg_folder="1.15",
     ulog_era="1.15",
@@ -380,6 +386,7 @@ V1_18 = replace(
     nav_rcl_fallback="after_degrade",
     nav_rcl_hold_no_failsafe=True,
     setpoint_types_control_mode=True,
+    external_mode_api=2,
     rover_drive_modes=True,
     guided_course_sub_mode=True,
     stick_override="man_override_spd",

@@ -28,11 +28,15 @@ from typing import Any
 
 from fuzzoff.events import (
     ActuatorMotors,
+    ArmingCheckReply,
+    ArmingCheckRequest,
     AttitudeSetpoint,
     Command,
     CommandAck,
     ControlMode,
     Event,
+    ExtComponentReply,
+    ExtComponentRequest,
     FailsafeFlags,
     LegacyControlMode,
     PositionSetpointTriplet,
@@ -137,6 +141,59 @@ def motors(t: float) -> list[Event]:
 
 
 POSITION = {"position": True}
+MODE_NAME, MODE_ID = "Survey", 23  # the first external mode: nav_state EXTERNAL1
+
+
+def external_mode_flight(api: int, replies_until: float) -> list[Event]:
+    """A px4-ros2-interface-lib mode on PX4 1.18 (API version 2), the vehicle disarmed in
+    POSCTL: the node registers its mode and arming check at 0.5 s with API version ``api``,
+    PX4 accepts at 0.55 s and asks for arming checks every 300 ms from 0.6 s; the node replies
+    within 10 ms while ``t < replies_until`` (never when the library refused PX4's API). PX4
+    drops a registration more than 3 requests after its last reply from
+    ``valid_registrations_mask``."""
+    out: list[Event] = [
+        ExtComponentRequest(
+            t=0.5,
+            sender_time_us=stamp(0.5),
+            request_id=4711,
+            name=MODE_NAME,
+            api_version=api,
+            arming_check=True,
+            mode=True,
+        ),
+        ExtComponentReply(
+            t=0.55,
+            sender_time_us=stamp(0.55),
+            request_id=4711,
+            name=MODE_NAME,
+            api_version=2,
+            success=True,
+            arming_check_id=0,
+            mode_id=MODE_ID,
+        ),
+    ]
+    for t in ticks(0.0, END_T, STATUS_PERIOD):
+        out.append(VehicleStatus(t=t, nav_state=POSCTL, armed=False))
+    misses, answering = 0, api == 2
+    for n, t in enumerate(ticks(0.6, END_T, 0.3)):
+        mask = 1 if misses <= 3 else 0
+        out.append(
+            ArmingCheckRequest(
+                t=t, sender_time_us=stamp(t), request_id=n % 256, registrations_mask=mask
+            )
+        )
+        if answering and t < replies_until:
+            out.append(
+                ArmingCheckReply(
+                    t=round(t + 0.01, 6),
+                    sender_time_us=stamp(t + 0.01),
+                    request_id=n % 256,
+                    registration_id=0,
+                )
+            )
+        else:
+            misses += 1
+    return sorted(out, key=lambda e: e.t)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -160,6 +217,8 @@ class Case:
     """Time of the offboard request (for OFB701), where it is not the flights' 1.5 s."""
     offboard: bool = True
     """The vehicle uses offboard (OFB701 states its loss behaviour)."""
+    stream: bool = True
+    """The recording holds a setpoint stream (without one, no rule is named not checkable)."""
     note: str = ""
 
     @property
@@ -489,6 +548,45 @@ def mcap_cases() -> list[Case]:
             ["OFB208"],
         )
     )
+    # OFB209 (external-mode-refused): px4-ros2-interface-lib's API 1 against PX4 1.18's API 2
+    # (the library gives up, no arming check is answered), and a mode whose node stops
+    # answering PX4's arming checks (a watchdog killed it at 3 s)
+    cases.append(
+        Case(
+            "ofb209_external_mode_refused",
+            external_mode_flight(api=1, replies_until=0.0),
+            [("OFB209", "error", 0.55)],
+            [],
+            px4="1.18",
+            release="main",
+            offboard=False,
+            stream=False,
+        )
+    )
+    cases.append(
+        Case(
+            "ofb209_external_mode_dropped",
+            external_mode_flight(api=2, replies_until=3.0),
+            [("OFB209", "error", 3.9)],
+            [],
+            px4="1.18",
+            release="main",
+            offboard=False,
+            stream=False,
+        )
+    )
+    cases.append(
+        Case(
+            "good_ofb209_external_mode",
+            external_mode_flight(api=2, replies_until=END_T),
+            [],
+            ["OFB209"],
+            px4="1.18",
+            release="main",
+            offboard=False,
+            stream=False,
+        )
+    )
     # -- scripts/add_rule.py adds a new rule's cases above this line
     return cases
 
@@ -765,9 +863,12 @@ def context_findings(case: Case) -> list[tuple[str, str, float | None]]:
     * OFB002 (info, no time), one line for the rules the format cannot show: in MCAP OFB305 (no
       estimator flags on ROS 2); in a 1.15 ULog OFB104, OFB105 (subsampled keep-alive), OFB106,
       OFB203, OFB302 (only PX4's copies of the messages); in a legacy ULog OFB104, OFB105.
-    * OFB005 (info, no time) where the flight never used offboard.
+    * OFB005 (info, no time) where the flight never used offboard; no OFB002 where it holds no
+      stream at all (the external-mode cases of OFB209).
     """
-    not_checkable = [("OFB002", "info", None)] if case.fmt in ("mcap", "ulg") else []
+    not_checkable = (
+        [("OFB002", "info", None)] if case.fmt in ("mcap", "ulg") and case.stream else []
+    )
     request = (
         case.request if case.request is not None else 1.6 if case.px4 == "legacy" else SWITCH_T
     )

@@ -112,8 +112,8 @@ TOPICS: dict[str, Topic] = {
     # the sticks PX4 flies by and its sticks_moving verdict (gate spec 16 S1); read from a ULog
     # only: a ROS 2 recording's manual_control_input is not modelled (docs/gate.md)
     "manual_control_setpoint": Topic(None, ev.ManualControl.kind, log_interval_s=0.2),
-    # external modes (1.15+; SetpointConfig 1.18+): not in PX4's default log profile, so a ULog
-    # has them only where the user added them (logger_topics.txt)
+    # external modes (1.15+; SetpointConfig 1.18+), read from ROS 2 recordings only: PX4's
+    # default log profile (logged_topics.cpp) does not log them
     "register_ext_component_request": Topic(
         "RegisterExtComponentRequest", ev.ExtComponentRequest.kind
     ),

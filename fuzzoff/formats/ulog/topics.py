@@ -471,24 +471,6 @@ def manual_control(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
         )
 
 
-def arming_check_request(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
-    """``valid_registrations_mask`` from 1.17; None before."""
-    masks: list[int | None] = (
-        list(c.i("valid_registrations_mask"))
-        if c.has("valid_registrations_mask")
-        else [None] * len(c.t)
-    )
-    for t, w, ts, request, mask in zip(c.t, c.where, c.ts, c.i("request_id"), masks, strict=True):
-        yield ev.ArmingCheckRequest(
-            t=t,
-            where=w,
-            sender_time_us=ts,
-            origin=VEHICLE,
-            request_id=request,
-            registrations_mask=mask,
-        )
-
-
 def command(c: Chunk, ctx: Context) -> Iterator[ev.Event]:
     params = list(zip(*(c.f(f"param{k}") for k in range(1, 8)), strict=True))
     for t, w, ts, p, cmd, tsys, tcomp, ssys, scomp, external in zip(
@@ -591,38 +573,6 @@ DECODERS: dict[str, Decoder] = {
     "vehicle_land_detected": land_detected,
     "vehicle_local_position": local_position,
     "manual_control_setpoint": manual_control,
-    # external modes: logged only where the user's logger_topics.txt adds them (the name,
-    # a char array, is not read from a ULog)
-    "register_ext_component_request": copied(
-        ev.ExtComponentRequest,
-        request_id=ints("request_id"),
-        api_version=ints("px4_ros2_api_version"),
-        arming_check=bools("register_arming_check"),
-        mode=bools("register_mode"),
-        executor=bools("register_mode_executor"),
-    ),
-    "register_ext_component_reply": copied(
-        ev.ExtComponentReply,
-        request_id=ints("request_id"),
-        api_version=ints("px4_ros2_api_version"),
-        success=bools("success"),
-        arming_check_id=ints("arming_check_id"),
-        mode_id=ints("mode_id"),
-        executor_id=ints("mode_executor_id"),
-    ),
-    "arming_check_request": arming_check_request,
-    "arming_check_reply": copied(
-        ev.ArmingCheckReply,
-        request_id=ints("request_id"),
-        registration_id=ints("registration_id"),
-        can_arm_and_run=bools("can_arm_and_run"),
-    ),
-    "unregister_ext_component": copied(
-        ev.ExtComponentUnregister,
-        arming_check_id=ints("arming_check_id"),
-        mode_id=ints("mode_id"),
-        executor_id=ints("mode_executor_id"),
-    ),
 }
 """uORB topic -> its decoder (what each topic is: ``uorb.TOPICS``)."""
 
