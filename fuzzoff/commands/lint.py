@@ -62,6 +62,13 @@ def add_parser(sub: Any) -> None:
         help="each finding in full: what the docs require, what PX4 does, the exact place",
     )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    parser.add_argument(
+        "--with",
+        dest="with_ulog",
+        metavar="ULOG",
+        help="PX4's ULog of the same flight: what the ROS 2 bag's companion sent and PX4 never"
+        " received, and what PX4 did that the companion never saw (OFB108)",
+    )
     add_fleet_options(parser)
     parser.set_defaults(run=run)
 
@@ -115,6 +122,10 @@ def run(args: argparse.Namespace) -> int:
     lint: Lint = lint_file_with_timelines if any(f == "html" for f, _ in targets) else lint_file
     with _watching(args) as watch:
         report = lint_each(plan, lint=lint, jobs=args.jobs, watch=watch)
+    if args.with_ulog is not None:
+        from fuzzoff.commands._with import add_delivery
+
+        add_delivery(report, Path(args.with_ulog))
     resolved = dict(plan)
 
     def settings_for(path: str) -> Settings:
