@@ -157,9 +157,11 @@ def _key(value: Any) -> Any:
     return int(value)
 
 
-def _companions(topic: BagTopic, logged: ULogTopic) -> tuple[np.ndarray, list[Any], list[Any]]:
+def _companions(
+    topic: BagTopic, logged: ULogTopic
+) -> tuple[np.ndarray, list[Any], list[Any], np.ndarray]:
     """The ULog's samples whose fields equal a sent one's: their times; each sent sample's key
-    and each logged sample's key (same fields)."""
+    and each such logged sample's key (same fields); the times of PX4's other samples."""
     names = sorted(
         (set(topic.samples[0].fields) & set(logged.data)) - STAMPS if topic.samples else set()
     )
@@ -172,6 +174,7 @@ def _companions(topic: BagTopic, logged: ULogTopic) -> tuple[np.ndarray, list[An
         logged.timestamps[mask] if len(mask) else logged.timestamps[:0],
         sent_keys,
         [k for k, m in zip(logged_keys, mask, strict=True) if m],
+        logged.timestamps[~mask] if len(mask) else logged.timestamps[:0],
     )
 
 
@@ -196,12 +199,13 @@ def _sent_topic(
             0,
             note="not in PX4's log: not judged",
         )
-    received, sent_keys, received_keys = _companions(topic, logged)
+    received, sent_keys, received_keys, foreign = _companions(topic, logged)
     window = _window_us(received, topic.name == "vehicle_command")
     mapped = np.array([clock.px4_us(s.received_us) for s in topic.samples])
     first_received = received[0] if len(received) else None
     delivered = []
     judged = []
+    mixed_out = 0
     per_message = topic.name == "vehicle_command"  # logged whole: each command by its fields
     times_of: dict[Any, np.ndarray] = {}
     for key in set(received_keys) if per_message else ():
@@ -209,8 +213,12 @@ def _sent_topic(
     for x, key in zip(mapped, sent_keys, strict=True):
         times = times_of.get(key, received[:0]) if per_message else received
         lo = int(np.searchsorted(times, x - TOLERANCE_US))
-        delivered.append(lo < len(times) and times[lo] <= x + window)
-        judged.append(log.start_us + window <= x <= log.last_us - window)
+        ok = lo < len(times) and times[lo] <= x + window
+        delivered.append(ok)
+        near = int(np.searchsorted(foreign, x - window))
+        mixed = not per_message and near < len(foreign) and foreign[near] <= x + window
+        judged.append(log.start_us + window <= x <= log.last_us - window and not mixed)
+        mixed_out += int(mixed and not ok)
     windows: list[Window] = []
     run: list[int] = []
     for i, (ok, judge) in enumerate([*zip(delivered, judged, strict=True), (True, True)]):
@@ -238,6 +246,12 @@ def _sent_topic(
         len(received),
         tuple(windows),
         _latency(received, received_keys, mapped, sent_keys),
+        note=(
+            f"{mixed_out} sent while PX4 logged its own samples of the topic (its logger keeps"
+            " one per interval, from any publisher): not judged"
+            if mixed_out
+            else None
+        ),
     )
 
 

@@ -158,7 +158,7 @@ def lines(delivery: Delivery) -> list[str]:
     ]
     for topic in delivery.topics:
         arrow = "->" if topic.direction == "in" else "<-"
-        if topic.note:
+        if topic.note and not topic.logged:
             out.append(f"  {arrow} {topic.topic}: {topic.recorded} recorded, {topic.note}")
             continue
         if topic.direction == "in":
@@ -178,6 +178,8 @@ def lines(delivery: Delivery) -> list[str]:
         if topic.latency_ms is not None:
             median, worst, _ = topic.latency_ms
             text += f"; latency {median:.1f} ms median, {worst:.1f} ms max"
+        if topic.note:
+            text += f"; {topic.note}"
         out.append(f"  {arrow} {topic.topic}: {text}")
     for change in delivery.changes:
         seen = (
