@@ -126,3 +126,17 @@ def test_files_of_two_flights_are_refused_in_one_line(bag: str, ulog: str, says:
     assert says in stderr
     assert len(stderr.strip().splitlines()) == 1
     assert "Traceback" not in stderr
+
+
+def test_the_gate_model_on_a_bridge_bag_agrees_with_px4_where_the_bridge_delivered() -> None:
+    from fuzzoff.sitl.ros2.verdict import compare
+
+    clean = compare(CORPUS / "example-1.16.2-ros2-mcap", "1.16", CORPUS / "example-1.16.2-ros2.ulg")
+    assert [(i.what, i.agree) for i in clean.items] == [
+        ("switch to OFFBOARD", True),
+        ("arm", True),
+    ]
+    flight = "example_agent_restart-1.16.2-ros2"
+    restart = compare(CORPUS / f"{flight}-sqlite3", "1.16", CORPUS / f"{flight}.ulg")
+    # the model sees the stream as sent: PX4's loss is the bridge's (OFB108), not the stream's
+    assert [(i.what, i.agree) for i in restart.items if not i.agree] == [("offboard loss", False)]

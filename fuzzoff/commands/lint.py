@@ -109,6 +109,8 @@ def run(args: argparse.Namespace) -> int:
     # As ruff: no path means the current folder.
     args.paths = args.paths or ["."]
     if _fleet_wanted(args):
+        if args.with_ulog is not None:
+            raise ConfigError("--with compares one bag linted here: not with the fleet options")
         from fuzzoff.commands._lint_fleet import run_fleet
 
         return run_fleet(args, settings)
