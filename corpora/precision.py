@@ -113,24 +113,78 @@ def sitl_row(specs: list[dict[str, Any]], vehicle: str) -> Row:
     )
 
 
-def ros2bridge_row() -> Row:
+WITH = ".with.expected.json"
+"""A bag linted with its flight's ULog (``lint --with``)."""
+
+
+def ros2bridge_rows(gate: Counter[tuple[str, str, bool | None]]) -> list[Row]:
     """PX4 over its ROS 2 bridge: the companion's bags (mcap and sqlite3, bytes as received) and
-    PX4's ULog of each flight; a hazard is caught when one of the codes its expected file names
-    is an error (a ULog cannot show a command that never reached PX4 or the client's setpoints
-    through PX4's own modes; the agent restart needs the bag and the ULog together)."""
-    specs = [_expected(p) for p in sorted((CORPORA / "ros2bridge").glob("*.expected.json"))]
+    PX4's ULog of each flight, each linted alone; a hazard is caught when one of the codes its
+    expected file names is an error (a ULog cannot show a command that never reached PX4 or the
+    client's setpoints through PX4's own modes; the agent restart needs the bag and the ULog
+    together: the second row, each bag linted ``--with`` its ULog). The gate model runs on each
+    flight's bag against PX4's ULog (``fuzzoff.sitl.ros2.verdict``)."""
+    every = sorted((CORPORA / "ros2bridge").glob("*.expected.json"))
+    alone = [_expected(p) for p in every if not p.name.endswith(WITH)]
+    paired = [_expected(p) for p in every if p.name.endswith(WITH)]
+    releases = sorted({s["px4_release"] for s in alone}, key=_release_key)
+    agree = sum(n for (v, _, ok), n in gate.items() if v == BRIDGE and ok)
+    judged = sum(n for (v, _, ok), n in gate.items() if v == BRIDGE and ok is not None)
+    rows = [
+        replace(
+            _counted(
+                "`corpora/ros2bridge/`",
+                f"real PX4 SITL {', '.join(releases)} over its ROS 2 bridge (uXRCE-DDS): the"
+                " companion's bags (mcap, sqlite3) and PX4's ULog, px4_ros_com's"
+                " offboard_control reproduced",
+                alone,
+            ),
+            gate=f"{agree}/{judged}" if judged else "-",
+        )
+    ]
+    if paired:
+        rows.append(
+            _counted(
+                "`corpora/ros2bridge/` `--with`",
+                "the same bags, each linted with its flight's ULog (`lint BAG --with ULOG`:"
+                " what was sent and never received, OFB108)",
+                paired,
+            )
+        )
+    return rows
+
+
+def _counted(recordings: str, what: str, specs: list[dict[str, Any]]) -> Row:
     clean = [s for s in specs if s["kind"] == "clean"]
     hazards = [s for s in specs if s["kind"] == "hazard"]
-    releases = sorted({s["px4_release"] for s in specs}, key=_release_key)
     return Row(
-        "`corpora/ros2bridge/`",
-        f"real PX4 SITL {', '.join(releases)} over its ROS 2 bridge (uXRCE-DDS): the companion's"
-        " bags (mcap, sqlite3) and PX4's ULog, px4_ros_com's offboard_control reproduced",
+        recordings,
+        what,
         len(clean),
         sum(map(_loud, clean)),
         len(hazards),
         sum(bool(_errors(h) & set(h["hazard"])) for h in hazards),
     )
+
+
+BRIDGE = "ros2bridge"
+"""The gate counter's key for the bridge flights (beside the SITL vehicles')."""
+
+
+def bridge_agreement() -> Counter[tuple[str, str, bool | None]]:
+    """(``BRIDGE``, kind, agree) over every ROS 2 bridge flight: the model run on the bag
+    against PX4's ULog (``fuzzoff.sitl.ros2.verdict``)."""
+    from fuzzoff.sitl.ros2.verdict import compare
+
+    folder = CORPORA / "ros2bridge"
+    runs: dict[str, Any] = json.loads((folder / "runs.json").read_text())
+    counts: Counter[tuple[str, str, bool | None]] = Counter()
+    for stem, run in sorted(runs.items()):
+        release = run["release"].split("-")[0]
+        verdict = compare(folder / f"{stem}-mcap", release, folder / f"{stem}.ulg")
+        for item in verdict.items:
+            counts[(BRIDGE, _kind(item.what), item.agree)] += 1
+    return counts
 
 
 def tlog_row() -> Row:
@@ -238,8 +292,8 @@ def render(rows: Iterable[Row], by_vehicle: Counter[tuple[str, str, bool | None]
 
 
 def table() -> str:
-    gate = gate_agreement()
-    return render([examples_row(), *sitl_rows(gate), ros2bridge_row(), tlog_row()], gate)
+    gate = gate_agreement() + bridge_agreement()
+    return render([examples_row(), *sitl_rows(gate), *ros2bridge_rows(gate), tlog_row()], gate)
 
 
 if __name__ == "__main__":

@@ -11,6 +11,7 @@ from fuzzoff.events import Where
 from fuzzoff.profiles import Profile
 
 if TYPE_CHECKING:
+    from fuzzoff.bridge.compare import Delivery
     from fuzzoff.timeline import Timeline
 
 
@@ -223,6 +224,8 @@ class FileReport:
     suppressed: list[tuple[Finding, Suppression]] = field(default_factory=list)
     """Findings a suppression took out of ``findings`` (``fuzzoff.suppress``): the reports
     show them apart, and they fail no run."""
+    delivery: Delivery | None = None
+    """A ROS 2 bag compared with PX4's ULog of the flight (``lint --with``, ``fuzzoff.bridge``)."""
 
     def to_json(self) -> dict[str, Any]:
         return {
@@ -242,6 +245,7 @@ class FileReport:
             "complete": self.complete,
             "findings": [f.to_json() for f in self.findings],
             "stats": self.stats,
+            **({"delivery": self.delivery.to_json()} if self.delivery is not None else {}),
         }
 
     def worst(self) -> Severity | None:

@@ -3,8 +3,9 @@
 The test stream is the rule's behaviour as tiny event lists (``[test_stream]`` in its TOML page,
 shown by ``fuzzoff rule CODE --verbose``); the page's Example and Use instead sections show client
 code instead. OFB001-OFB004 are about the input and the profile, and OFB006 about the message
-definitions a ROS 2 recording carries, not about a stream: they are exempt, and listed here so
-that the exemption is visible (OFB006's cases are in tests/test_px4_msgs_match.py).
+definitions a ROS 2 recording carries, and OFB108 about two recordings of one flight (a bag with
+PX4's ULog), not about a stream: they are exempt, and listed here so that the exemption is
+visible (OFB006's cases are in tests/test_px4_msgs_match.py, OFB108's in tests/test_bridge_with.py).
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from fuzzoff.findings import Finding
 from fuzzoff.profiles import DEFAULT_PX4, DEFAULT_VEHICLE, Profile
 from fuzzoff.recording import RecordingInfo
 
-NOT_STREAM_RULES = {"OFB001", "OFB002", "OFB003", "OFB004", "OFB006"}
+NOT_STREAM_RULES = {"OFB001", "OFB002", "OFB003", "OFB004", "OFB006", "OFB108"}
 """Rules about reading the file, choosing the profile or the definitions it carries: no event
 stream can show them."""
 

@@ -1,5 +1,7 @@
 """Write ``NAME.expected.json`` for every recording of ``runs.json``: what ``fuzzoff lint``
-says about it now, with what the recording is.
+says about it now, with what the recording is; and ``BAG.with.expected.json`` for each bag
+linted with its flight's ULog (``--with``: OFB108 on the agent restart and the lost ARM, clean
+of it on every other flight).
 
     PYTHONPATH=. .venv/bin/python corpora/ros2bridge/expected.py
 
@@ -84,6 +86,45 @@ def expected_for(recording: Path, run: dict[str, Any]) -> dict[str, Any]:
     return spec
 
 
+WITH_HAZARD = {"example_agent_restart": ("OFB108",), "example_arm_lost": ("OFB108",)}
+"""Program -> what ``lint BAG --with ULOG`` adds to its hazard (the bag and PX4's ULog compared);
+every other flight lists OFB108 as ``clean``."""
+
+
+def with_expected(bag: Path, ulog: Path, run: dict[str, Any]) -> dict[str, Any]:
+    """``NAME.with.expected.json``: the bag linted with its flight's ULog (``--with``, the path
+    from the repository's root, where the tests run)."""
+    program = PROGRAMS[run["program"]]
+    args = ["--with", str(ulog.relative_to(HERE.parent.parent))]
+    out = run_cli(["lint", str(bag), "--format", "json", *args])
+    assert out.returncode in (0, 1), out.stderr
+    (report,) = json.loads(out.stdout)["files"]
+    findings = [
+        {"code": f["code"], "severity": f["severity"], "time_s": f["time_s"]}
+        for f in report["findings"]
+    ]
+    hazard = WITH_HAZARD.get(program.name, ())
+    spec: dict[str, Any] = {
+        "recording": bag.name,
+        "args": args,
+        "exit_status": out.returncode,
+        "complete": report["complete"],
+        "kind": program.kind,
+        "hazard": sorted({*program.codes, *hazard}),
+        "program": f"fuzzoff.sitl.ros2.programs {program.name}: {program.summary}",
+        "px4_release": run["release"],
+        "findings": findings,
+    }
+    if not hazard:
+        spec["clean"] = ["OFB108"]
+    got = {f["code"] for f in report["findings"] if f["severity"] == "error"}
+    assert set(hazard) <= got and ("OFB108" in got) == bool(hazard), (bag, got)
+    if program.kind == "hazard" and not got & set(spec["hazard"]):
+        spec["missed"] = [f"{program.missed or 'to review'}: no error of {spec['hazard']}"]
+    assert not compare(findings, report["findings"])
+    return spec
+
+
 TABLE = "<!-- the table is written by expected.py -->"
 
 
@@ -112,6 +153,12 @@ def main() -> int:
             target = HERE / f"{recording.name}.expected.json"
             target.write_text(json.dumps(spec, indent=2) + "\n")
             rows.append(row(spec))
+            print(f"{target.name}: exit {spec['exit_status']}, {len(spec['findings'])} findings")
+        for suffix in RECORDINGS[:2]:
+            bag = HERE / f"{stem}{suffix}"
+            spec = with_expected(bag, HERE / f"{stem}.ulg", run)
+            target = HERE / f"{bag.name}.with.expected.json"
+            target.write_text(json.dumps(spec, indent=2) + "\n")
             print(f"{target.name}: exit {spec['exit_status']}, {len(spec['findings'])} findings")
     readme = HERE / "README.md"
     head, _, rest = readme.read_text().partition(TABLE)

@@ -62,6 +62,13 @@ def add_parser(sub: Any) -> None:
         help="each finding in full: what the docs require, what PX4 does, the exact place",
     )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    parser.add_argument(
+        "--with",
+        dest="with_ulog",
+        metavar="ULOG",
+        help="PX4's ULog of the same flight: what the ROS 2 bag's companion sent and PX4 never"
+        " received, and what PX4 did that the companion never saw (OFB108)",
+    )
     add_fleet_options(parser)
     parser.set_defaults(run=run)
 
@@ -102,6 +109,8 @@ def run(args: argparse.Namespace) -> int:
     # As ruff: no path means the current folder.
     args.paths = args.paths or ["."]
     if _fleet_wanted(args):
+        if args.with_ulog is not None:
+            raise ConfigError("--with compares one bag linted here: not with the fleet options")
         from fuzzoff.commands._lint_fleet import run_fleet
 
         return run_fleet(args, settings)
@@ -115,6 +124,10 @@ def run(args: argparse.Namespace) -> int:
     lint: Lint = lint_file_with_timelines if any(f == "html" for f, _ in targets) else lint_file
     with _watching(args) as watch:
         report = lint_each(plan, lint=lint, jobs=args.jobs, watch=watch)
+    if args.with_ulog is not None:
+        from fuzzoff.commands._with import add_delivery
+
+        add_delivery(report, Path(args.with_ulog))
     resolved = dict(plan)
 
     def settings_for(path: str) -> Settings:

@@ -168,6 +168,11 @@ def print_file(
         kinds = Counter(why.kind for _, why in file.suppressed)
         said = ", ".join(f"{n} by the {kind}" for kind, n in sorted(kinds.items()))
         console.print(Text(f"  {len(file.suppressed)} suppressed ({said})", style="dim"))
+    if file.delivery is not None and not quiet:
+        from fuzzoff.bridge.report import lines
+
+        for line in lines(file.delivery):
+            console.print(Text(printable(line, 400)), soft_wrap=True)
     console.print()
 
 

@@ -93,7 +93,8 @@ PROGRAMS: dict[str, Program] = {
             hazard="the bridge lost mid-flight: PX4's offboard loss while the node streams on",
             agent_stop_after_arm_s=5.0,
             missed="issue 28 item 3 (the bag's stream never stops; PX4's outputs fall silent and"
-            " come back with a failsafe status)",
+            " come back with a failsafe status): the bag alone cannot show it, `--with` its ULog"
+            " gives OFB108",
         ),
         Program(
             "example_no_setpoint",

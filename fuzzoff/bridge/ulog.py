@@ -1,0 +1,67 @@
+"""PX4's side: the topics of its ULog that a bag's topics are compared with, and the bridge's
+time sync.
+
+Kept apart from ``fuzzoff.formats.ulog`` (the lint's reader): pyulog loads only the topics
+asked for, whole. PX4's ``uxrce_dds_client`` says each time it synchronizes with an agent
+("synchronized with time offset Nus", a logged message kept in a cut ULog): N is the agent's
+clock minus PX4's, the offset the bridge subtracts from an incoming ``timestamp`` and adds to an
+outgoing one (``min(value - offset, now)`` on receipt: a stamp in PX4's future becomes the
+receive time; spec 2.1.1, ``Tools/msg/templates/ucdr/msg.h.em``).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from fuzzoff.bridge import BridgeError
+
+SYNCED = re.compile(r"synchronized with time offset (-?\d+)\s*us")
+
+
+@dataclass(frozen=True, slots=True)
+class ULogTopic:
+    name: str
+    timestamps: np.ndarray
+    """µs, PX4's clock (sorted)."""
+    data: dict[str, np.ndarray]
+
+
+@dataclass(frozen=True, slots=True)
+class Px4Log:
+    path: str
+    start_us: int
+    last_us: int
+    syncs: list[tuple[int, int]]
+    """(PX4 time, offset µs) of each time sync with an agent, in order."""
+    topics: dict[str, ULogTopic]
+
+
+def read_ulog(path: Path, names: set[str]) -> Px4Log:
+    """``names`` of ``path`` (those logged); BridgeError when it cannot be read."""
+    from pyulog import ULog
+
+    try:
+        log = ULog(str(path), message_name_filter_list=sorted(names))
+    except Exception as exc:  # pyulog raises what its parsing meets
+        raise BridgeError(f"{path}: cannot read the ULog ({exc})") from None
+    syncs = []
+    for logged in log.logged_messages:
+        match = SYNCED.search(logged.message)
+        if match is not None:
+            syncs.append((int(logged.timestamp), int(match.group(1))))
+    topics: dict[str, ULogTopic] = {}
+    for dataset in log.data_list:
+        if dataset.multi_id != 0 or dataset.name in topics:
+            continue
+        data: dict[str, Any] = dataset.data
+        order = np.argsort(data["timestamp"], kind="stable")
+        sorted_data = {k: v[order] for k, v in data.items()}
+        topics[dataset.name] = ULogTopic(
+            dataset.name, sorted_data["timestamp"].astype(np.int64), sorted_data
+        )
+    return Px4Log(str(path), int(log.start_timestamp), int(log.last_timestamp), syncs, topics)

@@ -1,0 +1,142 @@
+"""``fuzzoff lint BAG --with ULOG`` on real flights over PX4's ROS 2 bridge (issue 28 item 3).
+
+The recordings are corpora/ros2bridge's: px4_ros_com's example flown on the 1.16.2 and 1.18
+head SITL bundles, the companion's bag beside PX4's own ULog of the same flight. On a clean
+flight every message sent after the bridge matched the writers reached PX4, within
+milliseconds; on the agent restart (PX4 #26022) PX4 received nothing for about 10 s while the
+companion published on, flagged the offboard signal lost, and the companion heard of it only
+when the bridge came back.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from tests.helpers import run_cli
+from tests.test_ci_formats import errors, lint_report_validator
+
+ROOT = Path(__file__).resolve().parent.parent
+CORPUS = ROOT / "corpora" / "ros2bridge"
+
+
+def lint_with(bag: str, ulog: str, *more: str) -> tuple[int, dict[str, Any], str]:
+    out = run_cli(
+        ["lint", str(CORPUS / bag), *more, "--with", str(CORPUS / ulog), "--format", "json"]
+    )
+    return out.returncode, json.loads(out.stdout) if out.stdout else {}, out.stderr
+
+
+def topic(delivery: dict[str, Any], name: str) -> dict[str, Any]:
+    (found,) = [t for t in delivery["topics"] if t["topic"].startswith(name)]
+    return found
+
+
+@pytest.mark.parametrize(
+    "flight", ["example-1.16.2-ros2", "example-1.18.0-beta1-head", "example_stops-1.16.2-ros2"]
+)
+def test_a_clean_flight_delivered_everything_within_milliseconds(flight: str) -> None:
+    status, report, _ = lint_with(f"{flight}-mcap", f"{flight}.ulg")
+    assert status == (1 if "stops" in flight else 0)  # OFB103 there: the stream stopped
+    (file,) = report["files"]
+    assert not [f for f in file["findings"] if f["code"] == "OFB108"]
+    delivery = file["delivery"]
+    assert delivery["clock"]["source"] == "px4_outputs"
+    assert delivery["clock"]["residual_ms"] < 10
+    for name in ("/fmu/in/offboard_control_mode", "/fmu/in/vehicle_command"):
+        sent = topic(delivery, name)
+        assert sent["undelivered"] == 0
+        assert sent["logged_by_px4"] > 0
+        assert sent["latency_ms"]["median"] < 20
+    assert all(
+        c["seen_after_s"] is not None and c["seen_after_s"] < 0.5 for c in delivery["px4_changes"]
+    )
+
+
+@pytest.mark.parametrize(
+    ("flight", "storage", "failsafe"),
+    [
+        ("example_agent_restart-1.16.2-ros2", "mcap", "POSCTL"),
+        ("example_agent_restart-1.18.0-beta1-head", "sqlite3", "AUTO_RTL"),
+    ],
+)
+def test_the_agent_restart_gives_the_undelivered_stream_and_px4s_loss(
+    flight: str, storage: str, failsafe: str
+) -> None:
+    status, report, _ = lint_with(f"{flight}-{storage}", f"{flight}.ulg")
+    assert status == 1
+    (file,) = report["files"]
+    (finding,) = [f for f in file["findings"] if f["code"] == "OFB108"]
+    assert finding["severity"] == "error"
+    assert 6.0 < finding["time_s"] < 7.0 and finding["end_s"] - finding["time_s"] > 10
+    assert "flagged the offboard signal lost" in finding["message"]
+    assert "the bridge itself was down" in finding["message"]
+    delivery = file["delivery"]
+    assert topic(delivery, "/fmu/in/offboard_control_mode")["undelivered"] > 100
+    lost = [c for c in delivery["px4_changes"] if c["state"] == "offboard signal lost"]
+    assert lost and lost[0]["seen_after_s"] > 9  # the companion heard of it when PX4 came back
+    assert any(failsafe in c["state"] and "failsafe" in c["state"] for c in delivery["px4_changes"])
+    assert len(delivery["clock"]["time_syncs"]) == 2  # PX4 synchronized again with the new agent
+    assert not errors(lint_report_validator(), report)
+
+
+def test_the_terminal_shows_what_was_sent_and_never_received() -> None:
+    flight = "example_agent_restart-1.16.2-ros2"
+    out = run_cli(["lint", str(CORPUS / f"{flight}-mcap"), "--with", str(CORPUS / f"{flight}.ulg")])
+    assert out.returncode == 1
+    assert "OFB108" in out.stdout
+    assert "/fmu/in/offboard_control_mode: 170 sent" in out.stdout
+    assert "106 not received" in out.stdout
+    assert "offboard signal lost: seen 9.59 s later" in out.stdout
+
+
+def test_an_arm_px4_never_received_is_named() -> None:
+    flight = "example_arm_lost-1.16.2-ros2"
+    status, report, _ = lint_with(f"{flight}-mcap", f"{flight}.ulg")
+    assert status == 1
+    (finding,) = [f for f in report["files"][0]["findings"] if f["code"] == "OFB108"]
+    assert finding["summary"] == "a command PX4 never received"
+    assert topic(report["files"][0]["delivery"], "/fmu/in/vehicle_command")["undelivered"] == 1
+
+
+def test_bag_and_ulog_in_one_lint() -> None:
+    flight = "example-1.16.2-ros2"
+    status, report, _ = lint_with(
+        f"{flight}-sqlite3", f"{flight}.ulg", str(CORPUS / f"{flight}.ulg")
+    )
+    assert status == 0
+    assert [("delivery" in f) for f in report["files"]] == [True, False]
+
+
+@pytest.mark.parametrize(
+    ("bag", "ulog", "says"),
+    [
+        ("example-1.16.2-ros2-mcap", "example_stops-1.16.2-ros2.ulg", "are not the same flight"),
+        ("example_in_only-1.16.2-ros2-mcap", "example-1.16.2-ros2.ulg", "are not the same flight"),
+        ("example-1.16.2-ros2-mcap", "../sitl/acceleration_only-1.14.4.ulg", "no time sync"),
+        ("example-1.16.2-ros2.ulg", "example-1.16.2-ros2.ulg", "one ROS 2 bag folder"),
+    ],
+)
+def test_files_of_two_flights_are_refused_in_one_line(bag: str, ulog: str, says: str) -> None:
+    status, report, stderr = lint_with(bag, ulog)
+    assert status == 2 and not report
+    assert says in stderr
+    assert len(stderr.strip().splitlines()) == 1
+    assert "Traceback" not in stderr
+
+
+def test_the_gate_model_on_a_bridge_bag_agrees_with_px4_where_the_bridge_delivered() -> None:
+    from fuzzoff.sitl.ros2.verdict import compare
+
+    clean = compare(CORPUS / "example-1.16.2-ros2-mcap", "1.16", CORPUS / "example-1.16.2-ros2.ulg")
+    assert [(i.what, i.agree) for i in clean.items] == [
+        ("switch to OFFBOARD", True),
+        ("arm", True),
+    ]
+    flight = "example_agent_restart-1.16.2-ros2"
+    restart = compare(CORPUS / f"{flight}-sqlite3", "1.16", CORPUS / f"{flight}.ulg")
+    # the model sees the stream as sent: PX4's loss is the bridge's (OFB108), not the stream's
+    assert [(i.what, i.agree) for i in restart.items if not i.agree] == [("offboard loss", False)]
