@@ -23,6 +23,7 @@ import numpy as np
 from fuzzoff import events as ev
 from fuzzoff import releases
 from fuzzoff.formats.ulog.load import Loaded, load, quoted
+from fuzzoff.formats.ulog.thinning import windows_for
 from fuzzoff.formats.ulog.topics import (
     EXTRA_FIELDS,
     EXTRA_TOPICS,
@@ -120,12 +121,19 @@ def vehicle_from_params(params: dict[str, Any]) -> tuple[str | None, str]:
 
 
 class UlogSource(Source):
-    """A PX4 ULog (.ulg), read with pyulog 1.3."""
+    """A PX4 ULog (.ulg), read with pyulog 1.3.
+
+    ``events`` skips the rows of PX4's own high-rate setpoint topics that cannot be the
+    external controller's (``thinning``); ``every_row=True`` reads every row."""
 
     format = "ulog"
+    every_row = False
+    """Read every row of the thinned topics (for a tool that wants PX4's own setpoints too)."""
 
-    def __init__(self, path: Path) -> None:
+    def __init__(self, path: Path, *, every_row: bool | None = None) -> None:
         super().__init__(path)
+        if every_row is not None:
+            self.every_row = every_row
         self._loaded: Loaded | None = None
         self._header_info: RecordingInfo | None = None
         self._failed: SourceError | None = None
@@ -261,6 +269,7 @@ class UlogSource(Source):
         datasets = self._datasets()
         self.set_start(_utc_start(datasets, t0))
         self.aside.read((int(ulog.last_timestamp) - t0) / 1e6)  # the last row, event or not
+        windows = None if self.every_row else windows_for(datasets)
         for d in datasets:
             spec = specs.get(d.name)
             if spec is None:
@@ -268,6 +277,8 @@ class UlogSource(Source):
             rank = ranks[d.name] * 256 + d.multi_id
             topic = d.name if d.multi_id == 0 else f"{d.name}_{d.multi_id}"
             keep = None
+            if windows is not None:
+                keep = windows.rows(d.data, spec.kind)
             if spec.kind == ev.VehiclePosition.kind:
                 keep = _one_per_period(d.data["timestamp"], POSITION_PERIOD_S)
                 if self.aside.plot is not None:
@@ -280,6 +291,7 @@ class UlogSource(Source):
             topics.append(_stream(legacy.data, "vehicle_status", rank, t0, failsafe_flags, context))
         records = _Stream.of(self._records(ulog, t0))
         streams = [_Stream.of(self._preamble(ulog, info)), *topics, records]
+        self._total = sum(len(s.keys) for s in streams)  # the events to come (progress)
         try:
             yield from self._merge(streams)
         except (KeyError, ValueError, TypeError, IndexError, OverflowError) as exc:
