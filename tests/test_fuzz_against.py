@@ -394,6 +394,27 @@ def test_an_arm_in_position_without_manual_control_is_refused_as_px4_refused_it(
     assert verdict.agree
 
 
+@pytest.mark.parametrize(
+    ("stem", "px4"),
+    [
+        ("return_and_disarm_one_cycle", "stays (OFFBOARD), disarmed"),
+        ("disarm_before_return_one_cycle", "stays (AUTO_RTL), disarmed"),
+    ],
+)
+def test_a_return_in_the_cycle_px4_disarms_is_not_judged(stem: str, px4: str) -> None:
+    """Two disagreements of a live campaign on the 1.18 head (one confirmed): a stream with
+    losses every 0.5 s (COM_OF_LOSS_T 0.33) whose last setpoint and a disarm reach PX4 in one
+    Commander cycle. PX4's next status is already disarmed, so its return cannot be read; the
+    verdict had called it "stays" against the model's return. The earlier returns are judged."""
+    params = {"COM_OF_LOSS_T": 0.33, "COM_OBL_RC_ACT": 3.0, "FUZZOFF_RC_PRESENT": 1.0}
+    verdict = _judge(f"{stem}-1.18.0-beta1-head", params)
+    *earlier, last = [i for i in verdict.items if i.what == "automatic return"]
+    assert (last.px4, last.model, last.agree) == (px4, "back to OFFBOARD", None)
+    assert last.note.startswith("not judged: PX4 disarmed in the cycle the stream came back")
+    assert earlier and all(i.agree and i.px4 == "back to OFFBOARD" for i in earlier)
+    assert verdict.agree
+
+
 def test_a_disagreement_confirmed_before_is_counted_not_followed_up_again(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

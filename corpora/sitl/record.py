@@ -22,7 +22,7 @@ from pathlib import Path
 
 from fuzzoff.sitl import airframes, bundle
 from fuzzoff.sitl.link import LinkError
-from fuzzoff.sitl.scenarios import SCENARIOS, scenarios_for
+from fuzzoff.sitl.scenarios import SCENARIOS, scenarios_for, why_not_run
 from fuzzoff.sitl.session import Session
 from fuzzoff.sitl.trim import trim
 
@@ -71,6 +71,10 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     runs = json.loads(RUNS.read_text()) if RUNS.exists() else {}
     for name in args.scenarios or scenarios_for(args.release):
+        reason = why_not_run(bundle.find_build(args.release, None).release, name)
+        if reason is not None:
+            print(f"{name} on {args.release}: not recorded: {reason}", file=sys.stderr)
+            continue
         try:
             entry = record(args.release, args.instance, name)
         except (LinkError, bundle.BundleError) as exc:

@@ -25,6 +25,10 @@ VELOCITY = 0x0DC7
 """type_mask: velocity only."""
 ACCELERATION = 0x0C3F
 """type_mask: acceleration only (FORCE bit clear)."""
+ATTITUDE_AND_THRUST = 0b00000111
+"""SET_ATTITUDE_TARGET type_mask: the attitude and the thrust, body rates ignored."""
+ATTITUDE_NO_THRUST = 0b01000111
+"""SET_ATTITUDE_TARGET type_mask: the attitude only, body rates and thrust ignored (bit 64)."""
 NAV_POSCTL, NAV_LOITER, NAV_RTL, NAV_OFFBOARD, NAV_TAKEOFF, NAV_LAND = 2, 4, 5, 14, 17, 18
 MANUAL_EVERY_S = 0.1
 """A MAVLink joystick at 10 Hz: PX4 declares manual control lost after COM_RC_LOSS_T (0.5 s)."""
@@ -109,9 +113,9 @@ class Driver:
 
         return send
 
-    def attitude(self, thrust: float) -> Setpoint:
+    def attitude(self, thrust: float, type_mask: int = ATTITUDE_AND_THRUST) -> Setpoint:
         def send(d: Driver) -> None:
-            d.link.attitude_target((1.0, 0.0, 0.0, 0.0), thrust)
+            d.link.attitude_target((1.0, 0.0, 0.0, 0.0), thrust, type_mask)
 
         return send
 

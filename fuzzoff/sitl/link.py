@@ -206,7 +206,11 @@ class Link:
             host = time.monotonic()
             self.clock.observe(msg, host)
             if self.recorder is not None and self.clock.synced:
-                self.recorder.write(msg)
+                # after any send under way has recorded its message: pymavlink records a sent
+                # message after writing it, and an answer that came in between would otherwise
+                # be recorded before its command (seen on a busy host)
+                with self._send_lock:
+                    self.recorder.write(msg)
             with self._cond:
                 self._update(msg, host)
                 self._cond.notify_all()
@@ -278,8 +282,8 @@ class Link:
         """Send a packet as recorded (a replay), recording its parsed form."""
         with self._send_lock:
             self.conn.write(data)
-        if msg is not None:
-            self._sent(msg)
+            if msg is not None:
+                self._sent(msg)
 
     def close(self) -> None:
         self._stop.set()

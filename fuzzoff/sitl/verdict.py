@@ -489,15 +489,35 @@ def _failsafe(
     failsafe_t = after.t if after else t
     later = [m for m in truth.modes if m.t > failsafe_t + 0.001]
     px4_returns = bool(later) and later[0].nav_state == NAV_OFFBOARD and later[0].armed
+    agree: bool | None = px4_returns == model_returns
+    note = ""
+    if (
+        model_returns
+        and not px4_returns
+        and back_model is not None
+        and later
+        and not later[0].armed
+        and abs(later[0].t - back_model["px4_t"]) <= CHECK_PERIOD_S + LOOP_S
+    ):
+        # the stream came back in the Commander cycle that disarmed: PX4's next status is
+        # already disarmed (the failsafe cleared by the disarm, or still shown for one status),
+        # so whether PX4 would have returned cannot be read from it
+        agree = None
+        note = (
+            "not judged: PX4 disarmed in the cycle the stream came back"
+            f" ({1000 * (later[0].t - back_model['px4_t']):+.0f} ms)"
+        )
     verdict.items.append(
         Item(
             "automatic return",
             later[0].t if later else t,
             "back to OFFBOARD"
             if px4_returns
-            else f"stays ({nav_state_name(later[0].nav_state) if later else 'end'})",
+            else f"stays ({nav_state_name(later[0].nav_state) if later else 'end'})"
+            + ("" if not later or later[0].armed else ", disarmed"),
             "back to OFFBOARD" if model_returns else "no return",
-            px4_returns == model_returns,
+            agree,
+            note,
         )
     )
 
