@@ -409,6 +409,24 @@ def test_ofb303_grace_edge(first_at: float | None, flagged: bool) -> None:
         assert "VehicleAttitudeSetpoint" in found[0].message
 
 
+@pytest.mark.parametrize(
+    ("fmt", "first_at", "flagged"),
+    [("ulog", 0.75, False), ("ulog", 1.2, True), ("mcap", 0.75, True)],
+)
+def test_ofb303_a_ulogs_setpoint_topic_first_logged_late_is_not_missing(
+    fmt: str, first_at: float, flagged: bool
+) -> None:
+    """The 1.17.0 airplane's ULog (corpora/sitl/fw_loss-1.17.0.ulg): its MAVLink receiver
+    advertises trajectory_setpoint at the switch, and PX4's logger logged the first one 0.75 s
+    later. Up to 1 s is the logger; later, or in a stream as sent, the setpoint is missing."""
+    events: list[Event] = [status(0.0, OFFBOARD), *ocm(every(0.0, 3.0, 0.1), position=True)]
+    events += [
+        TrajectorySetpoint(t=first_at + 0.1 * k, position=(0.0, 0.0, -5.0)) for k in range(10)
+    ]
+    found = codes(lint_events(events, fmt=fmt, vehicle="fw", px4="1.17"), "OFB303")
+    assert bool(found) is flagged
+
+
 def test_ofb304_changes_outside_offboard_are_not_reported() -> None:
     events = [
         status(0.0, POSCTL),

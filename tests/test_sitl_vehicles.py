@@ -72,7 +72,9 @@ def test_the_multicopter_matrix_keeps_its_scenarios_and_the_others_fly_their_veh
     assert all(SCENARIOS[name].vehicle == "quad" for name in scenarios_for("1.16.2"))
     assert {SCENARIOS[name].vehicle for name in vehicle_scenarios()} == {
         "hex",
+        "fw",
         "vtol",
+        "tailsitter",
         "rover-ackermann",
     }
 
@@ -158,12 +160,42 @@ def test_each_real_vehicle_is_detected_from_its_recordings(stem: str, vehicle: s
         assert vehicle in out.stdout.splitlines()[0]
 
 
-def test_a_vtol_gliding_on_a_nan_altitude_in_fw_flight_is_not_a_copter_hold() -> None:
-    """The 1.18 head's standard VTOL in FW flight on position setpoints with z NaN glided
-    (it went down 29 m, then climbed back when z came again): OFB602's multicopter axis check
-    ("PX4 holds instead") does not apply in FW flight on 1.18."""
-    tlog = SITL / "vtol_fw_glide-1.18.0-beta1-head.tlog"
+@pytest.mark.parametrize(
+    "stem",
+    ["vtol_fw_glide-1.18.0-beta1-head", "vtol_fw_types-1.18.0-beta1-head", "vtol_fw_types-1.17.0"],
+)
+def test_a_vtol_on_a_nan_altitude_in_fw_flight_is_not_a_copter_hold(stem: str) -> None:
+    """The standard VTOL in FW flight on position setpoints with z NaN: the 1.18 head glided
+    (down 14-29 m, climbing back when z came again), 1.17.0 flew on at its altitude toward
+    x, y. Neither held as a multicopter does: OFB602's multicopter axis check ("PX4 holds
+    instead") does not apply in FW flight on any release."""
+    tlog = SITL / f"{stem}.tlog"
     out = run_cli(["lint", str(tlog), "--format", "json"])
     codes = {f["code"] for f in json.loads(out.stdout)["files"][0]["findings"]}
     assert "OFB602" not in codes
     assert out.returncode == 0
+
+
+@pytest.mark.parametrize(
+    ("name", "vehicle"),
+    [("fw", "fw"), ("plane", "fw"), ("mc", "quad"), ("hex", "hex"), ("vtol", "vtol")],
+)
+def test_a_live_campaign_takes_a_sitl_vehicle_or_a_vehicle_type(name: str, vehicle: str) -> None:
+    assert airframes.airframe_named(name).vehicle == vehicle
+
+
+def test_a_live_campaign_on_a_build_without_the_airframe_says_so_in_one_line(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    _bundle(tmp_path, "1.16.2", ["sihsim_quadx", "sihsim_airplane"], ["commander"])
+    monkeypatch.setenv("FUZZOFF_PX4_SITL", str(tmp_path))
+    out = run_cli(["fuzz", "--against", "sitl:1.16.2", "--vehicle", "hex"], cwd=tmp_path)
+    assert out.returncode == 2
+    assert "--vehicle hex: PX4 1.16.2 has no SIH airframe sihsim_hex" in out.stderr
+    assert len(out.stderr.strip().splitlines()) == 1
+
+
+def test_an_instance_above_nine_is_listened_for_where_px4_sends_it() -> None:
+    # px4-rc.mavlink of every bundle: above 9, the onboard link sends to 14549
+    assert bundle.send_port(3) == 14543
+    assert bundle.send_port(30) == bundle.send_port(31) == 14549

@@ -32,7 +32,6 @@ from fuzzoff.events import (
 from fuzzoff.findings import Severity, clip
 from fuzzoff.gate.estimates import Estimates
 from fuzzoff.gate.receiver import DROPPED, FLOAT_FIELDS, ReceiverContext, receive
-from fuzzoff.releases import Release
 from fuzzoff.tables import mavlink as tm
 
 VEHICLE_LABELS = {"copter": "multicopter/VTOL", "fixedwing": "fixed-wing", "rover": "rover"}
@@ -99,12 +98,6 @@ def set_components(event: PositionTarget, group: str) -> list[str]:
         if not ignored and value != 0 and not math.isnan(value):
             out.append(name)
     return out
-
-
-def _fw_by_component(release: Release) -> bool:
-    """1.18 and later take a fixed-wing's offboard setpoint by component (gate spec 16 S7);
-    1.14-1.17 only with x, y and z all given (what a NaN z does there was not flown)."""
-    return not release.minors or min(release.minors) >= 18
 
 
 class PositionTargetFields(Check):
@@ -179,11 +172,13 @@ class PositionTargetFields(Check):
 
     def _copter_axes(self) -> bool:
         """Does PX4's multicopter position controller take the setpoint now? Not a VTOL's in
-        FW flight: there the fixed-wing controllers do (1.18 glides on a NaN z, seen on the 1.18
-        head's standard VTOL, ``corpora/sitl/vtol_fw_glide-*``)."""
+        FW flight, on any release: there the fixed-wing controllers do. Seen on the standard
+        VTOL in FW flight with z NaN (type_mask 292): 1.18 glides (``vtol_fw_glide-*``,
+        ``vtol_fw_types-1.18.0-beta1-head``), 1.17.0 flew on at its altitude toward x, y
+        (``vtol_fw_types-1.17.0``); neither held as a multicopter would."""
         if self.group != "copter":
             return False
-        return self.ctx.state.vtol_phase != "fw" or not _fw_by_component(self.ctx.profile.release)
+        return self.ctx.state.vtol_phase != "fw"
 
     def on_event(self, event: Event) -> None:
         if event.origin != "sent" or not isinstance(

@@ -1,7 +1,8 @@
 """One PX4 for a whole live campaign: put back to a known state before each stream.
 
 ``Bench`` boots a bundle once (``Session``) and, before each stream, brings PX4 to where
-every stream starts: landed, disarmed, in Hold, the stream's parameters set and read back (the
+every stream starts: landed, disarmed (a plain disarm where PX4 counts the vehicle as landed,
+else AUTO_LAND), in Hold, the stream's parameters set and read back (the
 others at PX4's own values), and a MAVLink joystick running when the stream assumes manual
 control. A vehicle that does not land and disarm in time is disarmed by force
 (``MAV_CMD_COMPONENT_ARM_DISARM`` with PX4's 21196); a PX4 that died, stopped answering, or is
@@ -84,9 +85,21 @@ class LiveRun:
 
 
 class Bench:
-    def __init__(self, build: bundle.Build, instance: int, log: Log = print) -> None:
+    def __init__(
+        self,
+        build: bundle.Build,
+        instance: int,
+        log: Log = print,
+        env: dict[str, str] | None = None,
+        lands: bool = True,
+    ) -> None:
         self.build = build
+        self.lands = lands
+        """AUTO_LAND brings it down (a multicopter, a VTOL); else (an airplane, which lands
+        only on a mission's runway) a vehicle PX4 will not disarm plainly is disarmed by force."""
         self.instance = instance
+        self.env = dict(env or {})
+        """``PX4_*`` variables for each boot (``PX4_SIM_MODEL``: the airframe)."""
         self.log = log
         self.session: Session | None = None
         self.boots: list[float] = []
@@ -102,7 +115,7 @@ class Bench:
 
     def start(self) -> None:
         started = time.monotonic()
-        session = Session(self.build, self.instance, log=self.log)
+        session = Session(self.build, self.instance, env=self.env, log=self.log)
         try:
             session.connect()
             session.px4.command("logger", "off")
@@ -172,17 +185,24 @@ class Bench:
         link = self._link()
         driver = self._driver()
         if link.view.armed:
+            # PX4 takes a plain disarm only when it counts the vehicle as landed: an airplane or
+            # a rover rolling on the ground, a multicopter that never lifted off
+            ack = link.arm(False)
+            if ack is not None and ack.result == 0:
+                link.wait_for(lambda v: v.armed is False, 3.0)
+        if link.view.armed and self.lands:
             ack = link.set_mode(NAV_LAND)
             if ack is not None and ack.result == 0:
                 deadline = time.monotonic() + LAND_TIMEOUT_S
                 while link.view.armed and time.monotonic() < deadline:
                     driver.wait(0.5)
-            if link.view.armed:
-                link.command(MAV_CMD_COMPONENT_ARM_DISARM, 0.0, FORCE_DISARM)
-                link.wait_for(lambda v: v.armed is False, 3.0)
-                notes.append("disarmed by force (it did not land in time)")
-            if link.view.armed:
-                raise NeedsRestart("still armed after landing and a forced disarm")
+        if link.view.armed:
+            link.command(MAV_CMD_COMPONENT_ARM_DISARM, 0.0, FORCE_DISARM)
+            link.wait_for(lambda v: v.armed is False, 3.0)
+            why = "it did not land in time" if self.lands else "PX4 did not count it as landed"
+            notes.append(f"disarmed by force ({why})")
+        if link.view.armed:
+            raise NeedsRestart("still armed after landing and a forced disarm")
         if link.view.nav_state != NAV_LOITER:
             ack = link.set_mode(NAV_LOITER)
             if (

@@ -25,6 +25,9 @@ API_LISTEN_PORT = 14580
 """PX4's onboard (API) link listens here (+ instance): where a client sends."""
 API_SEND_PORT = 14540
 """PX4's onboard link sends here (+ instance): where a client listens."""
+SHARED_SEND_PORT = 14549
+"""Where every instance above 9 sends (PX4's ``px4-rc.mavlink``, 1.14 to main): only one such
+PX4 per network namespace can be talked to at a time."""
 STOP_TIMEOUT_S = 10.0
 RELEASE_PATTERN = re.compile(r"^\d+\.\d+\.\d+(-[0-9A-Za-z.]+)?$")
 
@@ -168,7 +171,7 @@ class Px4Process:
 
     @property
     def send_port(self) -> int:
-        return API_SEND_PORT + self.instance
+        return send_port(self.instance)
 
     @property
     def sysid(self) -> int:
@@ -225,6 +228,14 @@ class Px4Process:
 
 
 PR_SET_PDEATHSIG = 1
+MAX_INSTANCE = 99
+"""PX4_INSTANCE shifts PX4's ports (14580+N, 18570+N) and its system id (N+1); above 9 PX4 sends
+to 14549 whatever the instance (``send_port``)."""
+
+
+def send_port(instance: int) -> int:
+    """Where PX4 instance ``instance`` sends on its onboard link: where a client listens."""
+    return SHARED_SEND_PORT if instance > 9 else API_SEND_PORT + instance
 
 
 def _stop_with_parent() -> None:  # pragma: no cover (runs in the child before exec)
@@ -244,8 +255,8 @@ def start(
     adds ``PX4_*`` variables such as ``PX4_SIM_SPEED_FACTOR``. The logger is started and stopped
     per run with ``logger on``/``off`` (``Px4Process.command``): ``PX4_PARAM_SDLOG_MODE`` is
     ignored by 1.14 and 1.15, and their default log closes at disarm."""
-    if not 0 <= instance <= 9:
-        raise BundleError(f"instance {instance}: expected 0 to 9")
+    if not 0 <= instance <= MAX_INSTANCE:
+        raise BundleError(f"instance {instance}: expected 0 to {MAX_INSTANCE}")
     parent = keep_dir
     if parent is not None:
         parent.mkdir(parents=True, exist_ok=True)

@@ -20,7 +20,9 @@ from fuzzoff.sitl.driver import (
     NAV_OFFBOARD,
     NAV_TAKEOFF,
     Driver,
+    Setpoint,
 )
+from fuzzoff.sitl.link import LinkError
 
 ALT = -2.5
 """Cruise height, NED (2.5 m up)."""
@@ -268,6 +270,81 @@ def vtol_fw_glide(d: Driver) -> None:
     _vtol_back_and_land(d)
 
 
+def _typed(mask: int, point: tuple[float, float, float]) -> Setpoint:
+    """A LOCAL_NED position setpoint with ``type_mask`` as given (the fixed-wing setpoint types)."""
+
+    def send(d: Driver) -> None:
+        d.link.position_target(type_mask=mask, pos=point)
+
+    return send
+
+
+FW_SETPOINT_TYPES = ((12288, "loiter"), (292, "glide"), (8192, "land"), (16384, "idle"))
+"""The fixed-wing setpoint types of PX4's offboard docs, in the order flown (takeoff, 4096, is
+left out: it is sent in flight here, and would take a runway)."""
+
+
+def vtol_fw_types(d: Driver) -> None:
+    """In FW flight, the fixed-wing setpoint types of the docs, 4 s each, then the plain
+    position setpoint again: how each release takes them (1.13-1.17 do not read the type bits;
+    1.18 takes the setpoint by component)."""
+    _vtol_to_fw(d)
+    for mask, label in FW_SETPOINT_TYPES:
+        d.note(f"type_mask {mask} ({label})")
+        d.stream(_typed(mask, VTOL_FW_POINT), 4.0)
+    d.note("position setpoint again")
+    d.stream(d.position(*VTOL_FW_POINT), 4.0)
+    _vtol_back_and_land(d)
+
+
+TAILSITTER_PARAMS = {"FW_USE_AIRSPD": 0.0}
+"""SIH's tailsitter (``sihsim_xvert``) never shows the transition airspeed: the airspeed PX4
+validated stayed at 0.1-5 m/s while it flew 7 m/s over ground, the front transition waited
+for VT_ARSP_TRANS (10 m/s) and PX4 quad-chuted back to MC 6.6 s in (1.18 head). Without the
+airspeed (FW_USE_AIRSPD 0) PX4 times the transition (VT_F_TR_OL_TM) and it reached FW in
+3.4 s, then held 28 m at 10.7 m/s."""
+
+FW_CLIMB_TO_M = 15.0
+"""The airplane's runway takeoff (AUTO_TAKEOFF) climbs this high before the switch."""
+FW_POINT = (400.0, 0.0, -30.0)
+
+
+def _fw_takeoff(d: Driver) -> None:
+    """AUTO_TAKEOFF (the SIH airplane's runway takeoff, RWTO_TKOFF 1) until 15 m up, then the
+    stream and the switch to OFFBOARD in the air."""
+    d.require(d.set_mode(NAV_TAKEOFF, "AUTO_TAKEOFF"), "switch to AUTO_TAKEOFF")
+    d.require(d.arm(), "arm in AUTO_TAKEOFF")
+    deadline = d.now() + 25.0
+    while (d.link.view.relative_alt_m or 0.0) < FW_CLIMB_TO_M and d.now() < deadline:
+        d.wait(0.5)
+    if (d.link.view.relative_alt_m or 0.0) < FW_CLIMB_TO_M:
+        raise LinkError(f"the airplane did not climb to {FW_CLIMB_TO_M:g} m in AUTO_TAKEOFF")
+    d.note(f"{FW_CLIMB_TO_M:g} m up")
+    d.stream(d.position(*FW_POINT), 1.5)
+    d.require(d.set_mode(NAV_OFFBOARD, "OFFBOARD"), "switch to OFFBOARD")
+
+
+def _fw_hold(d: Driver) -> None:
+    d.set_mode(NAV_LOITER, "AUTO_LOITER")
+    d.wait(1.0)
+
+
+def fw_offboard(d: Driver) -> None:
+    _fw_takeoff(d)
+    d.stream(d.position(*FW_POINT), 10.0)
+    _fw_hold(d)
+
+
+def fw_loss(d: Driver) -> None:
+    _fw_takeoff(d)
+    d.stream(d.position(*FW_POINT), 4.0)
+    d.note("stream stops")
+    d.wait(3.0)
+    d.note("stream resumes")
+    d.stream(d.position(*FW_POINT), 4.0)
+    _fw_hold(d)
+
+
 def _rover_start(d: Driver) -> None:
     d.stream(d.position(0, 0, 0), 1.5)
     d.require(d.set_mode(NAV_OFFBOARD, "OFFBOARD"), "switch to OFFBOARD")
@@ -474,6 +551,50 @@ SCENARIOS: dict[str, Scenario] = {
             vtol_fw_glide,
             "clean",
             vehicle="vtol",
+        ),
+        Scenario(
+            "vtol_fw_types",
+            "standard VTOL in FW flight: the fixed-wing setpoint types (12288 loiter, 292 glide,"
+            " 8192 land, 16384 idle), 4 s each, then the position setpoint again",
+            vtol_fw_types,
+            "clean",
+            vehicle="vtol",
+        ),
+        Scenario(
+            "tailsitter_offboard",
+            "tailsitter: as vtol_offboard, with FW_USE_AIRSPD 0 (the transition timed, not on"
+            " the airspeed SIH's tailsitter never shows)",
+            vtol_offboard,
+            "clean",
+            params=TAILSITTER_PARAMS,
+            vehicle="tailsitter",
+        ),
+        Scenario(
+            "tailsitter_loss",
+            "tailsitter: the stream stops 2 s hovering in MC, then 2 s in FW (FW_USE_AIRSPD 0)",
+            vtol_loss,
+            "hazard",
+            "stream lost in OFFBOARD in each VTOL phase (failsafe, then back to OFFBOARD)",
+            ("OFB103",),
+            params=TAILSITTER_PARAMS,
+            vehicle="tailsitter",
+        ),
+        Scenario(
+            "fw_offboard",
+            "airplane: runway takeoff (AUTO_TAKEOFF) to 15 m, stream, switch to OFFBOARD in the"
+            " air, a position setpoint 400 m ahead, Hold",
+            fw_offboard,
+            "clean",
+            vehicle="fw",
+        ),
+        Scenario(
+            "fw_loss",
+            "airplane: takeoff, OFFBOARD, the stream stops 3 s and resumes, Hold",
+            fw_loss,
+            "hazard",
+            "stream lost in OFFBOARD (failsafe, then back to OFFBOARD)",
+            ("OFB103",),
+            vehicle="fw",
         ),
         Scenario(
             "rover_offboard",
