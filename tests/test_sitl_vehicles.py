@@ -167,3 +167,22 @@ def test_a_vtol_gliding_on_a_nan_altitude_in_fw_flight_is_not_a_copter_hold() ->
     codes = {f["code"] for f in json.loads(out.stdout)["files"][0]["findings"]}
     assert "OFB602" not in codes
     assert out.returncode == 0
+
+
+@pytest.mark.parametrize(
+    ("name", "vehicle"),
+    [("fw", "fw"), ("plane", "fw"), ("mc", "quad"), ("hex", "hex"), ("vtol", "vtol")],
+)
+def test_a_live_campaign_takes_a_sitl_vehicle_or_a_vehicle_type(name: str, vehicle: str) -> None:
+    assert airframes.airframe_named(name).vehicle == vehicle
+
+
+def test_a_live_campaign_on_a_build_without_the_airframe_says_so_in_one_line(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    _bundle(tmp_path, "1.16.2", ["sihsim_quadx", "sihsim_airplane"], ["commander"])
+    monkeypatch.setenv("FUZZOFF_PX4_SITL", str(tmp_path))
+    out = run_cli(["fuzz", "--against", "sitl:1.16.2", "--vehicle", "hex"], cwd=tmp_path)
+    assert out.returncode == 2
+    assert "--vehicle hex: PX4 1.16.2 has no SIH airframe sihsim_hex" in out.stderr
+    assert len(out.stderr.strip().splitlines()) == 1

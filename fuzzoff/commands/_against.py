@@ -31,7 +31,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--px4-build", metavar="DIR", type=Path, help="with --against: your own PX4 SITL build"
     )
     live.add_argument(
-        "--instance", type=int, default=0, help="with --against: PX4_INSTANCE (0-9; default 0)"
+        "--instance", type=int, default=0, help="with --against: PX4_INSTANCE (0-99; default 0)"
     )
     live.add_argument(
         "--shrink-runs",
@@ -65,12 +65,14 @@ def _release(text: str, px4_build: Path | None) -> str | None:
     return release or None
 
 
-def _checked(args: argparse.Namespace) -> None:
+def _checked(args: argparse.Namespace) -> str:
+    """The options' own checks (no bundle needed); the SITL vehicle (``airframes.AIRFRAMES``)."""
+    from fuzzoff.sitl import airframes
+    from fuzzoff.sitl.bundle import MAX_INSTANCE
+
     for name, option in NOT_WITH_AGAINST.items():
         if getattr(args, name, None):
             raise ConfigError(f"{option} does not go with --against")
-    if args.vehicle and args.vehicle not in ("mc", "quadrotor", "multicopter"):
-        raise ConfigError(f"--vehicle {args.vehicle}: the PX4 SITL bundles fly a multicopter")
     if args.transport not in (None, "mavlink"):
         raise ConfigError(f"--transport {args.transport}: --against sends MAVLink")
     if args.format not in ("terminal", "json"):
@@ -79,23 +81,30 @@ def _checked(args: argparse.Namespace) -> None:
         raise ConfigError("--examples must be at least 1")
     if args.budget is not None and not (math.isfinite(args.budget) and args.budget > 0):
         raise ConfigError(f"--budget {args.budget:g}: expected a finite number of seconds above 0")
-    if not 0 <= args.instance <= 9:
-        raise ConfigError(f"--instance {args.instance}: expected 0 to 9")
+    if not 0 <= args.instance <= MAX_INSTANCE:
+        raise ConfigError(f"--instance {args.instance}: expected 0 to {MAX_INSTANCE}")
     if args.shrink_runs is not None and args.shrink_runs < 0:
         raise ConfigError(f"--shrink-runs {args.shrink_runs}: expected 0 or more")
+    try:
+        return airframes.airframe_named(args.vehicle or airframes.DEFAULT).vehicle
+    except airframes.AirframeError as exc:
+        raise ConfigError(str(exc)) from None
 
 
 def run(args: argparse.Namespace) -> int:
     from fuzzoff.commands._common import check_save_dir, settings_from_args, write_output
     from fuzzoff.fuzz.reproducers import DEFAULT_DIR
-    from fuzzoff.sitl import bundle
+    from fuzzoff.sitl import airframes, bundle
     from fuzzoff.sitl.against import DEFAULT_BUDGET_S, SHRINK_RUNS, AgainstConfig, run_against
     from fuzzoff.sitl.against_report import to_json, to_terminal
 
-    _checked(args)
+    vehicle = _checked(args)
     release = _release(args.against, args.px4_build)
     try:
         build = bundle.find_build(release, args.px4_build)
+        airframes.boot_env(build, vehicle)  # refused here when the build cannot fly it
+    except airframes.AirframeError as exc:
+        raise ConfigError(str(exc)) from None
     except bundle.BundleError as exc:
         reason = str(exc).removeprefix(f"--release {release}: ")
         raise ConfigError(f"--against {args.against}: {reason}") from None
@@ -107,6 +116,7 @@ def run(args: argparse.Namespace) -> int:
     config = AgainstConfig(
         build=build,
         instance=args.instance,
+        vehicle=vehicle,
         budget_s=budget,
         examples=args.examples,
         seed=args.seed,

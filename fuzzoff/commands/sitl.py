@@ -50,7 +50,7 @@ def add_parser(sub: Any) -> None:
         )
         p.add_argument("--release", metavar="R", help="bundled PX4 release (1.16.2, 1.15)")
         p.add_argument("--px4-build", metavar="DIR", type=Path, help="your own SITL build")
-        p.add_argument("--instance", type=int, default=0, help="PX4_INSTANCE (0-9; default 0)")
+        p.add_argument("--instance", type=int, default=0, help="PX4_INSTANCE (0-99; default 0)")
         p.add_argument(
             "--param",
             action="append",

@@ -40,7 +40,7 @@ from fuzzoff.fuzz.scenario import Scenario
 from fuzzoff.profiles import px4_profile_for
 from fuzzoff.recording import SourceError
 from fuzzoff.releases import PX4Profile
-from fuzzoff.sitl import bundle, delivery
+from fuzzoff.sitl import airframes, bundle, delivery
 from fuzzoff.sitl.bench import Bench
 from fuzzoff.sitl.classify import edge_note, health_refusals, own_changes, shape, signature
 from fuzzoff.sitl.driver import NAV_LOITER
@@ -69,6 +69,8 @@ REPRODUCER_PREFIX = "px4"
 class AgainstConfig:
     build: bundle.Build
     instance: int = 0
+    vehicle: str = airframes.DEFAULT
+    """The SIH airframe PX4 flies (``airframes.AIRFRAMES``: ``sitl run --vehicle``)."""
     budget_s: float | None = DEFAULT_BUDGET_S
     examples: int | None = None
     seed: int = 0
@@ -80,6 +82,11 @@ class AgainstConfig:
     @property
     def profile(self) -> PX4Profile:
         return px4_profile_for(self.build.profile_release)
+
+    @property
+    def judged_as(self) -> str:
+        """The vehicle type the streams are drawn for and the model judges (``mc``, ``fw``...)."""
+        return airframes.airframe_for(self.vehicle).fuzzoff_vehicle
 
 
 @dataclass(slots=True)
@@ -201,7 +208,9 @@ class Campaign:
         self.log = log
         self.result = AgainstResult(config)
         self.started = 0.0
-        self.bench = Bench(config.build, config.instance, log)
+        quad = config.vehicle == airframes.DEFAULT  # PX4's own default: nothing to check
+        env = {} if quad else airframes.boot_env(config.build, config.vehicle)
+        self.bench = Bench(config.build, config.instance, log, env)
         self.known: dict[tuple[str, str, str], Disagreement] = {}
         """Disagreements followed up, by signature (a confirmed one is not followed again)."""
         self.work = Path(tempfile.gettempdir())
@@ -255,7 +264,9 @@ class Campaign:
                 raise _Stop
             self.searched(self.send(scenario, "search"))
 
-        strategy: st.SearchStrategy[Scenario] = scenarios(self.config.profile, "mc", "mavlink")
+        strategy: st.SearchStrategy[Scenario] = scenarios(
+            self.config.profile, self.config.judged_as, "mavlink"
+        )
         test = given(strategy)(one)
         test = settings(
             settings.get_profile(PROFILE_CI),
@@ -314,7 +325,9 @@ class Campaign:
         example.delivery = delivery.check(run.meant, run.sent)
         release = self.config.build.profile_release
         try:
-            verdict = compare(run.tlog, release, run.ulog, setup.params, COMPANION_SYSID)
+            verdict = compare(
+                run.tlog, release, run.ulog, setup.params, COMPANION_SYSID, self.config.judged_as
+            )
             truth = None if run.ulog is None else read_truth(run.ulog)
         except SourceError as exc:  # PX4 killed while writing its log, say
             example.reason = f"the run's recordings cannot be judged: {exc.line()}"

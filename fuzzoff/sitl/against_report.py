@@ -26,7 +26,10 @@ def to_terminal(result: AgainstResult) -> str:
     config = result.config
     search = result.search
     follow = len(result.examples) - len(search)
-    lines = [f"fuzzoff fuzz --against sitl:{config.build.release}, seed {config.seed}"]
+    lines = [
+        f"fuzzoff fuzz --against sitl:{config.build.release} --vehicle {config.vehicle},"
+        f" seed {config.seed}"
+    ]
     boots = ", ".join(f"{b:.0f} s" for b in result.boots) or "-"
     lines.append(
         f"  PX4 {config.build.release} (instance {config.instance}): ready to arm {boots} after"
@@ -143,6 +146,8 @@ def to_json(result: AgainstResult) -> str:
             "against": f"sitl:{config.build.release}",
             "px4_build": str(config.build.folder),
             "instance": config.instance,
+            "vehicle": config.vehicle,
+            "judged_as": config.judged_as,
             "seed": config.seed,
             "budget_s": config.budget_s,
             "examples": config.examples,

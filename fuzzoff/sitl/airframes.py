@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from fuzzoff.profiles import ProfileError, vehicle_type_for
 from fuzzoff.sitl import bundle
 
 
@@ -60,6 +61,24 @@ def airframe_for(vehicle: str) -> Airframe:
         raise AirframeError(
             f"--vehicle {vehicle}: no such SITL vehicle; one of {', '.join(AIRFRAMES)}"
         ) from None
+
+
+def airframe_named(name: str) -> Airframe:
+    """The airframe for a SITL vehicle (``fw``) or a fuzzoff vehicle type (``mc``,
+    ``fixed-wing``: the first airframe judged as that type); ``AirframeError`` for a type no SIH
+    airframe flies (a differential rover)."""
+    if name in AIRFRAMES:
+        return AIRFRAMES[name]
+    try:
+        vehicle = vehicle_type_for(name)
+    except ProfileError:
+        vehicle = None
+    found = next((a for a in AIRFRAMES.values() if a.fuzzoff_vehicle == vehicle), None)
+    if found is None:
+        raise AirframeError(
+            f"--vehicle {name}: no SIH airframe flies it; one of {', '.join(AIRFRAMES)}"
+        )
+    return found
 
 
 def why_not(build: bundle.Build, airframe: Airframe) -> str | None:

@@ -84,9 +84,17 @@ class LiveRun:
 
 
 class Bench:
-    def __init__(self, build: bundle.Build, instance: int, log: Log = print) -> None:
+    def __init__(
+        self,
+        build: bundle.Build,
+        instance: int,
+        log: Log = print,
+        env: dict[str, str] | None = None,
+    ) -> None:
         self.build = build
         self.instance = instance
+        self.env = dict(env or {})
+        """``PX4_*`` variables for each boot (``PX4_SIM_MODEL``: the airframe)."""
         self.log = log
         self.session: Session | None = None
         self.boots: list[float] = []
@@ -102,7 +110,7 @@ class Bench:
 
     def start(self) -> None:
         started = time.monotonic()
-        session = Session(self.build, self.instance, log=self.log)
+        session = Session(self.build, self.instance, env=self.env, log=self.log)
         try:
             session.connect()
             session.px4.command("logger", "off")

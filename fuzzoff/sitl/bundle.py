@@ -225,6 +225,9 @@ class Px4Process:
 
 
 PR_SET_PDEATHSIG = 1
+MAX_INSTANCE = 99
+"""PX4_INSTANCE shifts PX4's ports (14580+N, 14540+N, 18570+N) and its system id (N+1): up to 99
+they stay clear of each other's and of the GCS port 14550."""
 
 
 def _stop_with_parent() -> None:  # pragma: no cover (runs in the child before exec)
@@ -244,8 +247,8 @@ def start(
     adds ``PX4_*`` variables such as ``PX4_SIM_SPEED_FACTOR``. The logger is started and stopped
     per run with ``logger on``/``off`` (``Px4Process.command``): ``PX4_PARAM_SDLOG_MODE`` is
     ignored by 1.14 and 1.15, and their default log closes at disarm."""
-    if not 0 <= instance <= 9:
-        raise BundleError(f"instance {instance}: expected 0 to 9")
+    if not 0 <= instance <= MAX_INSTANCE:
+        raise BundleError(f"instance {instance}: expected 0 to {MAX_INSTANCE}")
     parent = keep_dir
     if parent is not None:
         parent.mkdir(parents=True, exist_ok=True)
