@@ -186,3 +186,9 @@ def test_a_live_campaign_on_a_build_without_the_airframe_says_so_in_one_line(
     assert out.returncode == 2
     assert "--vehicle hex: PX4 1.16.2 has no SIH airframe sihsim_hex" in out.stderr
     assert len(out.stderr.strip().splitlines()) == 1
+
+
+def test_an_instance_above_nine_is_listened_for_where_px4_sends_it() -> None:
+    # px4-rc.mavlink of every bundle: above 9, the onboard link sends to 14549
+    assert bundle.send_port(3) == 14543
+    assert bundle.send_port(30) == bundle.send_port(31) == 14549

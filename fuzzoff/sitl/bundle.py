@@ -25,6 +25,9 @@ API_LISTEN_PORT = 14580
 """PX4's onboard (API) link listens here (+ instance): where a client sends."""
 API_SEND_PORT = 14540
 """PX4's onboard link sends here (+ instance): where a client listens."""
+SHARED_SEND_PORT = 14549
+"""Where every instance above 9 sends (PX4's ``px4-rc.mavlink``, 1.14 to main): only one such
+PX4 per network namespace can be talked to at a time."""
 STOP_TIMEOUT_S = 10.0
 RELEASE_PATTERN = re.compile(r"^\d+\.\d+\.\d+(-[0-9A-Za-z.]+)?$")
 
@@ -168,7 +171,7 @@ class Px4Process:
 
     @property
     def send_port(self) -> int:
-        return API_SEND_PORT + self.instance
+        return send_port(self.instance)
 
     @property
     def sysid(self) -> int:
@@ -226,8 +229,13 @@ class Px4Process:
 
 PR_SET_PDEATHSIG = 1
 MAX_INSTANCE = 99
-"""PX4_INSTANCE shifts PX4's ports (14580+N, 14540+N, 18570+N) and its system id (N+1): up to 99
-they stay clear of each other's and of the GCS port 14550."""
+"""PX4_INSTANCE shifts PX4's ports (14580+N, 18570+N) and its system id (N+1); above 9 PX4 sends
+to 14549 whatever the instance (``send_port``)."""
+
+
+def send_port(instance: int) -> int:
+    """Where PX4 instance ``instance`` sends on its onboard link: where a client listens."""
+    return SHARED_SEND_PORT if instance > 9 else API_SEND_PORT + instance
 
 
 def _stop_with_parent() -> None:  # pragma: no cover (runs in the child before exec)
