@@ -257,3 +257,14 @@ def test_a_rover_program_publishes_its_flag_and_rover_setpoints_then_switches_an
 def test_a_ros2_flight_refuses_a_vehicle_the_build_cannot_fly() -> None:
     out = run_cli(["sitl", "run", "rover_position", "--transport", "ros2", "--vehicle", "boat"])
     assert out.returncode == 2 and "boat" in out.stderr and "Traceback" not in out.stderr
+
+
+def test_the_rover_on_main_is_refused_saying_why() -> None:
+    """Issue 33: main's SIH stalls with the rover; its ROS 2 rover flights say so, not hang."""
+    from fuzzoff.sitl.bundle import default_root
+
+    if not (default_root() / "main-2026-08-13").is_dir():
+        pytest.skip(f"no main-2026-08-13 bundle in {default_root()}")
+    args = ["sitl", "run", "rover_position", "--transport", "ros2"]
+    out = run_cli([*args, "--release", "main-2026-08-13"])
+    assert out.returncode == 2 and "stalls PX4's simulated clock" in out.stderr
