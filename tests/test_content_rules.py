@@ -968,3 +968,32 @@ def test_ofb303_mavlink_attitude_target_counts() -> None:
         *[SetAttitudeTarget(t=round(t, 6), type_mask=7, thrust=0.5) for t in every(0, 2, 0.1)],
     ]
     assert codes(lint_events(events, fmt="tlog"), "OFB303") == []
+
+
+def test_ofb107_a_rover_throttle_held_under_a_held_steering_drives_a_circle() -> None:
+    """Issue 33: PX4 1.17.0 and 1.18 drove the Ackermann rover on 0.3 throttle and 0.3
+    steering in a 5 m circle (corpora/ros2bridge rover_throttle_steering): a bounded motion,
+    reported after turning_s (60 s), not freeze_s; straight ahead (no steering) it is not."""
+    from fuzzoff.events import RoverSteeringSetpoint, RoverThrottleSetpoint
+
+    def drive(seconds: float, steering: float) -> list[Event]:
+        events: list[Event] = [status(0.0, OFFBOARD)]
+        events += ocm(every(0.0, seconds, 0.1), thrust_and_torque=True)
+        events += [
+            RoverThrottleSetpoint(t=round(t + 0.001, 6), throttle_body_x=0.3, throttle_body_y=0.0)
+            for t in every(0.0, seconds, 0.1)
+        ]
+        events += [
+            RoverSteeringSetpoint(t=round(t + 0.002, 6), normalized_steering_angle=steering)
+            for t in every(0.0, seconds, 0.1)
+        ]
+        return events
+
+    def frozen(events: list[Event]) -> list[Finding]:
+        return codes(lint_events(events, px4="1.17", vehicle="rover-ackermann"), "OFB107")
+
+    assert frozen(drive(20.0, 0.3)) == []
+    (circle,) = frozen(drive(65.0, 0.3))
+    assert "rover throttle 0.30 under a held turn (a bounded motion)" in circle.message
+    (straight,) = frozen(drive(20.0, 0.0))
+    assert "rover throttle 0.30 for" in straight.message

@@ -396,3 +396,32 @@ def test_a_jittered_command_keeps_the_vehicles_ack_after_it() -> None:
         for cmd, ack in zip(pairs[::2], pairs[1::2], strict=True)
     )
     assert "OFB201" in {f.code for f in run(jittered)}
+
+
+def _reached(vehicle: str, examples: int) -> dict[str, int]:
+    config = CampaignConfig(
+        px4="1.17",
+        vehicle=vehicle,
+        transport="ros2",
+        examples=examples,
+        seed=SEED,
+        properties=("docs-stricter",),
+    )
+    (result,) = run_campaign(config).results
+    assert result.to_json()["reached"] == result.reached
+    return result.reached
+
+
+def test_a_rover_campaign_reaches_the_rover_rules_and_a_held_command() -> None:
+    """Issue 33 item 5: the rover programs of the docs' table, mostly right (the flag, the NaN
+    crosses) and the deprecated TrajectorySetpoint; a held command (OFB107's 10 s)."""
+    reached = _reached("rover-ackermann", 150)
+    rover_rules = {"OFB501", "OFB502", "OFB503", "OFB504", "OFB505"}
+    assert rover_rules <= set(reached), sorted(reached)
+    assert "OFB107" in reached
+
+
+def test_a_multicopter_campaign_reaches_a_frozen_moving_command() -> None:
+    """Issue 33 item 5: OFB107 needs 10 s of one moving command held in OFFBOARD; the
+    campaign's streams lasted at most 6 s of changing setpoints and never reached it."""
+    assert "OFB107" in _reached("mc", 100)

@@ -221,3 +221,50 @@ def test_a_replay_plan_is_the_bags_inputs_to_px4_from_their_first_message(
 def test_a_ros2_replay_takes_a_bag_folder() -> None:
     out = run_cli(["sitl", "replay", "flight.tlog", "--transport", "ros2", "--release", "1.16.2"])
     assert out.returncode == 2 and "a ROS 2 replay takes a bag folder" in out.stderr
+
+
+def test_a_rover_program_publishes_its_flag_and_rover_setpoints_then_switches_and_arms() -> None:
+    """Issue 33: the rover node of the ``rover_*`` programs, as the example but for a rover."""
+    from fuzzoff.sitl.ros2.programs import PROGRAMS
+    from fuzzoff.sitl.ros2.rover import ROVER_MESSAGES, RoverNode
+
+    program = PROGRAMS["rover_stops"]
+    assert program.rover is not None and program.vehicle == "rover-ackermann"
+    assert program.lint_args == ("--vehicle", "rover-ackermann")
+    sent: list[tuple[str, dict[str, Any]]] = []
+    names = ("OffboardControlMode", "VehicleCommand", *program.rover.messages)
+    node = RoverNode({n: _Sink(n, sent) for n in names}, program.rover)
+    for i in range(12):
+        node.tick(float(i) * 0.1)
+    modes = [v for n, v in sent if n == "OffboardControlMode"]
+    assert len(modes) == 12 and all(m["thrust_and_torque"] and not m["velocity"] for m in modes)
+    commands = [(v["command"], v["param1"], v["param2"]) for n, v in sent if n == "VehicleCommand"]
+    assert commands == [(176, 1.0, 6.0), (400, 1.0, 0.0)]
+    first_command = next(i for i, (n, _) in enumerate(sent) if n == "VehicleCommand")
+    assert [n for n, _ in sent[:3]] == ["OffboardControlMode", *program.rover.messages]
+    assert first_command == 10 * 3  # after ten ticks of the mode and its two setpoints
+    node.tick(1.0 + 5.0)  # 5 s after the arm: the node stops
+    node.tick(6.1)
+    assert node.stopped and len([n for n, _ in sent if n == "OffboardControlMode"]) == 12
+    # every rover program's messages exist in both releases it flies on
+    for rover in (p.rover for p in PROGRAMS.values() if p.rover is not None):
+        for message in rover.messages:
+            assert message in (*ROVER_MESSAGES, "TrajectorySetpoint")
+            for release in ("1.17.0", "1.18.0"):
+                assert bridge_topic(release, message).ros_topic.startswith("/fmu/in/")
+
+
+def test_a_ros2_flight_refuses_a_vehicle_the_build_cannot_fly() -> None:
+    out = run_cli(["sitl", "run", "rover_position", "--transport", "ros2", "--vehicle", "boat"])
+    assert out.returncode == 2 and "boat" in out.stderr and "Traceback" not in out.stderr
+
+
+def test_the_rover_on_main_is_refused_saying_why() -> None:
+    """Issue 33: main's SIH stalls with the rover; its ROS 2 rover flights say so, not hang."""
+    from fuzzoff.sitl.bundle import default_root
+
+    if not (default_root() / "main-2026-08-13").is_dir():
+        pytest.skip(f"no main-2026-08-13 bundle in {default_root()}")
+    args = ["sitl", "run", "rover_position", "--transport", "ros2"]
+    out = run_cli([*args, "--release", "main-2026-08-13"])
+    assert out.returncode == 2 and "stalls PX4's simulated clock" in out.stderr

@@ -45,6 +45,20 @@ RUNS: tuple[tuple[str, str], ...] = (
     ("example_in_only", "1.16.2-ros2"),
     ("example_agent_restart", "1.16.2-ros2"),
     ("example_agent_restart", "1.18.0-beta1-head"),
+    *(
+        (program, bundle_name)
+        for program in (
+            "rover_position",
+            "rover_speed_steering",
+            "rover_speed_attitude",
+            "rover_throttle_steering",
+            "rover_trajectory",
+            "rover_speed_alone",
+            "rover_throttle_velocity_flag",
+            "rover_stops",
+        )
+        for bundle_name in ("1.17.0-ros2-rover", "1.18.0-beta1-head")
+    ),
 )
 """(program of ``fuzzoff.sitl.ros2.programs``, bundle): one PX4 boot each."""
 MAX_BYTES = 1_000_000

@@ -1,4 +1,4 @@
-"""Build the rover rule corpus: ROS 2 offboard control of rovers (OFB501-OFB506) as MCAP.
+"""Build the rover rule corpus: ROS 2 offboard control of rovers (OFB501-OFB506, OFB510) as MCAP.
 
 Run ``.venv/bin/python corpora/rules_rover/build.py``; it is deterministic. Every recording is
 written through ``fuzzoff.formats.mcap.writer`` with the px4_msgs of PX4 1.17 (1.16 has no
@@ -52,7 +52,7 @@ FIRST_SETPOINT = 1.55
 FIRST_JUDGED = 1.6
 """The first OffboardControlMode after the accepting ack (the combination rules' time)."""
 RELEASE = "1.17"
-ROVER_RULES = ["OFB501", "OFB502", "OFB503", "OFB504", "OFB505", "OFB506"]
+ROVER_RULES = ["OFB501", "OFB502", "OFB503", "OFB504", "OFB505", "OFB506", "OFB510"]
 
 
 def ticks(start: float, stop: float, period: float) -> list[float]:
@@ -121,6 +121,10 @@ def speed_rate(t: float) -> list[Event]:
 
 def speed_rate_no_nan(t: float) -> list[Event]:
     return [speed(t), yaw_rate(t)]
+
+
+def speed_steering(t: float) -> list[Event]:
+    return [speed(t), heading(t, nan=True), yaw_rate(t, nan=True), steering(t)]
 
 
 def speed_only(t: float) -> list[Event]:
@@ -254,6 +258,24 @@ def cases() -> list[Case]:
             Drive({"velocity": True, "direct_actuator": True}, actuators),
             [("OFB506", "error", FIRST_SETPOINT)],
             ["OFB501", "OFB502", "OFB503", "OFB504", "OFB505"],
+        ),
+        # OFB510: Speed + Steering to an Ackermann rover in OFFBOARD, as the docs' table says;
+        # PX4 1.17+ rewrites the speed and heading from TrajectorySetpoint (seen running).
+        Case(
+            "ofb510_ackermann_speed_steering",
+            "rover-ackermann",
+            Drive(velocity, speed_steering),
+            [("OFB510", "error", FIRST_JUDGED)],
+            ["OFB501", "OFB502", "OFB503", "OFB504", "OFB505", "OFB506"],
+        ),
+        # The same rover on the deprecated TrajectorySetpoint: PX4's conversion is what drives
+        # it (OFB501 only).
+        Case(
+            "ofb501_ackermann_trajectory",
+            "rover-ackermann",
+            Drive(velocity, trajectory_velocity),
+            [("OFB501", "warning", FIRST_SETPOINT)],
+            ["OFB502", "OFB503", "OFB504", "OFB506", "OFB510"],
         ),
         # -- scripts/add_rule.py adds a new rule's cases above this line
     ]

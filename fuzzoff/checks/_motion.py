@@ -10,7 +10,9 @@ the vehicle is not: re-sent after the controller behind it died, it flies the ve
   pitch rate or torque, a thrust away from hover, a rover speed or throttle;
 * ``TURNING``: the motion stays bounded: a body-frame velocity with a yaw rate (a circle: PX4
   turns the body velocity with the heading), a yaw rate alone (a turn on the spot), a banked
-  fixed-wing (an orbit).
+  fixed-wing (an orbit), a rover's speed or throttle held under a steering or yaw-rate setpoint
+  that turns it (``rover_turns``: on another topic, so the check pairs them; an Ackermann rover
+  on 0.3 throttle and 0.3 steering drove a 5 m circle on PX4 1.17.0 and 1.18).
 
 Direct actuator outputs cannot be judged without the vehicle's mixer: never a motion here.
 """
@@ -28,6 +30,7 @@ from fuzzoff.events import (
     RatesSetpoint,
     RoverRateSetpoint,
     RoverSpeedSetpoint,
+    RoverSteeringSetpoint,
     RoverThrottleSetpoint,
     SetAttitudeTarget,
     SetPositionTargetGlobal,
@@ -258,3 +261,18 @@ def held_motion(event: Event, vehicle: str, hover: Hover) -> Motion | None:
     if isinstance(event, RoverRateSetpoint):
         return _turn(event.yaw_rate_setpoint)
     return None
+
+
+ROVER_TURNS = ("rover_steering", "rover_rate")
+"""The rover setpoints that turn a rover driven by a held speed or throttle."""
+
+
+def rover_turns(event: Event) -> bool:
+    """Does this rover steering or yaw-rate setpoint turn the rover (a value, not zero)?
+    A speed or throttle held under it drives a circle: a bounded motion."""
+    if isinstance(event, RoverSteeringSetpoint):
+        values = (event.normalized_steering_angle, event.normalized_speed_diff)
+        return any(math.isfinite(v) and _nonzero(v) for v in values)
+    if isinstance(event, RoverRateSetpoint):
+        return math.isfinite(event.yaw_rate_setpoint) and _nonzero(event.yaw_rate_setpoint)
+    return False

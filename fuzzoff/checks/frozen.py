@@ -21,7 +21,7 @@ from typing import Any
 
 from fuzzoff.checks._external import external_only, from_external
 from fuzzoff.checks._keepalive import mode_note
-from fuzzoff.checks._motion import Hover, Motion, held_motion
+from fuzzoff.checks._motion import ROVER_TURNS, Hover, Motion, held_motion, rover_turns
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import MAVLINK_SETPOINTS, PX4_SETPOINTS, Event, VehicleStatus, Where
 from fuzzoff.gate import GateTransition
@@ -216,6 +216,9 @@ class SetpointFrozen(Check):
         (frozen content). Tried first on the next run."""
         self.quiet_single = self.shortest >= 0
         """A run of one message (duration 0) is never reported: the moving fast path needs it."""
+        self.turns: dict[str, tuple[float, float]] = {}
+        """Rover steering / yaw-rate kind -> (start, last) of its last closed run that turned
+        the rover: a speed or throttle held under it drives a circle (``_rover_turning``)."""
 
     def on_event(self, event: Event) -> None:
         if not self.ctx.flying:  # out of offboard, or disarmed
@@ -388,13 +391,30 @@ class SetpointFrozen(Check):
         motion = held_motion(run.first, self.ctx.profile.vehicle, self.hover)
         if motion is None:
             return None
+        if motion.kind == "straight" and run.first.kind in ("rover_speed", "rover_throttle"):
+            motion = self._rover_turning(run, motion)
         limit = self.freeze if motion.kind == "straight" else self.turning
         return motion if duration > limit else None
+
+    def _rover_turning(self, run: _Run, motion: Motion) -> Motion:
+        """A rover speed or throttle held while a steering or yaw-rate setpoint that turns the
+        rover covers its first ``freeze_s`` (from the start, within ``max_gap_s``): a circle."""
+        end = min(run.last, run.start + self.freeze) - self.max_gap
+        for kind in ROVER_TURNS:
+            open_run = self.runs.get(kind)
+            spans = [self.turns[kind]] if kind in self.turns else []
+            if open_run is not None and rover_turns(open_run.first):
+                spans.append((open_run.start, open_run.last))
+            if any(s <= run.start + self.max_gap and last >= end for s, last in spans):
+                return Motion("turning", f"{motion.what} under a held turn")
+        return motion
 
     def _close(self, kind: str) -> None:
         run = self.runs.pop(kind, None)
         if run is None:
             return
+        if kind in ROVER_TURNS and rover_turns(run.first):
+            self.turns[kind] = (run.start, run.last)
         motion = self._motion(run, run.last)
         if motion is None:
             return

@@ -160,6 +160,13 @@ def _run_ros2(args: argparse.Namespace) -> int:
         raise ConfigError("--speed is MAVLink-only for now: a ROS 2 replay keeps the bag's times")
     if args.action == "replay" and not Path(args.path).is_dir():
         raise ConfigError(f"{args.path}: a ROS 2 replay takes a bag folder (metadata.yaml)")
+    if getattr(args, "vehicle", None):
+        from fuzzoff.sitl.airframes import AirframeError, airframe_for
+
+        try:
+            airframe_for(args.vehicle)
+        except AirframeError as exc:
+            raise ConfigError(str(exc)) from None
     try:
         build = bundle.find_bridge_build(args.release, args.px4_build)
     except bundle.BundleError as exc:
@@ -171,7 +178,7 @@ def _run_ros2(args: argparse.Namespace) -> int:
 
     try:
         if args.action == "run":
-            outcome = ros2_run.fly(args.scenario, build, save_dir, log)
+            outcome = ros2_run.fly(args.scenario, build, save_dir, log, args.vehicle)
         else:
             outcome = ros2_run.replay_bag(Path(args.path), build, save_dir, log)
     except ros2_run.FlightError as exc:

@@ -74,6 +74,9 @@ class PropertyResult:
     started: float = 0.0
     known: dict[str, int] = field(default_factory=dict)
     """Known problems seen (pattern -> examples), when the campaign filters them."""
+    reached: dict[str, int] = field(default_factory=dict)
+    """Rule code -> the examples it gave a finding on, for the properties that lint the
+    stream (``explained``, ``docs-stricter``): which rules the campaign's streams reach."""
 
     def seconds_so_far(self) -> float:
         return time.perf_counter() - self.started
@@ -99,6 +102,7 @@ class PropertyResult:
             else self.counterexample.describe(),
             "counts": self.counts,
             "known": self.known,
+            "reached": self.reached,
         }
 
 
@@ -174,6 +178,7 @@ def run_property(
 
     try:
         _hypothesis(search, config, config.examples)
+        result.reached = dict(sorted(ctx.reached.items()))  # the search's, not the shrinking's
         if first:
             _shrink(spec, config, ctx, known, result, first)
     finally:

@@ -66,6 +66,9 @@ class FuzzContext:
     workdir: Path = field(default_factory=lambda: Path(tempfile.mkdtemp(prefix="fuzzoff-")))
     docs_fired: Counter[str] = field(default_factory=Counter)
     docs_stricter: Counter[str] = field(default_factory=Counter)
+    reached: Counter[str] = field(default_factory=Counter)
+    """Rule code -> the examples it gave a finding on (any severity; the properties that lint
+    the stream count it): which rules a campaign's streams reach."""
     cut_fraction: float = 1.0
     """Where ``truncated_recordings_give_a_prefix`` cuts (drawn per example)."""
     first_only: bool = True
@@ -84,6 +87,7 @@ Property = Callable[[Scenario, FuzzContext], list[str]]
 def _timelines(scenario: Scenario, ctx: FuzzContext) -> tuple[list[Finding], dict[str, Timeline]]:
     timelines: dict[str, Timeline] = {}
     findings = run(scenario, ctx.settings, timelines=timelines)
+    ctx.reached.update({f.code for f in findings})
     return findings, timelines
 
 

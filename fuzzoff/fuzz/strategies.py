@@ -1,11 +1,11 @@
 """Hypothesis strategies, one per concept of a setpoint stream (composed in ``fuzz.streams``).
 
-Timing: ``rates``, ``jitters``, ``stalls``, ``bursts``, ``held_streams``, ``keepalive_times``,
-``clock_skews``.
+Timing: ``rates``, ``jitters``, ``stalls``, ``bursts``, ``held_streams``, ``held_commands``,
+``keepalive_times``, ``clock_skews``.
 Declarations: ``control_modes``. Content: ``nan_patterns``, ``trajectory_setpoints``,
 ``quaternions``, ``attitude_setpoints``, ``rates_setpoints``, ``rover_setpoints``,
-``frames``, ``type_masks``, ``mavlink_setpoints``. Commands: ``command_plans``. Parameters:
-``gate_params``. Profile: ``px4_versions``, ``vehicle_types``.
+``rover_programs``, ``frames``, ``type_masks``, ``mavlink_setpoints``. Commands:
+``command_plans``. Parameters: ``gate_params``. Profile: ``px4_versions``, ``vehicle_types``.
 
 Values are float32-representable (``width=32``): every recording format stores setpoints as
 float32, so a stream survives the round trip through the writers unchanged.
@@ -135,6 +135,29 @@ def held_streams() -> st.SearchStrategy[tuple[float, float] | None]:
         st.none(),
         st.none(),
         st.tuples(st.sampled_from(HELD_SECONDS), st.sampled_from(HELD_RATES)),
+    )
+
+
+@dataclass(frozen=True, slots=True)
+class HeldCommand:
+    """One command that moves the vehicle, held identical in OFFBOARD for a long stream (what
+    OFB107 waits 10 s for): how long, how often, how fast (m/s, or a rover's throttle)."""
+
+    duration: float
+    rate: float
+    speed: float
+    switch: float
+    """When the switch to OFFBOARD is sent (after about 1 s of keep-alive, the arm before)."""
+
+
+def held_commands() -> st.SearchStrategy[HeldCommand]:
+    speed = st.floats(0.5, 5.0, width=32) | st.floats(-5.0, -0.5, width=32)
+    return st.builds(
+        HeldCommand,
+        duration=st.sampled_from(HELD_SECONDS),
+        rate=st.sampled_from(HELD_RATES),
+        speed=speed,
+        switch=st.sampled_from((1.0, 1.2, 1.5, 2.0)),
     )
 
 
@@ -364,12 +387,69 @@ ROVER_COMBINATIONS: tuple[tuple[str, ...], ...] = (
 )
 """The combinations the rover docs list (each needs the setpoints above it as NaN, OFB504)."""
 
+ROVER_FLAG: dict[tuple[str, ...], str] = {
+    ("rover_position",): "position",
+    ("rover_speed", "rover_attitude"): "velocity",
+    ("rover_speed", "rover_rate"): "velocity",
+    ("rover_speed", "rover_steering"): "velocity",
+    ("rover_throttle", "rover_attitude"): "attitude",
+    ("rover_throttle", "rover_rate"): "body_rate",
+    ("rover_throttle", "rover_steering"): "thrust_and_torque",
+}
+"""Every combination of the rover docs' table and the one ``OffboardControlMode`` flag it needs."""
+ROVER_NAN: dict[tuple[str, ...], tuple[str, ...]] = {
+    ("rover_speed", "rover_rate"): ("rover_attitude",),
+    ("rover_speed", "rover_steering"): ("rover_attitude", "rover_rate"),
+}
+"""The setpoints a combination needs published as NaN (the docs' crosses)."""
+
+
+@dataclass(frozen=True, slots=True)
+class RoverProgram:
+    """What a rover program publishes each cycle: the control-mode flag and its rover
+    setpoints (kind, values), NaN ones included."""
+
+    flag: str
+    published: tuple[tuple[str, RoverValues], ...]
+
+
+def _nan_values(values: RoverValues) -> RoverValues:
+    return {k: (NAN, NAN) if isinstance(v, tuple) else NAN for k, v in values.items()}
+
 
 @st.composite
-def rover_setpoints(draw: st.DrawFn, kind: str | None = None) -> tuple[str, RoverValues]:
-    """(kind, values) of one rover setpoint topic; NaN where the docs require it, or not."""
+def rover_programs(draw: st.DrawFn, available: Sequence[str] = ROVER_KINDS) -> RoverProgram:
+    """A rover program as the docs describe it, mostly right: one of the table's combinations
+    with values, its flag (now and then another: OFB503), and the crosses published as NaN,
+    left out or given a value (OFB504)."""
+    # the combinations with crosses twice: their NaN rule (OFB504) is the easiest to get wrong
+    combos = [c for c in (*ROVER_FLAG, *ROVER_NAN) if all(k in available for k in c)]
+    combo = draw(st.sampled_from(combos))
+    right = ROVER_FLAG[combo]
+    flag = draw(st.one_of(st.just(right), st.just(right), st.sampled_from(OCM_FLAGS_115)))
+    published = [draw(rover_setpoints(kind, finite=True)) for kind in combo]
+    for cross in ROVER_NAN.get(combo, ()):
+        if cross not in available:
+            continue
+        policy = draw(st.sampled_from(("nan", "missing", "value")))
+        if policy != "missing":
+            kind, values = draw(rover_setpoints(cross, finite=True))
+            published.append((kind, values if policy == "value" else _nan_values(values)))
+    return RoverProgram(flag, tuple(published))
+
+
+@st.composite
+def rover_setpoints(
+    draw: st.DrawFn, kind: str | None = None, finite: bool = False
+) -> tuple[str, RoverValues]:
+    """(kind, values) of one rover setpoint topic; NaN where the docs require it, or not
+    (``finite``: every value a number, never 0 for the first: a setpoint that drives)."""
     kind = kind or draw(st.sampled_from(ROVER_KINDS))
-    value = st.one_of(st.floats(-2.0, 2.0, width=32), st.just(NAN))
+    value: st.SearchStrategy[float] = (
+        st.floats(0.25, 2.0, width=32) | st.floats(-2.0, -0.25, width=32)
+        if finite
+        else st.one_of(st.floats(-2.0, 2.0, width=32), st.just(NAN))
+    )
     if kind == "rover_position":
         return kind, {"position_ned": (draw(f32), draw(f32)), "yaw": draw(value)}
     if kind == "rover_speed":

@@ -287,7 +287,10 @@ def ros2_sent(draw: st.DrawFn, px4: PX4Profile, vehicle: str, times: list[float]
     # A rover program publishes a combination of rover setpoints (OFB502, OFB504).
     most = 3 if is_rover(vehicle) else 1
     any_kinds = st.lists(st.sampled_from(choices), min_size=1, max_size=most, unique=True)
-    if is_rover(vehicle) and releases.get(px4).rover_setpoints:
+    rover_path = is_rover(vehicle) and releases.get(px4).rover_setpoints
+    if rover_path and draw(st.booleans()) and times:
+        return draw(_rover_program_series(px4, times, stamps))
+    if rover_path:
         combos = [c for c in fs.ROVER_COMBINATIONS if all(_published(k, px4) for k in c)]
         kinds = draw(
             st.one_of(any_kinds, st.sampled_from(combos).map(list)) if combos else any_kinds
@@ -301,14 +304,53 @@ def ros2_sent(draw: st.DrawFn, px4: PX4Profile, vehicle: str, times: list[float]
     return out
 
 
+def _control_mode_layout(px4: PX4Profile) -> fs.ControlModeFlags:
+    newer = releases.get(px4).control_mode == "thrust_and_torque"
+    return fs.ControlModeFlags(layout="thrust_and_torque" if newer else "actuator")
+
+
+@st.composite
+def _rover_program_series(
+    draw: st.DrawFn, px4: PX4Profile, times: list[float], stamps: list[int]
+) -> list[ev.Event]:
+    """A rover program's cycle (``fs.rover_programs``), or the deprecated ``TrajectorySetpoint``
+    under one of the flags the docs give it (position, velocity, attitude: yaw, which an
+    Ackermann rover cannot take), each message after the keep-alive."""
+    flags = _control_mode_layout(px4)
+    if draw(st.integers(0, 3)) == 0:
+        flag = draw(st.sampled_from(("position", "velocity", "attitude")))
+        published: list[tuple[str, fs.SetpointValues]] = [
+            ("trajectory", draw(fs.trajectory_setpoints()))
+        ]
+    else:
+        program = draw(fs.rover_programs([k for k in fs.ROVER_KINDS if _published(k, px4)]))
+        flag = program.flag
+        published = [(k, _carried(k, px4, v)) for k, v in program.published]
+    flags[flag] = True  # type: ignore[literal-required]  # a name of OCM_FLAGS_115
+    out: list[ev.Event] = [
+        ev.ControlMode(t=t, sender_time_us=s, **flags) for t, s in zip(times, stamps, strict=True)
+    ]
+    for offset, (kind, values) in enumerate(published):
+        out += draw(_setpoint_series(kind, times, 0.001 * (offset + 1), px4, values))
+    return out
+
+
 @st.composite
 def _setpoint_series(
-    draw: st.DrawFn, kind: str, times: list[float], lag: float, px4: PX4Profile
+    draw: st.DrawFn,
+    kind: str,
+    times: list[float],
+    lag: float,
+    px4: PX4Profile,
+    given: fs.SetpointValues | None = None,
 ) -> list[ev.Event]:
     """One setpoint topic following the keep-alive by ``lag``, maybe starting late or stopping
-    early (stale setpoints under a live keep-alive: OFB104), frozen or moving."""
+    early (stale setpoints under a live keep-alive: OFB104), frozen or moving; ``given``: its
+    values (else drawn)."""
     values: fs.SetpointValues
-    if kind == "trajectory":
+    if given is not None:
+        values = given
+    elif kind == "trajectory":
         values = draw(fs.trajectory_setpoints())
     elif kind == "attitude":
         values = draw(fs.attitude_setpoints())
@@ -347,8 +389,21 @@ def mavlink_sent(
         thrust = float(values["thrust"])
         values["thrust"] = min(max(thrust, 0.0), 1.0) if thrust == thrust else 0.0
     skew = draw(fs.clock_skews()) if transport == "mavlink" else fs.ClockSkew(0.0, 0.0, ())
+    nth = fs.frozen_or_moving(values) if draw(st.booleans()) else None
+    return _mavlink_series(times, transport, (kind, values), skew, nth)
+
+
+def _mavlink_series(
+    times: list[float],
+    transport: TransportName,
+    setpoint: tuple[str, dict[str, Any]],
+    skew: fs.ClockSkew,
+    nth: Callable[[int], Any] | None,
+) -> list[ev.Event]:
+    """One MAVLink setpoint per send time (``nth``: the i-th one's values; None: the same)."""
+    kind, values = setpoint
+    nth = nth or (lambda i: values)
     stamps = [s // 1000 * 1000 for s in skew.stamp(times)]
-    nth = fs.frozen_or_moving(values) if draw(st.booleans()) else (lambda i: values)
     build = _MAV_BUILD[kind]
     out: list[ev.Event] = []
     for i, t in enumerate(times):
@@ -361,6 +416,76 @@ def mavlink_sent(
             extra["vehicle"] = ""
         out.append(build(t=t, transport=transport, **extra, **nth(i)))
     return out
+
+
+VELOCITY_MASK = 0b110111000111
+"""SET_POSITION_TARGET_LOCAL_NED: velocity only (position, acceleration, yaw ignored)."""
+
+
+def _held_sent(
+    held: fs.HeldCommand, px4: PX4Profile, vehicle: str, transport: TransportName
+) -> list[ev.Event]:
+    """The companion's stream of a held command: one moving setpoint, identical in every
+    message, at a steady rate (``fs.held_commands``)."""
+    n = int(held.duration * held.rate) + 1
+    times = [round(i / held.rate, 4) for i in range(n)]
+    v = held.speed
+    if transport != "ros2":
+        values: dict[str, Any] = {
+            "type_mask": VELOCITY_MASK,
+            "coordinate_frame": 1,
+            "position": (0.0, 0.0, 0.0),
+            "velocity": (v, 0.0, 0.0),
+            "acceleration": (0.0, 0.0, 0.0),
+            "yaw": 0.0,
+            "yaw_rate": 0.0,
+        }
+        setpoint = ("set_position_target_local_ned", values)
+        return _mavlink_series(times, transport, setpoint, fs.ClockSkew(0.0, 0.0, ()), None)
+    flags = _control_mode_layout(px4)
+    flags["velocity"] = True
+    out: list[ev.Event] = [
+        ev.ControlMode(t=t, sender_time_us=round(t * 1e6), **flags) for t in times
+    ]
+    setpoints: list[ev.Event] = []
+    for t in times:
+        t1 = t + 0.001
+        if is_rover(vehicle) and releases.get(px4).rover_setpoints:
+            setpoints.append(
+                ev.RoverSpeedSetpoint(
+                    t=t1, sender_time_us=round(t1 * 1e6), speed_body_x=v, speed_body_y=0.0
+                )
+            )
+            t2 = t + 0.002
+            setpoints.append(
+                ev.RoverAttitudeSetpoint(t=t2, sender_time_us=round(t2 * 1e6), yaw_setpoint=0.0)
+            )
+        else:
+            setpoints.append(
+                ev.TrajectorySetpoint(
+                    t=t1, sender_time_us=round(t1 * 1e6), velocity=(v, 0.0, 0.0), yaw=0.0
+                )
+            )
+    return out + setpoints
+
+
+@st.composite
+def held_scenarios(
+    draw: st.DrawFn, px4: PX4Profile, vehicle: str, transport: TransportName
+) -> Scenario:
+    """A companion that arms, switches to OFFBOARD and holds one moving command for 12-20 s
+    (a frozen planner: OFB107), on the vehicle's own setpoints (a rover's speed and heading
+    from 1.16, else a velocity)."""
+    held = draw(fs.held_commands())
+    sent = _held_sent(held, px4, vehicle, transport)
+    plan = fs.CommandPlan(
+        arm=round(held.switch - 0.2, 3),
+        switch=held.switch,
+        leave=None,
+        disarm=None,
+        acks=transport != "mavros",
+    )
+    return _assembled(px4, vehicle, transport, {}, sent, plan)
 
 
 @st.composite
@@ -379,6 +504,8 @@ def scenarios(
     if chosen == "ros2" and not release.control_mode_flags:
         chosen = "mavlink"  # the ROS 2 control mode does not exist before 1.13
     vehicle = vehicle or draw(fs.vehicle_types())
+    if draw(st.sampled_from((False,) * 7 + (True,))):  # one stream in eight: a held command
+        return draw(held_scenarios(profile, vehicle, chosen))
     params = draw(fs.gate_params(profile))
     timeout = loss_timeout(profile, default_params(profile) | params)
     times = draw(fs.keepalive_times(timeout))
@@ -390,6 +517,18 @@ def scenarios(
     plan = draw(fs.command_plans(duration, chosen == "ros2" and release.handles_set_nav_state))
     if chosen == "mavros":
         plan = replace(plan, acks=False)
+    return _assembled(profile, vehicle, chosen, params, sent, plan)
+
+
+def _assembled(
+    profile: PX4Profile,
+    vehicle: str,
+    chosen: TransportName,
+    params: dict[str, float],
+    sent: list[ev.Event],
+    plan: fs.CommandPlan,
+) -> Scenario:
+    """The companion's stream with its commands and the vehicle's answers, as recorded."""
     sent = settle([*sent, *commands(plan, chosen)])
     answers = echo(
         sent,

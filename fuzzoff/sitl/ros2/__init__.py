@@ -10,6 +10,7 @@ interface is loopback (``netns``): DDS discovers its peers by multicast.
 - ``dds``: the px4_msgs types as DDS types, readers and writers (imports cyclonedds);
 - ``bag``: what was received, written as ``ros2 bag record`` writes it (rosbags' writer);
 - ``example``: the behaviour of px4_ros_com's ``offboard_control`` example, and its hazards;
+- ``rover``: a rover node driving with the rover setpoints (the ``rover_*`` programs);
 - ``flight``: one PX4 boot, the agent, the recorder and the client (inside the namespace);
 - ``netns``: starts ``flight`` inside ``unshare --net --mount``.
 """

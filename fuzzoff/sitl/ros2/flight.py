@@ -25,7 +25,7 @@ from typing import Any
 from cyclonedds.domain import DomainParticipant
 
 from fuzzoff.formats.rosbag2.writer import Storage
-from fuzzoff.sitl import bundle
+from fuzzoff.sitl import airframes, bundle
 from fuzzoff.sitl.ros2 import agent
 from fuzzoff.sitl.ros2.bag import Recording, write_bag
 from fuzzoff.sitl.ros2.dds import Publisher, idl_type
@@ -35,6 +35,7 @@ from fuzzoff.sitl.ros2.programs import PROGRAMS, Program
 from fuzzoff.sitl.ros2.recorder import Recorder
 from fuzzoff.sitl.ros2.replay import Plan as ReplayPlan
 from fuzzoff.sitl.ros2.replay import load_plan
+from fuzzoff.sitl.ros2.rover import ROVER_MESSAGES, RoverNode
 from fuzzoff.sitl.trim import trim
 
 READY_TIMEOUT_S = 90.0
@@ -78,7 +79,14 @@ class AgentRestart:
 class BridgeFlight:
     """PX4 with its agent, and a recorder on DDS: booted, ready, recorded, stopped."""
 
-    def __init__(self, release: str, program: Program | None, log: Log = print) -> None:
+    def __init__(
+        self,
+        release: str,
+        program: Program | None,
+        log: Log = print,
+        vehicle: str | None = None,
+    ) -> None:
+        """``vehicle``: the SIH airframe (``airframes``; None: the program's, else the quad)."""
         if "/" in release:  # a build folder (--px4-build)
             self.build = bundle.find_build(None, Path(release))
         else:
@@ -87,8 +95,14 @@ class BridgeFlight:
         self.topics_in_only = program is not None and program.topics == "in"
         release_name = self.build.profile_release  # no px4_msgs for it: fails before PX4 starts
         self.received = [bridge_topic(release_name, m) for m in RECEIVED]
-        self.sent = [bridge_topic(release_name, m) for m in SENT]
+        rover = program is not None and program.rover is not None
+        self.sent = [
+            bridge_topic(release_name, m) for m in SENT + (ROVER_MESSAGES if rover else ())
+        ]
         env = {"PX4_AGENT": str(bundle.default_root() / "agent"), "PX4_PARAM_SDLOG_MODE": "2"}
+        self.vehicle = vehicle or (program.vehicle if program is not None else None)
+        if self.vehicle is not None:
+            env = airframes.boot_env(self.build, self.vehicle, env)
         self.px4 = bundle.start(self.build, 0, env)
         self.restart = AgentRestart(program, self.px4)
         self.participant = DomainParticipant(0)
@@ -146,6 +160,7 @@ class BridgeFlight:
             "recording": stem,
             "program": name,
             "release": self.build.release,
+            "vehicle": self.vehicle or airframes.DEFAULT,
             "notes": [(round(t - t0, 3), n) for t, n in sorted(notes + self.restart.notes)],
             "modes": [(round(t - t0, 3), *rest) for t, *rest in watch.modes],
             "acks": [{**a, "t": round(a["t"] - t0, 3)} for a in watch.acks if a["t"] >= t0],
@@ -166,20 +181,33 @@ class BridgeFlight:
         self.px4.cleanup()
 
 
-def fly(release: str, out: Path, stem: str, program: Program, log: Log = print) -> dict[str, Any]:
+def fly(
+    release: str,
+    out: Path,
+    stem: str,
+    program: Program,
+    log: Log = print,
+    vehicle: str | None = None,
+) -> dict[str, Any]:
     """Fly ``program`` on the bundle ``release``; what happened (the run's summary)."""
-    with BridgeFlight(release, program, log) as flight:
+    with BridgeFlight(release, program, log, vehicle) as flight:
         flight.wait_ready()
         if program.record_from_s is None:
             flight.record()
             time.sleep(LEAD_S)
         node_participant = DomainParticipant(0)
         by_message = {t.message: t for t in flight.sent}
-        node = OffboardControl(
-            {t.message: Publisher(node_participant, t) for t in flight.sent},
-            program.plan,
-            new_sink=lambda message: Publisher(node_participant, by_message[message]),
-        )
+        node: OffboardControl | RoverNode
+        if program.rover is not None:
+            wanted = {"OffboardControlMode", "VehicleCommand", *program.rover.messages}
+            sinks = {m: Publisher(node_participant, by_message[m]) for m in wanted}
+            node = RoverNode(sinks, program.rover)
+        else:
+            node = OffboardControl(
+                {t.message: Publisher(node_participant, t) for t in flight.sent},
+                program.plan,
+                new_sink=lambda message: Publisher(node_participant, by_message[message]),
+            )
         flight.t0 = t0 = time.monotonic()
         tick = t0 + TICK_S
         while True:
@@ -239,12 +267,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("program", help=f"one of {', '.join(PROGRAMS)}, or a replay plan (.json)")
     parser.add_argument("release", help="a bundle with the bridge (1.16.2-ros2) or a build folder")
     parser.add_argument("stem", help="the outputs' name")
+    parser.add_argument("--vehicle", help="the SIH airframe (fuzzoff.sitl.airframes)")
     args = parser.parse_args(argv)
     out = Path(".")  # the caller's folder: netns binds it at its own path and enters it
     if args.program.endswith(".json"):
         summary = replay(args.release, out, args.stem, load_plan(Path(args.program)))
     elif args.program in PROGRAMS:
-        summary = fly(args.release, out, args.stem, PROGRAMS[args.program])
+        summary = fly(args.release, out, args.stem, PROGRAMS[args.program], vehicle=args.vehicle)
     else:
         parser.error(f"no program {args.program!r}")
     (out / f"{args.stem}.json").write_text(json.dumps(summary, indent=1, default=str) + "\n")

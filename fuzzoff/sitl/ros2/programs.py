@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
+from fuzzoff.sitl.ros2 import rover as r
 from fuzzoff.sitl.ros2.example import Plan
 
 
@@ -38,6 +39,155 @@ class Program:
     """The agent is stopped this long after the arm (PX4 loses the bridge) ..."""
     agent_down_s: float = 2.0
     """... and a new one started this much later (PX4 #26022: does PX4 come back?)."""
+    rover: r.RoverPlan | None = None
+    """A rover node (``rover.py``) instead of the example's; ``plan`` is then unused."""
+    vehicle: str | None = None
+    """The SIH airframe it flies (``fuzzoff.sitl.airframes``; None: PX4's default quad)."""
+    lint_args: tuple[str, ...] = ()
+    """What ``fuzzoff lint`` needs beside the recording (a rover's kind: ``--vehicle``)."""
+
+
+ROVER = "rover-ackermann"
+ROVER_LINT = ("--vehicle", ROVER)
+"""Neither the rover topics nor VehicleStatus say which kind of rover (docs/ros2.md)."""
+
+
+def _rover(
+    name: str,
+    summary: str,
+    plan: r.RoverPlan,
+    kind: Literal["clean", "hazard"],
+    codes: tuple[str, ...] = (),
+    *,
+    hazard: str | None = None,
+    fly_s: float = 12.0,
+    tail_s: float = 0.0,
+    notes: str | None = None,
+) -> Program:
+    return Program(
+        name,
+        summary,
+        Plan(),
+        fly_s,
+        kind,
+        codes,
+        tail_s=tail_s,
+        hazard=hazard,
+        notes=notes,
+        rover=plan,
+        vehicle=ROVER,
+        lint_args=ROVER_LINT,
+    )
+
+
+_STILL = (
+    "PX4 overwrote the node's {what} with its own from the (never published)"
+    " TrajectorySetpoint from the arm on; the rover stayed within 0.4 m of its start for 12 s,"
+    " on 1.17.0 and the 1.18 head (OFB510)"
+)
+
+ROVER_PROGRAMS = (
+    _rover(
+        "rover_position",
+        "Ackermann rover: RoverPositionSetpoint 10 m north with the position flag",
+        r.RoverPlan(("position",), (("RoverPositionSetpoint", r.POSITION_10M_NORTH),)),
+        "hazard",
+        ("OFB510",),
+        hazard="the docs' Position combination in OFFBOARD, which PX4 rewrites",
+        notes=_STILL.format(what="RoverPositionSetpoint (logged as 0, 0)"),
+    ),
+    _rover(
+        "rover_speed_steering",
+        "Ackermann rover: Speed + Steering (velocity flag; attitude and rate published as NaN)",
+        r.RoverPlan(
+            ("velocity",),
+            (
+                ("RoverSpeedSetpoint", r.SPEED_1),
+                ("RoverAttitudeSetpoint", r.ATTITUDE_NAN),
+                ("RoverRateSetpoint", r.RATE_NAN),
+                ("RoverSteeringSetpoint", r.STEER_RIGHT),
+            ),
+        ),
+        "hazard",
+        ("OFB510",),
+        hazard="the docs' Speed + Steering combination in OFFBOARD, which PX4 rewrites",
+        notes=_STILL.format(what="speed, heading and steering (logged as 0)"),
+    ),
+    _rover(
+        "rover_speed_attitude",
+        "Ackermann rover: Speed + Attitude (velocity flag), 1 m/s heading east",
+        r.RoverPlan(
+            ("velocity",),
+            (("RoverSpeedSetpoint", r.SPEED_1), ("RoverAttitudeSetpoint", r.ATTITUDE_EAST)),
+        ),
+        "hazard",
+        ("OFB510",),
+        hazard="the docs' Speed + Attitude combination in OFFBOARD, which PX4 rewrites",
+        notes=_STILL.format(what="speed and heading (logged as 0)"),
+    ),
+    _rover(
+        "rover_throttle_steering",
+        "Ackermann rover: Throttle + Steering (thrust_and_torque flag)",
+        r.RoverPlan(
+            ("thrust_and_torque",),
+            (("RoverThrottleSetpoint", r.THROTTLE_30), ("RoverSteeringSetpoint", r.STEER_RIGHT)),
+        ),
+        "clean",
+        notes="the rover drove a circle (up to 5.1 m from its start, 1.6-2.0 m/s) on 1.17.0 and"
+        " the 1.18 head: the throttle level is not rewritten in OFFBOARD",
+    ),
+    _rover(
+        "rover_trajectory",
+        "Ackermann rover driven with the deprecated TrajectorySetpoint (position flag, 10 m north)",
+        r.RoverPlan(("position",), (("TrajectorySetpoint", r.TRAJECTORY_10M_NORTH),)),
+        "hazard",
+        ("OFB501",),
+        hazard="the deprecated rover TrajectorySetpoint path",
+        notes="the rover drove to the 10 m point and stopped on 1.17.0 and the 1.18 head: in"
+        " OFFBOARD the deprecated path is what PX4's rover offboard mode converts",
+    ),
+    _rover(
+        "rover_speed_alone",
+        "Ackermann rover: RoverSpeedSetpoint alone with the velocity flag (no heading source)",
+        r.RoverPlan(("velocity",), (("RoverSpeedSetpoint", r.SPEED_ALONE_2),)),
+        "hazard",
+        ("OFB502",),
+        hazard="an invalid rover setpoint combination",
+        notes="the rover stood still (PX4 rewrote the speed to 0 from TrajectorySetpoint), on"
+        " 1.17.0 and the 1.18 head",
+    ),
+    _rover(
+        "rover_throttle_velocity_flag",
+        "Ackermann rover: Throttle + Steering under the velocity flag (thrust_and_torque needed)",
+        r.RoverPlan(
+            ("velocity",),
+            (("RoverThrottleSetpoint", r.THROTTLE_30), ("RoverSteeringSetpoint", r.STEER_RIGHT)),
+        ),
+        "hazard",
+        ("OFB503",),
+        hazard="rover setpoints under the wrong OffboardControlMode flag",
+        notes="the rover stood still: the velocity flag ran the speed controller on PX4's own"
+        " zero speed, not the throttle sent, on 1.17.0 and the 1.18 head",
+    ),
+    _rover(
+        "rover_stops",
+        "Ackermann rover: Throttle + Steering (driving a circle), the node stops 5 s after the arm",
+        r.RoverPlan(
+            ("thrust_and_torque",),
+            (("RoverThrottleSetpoint", r.THROTTLE_30), ("RoverSteeringSetpoint", r.STEER_RIGHT)),
+            stop_after_arm_s=5.0,
+        ),
+        "hazard",
+        ("OFB103",),
+        fly_s=7.0,
+        tail_s=4.0,
+        hazard="stream lost in OFFBOARD while driving (PX4's loss failsafe)",
+        notes="AUTO_RTL with failsafe 1.09-1.10 s after the last keep-alive PX4 logged, on"
+        " 1.17.0 and the 1.18 head; on 1.17.0 the rover drove back, disarmed at home and its"
+        " status showed OFFBOARD again (the user intention)",
+    ),
+)
+"""Issue 33 item 1: the rover setpoints of 1.17 and the 1.18 head, each release has all six."""
 
 
 PROGRAMS: dict[str, Program] = {
@@ -135,5 +285,6 @@ PROGRAMS: dict[str, Program] = {
             "clean",
             topics="in",
         ),
+        *ROVER_PROGRAMS,
     )
 }

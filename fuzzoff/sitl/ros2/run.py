@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from fuzzoff.sitl import bundle
+from fuzzoff.sitl import airframes, bundle
 from fuzzoff.sitl.ros2 import netns, replay
 from fuzzoff.sitl.ros2.programs import PROGRAMS
 
@@ -47,11 +47,21 @@ def fly(
     build: bundle.Build,
     save_dir: Path,
     log: Callable[[str], None] = print,
+    vehicle: str | None = None,
 ) -> FlightOutcome:
+    """``vehicle``: the SIH airframe (``fuzzoff.sitl.airframes``; None: the program's own)."""
     if program not in PROGRAMS:
         raise FlightError(f"no ROS 2 program {program!r}; have {', '.join(PROGRAMS)}")
-    log(f"{program} on PX4 {build.release} over its ROS 2 bridge (private network namespace)")
-    return _flight(program, program, build, save_dir)
+    vehicle = vehicle or PROGRAMS[program].vehicle
+    if vehicle is not None:
+        try:
+            airframes.boot_env(build, vehicle)
+        except airframes.AirframeError as exc:
+            raise FlightError(str(exc)) from None
+    on = f", {vehicle}" if vehicle else ""
+    log(f"{program} on PX4 {build.release}{on} over its ROS 2 bridge (private network namespace)")
+    extra = ["--vehicle", vehicle] if vehicle else []
+    return _flight(program, program, build, save_dir, extra=extra)
 
 
 def replay_bag(
@@ -73,7 +83,12 @@ def replay_bag(
 
 
 def _flight(
-    what: str, name: str, build: bundle.Build, save_dir: Path, stem: str | None = None
+    what: str,
+    name: str,
+    build: bundle.Build,
+    save_dir: Path,
+    stem: str | None = None,
+    extra: list[str] | None = None,
 ) -> FlightOutcome:
     why = missing()
     if why is not None:
@@ -81,7 +96,9 @@ def _flight(
     stem = stem or f"{name}-{build.release}"
     bundled = build.folder.parent.resolve() == bundle.default_root().resolve()
     target = build.release if bundled else str(build.folder)
-    done = netns.run_flight(save_dir.resolve(), [what, target, stem], timeout=FLIGHT_TIMEOUT_S)
+    done = netns.run_flight(
+        save_dir.resolve(), [what, target, stem, *(extra or [])], timeout=FLIGHT_TIMEOUT_S
+    )
     summary_file = save_dir / f"{stem}.json"
     if done.returncode != 0 or not summary_file.exists():
         tail = (done.stderr or done.stdout).strip().splitlines()[-3:]
