@@ -125,7 +125,8 @@ def ros2bridge_row() -> Row:
     return Row(
         "`corpora/ros2bridge/`",
         f"real PX4 SITL {', '.join(releases)} over its ROS 2 bridge (uXRCE-DDS): the companion's"
-        " bags (mcap, sqlite3) and PX4's ULog, px4_ros_com's offboard_control reproduced",
+        " bags (mcap, sqlite3) and PX4's ULog, px4_ros_com's offboard_control and"
+        " px4-ros2-interface-lib's mode registration reproduced",
         len(clean),
         sum(map(_loud, clean)),
         len(hazards),

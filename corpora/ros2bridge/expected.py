@@ -31,6 +31,8 @@ NOT_IN_ULOG = {
     " the client's, so OFB203 is not checkable there (OFB002 says so); the bags show it",
     "OFB208": "a command that never reached PX4 leaves no trace in its ULog (its vehicle_command"
     " holds what PX4 received); the bags show it",
+    "OFB209": "PX4's default log profile does not log the external-mode registration and"
+    " arming-check topics; the bags show them",
 }
 """Hazard code -> why PX4's ULog cannot show it."""
 

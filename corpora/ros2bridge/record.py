@@ -44,6 +44,9 @@ RUNS: tuple[tuple[str, str], ...] = (
     ("example_late_bag", "1.16.2-ros2"),
     ("example_in_only", "1.16.2-ros2"),
     ("example_agent_restart", "1.16.2-ros2"),
+    ("ext_mode", "1.18.0-beta1-head"),
+    ("ext_mode_old_api", "1.18.0-beta1-head"),
+    ("ext_mode_dies", "1.18.0-beta1-head"),
 )
 """(program of ``fuzzoff.sitl.ros2.programs``, bundle): one PX4 boot each."""
 MAX_BYTES = 1_000_000
