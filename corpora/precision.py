@@ -136,7 +136,7 @@ def ros2bridge_rows(gate: Counter[tuple[str, str, bool | None]]) -> list[Row]:
                 "`corpora/ros2bridge/`",
                 f"real PX4 SITL {', '.join(releases)} over its ROS 2 bridge (uXRCE-DDS): the"
                 " companion's bags (mcap, sqlite3) and PX4's ULog, px4_ros_com's"
-                " offboard_control reproduced",
+                " offboard_control and px4-ros2-interface-lib's mode registration reproduced",
                 alone,
             ),
             gate=f"{agree}/{judged}" if judged else "-",

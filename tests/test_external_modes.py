@@ -94,6 +94,15 @@ def test_checks_unanswered_more_than_three_times_drop_the_mode() -> None:
     assert found.time_s == 3.0 and "arming checks unanswered" in found.summary
 
 
+def test_the_last_request_counts_when_px4_stops_asking() -> None:
+    # PX4 stops sending requests once it dropped the registration: the fourth unanswered
+    # request is the last one in the recording, closed by the recording going on
+    events = [*_register(), *_checks(3.1, 2.0), VehicleStatus(t=4.5, nav_state=2, armed=False)]
+    (found,) = _lint(events)
+    assert found.time_s == 3.0
+    assert _lint([*_register(), *_checks(3.1, 2.0)]) == []  # ends before the reply was due
+
+
 def test_three_unanswered_requests_are_tolerated() -> None:
     events = [*_register(), *_checks(6.0, 6.0)]
     skipped = {2, 3, 4}  # three requests in a row without a reply, then replies again

@@ -40,6 +40,8 @@ NOT_IN_ULOG = {
         " checkable there (OFB002 says so); the bags show it"
         for code in ("OFB501", "OFB502", "OFB503", "OFB510")
     },
+    "OFB209": "PX4's default log profile does not log the external-mode registration and"
+    " arming-check topics; the bags show them",
 }
 """Hazard code -> why PX4's ULog cannot show it."""
 

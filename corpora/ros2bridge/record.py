@@ -59,6 +59,11 @@ RUNS: tuple[tuple[str, str], ...] = (
         )
         for bundle_name in ("1.17.0-ros2-rover", "1.18.0-beta1-head")
     ),
+    ("ext_mode", "1.18.0-beta1-head"),
+    ("ext_mode_old_api", "1.18.0-beta1-head"),
+    ("ext_mode_dies", "1.18.0-beta1-head"),
+    ("ext_mode", "1.17.0-ros2-rover"),
+    ("ext_mode_old_api", "1.17.0-ros2-rover"),
 )
 """(program of ``fuzzoff.sitl.ros2.programs``, bundle): one PX4 boot each."""
 MAX_BYTES = 1_000_000

@@ -152,15 +152,8 @@ class ExternalModes(Check):
     # -- liveness ----------------------------------------------------------------------------
 
     def _next_request(self, request: ArmingCheckRequest) -> None:
-        previous = self.check_request
-        if previous is not None and self._judged():
-            for reg_id, held in self.registrations.items():
-                if held.dropped or reg_id in self.replied:
-                    continue
-                held.misses += 1
-                limit = MISSES if held.replied else MISSES_FIRST
-                if held.misses > limit:
-                    self._dropped(reg_id, held, previous, by_px4=False)
+        if self.check_request is not None:
+            self._close(self.check_request)
         mask = request.registrations_mask
         if mask is not None:
             for reg_id, held in self.registrations.items():
@@ -168,6 +161,18 @@ class ExternalModes(Check):
                 if not held.dropped and known and not mask >> reg_id & 1:
                     self._dropped(reg_id, held, request, by_px4=True)
         self.check_request, self.replied = request, set()
+
+    def _close(self, request: ArmingCheckRequest) -> None:
+        """The replies to ``request`` are in: count a miss for each registration without one."""
+        if not self._judged():
+            return
+        for reg_id, held in self.registrations.items():
+            if held.dropped or reg_id in self.replied:
+                continue
+            held.misses += 1
+            limit = MISSES if held.replied else MISSES_FIRST
+            if held.misses > limit:
+                self._dropped(reg_id, held, request, by_px4=False)
 
     def _judged(self) -> bool:
         """The companion's side is in the recording (its replies, or its own requests)."""
@@ -224,6 +229,11 @@ class ExternalModes(Check):
         )
 
     def finish(self, t_end: float) -> None:
+        last = self.check_request
+        if last is not None and t_end - last.t >= REQUEST_PERIOD_S:
+            # the last request's replies were due long before the end (PX4 stops asking
+            # once it has dropped the last registration, so no next request closes it)
+            self._close(last)
         expected = self.ctx.profile.release.external_mode_api
         for request_id, request in self.requests.items():
             if request_id in self.answered or expected is None:

@@ -85,35 +85,61 @@ def _zero(base: str) -> Any:
 def _layout(topic: BridgeTopic) -> tuple[dict[str, Any], dict[str, Any]]:
     """The fields' cyclonedds types and their zero values (as a C++ message starts)."""
     store = px4_msgs.typestore_for(topic.ros_type, topic.msgdef)
+    return _fields(store, topic.ros_type)
+
+
+def _fields(store: Any, typename: str) -> tuple[dict[str, Any], dict[str, Any]]:
+    """``typename``'s fields in ``store``: numbers, fixed arrays of numbers, and px4_msgs
+    types nested in it (``ArmingCheckReply.events``, an array of ``Event``)."""
     fields: dict[str, Any] = {}
     zeros: dict[str, Any] = {}
-    field_defs: list[tuple[str, Any]] = store.fielddefs[topic.ros_type][1]
+    field_defs: list[tuple[str, Any]] = store.fielddefs[typename][1]
     for name, (nodetype, details) in field_defs:
         if nodetype == Nodetype.ARRAY:
             (inner_type, inner), count = details
+            if inner_type == Nodetype.NAME:
+                nested, zero = _nested(store, inner)
+                fields[name] = _ARRAY[nested, count]
+                zeros[name] = [zero] * count
+                continue
             if inner_type != Nodetype.BASE:
-                raise TypeError(f"{topic.message}.{name}: only arrays of numbers are supported")
+                raise TypeError(f"{typename}.{name}: only arrays of numbers are supported")
             fields[name] = _ARRAY[_BASE[inner[0]], count]
             zeros[name] = [_zero(inner[0])] * count
         elif nodetype == Nodetype.BASE:
             fields[name] = _BASE[details[0]]
             zeros[name] = _zero(details[0])
+        elif nodetype == Nodetype.NAME:
+            fields[name], zeros[name] = _nested(store, details)
         else:
-            raise TypeError(f"{topic.message}.{name}: nested and sequence fields are not supported")
+            raise TypeError(f"{typename}.{name}: sequence fields are not supported")
     return fields, zeros
+
+
+def _nested(store: Any, typename: str) -> tuple[Any, Any]:
+    """A nested px4_msgs type as a cyclonedds struct (named as the middleware names it), and
+    its zero value."""
+    fields, zeros = _fields(store, typename)
+    message = typename.rsplit("/", 1)[-1]
+    cls = _struct(message, f"px4_msgs::msg::dds_::{message}_", fields)
+    return cls, cls(**zeros)
+
+
+def _struct(message: str, dds_type: str, fields: dict[str, Any]) -> Any:
+    cls = types.new_class(
+        message + "_",
+        (IdlStruct,),
+        {"typename": dds_type},
+        lambda ns: ns.update({"__annotations__": fields}),
+    )
+    return dataclasses.dataclass(cls)
 
 
 @cache
 def idl_type(topic: BridgeTopic) -> Any:
     """The cyclonedds type of ``topic``'s message (one class per definition)."""
     fields, _ = _layout(topic)
-    cls = types.new_class(
-        topic.message + "_",
-        (IdlStruct,),
-        {"typename": topic.dds_type},
-        lambda ns: ns.update({"__annotations__": fields}),
-    )
-    return dataclasses.dataclass(cls)
+    return _struct(topic.message, topic.dds_type, fields)
 
 
 def zero_sample(topic: BridgeTopic, **values: Any) -> Any:

@@ -25,8 +25,10 @@ from typing import Any
 from cyclonedds.domain import DomainParticipant
 
 from fuzzoff.formats.rosbag2.writer import Storage
+from fuzzoff.profiles import px4_profile_for
+from fuzzoff.releases import get as release_record
 from fuzzoff.sitl import airframes, bundle
-from fuzzoff.sitl.ros2 import agent
+from fuzzoff.sitl.ros2 import agent, external_mode
 from fuzzoff.sitl.ros2.bag import Recording, write_bag
 from fuzzoff.sitl.ros2.dds import Publisher, idl_type
 from fuzzoff.sitl.ros2.example import TICK_S, OffboardControl, now_us
@@ -94,11 +96,16 @@ class BridgeFlight:
         self.log = log
         self.topics_in_only = program is not None and program.topics == "in"
         release_name = self.build.profile_release  # no px4_msgs for it: fails before PX4 starts
-        self.received = [bridge_topic(release_name, m) for m in RECEIVED]
         rover = program is not None and program.rover is not None
-        self.sent = [
-            bridge_topic(release_name, m) for m in SENT + (ROVER_MESSAGES if rover else ())
-        ]
+        moding = program is not None and program.mode is not None
+        received = (*RECEIVED, *(external_mode.RECEIVED if moding else ()))
+        sent = (
+            *SENT,
+            *(external_mode.SENT if moding else ()),
+            *(ROVER_MESSAGES if rover else ()),
+        )
+        self.received = [bridge_topic(release_name, m) for m in received]
+        self.sent = [bridge_topic(release_name, m) for m in sent]
         env = {"PX4_AGENT": str(bundle.default_root() / "agent"), "PX4_PARAM_SDLOG_MODE": "2"}
         self.vehicle = vehicle or (program.vehicle if program is not None else None)
         if self.vehicle is not None:
@@ -190,6 +197,8 @@ def fly(
     vehicle: str | None = None,
 ) -> dict[str, Any]:
     """Fly ``program`` on the bundle ``release``; what happened (the run's summary)."""
+    if program.mode is not None:
+        return fly_mode(release, out, stem, program, log)
     with BridgeFlight(release, program, log, vehicle) as flight:
         flight.wait_ready()
         if program.record_from_s is None:
@@ -227,6 +236,43 @@ def fly(
             time.sleep(program.tail_s)
         flight.stop_recording()
         summary = flight.summary(program.name, stem, node.notes)
+    flight.write(out, stem, summary)
+    return summary
+
+
+def fly_mode(
+    release: str, out: Path, stem: str, program: Program, log: Log = print
+) -> dict[str, Any]:
+    """Run an external mode's node (``external_mode.py``) for ``program.fly_s``: PX4 stays
+    disarmed; the recording holds the registration and the arming-check exchange."""
+    assert program.mode is not None
+    with BridgeFlight(release, program, log) as flight:
+        api = release_record(px4_profile_for(flight.build.profile_release)).external_mode_api
+        if api is None:
+            raise bundle.BundleError(f"PX4 {flight.build.release} has no external modes")
+        flight.wait_ready()
+        flight.record()
+        time.sleep(LEAD_S)
+        node_participant = DomainParticipant(0)
+        node = external_mode.ExternalMode(
+            {t.message: Publisher(node_participant, t) for t in flight.sent},
+            program.mode,
+            api,
+        )
+        flight.recorder.on_message.update(
+            RegisterExtComponentReply=node.on_reply, ArmingCheckRequest=node.on_check
+        )
+        flight.t0 = t0 = time.monotonic()
+        node.start(t0)
+        while (now := time.monotonic()) - t0 < program.fly_s:
+            node.tick(now)
+            time.sleep(TICK_S)
+        flight.recorder.on_message.clear()
+        if program.tail_s > 0:
+            time.sleep(program.tail_s)
+        flight.stop_recording()
+        notes = [*node.notes, (time.monotonic(), f"{node.answered} arming checks answered")]
+        summary = flight.summary(program.name, stem, notes)
     flight.write(out, stem, summary)
     return summary
 

@@ -12,6 +12,7 @@ from typing import Literal
 
 from fuzzoff.sitl.ros2 import rover as r
 from fuzzoff.sitl.ros2.example import Plan
+from fuzzoff.sitl.ros2.external_mode import ModePlan
 
 
 @dataclass(frozen=True, slots=True)
@@ -45,6 +46,10 @@ class Program:
     """The SIH airframe it flies (``fuzzoff.sitl.airframes``; None: PX4's default quad)."""
     lint_args: tuple[str, ...] = ()
     """What ``fuzzoff lint`` needs beside the recording (a rover's kind: ``--vehicle``)."""
+    mode: ModePlan | None = None
+    """The node is an external mode (``external_mode.py``), not the offboard example: it
+    registers, answers PX4's arming checks and flies nothing; ``fly_s`` counts from its
+    start."""
 
 
 ROVER = "rover-ackermann"
@@ -275,6 +280,39 @@ PROGRAMS: dict[str, Program] = {
             "clean",
             record_from_s=0.94,
             notes="no false OFB202 here (issue 28 miss 4 did not happen)",
+        ),
+        Program(
+            "ext_mode",
+            "an external mode as px4-ros2-interface-lib registers it, with the release's API"
+            " version: it answers every arming-check request and unregisters 6 s later",
+            Plan(),
+            8.0,
+            "clean",
+            mode=ModePlan(unregister_after_s=6.0),
+        ),
+        Program(
+            "ext_mode_old_api",
+            "an external mode built for the API version before the release's (the library's"
+            " 2.1.1 on PX4 1.18): PX4 registers it, the library gives up at the reply and"
+            " answers no arming check, PX4 drops the mode",
+            Plan(),
+            8.0,
+            "hazard",
+            ("OFB209",),
+            hazard="an external mode that never works: API version mismatch",
+            mode=ModePlan(api_offset=-1),
+        ),
+        Program(
+            "ext_mode_dies",
+            "an external mode whose node dies 3 s after it registered, without unregistering"
+            " (px4-ros2-interface-lib #195: its watchdog's exception ends the node): PX4's arming"
+            " checks go unanswered and PX4 drops the mode",
+            Plan(),
+            8.0,
+            "hazard",
+            ("OFB209",),
+            hazard="an external mode PX4 drops: arming checks unanswered",
+            mode=ModePlan(stops_after_s=3.0),
         ),
         Program(
             "example_in_only",

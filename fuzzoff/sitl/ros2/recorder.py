@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import threading
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -37,6 +38,8 @@ class Recorder:
         self.readers = [RawReader(participant, t) for t in topics]
         self.recording: Recording | None = None
         self.watch = Watch()
+        self.on_message: dict[str, Callable[[Any], None]] = {}
+        """px4_msgs message -> a node's callback, given each one decoded as it arrives."""
         self.error: BaseException | None = None
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._loop, daemon=True)
@@ -60,6 +63,9 @@ class Recorder:
     def _deliver(self, topic: BridgeTopic, data: bytes, received_ns: int) -> None:
         if self.recording is not None:
             self.recording.add(topic, data, received_ns)
+        handler = self.on_message.get(topic.message)
+        if handler is not None:
+            handler(self._decode(topic, data))
         if topic.message == "VehicleStatus":
             self._status(self._decode(topic, data))
         elif topic.message == "VehicleCommandAck":
