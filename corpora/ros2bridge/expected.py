@@ -105,7 +105,7 @@ def with_expected(bag: Path, ulog: Path, run: dict[str, Any]) -> dict[str, Any]:
     """``NAME.with.expected.json``: the bag linted with its flight's ULog (``--with``, the path
     from the repository's root, where the tests run)."""
     program = PROGRAMS[run["program"]]
-    args = ["--with", str(ulog.relative_to(HERE.parent.parent))]
+    args = [*program.lint_args, "--with", str(ulog.relative_to(HERE.parent.parent))]
     out = run_cli(["lint", str(bag), "--format", "json", *args])
     assert out.returncode in (0, 1), out.stderr
     (report,) = json.loads(out.stdout)["files"]
