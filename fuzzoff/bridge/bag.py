@@ -83,7 +83,12 @@ def read_bag(path: Path) -> Bag:
                     continue
                 name = match.group(2)
                 direction: Direction = "in" if match.group(1) == "in" else "out"
-                topics.setdefault(name, BagTopic(connection.topic, name, direction))
+                known = topics.setdefault(name, BagTopic(connection.topic, name, direction))
+                if known.topic != connection.topic:
+                    raise BridgeError(
+                        f"{path}: {known.topic} and {connection.topic}: --with compares one"
+                        " vehicle's topics with its ULog, this bag holds several"
+                    )
                 wanted.append(connection)
             first = last = None
             for connection, received_ns, raw in reader.messages(connections=wanted):

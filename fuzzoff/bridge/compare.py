@@ -13,9 +13,7 @@ receive time (``ulog`` module): those give the delivery latency, PX4's receive t
 send time mapped onto PX4's clock (``clock``).
 
 For each ``/fmu/out`` topic: the stretches in which PX4 published (its ULog) and the companion
-received nothing. And PX4's status changes (``vehicle_status``: mode, arming, failsafe;
-``failsafe_flags``: the offboard signal lost): when the companion first received the new state,
-or that it never did.
+received nothing; PX4's status changes and their receipt come from ``changes``.
 """
 
 from __future__ import annotations
@@ -29,9 +27,9 @@ import numpy as np
 
 from fuzzoff.bridge import BridgeError
 from fuzzoff.bridge.bag import Bag, BagTopic
+from fuzzoff.bridge.changes import Change, changes_of, signal_lost
 from fuzzoff.bridge.clock import Clock, measure, pairs
 from fuzzoff.bridge.ulog import Px4Log, ULogTopic
-from fuzzoff.modes import nav_state_name
 
 TOLERANCE_US = 30_000
 """Slack between a send time mapped onto PX4's clock and PX4's record of it."""
@@ -39,10 +37,7 @@ WINDOW_MIN_US, WINDOW_MAX_US = 300_000, 2_000_000
 COMMAND_WINDOW_US = 1_000_000
 GAP_US = 1_000_000
 """A silence of PX4's outputs this long (or 3 of their intervals) is reported."""
-LATE_S = 1.0
-"""A status change the companion received this much later than PX4 published it is late."""
 STAMPS = frozenset({"timestamp", "timestamp_sample"})
-STATUS_FIELDS = ("nav_state", "arming_state", "failsafe")
 
 
 @dataclass(frozen=True, slots=True)
@@ -98,27 +93,6 @@ class TopicResult:
         if self.note:
             out["note"] = self.note
         return out
-
-
-@dataclass(frozen=True, slots=True)
-class Change:
-    time_s: float
-    """When PX4 published it, as seconds from the bag's first message."""
-    px4_s: float
-    """The same on PX4's clock (the ULog's timestamps)."""
-    what: str
-    seen_after_s: float | None
-    """How long after PX4 published it the companion received it (None: never)."""
-    lost_signal: bool = False
-    armed: bool = False
-
-    def to_json(self) -> dict[str, Any]:
-        return {
-            "time_s": round(self.time_s, 3),
-            "px4_time_s": round(self.px4_s, 3),
-            "state": self.what,
-            "seen_after_s": None if self.seen_after_s is None else round(self.seen_after_s, 3),
-        }
 
 
 @dataclass(frozen=True, slots=True)
@@ -302,88 +276,6 @@ def _heard_topic(
     )
 
 
-def _states(topic: ULogTopic, fields: tuple[str, ...]) -> list[tuple[int, tuple[int, ...]]]:
-    columns = [topic.data[f].tolist() for f in fields if f in topic.data]
-    rows = [tuple(int(c[i]) for c in columns) for i in range(len(topic.timestamps))]
-    out: list[tuple[int, tuple[int, ...]]] = []
-    for t, row in zip(topic.timestamps.tolist(), rows, strict=True):
-        if not out or out[-1][1] != row:
-            out.append((int(t), row))
-    return out
-
-
-def _describe(name: str, state: tuple[int, ...]) -> str:
-    if name == "failsafe_flags":
-        return "offboard signal lost" if state[0] else "offboard signal back"
-    nav, arming, *failsafe = state
-    text = f"{nav_state_name(nav)}, {'armed' if arming == 2 else 'disarmed'}"
-    return text + (", failsafe" if failsafe and failsafe[0] else "")
-
-
-def _changes(
-    bag: Bag, log: Px4Log, clock: Clock, span: tuple[float, float], seconds: Any
-) -> tuple[list[Change], str | None]:
-    changes: list[Change] = []
-    missing = []
-    armed_at: list[tuple[int, bool]] = []
-    if "vehicle_status" in log.topics:
-        armed_at = [
-            (t, s[0] == 2) for t, s in _states(log.topics["vehicle_status"], ("arming_state",))
-        ]
-    for name, fields in (
-        ("vehicle_status", STATUS_FIELDS),
-        ("failsafe_flags", ("offboard_control_signal_lost",)),
-    ):
-        logged, topic = log.topics.get(name), bag.topics.get(name)
-        if logged is None:
-            continue
-        if topic is None or topic.direction != "out":
-            missing.append(name)
-            continue
-        states = _states(logged, fields)
-        heard = [
-            (clock.px4_us(s.received_us), tuple(int(s.fields.get(f, 0)) for f in fields))
-            for s in topic.samples
-        ]
-        for i, (t, state) in enumerate(states):
-            if not span[0] <= t <= span[1] or i == 0:
-                continue
-            until = states[i + 1][0] if i + 1 < len(states) else span[1]
-            seen = next(
-                (h for h, got in heard if got == state and t - TOLERANCE_US <= h <= until + GAP_US),
-                None,
-            )
-            armed = (
-                any(a for at, a in armed_at if at <= t)
-                and ([a for at, a in armed_at if at <= t][-1])
-            )
-            changes.append(
-                Change(
-                    seconds(clock.host_us(t)),
-                    t / 1e6,
-                    _describe(name, state),
-                    None if seen is None else max(0.0, (seen - t) / 1e6),
-                    lost_signal=name == "failsafe_flags" and bool(state[0]),
-                    armed=armed,
-                )
-            )
-    note = None
-    if missing:
-        note = f"the bag holds no {', '.join('/fmu/out/' + m for m in missing)}: not judged"
-    changes.sort(key=lambda c: c.px4_s)
-    return changes, note
-
-
-def _lost(changes: list[Change], span_end_s: float) -> list[tuple[float, float]]:
-    out = []
-    signal = [c for c in changes if c.what.startswith("offboard signal")]
-    for i, change in enumerate(signal):
-        if change.lost_signal and change.armed:
-            end = signal[i + 1].time_s if i + 1 < len(signal) else span_end_s
-            out.append((change.time_s, end))
-    return out
-
-
 def compare(bag: Bag, log: Px4Log) -> Delivery:
     """BridgeError when the two are not one flight."""
     if not log.syncs:
@@ -432,7 +324,13 @@ def compare(bag: Bag, log: Px4Log) -> Delivery:
             f"{bag.path} and {log.path} are not the same flight: none of the messages the bag"
             " sent is in the ULog"
         )
-    changes, note = _changes(bag, log, clock, span, seconds)
+    changes, note = changes_of(bag, log, clock, span, seconds)
     return Delivery(
-        log.path, clock, log.syncs, results, changes, _lost(changes, seconds(bag.last_us)), note
+        log.path,
+        clock,
+        log.syncs,
+        results,
+        changes,
+        signal_lost(changes, seconds(bag.last_us)),
+        note,
     )

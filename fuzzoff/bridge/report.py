@@ -10,7 +10,8 @@ the offboard signal lost in the stretch; ``warning`` otherwise.
 
 from __future__ import annotations
 
-from fuzzoff.bridge.compare import LATE_S, Change, Delivery, TopicResult, Window
+from fuzzoff.bridge.changes import LATE_S, Change
+from fuzzoff.bridge.compare import Delivery, TopicResult, Window
 from fuzzoff.events import Where
 from fuzzoff.findings import Finding, Severity
 

@@ -6,7 +6,8 @@ asked for, whole. PX4's ``uxrce_dds_client`` says each time it synchronizes with
 ("synchronized with time offset Nus", a logged message kept in a cut ULog): N is the agent's
 clock minus PX4's, the offset the bridge subtracts from an incoming ``timestamp`` and adds to an
 outgoing one (``min(value - offset, now)`` on receipt: a stamp in PX4's future becomes the
-receive time; spec 2.1.1, ``Tools/msg/templates/ucdr/msg.h.em``).
+receive time; spec 2.1.1, ``Tools/msg/templates/ucdr/msg.h.em``). A log without that line (its
+logging started after the client connected) may still hold the client's ``timesync_status``.
 """
 
 from __future__ import annotations
@@ -21,6 +22,10 @@ import numpy as np
 from fuzzoff.bridge import BridgeError
 
 SYNCED = re.compile(r"synchronized with time offset (-?\d+)\s*us")
+SOURCE_PROTOCOL_DDS = 2
+"""``timesync_status.source_protocol`` of the bridge's client (seen on the 1.18 head)."""
+SESSION_JUMP_US = 20_000
+"""``timesync_status``: an offset this far from the last one starts a new session."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -46,7 +51,7 @@ def read_ulog(path: Path, names: set[str]) -> Px4Log:
     from pyulog import ULog
 
     try:
-        log = ULog(str(path), message_name_filter_list=sorted(names))
+        log = ULog(str(path), message_name_filter_list=sorted(names | {"timesync_status"}))
     except Exception as exc:  # pyulog raises what its parsing meets
         raise BridgeError(f"{path}: cannot read the ULog ({exc})") from None
     syncs = []
@@ -54,6 +59,8 @@ def read_ulog(path: Path, names: set[str]) -> Px4Log:
         match = SYNCED.search(logged.message)
         if match is not None:
             syncs.append((int(logged.timestamp), int(match.group(1))))
+    if not syncs:
+        syncs = _from_status(log.data_list)
     topics: dict[str, ULogTopic] = {}
     for dataset in log.data_list:
         if dataset.multi_id != 0 or dataset.name in topics:
@@ -65,3 +72,25 @@ def read_ulog(path: Path, names: set[str]) -> Px4Log:
             dataset.name, sorted_data["timestamp"].astype(np.int64), sorted_data
         )
     return Px4Log(str(path), int(log.start_timestamp), int(log.last_timestamp), syncs, topics)
+
+
+def _from_status(datasets: list[Any]) -> list[tuple[int, int]]:
+    """The sessions' offsets from the bridge's ``timesync_status`` (logged at 1 Hz), for a log
+    without the time sync line (one started after the client connected): its
+    ``estimated_offset`` is PX4's clock less the agent's, the line's offset negated."""
+    syncs: list[tuple[int, int]] = []
+    for dataset in datasets:
+        data = dataset.data
+        if dataset.name != "timesync_status" or "estimated_offset" not in data:
+            continue
+        for t, offset, source in zip(
+            data["timestamp"].tolist(),
+            data["estimated_offset"].tolist(),
+            data.get("source_protocol", np.full(len(data["timestamp"]), -1)).tolist(),
+            strict=True,
+        ):
+            if source != SOURCE_PROTOCOL_DDS or offset == 0:
+                continue
+            if not syncs or abs(-int(offset) - syncs[-1][1]) > SESSION_JUMP_US:
+                syncs.append((int(t), -int(offset)))
+    return sorted(syncs)

@@ -28,6 +28,9 @@ FAST_TOPICS = frozenset(
         "vehicle_attitude_setpoint",
     }
 )
+ALIGN_TOPICS = ("timesync_status",)
+"""Kept beside the topics fuzzoff reads: the bridge's clock offset, 1 Hz, for ``lint --with``
+(``fuzzoff.bridge``) where a log holds no time sync line."""
 POSITION_MIN_S = 0.02
 """Without ``thin_s``: the slot ``vehicle_local_position`` keeps one sample of (50 Hz)."""
 
@@ -42,7 +45,7 @@ def _thinned(timestamps: np.ndarray, every_us: int) -> np.ndarray:
 
 
 def trim(source: Path, target: Path, thin_s: float | None = None) -> Path:
-    log = ULog(str(source), message_name_filter_list=list(LOADED_TOPICS))
+    log = ULog(str(source), message_name_filter_list=[*LOADED_TOPICS, *ALIGN_TOPICS])
     topics = FAST_TOPICS if thin_s is not None else frozenset({"vehicle_local_position"})
     every_us = round((thin_s if thin_s is not None else POSITION_MIN_S) * 1e6)
     for dataset in log.data_list:
