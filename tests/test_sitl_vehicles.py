@@ -171,7 +171,12 @@ def test_each_real_vehicle_is_detected_from_its_recordings(stem: str, vehicle: s
 
 @pytest.mark.parametrize(
     "stem",
-    ["vtol_fw_glide-1.18.0-beta1-head", "vtol_fw_types-1.18.0-beta1-head", "vtol_fw_types-1.17.0"],
+    [
+        "vtol_fw_glide-1.18.0-beta1-head",
+        "vtol_fw_types-1.18.0-beta1-head",
+        "vtol_fw_types-main-2026-08-13",
+        "vtol_fw_types-1.17.0",
+    ],
 )
 def test_a_vtol_on_a_nan_altitude_in_fw_flight_is_not_a_copter_hold(stem: str) -> None:
     """The standard VTOL in FW flight on position setpoints with z NaN: the 1.18 head glided

@@ -209,7 +209,7 @@ VTOL_FW_S = 15.0
 
 def _vtol_to_fw(d: Driver) -> None:
     """MC offboard takeoff to 20 m, then DO_VTOL_TRANSITION to FW while in OFFBOARD, streaming
-    a full position setpoint (1.14-1.17 fly FW offboard only on all three components)."""
+    a full position setpoint (x, y and z: a NaN z glides on 1.18, ``vtol_fw_glide``)."""
     _offboard_takeoff(d, VTOL_MC_ALT, climb_s=10.0)
     d.stream(d.position(0, 0, VTOL_MC_ALT), 0.5)
     d.require(d.transition(to_fw=True), "DO_VTOL_TRANSITION to FW")
