@@ -69,6 +69,8 @@ VEHICLE_ROWS = {
     "quad": "quadrotor (`sihsim_quadx`)",
     "hex": "hexacopter (`sihsim_hex`)",
     "vtol": "standard VTOL (`sihsim_standard_vtol`): MC, transition to FW in OFFBOARD, FW",
+    "tailsitter": "tailsitter VTOL (`sihsim_xvert`, FW_USE_AIRSPD 0): MC, transition, FW",
+    "fw": "airplane (`sihsim_airplane`): runway takeoff, then OFFBOARD in the air",
     "rover-ackermann": "Ackermann rover (`sihsim_rover_ackermann`)",
 }
 """The SITL vehicles, one row each (``fuzzoff.sitl.airframes``)."""

@@ -160,6 +160,9 @@ def _vehicle_matrix() -> list[object]:
         build = bundle.find_build(release, None)
         for name in vehicle_scenarios():
             reason = why_not(build, airframe_for(SCENARIOS[name].vehicle))
+            flies_on = SCENARIOS[name].flies_on
+            if reason is None and flies_on is not None and release not in flies_on:
+                reason = f"{name} flies on {', '.join(flies_on)} only (docs/sitl.md)"
             if reason is not None and "no SIH airframe" not in reason and "without" not in reason:
                 marks = [pytest.mark.skip(reason=reason)]
             elif reason is not None:
@@ -176,8 +179,8 @@ def _vehicle_matrix() -> list[object]:
 def test_px4_and_the_gate_model_agree_on_another_vehicle(
     release: str, scenario: str, tmp_path: Path
 ) -> None:
-    """Issue 33: the hexacopter, standard VTOL and Ackermann rover scenarios, each on its own
-    SIH airframe, compared with the gate model for that vehicle."""
+    """Issue 33: the hexacopter, standard VTOL, tailsitter, airplane and Ackermann rover
+    scenarios, each on its own SIH airframe, compared with the gate model for that vehicle."""
     out = run_cli_process(
         [
             "sitl",

@@ -79,6 +79,15 @@ def test_the_multicopter_matrix_keeps_its_scenarios_and_the_others_fly_their_veh
     }
 
 
+def test_the_airplane_flies_only_where_it_takes_off_and_the_tailsitter_without_airspeed() -> None:
+    # docs/sitl.md: the SIH airplane takes off on 1.16.2 and 1.17.0 only; the tailsitter's
+    # transition waits for an airspeed SIH never shows unless FW_USE_AIRSPD is 0
+    assert SCENARIOS["fw_loss"].flies_on == ("1.16.2", "1.17.0")
+    assert SCENARIOS["tailsitter_loss"].params == {"FW_USE_AIRSPD": 0.0}
+    assert SCENARIOS["tailsitter_offboard"].flies_on == ("1.18.0-beta1-head",)
+    assert SCENARIOS["vtol_loss"].flies_on is None
+
+
 def test_thinning_cuts_the_fast_topics_and_keeps_the_stream_whole(tmp_path: Path) -> None:
     from pyulog import ULog
 
@@ -162,7 +171,12 @@ def test_each_real_vehicle_is_detected_from_its_recordings(stem: str, vehicle: s
 
 @pytest.mark.parametrize(
     "stem",
-    ["vtol_fw_glide-1.18.0-beta1-head", "vtol_fw_types-1.18.0-beta1-head", "vtol_fw_types-1.17.0"],
+    [
+        "vtol_fw_glide-1.18.0-beta1-head",
+        "vtol_fw_types-1.18.0-beta1-head",
+        "vtol_fw_types-main-2026-08-13",
+        "vtol_fw_types-1.17.0",
+    ],
 )
 def test_a_vtol_on_a_nan_altitude_in_fw_flight_is_not_a_copter_hold(stem: str) -> None:
     """The standard VTOL in FW flight on position setpoints with z NaN: the 1.18 head glided
@@ -199,3 +213,22 @@ def test_an_instance_above_nine_is_listened_for_where_px4_sends_it() -> None:
     # px4-rc.mavlink of every bundle: above 9, the onboard link sends to 14549
     assert bundle.send_port(3) == 14543
     assert bundle.send_port(30) == bundle.send_port(31) == 14549
+
+
+def test_the_tailsitters_runs_agree_with_the_model_beside_a_parameter_it_does_not_read() -> None:
+    """tailsitter_loss sets FW_USE_AIRSPD 0 (not a gate parameter): the verdict leaves it out
+    and the model agrees with PX4 on both losses, in MC and in FW flight."""
+    from fuzzoff.sitl.verdict import compare
+
+    stem = "tailsitter_loss-1.18.0-beta1-head"
+    verdict = compare(
+        SITL / f"{stem}.tlog",
+        "1.18",
+        SITL / f"{stem}.ulg",
+        SCENARIOS["tailsitter_loss"].params,
+        245,
+        "vtol",
+    )
+    losses = [i for i in verdict.items if i.what == "failsafe action"]
+    assert len(losses) == 2
+    assert all(i.agree for i in verdict.items)

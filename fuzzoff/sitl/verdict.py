@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from fuzzoff.config import load_settings
+from fuzzoff.gate.params import GATE_PARAMS
 from fuzzoff.modes import custom_mode_to_nav_state, nav_state_name
 from fuzzoff.sitl.truth import Mode, Truth, read_tlog, read_truth
 
@@ -98,8 +99,13 @@ def model_rows(
     from fuzzoff.gate_timeline import gate_report
 
     overrides: dict[str, Any] = {"px4": release, "vehicle": vehicle}
-    if params:  # as `fuzzoff gate --px4 RELEASE --vehicle V --param NAME=VALUE...` has them
-        overrides["params"] = {name.upper(): float(value) for name, value in params.items()}
+    # as `fuzzoff gate --px4 RELEASE --vehicle V --param NAME=VALUE...` has them; a run may set
+    # others the gate does not read (the tailsitter's FW_USE_AIRSPD)
+    read = {
+        name.upper(): float(value) for name, value in params.items() if name.upper() in GATE_PARAMS
+    }
+    if read:
+        overrides["params"] = read
     settings = load_settings(Path.cwd(), overrides, per_recording=True)
     report, rows = gate_report(str(tlog), settings, controllers=False)
     vehicles = [v for v in rows if v != ""] or list(rows)
