@@ -241,22 +241,36 @@ def test_a_stream_loss_without_rc_is_return_on_1_17_and_later_as_the_model_says(
     assert ("automatic return", "back to OFFBOARD", True) in items, items
 
 
-def test_the_1_18_heads_unasked_gripper_ack_is_in_its_ulog_and_judges_no_request() -> None:
-    """The 1.18 head acks MAV_CMD_DO_GRIPPER (211) about 1 s after boot with no client asking:
-    the ULogs kept of it hold the ack, and the model agrees with PX4 on every request there."""
+@pytest.mark.parametrize(
+    "stem",
+    [
+        "clean_offboard-1.18.0-beta1-head",
+        "attitude_no_thrust-1.18.0-beta1-head",
+        "clean_offboard-main-2026-08-13",
+    ],
+)
+def test_the_unasked_gripper_ack_is_px4s_own_command_and_judges_no_request(stem: str) -> None:
+    """The 1.18 head (and main) ack MAV_CMD_DO_GRIPPER (211) about 1 s after boot with no
+    client asking: PX4's own command at boot (not from outside), whose ack is addressed to
+    system 0, so a MAVLink client receives it. The ULogs kept hold both; the model agrees with
+    PX4 on every request there."""
     from pyulog import ULog
 
-    for stem in ("clean_offboard-1.18.0-beta1-head", "attitude_no_thrust-1.18.0-beta1-head"):
-        log = ULog(str(SITL / f"{stem}.ulg"), ["vehicle_command_ack"])
-        acks = log.get_dataset("vehicle_command_ack").data
-        gripper = [
-            (int(t) - log.start_timestamp) / 1e6
-            for t, c, r in zip(acks["timestamp"], acks["command"], acks["result"], strict=True)
-            if c == 211 and r == 0 and int(t) >= log.start_timestamp
-        ]
-        assert gripper and gripper[0] < 2.0, stem
-        items = _verdict(stem)
-        assert items and all(a is not False for _, _, a in items), items
+    log = ULog(str(SITL / f"{stem}.ulg"), ["vehicle_command", "vehicle_command_ack"])
+    commands = log.get_dataset("vehicle_command").data
+    own = [i for i, c in enumerate(commands["command"]) if c == 211]
+    assert own and not any(commands["from_external"][i] for i in own)
+    acks = log.get_dataset("vehicle_command_ack").data
+    gripper = [
+        (int(t) - log.start_timestamp) / 1e6
+        for t, c, r, to in zip(
+            acks["timestamp"], acks["command"], acks["result"], acks["target_system"], strict=True
+        )
+        if c == 211 and r == 0 and to == 0 and int(t) >= log.start_timestamp
+    ]
+    assert gripper and gripper[0] < 2.0, stem
+    items = _verdict(stem)
+    assert items and all(a is not False for _, _, a in items), items
 
 
 def test_main_s_bundle_is_not_asked_to_run_what_stops_its_simulated_clock() -> None:
