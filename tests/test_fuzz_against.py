@@ -416,6 +416,22 @@ def test_a_return_in_the_cycle_px4_disarms_is_not_judged(stem: str, px4: str) ->
     assert verdict.agree
 
 
+def test_a_heartbeat_still_showing_the_failsafe_after_the_stream_is_back_is_not_a_mode_change() -> (
+    None
+):
+    """The reproducer above replayed on the 1.18 head: a 1 Hz HEARTBEAT showed AUTO_RTL 11 ms
+    after the model's signal came back, before PX4's next check pass ended the failsafe. The
+    model took it for a mode the pilot chose (no command for it), so the three losses after it
+    were "no loss predicted"; it now keeps the intention, and every loss, action and return
+    agrees."""
+    params = {"COM_OF_LOSS_T": 0.33, "COM_OBL_RC_ACT": 3.0, "FUZZOFF_RC_PRESENT": 1.0}
+    verdict = _judge("heartbeat_in_failsafe_after_resume-1.18.0-beta1-head", params)
+    assert not [i for i in verdict.items if i.what in ("offboard loss", "recorded vs model")]
+    losses = [i for i in verdict.items if i.what == "failsafe action"]
+    assert len(losses) == 7 and all(i.agree and i.px4 == "AUTO_RTL" for i in losses)
+    assert verdict.agree
+
+
 def test_a_disagreement_confirmed_before_is_counted_not_followed_up_again(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

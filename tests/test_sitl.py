@@ -197,6 +197,94 @@ def test_the_sticks_end_offboard_on_px4_1_18_and_not_on_1_17_as_the_model_says(
     assert verdict.agree
 
 
+def _verdict(stem: str) -> list[tuple[str, str, bool | None]]:
+    run = RUNS[stem]
+    verdict = compare(
+        SITL / f"{stem}.tlog",
+        run["release"].split("-")[0],
+        SITL / f"{stem}.ulg",
+        run.get("params") or {},
+        COMPANION_SYSID,
+    )
+    return [(i.what, i.px4, i.agree) for i in verdict.items]
+
+
+@pytest.mark.parametrize(
+    ("stem", "arm"),
+    [
+        ("attitude_no_thrust-1.17.0", "accepted"),
+        ("attitude_no_thrust-1.18.0-beta1-head", "rejected"),
+    ],
+)
+def test_an_attitude_setpoint_without_thrust_keeps_1_17_alive_and_not_1_18_as_the_model_says(
+    stem: str, arm: str
+) -> None:
+    """Gate spec 16 S3, seen live: SET_ATTITUDE_TARGET with the thrust ignored is a keep-alive
+    on 1.17.0 (the arm in OFFBOARD accepted) and dropped on the 1.18 head (refused); the model
+    says the same, and lint gives OFB606 on both tlogs. (main's SIH cannot run it: below.)"""
+    items = _verdict(stem)
+    assert ("arm", arm, True) in [(w, p.split(" ")[0], a) for w, p, a in items], items
+    assert all(a is not False for _, _, a in items), items
+    out = run_cli(["lint", str(SITL / f"{stem}.tlog"), "--format", "json"])
+    assert "OFB606" in {f["code"] for f in json.loads(out.stdout)["files"][0]["findings"]}
+
+
+@pytest.mark.parametrize(
+    "stem",
+    ["loss_no_manual-1.17.0", "loss_no_manual-1.18.0-beta1-head", "loss_no_manual-main-2026-08-13"],
+)
+def test_a_stream_loss_without_rc_is_return_on_1_17_and_later_as_the_model_says(stem: str) -> None:
+    """No manual control: NAV_RCL_ACT's Return replaces the loss action's Position from 1.17,
+    then OFFBOARD again when the stream resumes (seen on 1.17.0, the 1.18 head and main)."""
+    items = _verdict(stem)
+    assert ("failsafe action", "AUTO_RTL", True) in items, items
+    assert ("automatic return", "back to OFFBOARD", True) in items, items
+
+
+@pytest.mark.parametrize(
+    "stem",
+    [
+        "clean_offboard-1.18.0-beta1-head",
+        "attitude_no_thrust-1.18.0-beta1-head",
+        "clean_offboard-main-2026-08-13",
+    ],
+)
+def test_the_unasked_gripper_ack_is_px4s_own_command_and_judges_no_request(stem: str) -> None:
+    """The 1.18 head (and main) ack MAV_CMD_DO_GRIPPER (211) about 1 s after boot with no
+    client asking: PX4's own command at boot (not from outside), whose ack is addressed to
+    system 0, so a MAVLink client receives it. The ULogs kept hold both; the model agrees with
+    PX4 on every request there."""
+    from pyulog import ULog
+
+    log = ULog(str(SITL / f"{stem}.ulg"), ["vehicle_command", "vehicle_command_ack"])
+    commands = log.get_dataset("vehicle_command").data
+    own = [i for i, c in enumerate(commands["command"]) if c == 211]
+    assert own and not any(commands["from_external"][i] for i in own)
+    acks = log.get_dataset("vehicle_command_ack").data
+    gripper = [
+        (int(t) - log.start_timestamp) / 1e6
+        for t, c, r, to in zip(
+            acks["timestamp"], acks["command"], acks["result"], acks["target_system"], strict=True
+        )
+        if c == 211 and r == 0 and to == 0 and int(t) >= log.start_timestamp
+    ]
+    assert gripper and gripper[0] < 2.0, stem
+    items = _verdict(stem)
+    assert items and all(a is not False for _, _, a in items), items
+
+
+def test_main_s_bundle_is_not_asked_to_run_what_stops_its_simulated_clock() -> None:
+    """On main-2026-08-13 a quadrotor in OFFBOARD disarmed with no setpoint it takes stops
+    SIH's clock (lockstep waiting for actuator outputs): those scenarios are skipped there with
+    the reason, and run everywhere else."""
+    from fuzzoff.sitl.scenarios import scenarios_for, why_not_run
+
+    stalled = [n for n in scenarios_for("main-2026-08-13") if why_not_run("main-2026-08-13", n)]
+    assert stalled == ["disarmed_switch_no_stream", "attitude_no_thrust"]
+    assert "actuator_outputs_sim" in (why_not_run("main-2026-08-13", stalled[0]) or "")
+    assert not any(why_not_run("1.18.0-beta1-head", n) for n in scenarios_for("1.18.0-beta1-head"))
+
+
 def test_the_proxy_forwards_both_ways_unchanged_and_records_them(tmp_path: Path) -> None:
     """Between a client and a PX4 (here two sockets speaking pymavlink): every datagram goes
     through as it was sent, and the tlog holds both directions once PX4's clock is known."""
@@ -278,3 +366,68 @@ def test_sitl_run_over_ros2_names_an_unknown_program_or_a_mavlink_only_option() 
     assert out.returncode == 2 and "MAVLink-only" in out.stderr
     listed = run_cli(["sitl", "list"]).stdout
     assert "ROS 2 programs (--transport ros2):" in listed and "example_stops" in listed
+
+
+def test_an_answer_that_comes_while_its_command_is_being_sent_is_recorded_after_it(
+    tmp_path: Path,
+) -> None:
+    """pymavlink records a sent message only after writing it to the socket; on a busy host
+    PX4's answer came in between and the tlog held the COMMAND_ACK before its COMMAND_LONG
+    (OFB208 then saw a command without an answer). Here a stand-in for PX4 answers at once
+    and the send is held up after the write: the command is still recorded first."""
+    import threading
+    import time
+
+    from pymavlink.dialects.v20 import development as mavlink
+
+    from fuzzoff.sitl.link import Link
+    from fuzzoff.sitl.recorder import TlogRecorder
+
+    px4_sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    px4_sock.bind(("127.0.0.1", 0))
+    px4_sock.settimeout(5.0)
+    probe = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    probe.bind(("127.0.0.1", 0))
+    client_port = probe.getsockname()[1]
+    probe.close()
+    link = Link(f"udpin:127.0.0.1:{client_port}")
+    px4 = mavlink.MAVLink(None, srcSystem=1, srcComponent=1)
+    client = ("127.0.0.1", client_port)
+    try:
+        for ms in (1000, 1100, 1200):  # PX4's clock, so that records are written
+            px4_sock.sendto(px4.system_time_encode(0, ms).pack(px4), client)
+        deadline = time.monotonic() + 5.0
+        while not link.clock.synced and time.monotonic() < deadline:
+            time.sleep(0.01)
+        link.recorder = TlogRecorder(tmp_path / "x.tlog", clock=link.clock.now)
+
+        def answer() -> None:
+            while True:  # the client's heartbeats, then the command
+                data, where = px4_sock.recvfrom(2048)
+                msgs = mavlink.MAVLink(None).parse_buffer(data) or []
+                if any(m.get_type() == "COMMAND_LONG" for m in msgs):
+                    break
+            px4_sock.sendto(px4.command_ack_encode(176, 0, 0, 0, 245, 191).pack(px4), where)
+
+        responder = threading.Thread(target=answer, daemon=True)
+        responder.start()
+        write = link.conn.write
+
+        def slow_write(buf: bytes) -> None:
+            write(buf)
+            msgs = mavlink.MAVLink(None).parse_buffer(buf) or []
+            if any(m.get_type() == "COMMAND_LONG" for m in msgs):
+                time.sleep(0.3)  # the answer arrives before pymavlink's send callback runs
+
+        link.conn.write = slow_write
+        link.send(link.mav.command_long_encode(1, 1, 176, 0, 1, 6, 0, 0, 0, 0, 0))
+        responder.join(5.0)
+        time.sleep(0.3)
+    finally:
+        link.close()
+        px4_sock.close()
+        if link.recorder is not None:
+            link.recorder.close()
+    kinds = [m.get_type() for _, m in _messages(tmp_path / "x.tlog")]
+    commands = [k for k in kinds if k in ("COMMAND_LONG", "COMMAND_ACK")]
+    assert commands == ["COMMAND_LONG", "COMMAND_ACK"], kinds

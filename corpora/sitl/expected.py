@@ -141,7 +141,9 @@ def context_of(stem: str, suffix: str) -> str | None:
         return None
     if suffix and suffix not in scenario.shown_in:
         return CONTEXT_UNSEEN
-    major, minor = (int(part) for part in release.split(".")[:2])
+    base = release.split("-")[0]
+    # a build of main (main-2026-08-13) is past every 1.x release
+    major, minor = (int(p) for p in base.split(".")[:2]) if base[:1].isdigit() else (999, 0)
     if scenario.hazard_until is not None and (major, minor) >= scenario.hazard_until:
         return CONTEXT_RELEASE
     return None

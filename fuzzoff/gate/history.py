@@ -134,11 +134,26 @@ class RecordedHistory:
             and status.nav_state != s.nav
             and (
                 s.user_intention != NAV_STATE_OFFBOARD
-                or (s.signal.available and status.failsafe is not True)
+                or (
+                    s.signal.available
+                    and status.failsafe is not True
+                    and not self._failsafe_still_shown(status)
+                )
             )
         ):
             intention = status.nav_state
         return armed, intention
+
+    def _failsafe_still_shown(self, status: VehicleStatus) -> bool:
+        """The loss action's mode, shown within the slack after the model's signal came back:
+        PX4 ends the failsafe at its next check pass (gate.md#check-timing), so a status sent
+        in between (a tlog's HEARTBEAT, which has no failsafe flag) still shows it. Not a mode
+        the pilot chose."""
+        s = self.s
+        return (
+            status.t - s.sig_changed_at <= s.compare.slack
+            and status.nav_state == s.loss_action().nav_state
+        )
 
     def _intention_for(self, status: VehicleStatus) -> int | None:
         """The user intention a confirmed difference re-synchronises to."""
