@@ -398,13 +398,13 @@ def test_a_jittered_command_keeps_the_vehicles_ack_after_it() -> None:
     assert "OFB201" in {f.code for f in run(jittered)}
 
 
-def _reached(vehicle: str, examples: int) -> dict[str, int]:
+def _reached(vehicle: str, examples: int, seed: int = SEED) -> dict[str, int]:
     config = CampaignConfig(
         px4="1.17",
         vehicle=vehicle,
         transport="ros2",
         examples=examples,
-        seed=SEED,
+        seed=seed,
         properties=("docs-stricter",),
     )
     (result,) = run_campaign(config).results
@@ -415,8 +415,13 @@ def _reached(vehicle: str, examples: int) -> dict[str, int]:
 def test_a_rover_campaign_reaches_the_rover_rules_and_a_held_command() -> None:
     """Issue 33 item 5: the rover programs of the docs' table, mostly right (the flag, the NaN
     crosses) and the deprecated TrajectorySetpoint; a held command (OFB107's 10 s)."""
-    reached = _reached("rover-ackermann", 150)
-    rover_rules = {"OFB501", "OFB502", "OFB503", "OFB504", "OFB505"}
+    # the search steers toward the gate's thresholds, so one seed dwells on a few streams:
+    # three seeds' campaigns together reach what a user's longer campaign does
+    reached: dict[str, int] = {}
+    for seed in (SEED, 1, 2):
+        for code, count in _reached("rover-ackermann", 120, seed).items():
+            reached[code] = reached.get(code, 0) + count
+    rover_rules = {"OFB501", "OFB502", "OFB503", "OFB504", "OFB505", "OFB510"}
     assert rover_rules <= set(reached), sorted(reached)
     assert "OFB107" in reached
 
