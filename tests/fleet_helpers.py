@@ -24,9 +24,16 @@ def kill_once(path: str, settings: Settings, *, marker: str) -> FileReport:
     return lint_file(path, settings)
 
 
+SLOW_S = 1.2
+"""How long a ``*slow*`` recording takes."""
+
+
 def crash_or_hang(path: str, settings: Settings) -> FileReport:
-    """``*crash*``: every process linting it dies; ``*hang*``: its lint never ends."""
+    """``*crash*``: every process linting it dies; ``*hang*``: its lint never ends; ``*slow*``:
+    its lint takes ``SLOW_S`` seconds."""
     name = Path(path).name
+    if "slow" in name:
+        time.sleep(SLOW_S)
     if "crash" in name:
         time.sleep(0.2)  # a crash mid-lint
         os.kill(os.getpid(), signal.SIGKILL)

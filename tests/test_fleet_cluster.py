@@ -5,10 +5,12 @@ that kills every worker, one that hangs, URLs fetched by the workers, an increme
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import json
 import shutil
 import threading
+import time
 from collections.abc import Iterator
 from functools import partial
 from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
@@ -30,8 +32,33 @@ TLOGS = CORPORA / "tlog"
 
 @pytest.fixture(scope="module")
 def client() -> Iterator[Any]:
-    with local_cluster(2) as cluster, Client(cluster) as c:
-        yield c
+    cluster = local_cluster(2)
+    try:
+        with Client(cluster) as c:
+            yield c
+    finally:
+        # the LocalCluster's own view of its workers may have failed on a worker killed
+        # twice in a row (``_two_workers``); its close re-raises that KeyError
+        with contextlib.suppress(KeyError):
+            cluster.close()
+
+
+def _two_workers(client: Any) -> None:
+    """Wait until the scheduler has both workers again (the nannies restart killed ones).
+    Asked of the scheduler: ``Client.wait_for_workers`` asks the LocalCluster object, whose
+    view of the workers stops updating when a restarted worker is killed again before the
+    cluster saw it arrive (a KeyError in distributed's ``_update_worker_status``)."""
+    deadline = time.monotonic() + 120
+    while len(client.nthreads()) < 2:
+        assert time.monotonic() < deadline, "the killed workers were not restarted in 120 s"
+        time.sleep(0.2)
+
+
+def _warm(client: Any) -> None:
+    """Both workers up and past their first lint (its imports take seconds on a loaded
+    machine, and the timeout tests time seconds)."""
+    _two_workers(client)
+    client.run(lint_file, str(TLOGS / "good_offboard.tlog"))
 
 
 def _some(tmp_path: Path, *special: str) -> list[str]:
@@ -44,9 +71,14 @@ def _some(tmp_path: Path, *special: str) -> list[str]:
     return targets
 
 
-def test_scheduler_local_gives_the_findings_of_a_plain_lint() -> None:
-    plain = run_cli(["lint", str(CORPORA), "--format", "json"])
-    dask_run = run_cli(["lint", "--scheduler", "local", str(CORPORA), "--format", "json"])
+@pytest.mark.parametrize("jobs", ["1", "2"])
+def test_scheduler_local_gives_the_findings_of_jobs(jobs: str) -> None:
+    """The whole corpus, several recordings to a task (``test_fleet_batches``), beside the
+    same ``--jobs``."""
+    plain = run_cli(["lint", str(CORPORA), "--format", "json", "--jobs", jobs])
+    dask_run = run_cli(
+        ["lint", "--scheduler", "local", "--jobs", jobs, str(CORPORA), "--format", "json"]
+    )
     assert plain.returncode == 2, "the corpus holds damaged recordings on purpose"
     assert dask_run.returncode == plain.returncode
     assert json.loads(dask_run.stdout) == json.loads(plain.stdout)
@@ -65,7 +97,7 @@ def test_a_worker_killed_mid_run_the_run_finishes_and_the_recording_is_reported(
     victim = outcomes[-1].report
     assert victim is not None
     assert victim.to_json() == lint_file(targets[-1]).to_json()
-    client.wait_for_workers(2, timeout=30)
+    _two_workers(client)
 
 
 def test_a_recording_that_kills_every_worker_is_its_ofb001_and_the_run_goes_on(
@@ -84,11 +116,12 @@ def test_a_recording_that_kills_every_worker_is_its_ofb001_and_the_run_goes_on(
     assert finding.code == "OFB001"
     assert finding.message.startswith(f"{targets[-1]}: the lint did not finish")
     assert "worker process linting it died after" in finding.message
-    client.wait_for_workers(2, timeout=30)
+    _two_workers(client)
 
 
 def test_a_recording_that_hangs_is_stopped_after_the_timeout(client: Any, tmp_path: Path) -> None:
     targets = _some(tmp_path, "hang.tlog")
+    _warm(client)
     outcomes = run_on_cluster(
         client, targets, Settings(), lint=fleet_helpers.crash_or_hang, timeout_s=2.0
     )
@@ -101,10 +134,92 @@ def test_a_recording_that_hangs_is_stopped_after_the_timeout(client: Any, tmp_pa
         "Dask worker tcp://127.0.0.1:"
     )
     assert problem.endswith(" (its nanny starts a new one)")
-    client.wait_for_workers(2, timeout=30)
+    _two_workers(client)
     # the restarted worker lints again
     again = run_on_cluster(client, targets[:3], Settings())
     assert [o.status for o in again] == [LINTED] * 3
+
+
+def _one_task(targets: list[str]) -> list[tuple[int, ...]]:
+    return [tuple(range(len(targets)))]
+
+
+def _same_as_plain(outcomes: list[Any], targets: list[str], skip: int) -> None:
+    for k, (outcome, target) in enumerate(zip(outcomes, targets, strict=True)):
+        if k != skip:
+            assert outcome.status == LINTED
+            assert outcome.report.to_json() == lint_file(target).to_json()
+
+
+def test_a_recording_that_kills_every_worker_in_a_batch_is_its_ofb001_alone(
+    client: Any, tmp_path: Path
+) -> None:
+    targets = _some(tmp_path, "crash.tlog", "after.tlog")
+    # the crash in the middle of one task of five recordings
+    targets[3], targets[1] = targets[1], targets[3]
+    outcomes = run_on_cluster(
+        client, targets, Settings(), lint=fleet_helpers.crash_or_hang, tasks=_one_task(targets)
+    )
+    assert [o.status for o in outcomes] == [LINTED, CRASHED, LINTED, LINTED, LINTED]
+    _same_as_plain(outcomes, targets, skip=1)
+    crashed = outcomes[1].report
+    assert crashed is not None and not crashed.complete
+    [finding] = crashed.findings
+    assert finding.code == "OFB001"
+    assert finding.message.startswith(f"{targets[1]}: the lint did not finish: the Dask worker")
+    _two_workers(client)
+
+
+def test_a_worker_killed_once_mid_batch_the_batch_is_linted_elsewhere(
+    client: Any, tmp_path: Path
+) -> None:
+    targets = _some(tmp_path, "victim.tlog", "after.tlog")
+    marker = tmp_path / "killed"
+    lint = partial(fleet_helpers.kill_once, marker=str(marker))
+    outcomes = run_on_cluster(client, targets, Settings(), lint=lint, tasks=_one_task(targets))
+    assert marker.exists(), "a worker process was killed while linting the batch"
+    _same_as_plain(outcomes, targets, skip=-1)
+    _two_workers(client)
+
+
+def test_a_recording_that_hangs_in_a_batch_is_stopped_and_the_others_linted(
+    client: Any, tmp_path: Path
+) -> None:
+    targets = _some(tmp_path, "hang.tlog", "after.tlog")
+    targets[3], targets[1] = targets[1], targets[3]
+    _warm(client)
+    outcomes = run_on_cluster(
+        client,
+        targets,
+        Settings(),
+        lint=fleet_helpers.crash_or_hang,
+        timeout_s=2.0,
+        tasks=_one_task(targets),
+    )
+    assert [o.status for o in outcomes] == [LINTED, TIMED_OUT, LINTED, LINTED, LINTED]
+    _same_as_plain(outcomes, targets, skip=1)
+    hung = outcomes[1].report
+    assert hung is not None
+    [problem] = hung.problems
+    assert problem.startswith(f"{targets[1]}: the lint did not finish within 2 s (--timeout)")
+    _two_workers(client)
+
+
+def test_the_timeout_is_per_recording_not_per_batch(client: Any, tmp_path: Path) -> None:
+    """Four recordings of 1.2 s each in one task: 4.8 s in all, past a 3 s timeout, and
+    none of them past it alone."""
+    slow = [f"slow_{k}.tlog" for k in range(4)]
+    targets = _some(tmp_path, *slow)
+    _warm(client)
+    outcomes = run_on_cluster(
+        client,
+        targets,
+        Settings(),
+        lint=fleet_helpers.crash_or_hang,
+        timeout_s=3.0,
+        tasks=_one_task(targets),
+    )
+    _same_as_plain(outcomes, targets, skip=-1)
 
 
 def test_an_incremental_second_run_lints_nothing_new(client: Any, tmp_path: Path) -> None:

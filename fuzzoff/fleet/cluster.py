@@ -1,14 +1,17 @@
-"""Recordings as Dask tasks: one task per recording, results as they finish, no recording able
-to end the run.
+"""Recordings as Dask tasks: several small recordings per task (sized by their bytes,
+``batches``), results as they finish, no recording able to end the run.
 
 A worker process that dies while linting (a crash in a reader's C code, the kernel's OOM
-killer) is restarted by its nanny and the scheduler tries the recording again elsewhere; when
-it has killed ``allowed-failures`` + 1 workers the scheduler gives up on it (``KilledWorker``)
-and it becomes that recording's OFB001. A recording that runs past ``--timeout`` is stopped
-the only way a thread can be: its task is cancelled and its worker process ended, and the
-worker's nanny starts a new one. The clock runs
-from the moment the task starts on its worker (each task announces itself with
-``Worker.log_event``), not from its submission, so a long queue does not time anything out.
+killer) is restarted by its nanny and the scheduler tries the task again elsewhere; when it
+has killed ``allowed-failures`` + 1 workers the scheduler gives up on it (``KilledWorker``).
+A task of several recordings that fails so is run again one recording per task, to find
+which: the one that kills its workers alone becomes that recording's OFB001. ``--timeout`` is
+per recording: each recording announces itself as it starts (``Worker.log_event``), and the
+clock runs from then, not from the task's submission (a long queue times nothing out) nor
+from its task's start (a recording late in a task has the whole timeout too). A recording past
+it is stopped the only way a thread can be: its task is cancelled and its worker process
+ended, and the worker's nanny starts a new one; the task's other recordings go again as a
+task of their own.
 """
 
 from __future__ import annotations
@@ -28,6 +31,7 @@ from typing import Any
 from fuzzoff.config import ConfigError, Settings
 from fuzzoff.engine import lint_file
 from fuzzoff.fleet import require
+from fuzzoff.fleet.batches import plan, recording_bytes
 from fuzzoff.fleet.task import CRASHED, FAILED, TIMED_OUT, Lint, Outcome, failed_report, lint_target
 
 LOCAL = "local"
@@ -97,21 +101,25 @@ def local_cluster(workers: int) -> Any:
 
 
 def _run(
-    index: int,
-    target: str,
-    settings: Settings,
+    key: str,
+    targets: Sequence[str],
+    settings: Sequence[Settings],
     topic: str,
     lint: Lint,
     known: Collection[str],
     record: bool,
-) -> Outcome:
-    """The task: say it started (the timeout's clock), then lint."""
+) -> list[Outcome]:
+    """The task: lint its recordings in turn, each announced as it starts (the clock of its
+    timeout, and how the client knows which recording a stopped task was on)."""
     from distributed import get_worker
 
     worker = get_worker()
-    worker.log_event(topic, {"index": index, "worker": worker.address})
     _freeze_once()
-    return lint_target(target, settings, lint=lint, known=known, record=record)
+    outcomes = []
+    for position, (target, each) in enumerate(zip(targets, settings, strict=True)):
+        worker.log_event(topic, {"key": key, "position": position, "worker": worker.address})
+        outcomes.append(lint_target(target, each, lint=lint, known=known, record=record))
+    return outcomes
 
 
 _frozen = False
@@ -130,51 +138,99 @@ def _freeze_once() -> None:
 
 
 @dataclass(slots=True)
+class _Task:
+    """One Dask task: the recordings it lints in turn (one, or a batch)."""
+
+    indices: tuple[int, ...]
+    tries: int = 1
+    """Submissions of these recordings together (a task that died with workers another task
+    killed is submitted again as it was)."""
+
+
+@dataclass(slots=True)
 class _Start:
+    """The recording a task last announced: when, where, and which of its recordings."""
+
     at: float
     worker: str
+    position: int
 
 
 class _Run:
-    """One fleet run's futures, the start of each task, and the outcomes so far."""
+    """One fleet run's tasks, the recording each is on, and the outcomes so far.
 
-    def __init__(self, client: Any, targets: Sequence[str], settings: Sequence[Settings]) -> None:
+    ``lock`` guards ``pending``: whoever takes a task out of it (its result arriving, or the
+    watchdog stopping it) decides what becomes of its recordings, once."""
+
+    def __init__(
+        self,
+        client: Any,
+        targets: Sequence[str],
+        settings: Sequence[Settings],
+        submit: Callable[[_Task], None],
+    ) -> None:
         self.client = client
         self.targets = targets
         self.settings = settings
         """Each target's settings, in the order of ``targets``."""
+        self.submit = submit
         self.id = uuid.uuid4().hex[:12]
         self.topic = f"fuzzoff-started-{self.id}"
-        self.lock = threading.Lock()
-        self.started: dict[int, _Start] = {}
+        self.lock = threading.RLock()
+        self.pending: dict[str, tuple[_Task, Any]] = {}
+        """Each task not yet resolved, with its future, by key."""
+        self.started: dict[str, _Start] = {}
         self.outcomes: list[Outcome | None] = [None] * len(targets)
+        self.on_outcome: Callable[[Outcome], None] | None = None
+        self._serial = 0
+
+    def key(self) -> str:
+        with self.lock:
+            self._serial += 1
+            return f"fuzzoff-lint-{self.id}-{self._serial}"
 
     def on_start(self, event: tuple[float, dict[str, Any]]) -> None:
         msg = event[1]
+        start = _Start(time.monotonic(), str(msg["worker"]), int(msg["position"]))
         with self.lock:
-            self.started[int(msg["index"])] = _Start(time.monotonic(), str(msg["worker"]))
+            self.started[str(msg["key"])] = start
 
-    def elapsed(self, index: int) -> float | None:
+    def take(self, key: str) -> _Task | None:
+        """The task, now resolved by the caller; None when it was resolved already."""
         with self.lock:
-            start = self.started.get(index)
+            taken = self.pending.pop(key, None)
+        return None if taken is None else taken[0]
+
+    def done(self, index: int, outcome: Outcome) -> None:
+        with self.lock:
+            if self.outcomes[index] is not None:
+                return
+            self.outcomes[index] = outcome
+            if self.on_outcome is not None:
+                self.on_outcome(outcome)
+
+    def elapsed(self, key: str) -> float | None:
+        with self.lock:
+            start = self.started.get(key)
         return None if start is None else time.monotonic() - start.at
 
-    def overdue(self, timeout_s: float) -> list[tuple[int, str]]:
+    def overdue(self, timeout_s: float) -> list[tuple[str, _Start]]:
+        """The tasks whose current recording started more than ``timeout_s`` ago."""
         now = time.monotonic()
         with self.lock:
             return [
-                (i, s.worker)
-                for i, s in self.started.items()
-                if self.outcomes[i] is None and now - s.at > timeout_s
+                (key, start)
+                for key, start in self.started.items()
+                if key in self.pending and now - start.at > timeout_s
             ]
 
     def forget_worker(self, worker: str) -> None:
         """Tasks that were on a restarted worker start again elsewhere: their clocks too."""
         with self.lock:
-            for i in [i for i, s in self.started.items() if s.worker == worker]:
-                del self.started[i]
+            for key in [k for k, s in self.started.items() if s.worker == worker]:
+                del self.started[key]
 
-    def bystander(self, index: int, exc: BaseException) -> bool:
+    def bystander(self, key: str, exc: BaseException) -> bool:
         """Did the task die with workers that were killed by another task? A worker that
         dies takes the tasks queued on it along; the one that killed it had started there."""
         from distributed import KilledWorker
@@ -182,15 +238,15 @@ class _Run:
         if not isinstance(exc, KilledWorker):
             return False
         with self.lock:
-            start = self.started.get(index)
+            start = self.started.get(key)
         return start is None or start.worker != exc.last_worker.address
 
-    def failed(self, index: int, exc: BaseException) -> Outcome:
-        """The outcome of a task that raised: its worker died (``KilledWorker``) or fuzzoff
-        raised (a bug: the report names the exception)."""
+    def failed(self, key: str, index: int, exc: BaseException) -> Outcome:
+        """The outcome of a task of one recording that raised: its worker died
+        (``KilledWorker``) or fuzzoff raised (a bug: the report names the exception)."""
         from distributed import KilledWorker
 
-        after = self.elapsed(index)
+        after = self.elapsed(key)
         took = "" if after is None else f" after {after:.1f} s"
         if isinstance(exc, KilledWorker):
             what = (
@@ -207,12 +263,52 @@ class _Run:
         report = failed_report(target, what, self.settings[index])
         return Outcome(target, report, status, seconds=after or 0.0)
 
-    def timed_out(self, index: int, worker: str, timeout_s: float) -> Outcome:
-        what = (
-            f"the lint did not finish within {timeout_s:g} s (--timeout): stopped by ending "
-            f"its Dask worker {worker} (its nanny starts a new one)"
-        )
-        return self._failed(index, what, TIMED_OUT, timeout_s)
+    def resolve(self, key: str, task: _Task, result: Any) -> None:
+        """What a finished task's result means for its recordings: their outcomes; or, where
+        it raised, the same task again (it died with a worker another task killed), each of
+        its recordings as a task of its own (to find which one failed it), or the outcome of
+        its one recording (``crashed``, ``failed``)."""
+        if isinstance(result, list):
+            for index, outcome in zip(task.indices, result, strict=True):
+                self.done(index, outcome)
+            return
+        exc = _raised(result)
+        if self.bystander(key, exc) and task.tries < BYSTANDER_TRIES:
+            self.submit(_Task(task.indices, task.tries + 1))
+        elif len(task.indices) > 1:
+            for index in task.indices:
+                self.submit(_Task((index,)))
+        else:
+            self.done(task.indices[0], self.failed(key, task.indices[0], exc))
+
+    def stop(self, key: str, start: _Start, timeout_s: float) -> Any:
+        """Stop a task whose recording ran past the timeout: that recording is ``timed out``,
+        the task's other recordings go again as a task of their own. The stopped task's
+        future, or None when it was resolved already."""
+        with self.lock:
+            taken = self.pending.pop(key, None)
+            if taken is None:
+                return None
+            task, future = taken
+            index = task.indices[start.position]
+            what = (
+                f"the lint did not finish within {timeout_s:g} s (--timeout): stopped by ending "
+                f"its Dask worker {start.worker} (its nanny starts a new one)"
+            )
+            self.done(index, self._failed(index, what, TIMED_OUT, timeout_s))
+            rest = tuple(i for i in task.indices if self.outcomes[i] is None)
+            if rest:
+                self.submit(_Task(rest))
+        return future
+
+
+def workers_of(client: Any) -> int:
+    """The threads the cluster's workers run tasks in (at least one)."""
+    try:
+        threads: dict[str, int] = client.nthreads()
+    except Exception:  # a scheduler that cannot say: plan for one
+        return 1
+    return max(1, sum(threads.values()))
 
 
 def run_on_cluster(
@@ -225,73 +321,66 @@ def run_on_cluster(
     known: Collection[str] = (),
     record: bool = False,
     on_outcome: Callable[[Outcome], None] | None = None,
+    tasks: Sequence[tuple[int, ...]] | None = None,
 ) -> list[Outcome]:
-    """Lint every target as its own task on ``client``'s cluster, with ``settings`` (one for
-    all, or each target's own in the order of ``targets``); the outcomes in the order of
-    ``targets``, each handed to ``on_outcome`` as it arrives. Results are gathered in batches
-    as they finish; a watchdog thread stops the tasks that run past ``timeout_s``."""
+    """Lint every target on ``client``'s cluster, with ``settings`` (one for all, or each
+    target's own in the order of ``targets``); the outcomes in the order of ``targets``,
+    each handed to ``on_outcome`` as it arrives. ``tasks`` groups the targets' indices into
+    tasks (default: by their bytes, ``batches.plan``). Results are gathered in batches as
+    they finish; a watchdog thread stops the recordings that run past ``timeout_s``."""
     from distributed import as_completed
 
     each = [settings] * len(targets) if isinstance(settings, Settings) else list(settings)
-    run = _Run(client, targets, each)
-    client.subscribe_topic(run.topic, run.on_start)
+    if tasks is None:
+        tasks = plan([recording_bytes(t) for t in targets], workers_of(client))
+    results = as_completed([], loop=client.loop, with_results=True, raise_errors=False)
     known_arg: Any = frozenset(known)
+
+    def submit(task: _Task) -> None:
+        key = run.key()
+        future = client.submit(
+            _run,
+            key,
+            [targets[i] for i in task.indices],
+            [each[i] for i in task.indices],
+            run.topic,
+            lint,
+            known_arg,
+            record,
+            key=key,
+            pure=False,
+        )
+        with run.lock:
+            run.pending[key] = (task, future)
+        results.add(future)
+
+    run = _Run(client, targets, each, submit)
+    run.on_outcome = on_outcome
+    client.subscribe_topic(run.topic, run.on_start)
     if known:  # once to every worker, not once per task
         # in a list: scatter sends a collection's items one by one
         [known_arg] = client.scatter([frozenset(known)], broadcast=True, hash=False)
-    futures: dict[str, Any] = {}
-    tries: dict[int, int] = {}
-
-    def submit(i: int) -> Any:
-        tries[i] = tries.get(i, 0) + 1
-        key = _key(run, i, tries[i])
-        future = client.submit(
-            _run, i, targets[i], each[i], run.topic, lint, known_arg, record, key=key, pure=False
-        )
-        futures[key] = future
-        return future
-
-    def done(i: int, outcome: Outcome) -> None:
-        with run.lock:
-            if run.outcomes[i] is not None:
-                return
-            run.outcomes[i] = outcome
-            if on_outcome is not None:
-                on_outcome(outcome)
-
-    results = as_completed(
-        [submit(i) for i in range(len(targets))], with_results=True, raise_errors=False
-    )
+    for indices in tasks:
+        submit(_Task(tuple(indices)))
     stop = threading.Event()
-    watchdog = threading.Thread(
-        target=_watch, args=(run, futures, tries, timeout_s, done, stop), daemon=True
-    )
+    watchdog = threading.Thread(target=_watch, args=(run, timeout_s, stop), daemon=True)
     watchdog.start()
     try:
         for batch in results.batches():
             for future, result in batch:
-                i = int(future.key.rsplit("-", 2)[1])
-                futures.pop(future.key, None)
+                task = run.take(future.key)
                 future.release()
-                if isinstance(result, Outcome):
-                    done(i, result)
-                    continue
-                exc = _raised(result)
-                if run.bystander(i, exc) and tries[i] < BYSTANDER_TRIES:
-                    results.add(submit(i))
-                else:
-                    done(i, run.failed(i, exc))
+                if task is not None:
+                    run.resolve(future.key, task, result)
     finally:
         stop.set()
         watchdog.join()
         client.unsubscribe_topic(run.topic)
-        for future in list(futures.values()):
+        with run.lock:
+            left = [future for _, future in run.pending.values()]
+        for future in left:
             future.cancel()
     return [o for o in run.outcomes if o is not None]
-
-
-def _key(run: _Run, index: int, attempt: int) -> str:
-    return f"fuzzoff-lint-{run.id}-{index}-{attempt}"
 
 
 def _raised(result: Any) -> BaseException:
@@ -301,29 +390,20 @@ def _raised(result: Any) -> BaseException:
     return RuntimeError(f"unexpected task result {type(result).__name__}")
 
 
-def _watch(
-    run: _Run,
-    futures: dict[str, Any],
-    tries: dict[int, int],
-    timeout_s: float,
-    done: Callable[[int, Outcome], None],
-    stop: threading.Event,
-) -> None:
-    """Every ``WATCH_S``: a task past the timeout is cancelled (its outcome: OFB001) and its
-    worker process ended, the only way to stop the thread that runs it."""
+def _watch(run: _Run, timeout_s: float, stop: threading.Event) -> None:
+    """Every ``WATCH_S``: a recording past the timeout is ``timed out`` (OFB001), its task
+    cancelled and its worker process ended, the only way to stop the thread that runs it."""
     while not stop.wait(WATCH_S):
-        for i, worker in run.overdue(timeout_s):
-            key = _key(run, i, tries[i])
-            if not _still_on(run.client, key, worker):
-                run.forget_worker(worker)  # it died and the task is queued again
+        for key, start in run.overdue(timeout_s):
+            if not _still_on(run.client, key, start.worker):
+                run.forget_worker(start.worker)  # it died and the task is queued again
                 continue
             # the outcome first: the cancelled task may come back as cancelled, not as this
-            done(i, run.timed_out(i, worker, timeout_s))
-            future = futures.pop(key, None)
+            future = run.stop(key, start, timeout_s)
             if future is not None:
                 future.cancel()
-            _end_worker(run.client, worker)
-            run.forget_worker(worker)
+            _end_worker(run.client, start.worker)
+            run.forget_worker(start.worker)
 
 
 def _end_worker(client: Any, worker: str) -> None:
