@@ -299,16 +299,18 @@ def vtol_fw_types(d: Driver) -> None:
     _vtol_back_and_land(d)
 
 
-TAILSITTER_PARAMS = {"FW_USE_AIRSPD": 0.0}
+TAILSITTER_PARAMS = {"FW_USE_AIRSPD": 0.0, "CA_SV_CS1_TRQ_P": -0.5, "CA_SV_CS1_TRQ_Y": -0.5}
 """SIH's tailsitter (``sihsim_xvert``) never shows the transition airspeed: the airspeed PX4
 validated stayed at 0.1-5 m/s while it flew 7 m/s over ground, the front transition waited
 for VT_ARSP_TRANS (10 m/s) and PX4 quad-chuted back to MC 6.6 s in (1.18 head). Without the
 airspeed (FW_USE_AIRSPD 0) PX4 times the transition (VT_F_TR_OL_TM) and it reached FW in
-3.4 s, then held 28 m at 10.7 m/s."""
+3.4 s, then held 28 m at 10.7 m/s. The right elevon's pitch and yaw torques are -0.5 as the
+1.18 head's and main's airframe has them: the airframes of 1.14.4 to 1.18.0-alpha1 give +0.5,
+the two elevons then cancel in pitch, and the tailsitter rose 0.1-1.3 m at most in OFFBOARD
+(PX4 counted it landed); with -0.5 it climbed to 20 m and flew FW on 1.17.0."""
 
-TAILSITTER_FLIES_ON = ("1.18.0-beta1-head",)
-"""Where SIH's tailsitter climbs in OFFBOARD: on 1.15.4, 1.16.2 and 1.17.0 it rose 0.1-1.3 m at
-most, PX4 counted it landed (a transition on the ground, no failsafe on a stream stop)."""
+TAILSITTER_FLIES_ON: tuple[str, ...] | None = None
+"""Every bundle (with the parameters above)."""
 
 AIRPLANE_FLIES_ON = ("1.16.2", "1.17.0")
 """Where SIH's airplane takes off by itself (docs/sitl.md: on the 1.18 head its ground run
@@ -353,6 +355,63 @@ def fw_loss(d: Driver) -> None:
     d.note("stream resumes")
     d.stream(d.position(*FW_POINT), 4.0)
     _fw_hold(d)
+
+
+AIRPLANE_OUTPUTS = {
+    "PWM_MAIN_FUNC1": 201.0,
+    "PWM_MAIN_FUNC2": 202.0,
+    "PWM_MAIN_FUNC3": 203.0,
+    "PWM_MAIN_FUNC4": 101.0,
+    "PWM_MAIN_FUNC5": 0.0,
+    "PWM_MAIN_FUNC6": 0.0,
+}
+"""The SIH airplane's outputs as SIH reads them (servos on outputs 1-3, the motor on 4): the
+1.16 airframe's mapping. The 1.14 and 1.15 airframes put them on outputs 3-6; there SIH's
+state went NaN within 0.1 s of the arm (attitude, then position invalid) and PX4 flew flight
+termination. With this mapping the arm, the loss and the failsafe are PX4's own; on 1.16 and
+later it is what the airframe sets already."""
+
+AIRPLANE_RATE_GAINS = {
+    "FW_RR_P": 0.05,
+    "FW_RR_I": 2.0,
+    "FW_RR_FF": 0.0,
+    "FW_PR_P": 0.08,
+    "FW_PR_I": 2.5,
+    "FW_PR_FF": 0.0,
+    "FW_YR_P": 0.05,
+    "FW_YR_I": 3.0,
+    "FW_YR_FF": 0.0,
+}
+"""The fixed-wing rate gains the 1.17.0 airframe gives SIH's airplane. With the outputs mapped
+but PX4 1.14's default gains the airplane reached 12-14 m/s on its runway and then tripped the
+failure detector (roll past 60 degrees, "Attitude failure", disarmed by failsafe); with these
+it took off and climbed to 15 m in 12 s (1.14.4)."""
+
+AIRPLANE_PARAMS = {**AIRPLANE_OUTPUTS, **AIRPLANE_RATE_GAINS}
+"""What the airplane's flights set: the outputs SIH reads and the 1.17.0 airframe's gains."""
+
+FW_GROUND_POINT = (0.0, 0.0, 0.0)
+"""Where the airplane's ground gate run holds: where it stands, on the ground."""
+
+
+def fw_gate(d: Driver) -> None:
+    """The airplane's gate on the ground, for the builds where it cannot take off: a position
+    stream, the switch to OFFBOARD and the arm, a 3 s stream stop (the loss and its action),
+    the stream again, a disarm (forced when PX4 counts the rolling airplane as flying)."""
+    d.stream(d.position(*FW_GROUND_POINT), 1.5)
+    d.set_mode(NAV_OFFBOARD, "OFFBOARD")
+    d.stream(d.position(*FW_GROUND_POINT), 0.5)
+    d.arm()
+    d.stream(d.position(*FW_GROUND_POINT), 3.0)
+    d.note("stream stops")
+    d.wait(3.0)
+    d.note("stream resumes")
+    d.stream(d.position(*FW_GROUND_POINT), 3.0)
+    if d.link.view.armed:
+        ack = d.disarm()
+        if ack is None or ack.result != 0:
+            d.force_disarm()
+    d.wait(1.0)
 
 
 def _rover_start(d: Driver) -> None:
@@ -597,6 +656,7 @@ SCENARIOS: dict[str, Scenario] = {
             " air, a position setpoint 400 m ahead, Hold",
             fw_offboard,
             "clean",
+            params=AIRPLANE_PARAMS,
             vehicle="fw",
             flies_on=AIRPLANE_FLIES_ON,
         ),
@@ -607,8 +667,20 @@ SCENARIOS: dict[str, Scenario] = {
             "hazard",
             "stream lost in OFFBOARD (failsafe, then back to OFFBOARD)",
             ("OFB103",),
+            params=AIRPLANE_PARAMS,
             vehicle="fw",
             flies_on=AIRPLANE_FLIES_ON,
+        ),
+        Scenario(
+            "fw_gate",
+            "airplane on the ground: stream, switch to OFFBOARD, arm, the stream stops 3 s and"
+            " resumes, disarm (forced if PX4 counts it flying)",
+            fw_gate,
+            "hazard",
+            "stream lost in OFFBOARD (failsafe, then back to OFFBOARD)",
+            ("OFB103",),
+            params=AIRPLANE_OUTPUTS,
+            vehicle="fw",
         ),
         Scenario(
             "rover_offboard",
