@@ -294,3 +294,30 @@ def test_the_tailsitters_runs_agree_with_the_model_beside_a_parameter_it_does_no
     losses = [i for i in verdict.items if i.what == "failsafe action"]
     assert len(losses) == 2
     assert all(i.agree for i in verdict.items)
+
+
+def test_a_parameter_is_set_under_its_old_name_on_a_px4_that_predates_it() -> None:
+    """1.14.4 has FW_ARSP_MODE (1: airspeed not used) where 1.15 and later have FW_USE_AIRSPD
+    (0: not used): the tailsitter's runs set whichever PX4 has."""
+    from typing import cast
+
+    from fuzzoff.sitl.link import Link
+    from fuzzoff.sitl.session import apply_params
+
+    class FakeLink:
+        def __init__(self, names: set[str]) -> None:
+            self.values = dict.fromkeys(names, -1.0)
+
+        def get_param(self, name: str) -> tuple[float, int] | None:
+            return (self.values[name], 6) if name in self.values else None
+
+        def set_param(self, name: str, value: float) -> float:
+            self.values[name] = value
+            return value
+
+    old = FakeLink({"FW_ARSP_MODE", "CA_SV_CS1_TRQ_P"})
+    params = {"FW_USE_AIRSPD": 0.0, "CA_SV_CS1_TRQ_P": -0.5}
+    applied = apply_params(cast(Link, old), params)
+    assert applied == {"FW_ARSP_MODE": 1.0, "CA_SV_CS1_TRQ_P": -0.5}
+    new = FakeLink({"FW_USE_AIRSPD", "CA_SV_CS1_TRQ_P"})
+    assert apply_params(cast(Link, new), params) == params

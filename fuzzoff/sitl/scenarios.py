@@ -724,15 +724,19 @@ RELEASE_DEPENDENT = (
 
 
 VEHICLE_RELEASES = (
+    "1.14.4",
+    "1.15.4",
     "1.16.2",
     "1.17.0",
     "1.17.0-ros2-rover",
+    "1.18.0-alpha1",
     "1.18.0-beta1-head",
     "main-2026-08-13",
 )
-"""The bundles the other vehicles' scenarios run on (the standard VTOL came with 1.16's SIH,
-the hexacopter and the rover with 1.17.0's; the rover flies only where the bundle has its
-module: ``airframes.why_not``; a program only on its ``flies_on``)."""
+"""The bundles the other vehicles' scenarios run on: every bundle with the airframe (the
+airplane and the tailsitter are in all; the standard VTOL came with 1.16's SIH, the hexacopter
+and the rover with 1.17.0's; the rover flies only where the bundle has its module:
+``airframes.why_not``; a program only on its ``flies_on``)."""
 
 
 SIM_STALLS = (
