@@ -307,7 +307,8 @@ airspeed (FW_USE_AIRSPD 0) PX4 times the transition (VT_F_TR_OL_TM) and it reach
 3.4 s, then held 28 m at 10.7 m/s. The right elevon's pitch and yaw torques are -0.5 as the
 1.18 head's and main's airframe has them: the airframes of 1.14.4 to 1.18.0-alpha1 give +0.5,
 the two elevons then cancel in pitch, and the tailsitter rose 0.1-1.3 m at most in OFFBOARD
-(PX4 counted it landed); with -0.5 it climbed to 20 m and flew FW on 1.17.0."""
+(PX4 counted it landed); with -0.5 it climbed to 20 m and flew FW on every bundle. On 1.14
+FW_USE_AIRSPD is FW_ARSP_MODE (``session.RENAMED``)."""
 
 TAILSITTER_FLIES_ON: tuple[str, ...] | None = None
 """Every bundle (with the parameters above)."""
