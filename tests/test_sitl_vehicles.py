@@ -301,17 +301,16 @@ def test_a_parameter_is_set_under_its_old_name_on_a_px4_that_predates_it() -> No
     (0: not used): the tailsitter's runs set whichever PX4 has."""
     from typing import cast
 
-    from fuzzoff.sitl.link import Link
+    from fuzzoff.sitl.link import Link, LinkError
     from fuzzoff.sitl.session import apply_params
 
     class FakeLink:
         def __init__(self, names: set[str]) -> None:
             self.values = dict.fromkeys(names, -1.0)
 
-        def get_param(self, name: str) -> tuple[float, int] | None:
-            return (self.values[name], 6) if name in self.values else None
-
         def set_param(self, name: str, value: float) -> float:
+            if name not in self.values:
+                raise LinkError(f"PX4 has no parameter {name} (no PARAM_VALUE for it)")
             self.values[name] = value
             return value
 

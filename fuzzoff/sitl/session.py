@@ -47,7 +47,13 @@ def apply_params(link: Link, params: dict[str, float]) -> dict[str, float]:
     the names and values PX4 holds now."""
     applied: dict[str, float] = {}
     for name, value in params.items():
-        if name in RENAMED and link.get_param(name) is None:
+        if name in RENAMED:
+            try:
+                applied[name] = link.set_param(name, value)
+                continue
+            except LinkError as exc:
+                if "has no parameter" not in str(exc):
+                    raise
             old, convert = RENAMED[name]
             name, value = old, convert(value)
         applied[name] = link.set_param(name, value)
