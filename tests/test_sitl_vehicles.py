@@ -320,3 +320,29 @@ def test_a_parameter_is_set_under_its_old_name_on_a_px4_that_predates_it() -> No
     assert applied == {"FW_ARSP_MODE": 1.0, "CA_SV_CS1_TRQ_P": -0.5}
     new = FakeLink({"FW_USE_AIRSPD", "CA_SV_CS1_TRQ_P"})
     assert apply_params(cast(Link, new), params) == params
+
+
+@pytest.mark.parametrize(
+    ("vehicle", "fixed"),
+    [("fw", "PWM_MAIN_FUNC4"), ("tailsitter", "CA_SV_CS1_TRQ_P"), ("quad", None)],
+)
+def test_a_live_campaign_boots_the_airframe_with_the_scenarios_fixes(
+    tmp_path: Path, vehicle: str, fixed: str | None
+) -> None:
+    """A campaign on the airplane or the tailsitter sets what their scenarios set (the 1.14/1.15
+    airplane's outputs, the tailsitter's airspeed use and elevon) at each boot of PX4."""
+    from fuzzoff.sitl.against import AgainstConfig, Campaign
+
+    build = _bundle(
+        tmp_path, "1.14.4", ["sihsim_quadx", "sihsim_airplane", "sihsim_xvert"], ["commander"]
+    )
+    campaign = Campaign(AgainstConfig(build=build, vehicle=vehicle), log=lambda line: None)
+    try:
+        fixes = campaign.bench.fixes
+    finally:
+        campaign.bench.close()
+    if fixed is None:
+        assert fixes == {}
+    else:
+        scenario = "fw_gate" if vehicle == "fw" else "tailsitter_loss"
+        assert fixed in fixes and fixes == SCENARIOS[scenario].params

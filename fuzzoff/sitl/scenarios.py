@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 from fuzzoff.mavlink_ids import MAV_FRAME_LOCAL_ENU
+from fuzzoff.sitl.airframes import AIRFRAMES
 from fuzzoff.sitl.driver import (
     ATTITUDE_NO_THRUST,
     NAV_LOITER,
@@ -299,16 +300,8 @@ def vtol_fw_types(d: Driver) -> None:
     _vtol_back_and_land(d)
 
 
-TAILSITTER_PARAMS = {"FW_USE_AIRSPD": 0.0, "CA_SV_CS1_TRQ_P": -0.5, "CA_SV_CS1_TRQ_Y": -0.5}
-"""SIH's tailsitter (``sihsim_xvert``) never shows the transition airspeed: the airspeed PX4
-validated stayed at 0.1-5 m/s while it flew 7 m/s over ground, the front transition waited
-for VT_ARSP_TRANS (10 m/s) and PX4 quad-chuted back to MC 6.6 s in (1.18 head). Without the
-airspeed (FW_USE_AIRSPD 0) PX4 times the transition (VT_F_TR_OL_TM) and it reached FW in
-3.4 s, then held 28 m at 10.7 m/s. The right elevon's pitch and yaw torques are -0.5 as the
-1.18 head's and main's airframe has them: the airframes of 1.14.4 to 1.18.0-alpha1 give +0.5,
-the two elevons then cancel in pitch, and the tailsitter rose 0.1-1.3 m at most in OFFBOARD
-(PX4 counted it landed); with -0.5 it climbed to 20 m and flew FW on every bundle. On 1.14
-FW_USE_AIRSPD is FW_ARSP_MODE (``session.RENAMED``)."""
+TAILSITTER_PARAMS = AIRFRAMES["tailsitter"].fixes
+"""The tailsitter's airspeed use and right elevon (``airframes.TAILSITTER_FIXES``)."""
 
 TAILSITTER_FLIES_ON: tuple[str, ...] | None = None
 """Every bundle (with the parameters above)."""
@@ -364,19 +357,8 @@ def fw_loss(d: Driver) -> None:
     _fw_hold(d)
 
 
-AIRPLANE_OUTPUTS = {
-    "PWM_MAIN_FUNC1": 201.0,
-    "PWM_MAIN_FUNC2": 202.0,
-    "PWM_MAIN_FUNC3": 203.0,
-    "PWM_MAIN_FUNC4": 101.0,
-    "PWM_MAIN_FUNC5": 0.0,
-    "PWM_MAIN_FUNC6": 0.0,
-}
-"""The SIH airplane's outputs as SIH reads them (servos on outputs 1-3, the motor on 4): the
-1.16 airframe's mapping. The 1.14 and 1.15 airframes put them on outputs 3-6; there SIH's
-state went NaN within 0.1 s of the arm (attitude, then position invalid) and PX4 flew flight
-termination. With this mapping the arm, the loss and the failsafe are PX4's own; on 1.16 and
-later it is what the airframe sets already."""
+AIRPLANE_OUTPUTS = AIRFRAMES["fw"].fixes
+"""The airplane's outputs where SIH reads them (``airframes.AIRPLANE_OUTPUTS``)."""
 
 FW_GROUND_POINT = (0.0, 0.0, 0.0)
 """Where the airplane's ground gate run holds: where it stands, on the ground."""
