@@ -602,7 +602,7 @@ SCENARIOS: dict[str, Scenario] = {
         Scenario(
             "tailsitter_offboard",
             "tailsitter: as vtol_offboard, with FW_USE_AIRSPD 0 (the transition timed, not on"
-            " the airspeed SIH's tailsitter never shows)",
+            " the airspeed SIH's tailsitter never shows) and the 1.18 airframe's right elevon",
             vtol_offboard,
             "clean",
             params=TAILSITTER_PARAMS,
@@ -611,7 +611,8 @@ SCENARIOS: dict[str, Scenario] = {
         ),
         Scenario(
             "tailsitter_loss",
-            "tailsitter: the stream stops 2 s hovering in MC, then 2 s in FW (FW_USE_AIRSPD 0)",
+            "tailsitter: the stream stops 2 s hovering in MC, then 2 s in FW (FW_USE_AIRSPD 0,"
+            " the 1.18 airframe's right elevon)",
             vtol_loss,
             "hazard",
             "stream lost in OFFBOARD in each VTOL phase (failsafe, then back to OFFBOARD)",
