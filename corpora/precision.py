@@ -69,8 +69,10 @@ VEHICLE_ROWS = {
     "quad": "quadrotor (`sihsim_quadx`)",
     "hex": "hexacopter (`sihsim_hex`)",
     "vtol": "standard VTOL (`sihsim_standard_vtol`): MC, transition to FW in OFFBOARD, FW",
-    "tailsitter": "tailsitter VTOL (`sihsim_xvert`, FW_USE_AIRSPD 0): MC, transition, FW",
-    "fw": "airplane (`sihsim_airplane`): runway takeoff, then OFFBOARD in the air",
+    "tailsitter": "tailsitter VTOL (`sihsim_xvert`, FW_USE_AIRSPD 0, the right elevon's torques"
+    " of the 1.18 airframe): MC, transition, FW",
+    "fw": "airplane (`sihsim_airplane`): runway takeoff, then OFFBOARD in the air; the gate on"
+    " the ground (`fw_gate`) on every bundle",
     "rover-ackermann": "Ackermann rover (`sihsim_rover_ackermann`)",
 }
 """The SITL vehicles, one row each (``fuzzoff.sitl.airframes``)."""

@@ -79,13 +79,75 @@ def test_the_multicopter_matrix_keeps_its_scenarios_and_the_others_fly_their_veh
     }
 
 
-def test_the_airplane_flies_only_where_it_takes_off_and_the_tailsitter_without_airspeed() -> None:
-    # docs/sitl.md: the SIH airplane takes off on 1.16.2 and 1.17.0 only; the tailsitter's
-    # transition waits for an airspeed SIH never shows unless FW_USE_AIRSPD is 0
+def test_the_airplane_and_the_tailsitter_fly_with_what_later_airframes_set() -> None:
+    # docs/sitl.md: the 1.14/1.15 airplane arms only with its outputs where SIH reads them (the
+    # 1.16 airframe's); it takes off on 1.16.2 and 1.17.0 only; the tailsitter's transition
+    # waits for an airspeed SIH never shows unless FW_USE_AIRSPD is 0, and it climbs only with
+    # the 1.18 airframe's right elevon
+    params = SCENARIOS["fw_gate"].params
+    assert [params[f"PWM_MAIN_FUNC{n}"] for n in range(1, 7)] == [201, 202, 203, 101, 0, 0]
+    assert SCENARIOS["fw_gate"].flies_on is None
     assert SCENARIOS["fw_loss"].flies_on == ("1.16.2", "1.17.0")
-    assert SCENARIOS["tailsitter_loss"].params == {"FW_USE_AIRSPD": 0.0}
-    assert SCENARIOS["tailsitter_offboard"].flies_on == ("1.18.0-beta1-head",)
+    assert SCENARIOS["tailsitter_loss"].params["FW_USE_AIRSPD"] == 0.0
+    assert SCENARIOS["tailsitter_loss"].params["CA_SV_CS1_TRQ_P"] == -0.5
     assert SCENARIOS["vtol_loss"].flies_on is None
+
+
+def _verdict_of(stem: str) -> list[tuple[str, bool | None, str]]:
+    from fuzzoff.sitl.verdict import compare
+
+    runs = json.loads((SITL / "runs.json").read_text())
+    run = runs[stem]
+    verdict = compare(
+        SITL / f"{stem}.tlog",
+        run["release"].split("-")[0],
+        SITL / f"{stem}.ulg",
+        run.get("params") or {},
+        245,
+        airframes.airframe_for(run["vehicle"]).fuzzoff_vehicle,
+    )
+    return [(i.what, i.agree, i.note) for i in verdict.items]
+
+
+def _fw_gate_stems() -> list[str]:
+    return sorted(p.stem for p in (CORPORA / "sitl").glob("fw_gate-*.tlog"))
+
+
+def test_the_airplanes_gate_is_recorded_on_every_bundle() -> None:
+    # every bundle has sihsim_airplane (the SIH README): its ground run is on each of them
+    assert len(_fw_gate_stems()) == 7
+
+
+@pytest.mark.parametrize("stem", _fw_gate_stems())
+def test_the_airplanes_gate_on_the_ground_judges_the_loss_and_its_action(stem: str) -> None:
+    """fw_gate: armed in OFFBOARD on the ground, a 3 s stream stop: PX4 flags the loss, flies
+    its failsafe action and returns to OFFBOARD; the model agrees on each, and on the disarm
+    (refused while PX4 counts the rolling airplane as flying, then forced)."""
+    items = _verdict_of(stem)
+    judged = {what: agree for what, agree, _ in items if agree is not None}
+    assert judged["loss time"] and judged["failsafe action"] and judged["automatic return"]
+    assert not [i for i in items if i[1] is False]
+
+
+def test_a_disarm_just_after_px4_counted_the_airplane_landed_is_not_judged_from_a_tlog() -> None:
+    """fw_gate on 1.18.0-alpha1: PX4's land detector said landed 72 ms before the disarm; the
+    tlog's EXTENDED_SYS_STATE (5 Hz) still said in the air, so the model refused the disarm PX4
+    took. The verdict says why it cannot judge it instead of calling it a disagreement."""
+    (disarm,) = [i for i in _verdict_of("fw_gate-1.18.0-alpha1") if i[0] == "disarm"]
+    assert disarm[1] is None
+    assert "land detector said landed 72 ms before the disarm" in disarm[2]
+
+
+def test_a_land_verdict_older_than_one_sample_period_is_judged() -> None:
+    from fuzzoff.sitl.truth import Truth
+    from fuzzoff.sitl.verdict import _land_sample_lag
+
+    truth = Truth(landed=[(0.0, True), (5.0, False), (9.9, True)])
+    refused = {"what": "disarm_rejected", "message": "land detector: not landed since 5.00 s"}
+    assert "100 ms before the disarm" in _land_sample_lag(truth, 10.0, "disarm", refused)
+    assert _land_sample_lag(truth, 10.5, "disarm", refused) == ""
+    assert _land_sample_lag(truth, 10.0, "arm", refused) == ""
+    assert _land_sample_lag(Truth(), 10.0, "disarm", refused) == ""
 
 
 def test_thinning_cuts_the_fast_topics_and_keeps_the_stream_whole(tmp_path: Path) -> None:
@@ -232,3 +294,55 @@ def test_the_tailsitters_runs_agree_with_the_model_beside_a_parameter_it_does_no
     losses = [i for i in verdict.items if i.what == "failsafe action"]
     assert len(losses) == 2
     assert all(i.agree for i in verdict.items)
+
+
+def test_a_parameter_is_set_under_its_old_name_on_a_px4_that_predates_it() -> None:
+    """1.14.4 has FW_ARSP_MODE (1: airspeed not used) where 1.15 and later have FW_USE_AIRSPD
+    (0: not used): the tailsitter's runs set whichever PX4 has."""
+    from typing import cast
+
+    from fuzzoff.sitl.link import Link, LinkError
+    from fuzzoff.sitl.session import apply_params
+
+    class FakeLink:
+        def __init__(self, names: set[str]) -> None:
+            self.values = dict.fromkeys(names, -1.0)
+
+        def set_param(self, name: str, value: float) -> float:
+            if name not in self.values:
+                raise LinkError(f"PX4 has no parameter {name} (no PARAM_VALUE for it)")
+            self.values[name] = value
+            return value
+
+    old = FakeLink({"FW_ARSP_MODE", "CA_SV_CS1_TRQ_P"})
+    params = {"FW_USE_AIRSPD": 0.0, "CA_SV_CS1_TRQ_P": -0.5}
+    applied = apply_params(cast(Link, old), params)
+    assert applied == {"FW_ARSP_MODE": 1.0, "CA_SV_CS1_TRQ_P": -0.5}
+    new = FakeLink({"FW_USE_AIRSPD", "CA_SV_CS1_TRQ_P"})
+    assert apply_params(cast(Link, new), params) == params
+
+
+@pytest.mark.parametrize(
+    ("vehicle", "fixed"),
+    [("fw", "PWM_MAIN_FUNC4"), ("tailsitter", "CA_SV_CS1_TRQ_P"), ("quad", None)],
+)
+def test_a_live_campaign_boots_the_airframe_with_the_scenarios_fixes(
+    tmp_path: Path, vehicle: str, fixed: str | None
+) -> None:
+    """A campaign on the airplane or the tailsitter sets what their scenarios set (the 1.14/1.15
+    airplane's outputs, the tailsitter's airspeed use and elevon) at each boot of PX4."""
+    from fuzzoff.sitl.against import AgainstConfig, Campaign
+
+    build = _bundle(
+        tmp_path, "1.14.4", ["sihsim_quadx", "sihsim_airplane", "sihsim_xvert"], ["commander"]
+    )
+    campaign = Campaign(AgainstConfig(build=build, vehicle=vehicle), log=lambda line: None)
+    try:
+        fixes = campaign.bench.fixes
+    finally:
+        campaign.bench.close()
+    if fixed is None:
+        assert fixes == {}
+    else:
+        scenario = "fw_gate" if vehicle == "fw" else "tailsitter_loss"
+        assert fixed in fixes and fixes == SCENARIOS[scenario].params

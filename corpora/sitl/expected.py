@@ -209,9 +209,11 @@ README_HEAD = """# Real PX4 SITL runs
 
 Recordings written by real PX4 (its own ULog) and by real clients on its offboard link (the
 tlog of both directions), on the PX4 SITL bundles of `../shared/px4-sitl/` (SIH quadrotor;
-`hex_*`, `vtol_*` and `rover_*` the SIH hexacopter, standard VTOL and Ackermann rover, whose
-ULogs keep PX4's fastest estimator and controller topics at 10 Hz; default parameters, no RC).
-Each run boots a fresh PX4.
+`hex_*`, `vtol_*`, `tailsitter_*`, `fw_*` and `rover_*` the SIH hexacopter, standard VTOL,
+tailsitter, airplane and Ackermann rover, whose ULogs keep PX4's fastest estimator and
+controller topics at 10 Hz; PX4's default parameters but those a scenario sets, listed per run
+in `runs.json`: the tailsitter's airspeed use and right elevon, the airplane's outputs in
+`fw_gate`, the stick override; no RC). Each run boots a fresh PX4.
 
 - `NAME-RELEASE.tlog`: the exchange as the client saw it, on PX4's clock (`docs/sitl.md`);
 - `NAME-RELEASE.ulg`: PX4's log from boot to exit, cut with pyulog to the topics fuzzoff reads

@@ -210,7 +210,8 @@ class Campaign:
         self.started = 0.0
         quad = config.vehicle == airframes.DEFAULT  # PX4's own default: nothing to check
         env = {} if quad else airframes.boot_env(config.build, config.vehicle)
-        self.bench = Bench(config.build, config.instance, log, env, config.judged_as != "fw")
+        fixes = airframes.airframe_for(config.vehicle).fixes
+        self.bench = Bench(config.build, config.instance, log, env, config.judged_as != "fw", fixes)
         self.known: dict[tuple[str, str, str], Disagreement] = {}
         """Disagreements followed up, by signature (a confirmed one is not followed again)."""
         self.work = Path(tempfile.gettempdir())

@@ -8,7 +8,7 @@ builds have an airframe that does not fly, each said here with the reason.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from fuzzoff.profiles import ProfileError, vehicle_type_for
 from fuzzoff.sitl import bundle
@@ -24,15 +24,44 @@ class Airframe:
     """The vehicle type the gate model and the rules judge it as (``fuzzoff profiles``)."""
     module: str | None = None
     """A PX4 module the build needs beside the airframe file."""
+    fixes: dict[str, float] = field(default_factory=dict)
+    """Parameters every run sets so that SIH flies the airframe as PX4 means it, on every
+    build (where a build's airframe has them right already, they are its own values): the
+    scenarios of the vehicle and a live campaign on it (docs/sitl.md, "Other vehicles")."""
 
+
+AIRPLANE_OUTPUTS = {
+    "PWM_MAIN_FUNC1": 201.0,
+    "PWM_MAIN_FUNC2": 202.0,
+    "PWM_MAIN_FUNC3": 203.0,
+    "PWM_MAIN_FUNC4": 101.0,
+    "PWM_MAIN_FUNC5": 0.0,
+    "PWM_MAIN_FUNC6": 0.0,
+}
+"""The SIH airplane's outputs as SIH reads them (servos on outputs 1-3, the motor on 4): the
+1.16 airframe's mapping. The 1.14 and 1.15 airframes put them on outputs 3-6; there SIH's
+state went NaN within 0.1 s of the arm (attitude, then position invalid) and PX4 flew flight
+termination. With this mapping the arm, the loss and the failsafe are PX4's own; on 1.16 and
+later it is what the airframe sets already."""
+
+TAILSITTER_FIXES = {"FW_USE_AIRSPD": 0.0, "CA_SV_CS1_TRQ_P": -0.5, "CA_SV_CS1_TRQ_Y": -0.5}
+"""SIH's tailsitter (``sihsim_xvert``) never shows the transition airspeed: the airspeed PX4
+validated stayed at 0.1-5 m/s while it flew 7 m/s over ground, the front transition waited
+for VT_ARSP_TRANS (10 m/s) and PX4 quad-chuted back to MC 6.6 s in (1.18 head). Without the
+airspeed (FW_USE_AIRSPD 0) PX4 times the transition (VT_F_TR_OL_TM) and it reached FW in
+3.4 s, then held 28 m at 10.7 m/s. The right elevon's pitch and yaw torques are -0.5 as the
+1.18 head's and main's airframe has them: the airframes of 1.14.4 to 1.18.0-alpha1 give +0.5,
+SIH deflects the two elevons with opposite signs, their pitch then cancels, and the tailsitter
+rose 0.1-1.3 m at most in OFFBOARD (PX4 counted it landed); with -0.5 it climbed to 20 m and
+flew FW on every bundle. On 1.14 FW_USE_AIRSPD is FW_ARSP_MODE (``session.RENAMED``)."""
 
 AIRFRAMES: dict[str, Airframe] = {
     a.vehicle: a
     for a in (
         Airframe("quad", "sihsim_quadx", "mc"),
         Airframe("hex", "sihsim_hex", "mc"),
-        Airframe("fw", "sihsim_airplane", "fw"),
-        Airframe("tailsitter", "sihsim_xvert", "vtol"),
+        Airframe("fw", "sihsim_airplane", "fw", fixes=AIRPLANE_OUTPUTS),
+        Airframe("tailsitter", "sihsim_xvert", "vtol", fixes=TAILSITTER_FIXES),
         Airframe("vtol", "sihsim_standard_vtol", "vtol"),
         Airframe("rover-ackermann", "sihsim_rover_ackermann", "rover-ackermann", "rover_ackermann"),
     )

@@ -27,7 +27,7 @@ from fuzzoff.sitl.driver import NAV_LAND, NAV_LOITER, Driver
 from fuzzoff.sitl.link import Link, LinkError
 from fuzzoff.sitl.recorder import TlogRecorder
 from fuzzoff.sitl.run import MANUAL_SETTLE_S, TAIL_S
-from fuzzoff.sitl.session import LOGGER_SETTLE_S, Session
+from fuzzoff.sitl.session import LOGGER_SETTLE_S, Session, apply_params
 from fuzzoff.sitl.trim import trim
 
 LAND_TIMEOUT_S = 45.0
@@ -92,9 +92,13 @@ class Bench:
         log: Log = print,
         env: dict[str, str] | None = None,
         lands: bool = True,
+        fixes: dict[str, float] | None = None,
     ) -> None:
         self.build = build
         self.lands = lands
+        self.fixes = dict(fixes or {})
+        """Set at each boot and kept (``airframes.Airframe.fixes``): what makes SIH fly the
+        airframe as PX4 means it."""
         """AUTO_LAND brings it down (a multicopter, a VTOL); else (an airplane, which lands
         only on a mission's runway) a vehicle PX4 will not disarm plainly is disarmed by force."""
         self.instance = instance
@@ -118,6 +122,8 @@ class Bench:
         session = Session(self.build, self.instance, env=self.env, log=self.log)
         try:
             session.connect()
+            if session.link is not None and self.fixes:
+                apply_params(session.link, self.fixes)
             session.px4.command("logger", "off")
             self._wait_closed(session)
         except BaseException:

@@ -12,6 +12,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from fuzzoff.mavlink_ids import (
+    MAV_CMD_COMPONENT_ARM_DISARM,
     MAV_CMD_DO_VTOL_TRANSITION,
     MAV_FRAME_LOCAL_NED,
     MAV_VTOL_STATE_FW,
@@ -29,6 +30,8 @@ ATTITUDE_AND_THRUST = 0b00000111
 """SET_ATTITUDE_TARGET type_mask: the attitude and the thrust, body rates ignored."""
 ATTITUDE_NO_THRUST = 0b01000111
 """SET_ATTITUDE_TARGET type_mask: the attitude only, body rates and thrust ignored (bit 64)."""
+FORCE_DISARM = 21196.0
+"""``param2`` of MAV_CMD_COMPONENT_ARM_DISARM that makes PX4 disarm in the air too."""
 NAV_POSCTL, NAV_LOITER, NAV_RTL, NAV_OFFBOARD, NAV_TAKEOFF, NAV_LAND = 2, 4, 5, 14, 17, 18
 MANUAL_EVERY_S = 0.1
 """A MAVLink joystick at 10 Hz: PX4 declares manual control lost after COM_RC_LOSS_T (0.5 s)."""
@@ -144,6 +147,12 @@ class Driver:
 
     def disarm(self) -> Ack | None:
         return self.note("disarm", self.link.arm(False))
+
+    def force_disarm(self) -> Ack | None:
+        """A disarm PX4 takes in the air too (param2 21196): an airplane rolling on the ground
+        counts as flying, and a plain disarm is refused."""
+        ack = self.link.command(MAV_CMD_COMPONENT_ARM_DISARM, 0.0, FORCE_DISARM)
+        return self.note("disarm (forced)", ack)
 
     def land_and_wait(self, timeout: float = 40.0) -> None:
         """AUTO_LAND, then wait (joystick going) until PX4 disarms by itself after landing."""

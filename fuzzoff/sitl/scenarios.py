@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 from fuzzoff.mavlink_ids import MAV_FRAME_LOCAL_ENU
+from fuzzoff.sitl.airframes import AIRFRAMES
 from fuzzoff.sitl.driver import (
     ATTITUDE_NO_THRUST,
     NAV_LOITER,
@@ -299,20 +300,17 @@ def vtol_fw_types(d: Driver) -> None:
     _vtol_back_and_land(d)
 
 
-TAILSITTER_PARAMS = {"FW_USE_AIRSPD": 0.0}
-"""SIH's tailsitter (``sihsim_xvert``) never shows the transition airspeed: the airspeed PX4
-validated stayed at 0.1-5 m/s while it flew 7 m/s over ground, the front transition waited
-for VT_ARSP_TRANS (10 m/s) and PX4 quad-chuted back to MC 6.6 s in (1.18 head). Without the
-airspeed (FW_USE_AIRSPD 0) PX4 times the transition (VT_F_TR_OL_TM) and it reached FW in
-3.4 s, then held 28 m at 10.7 m/s."""
+TAILSITTER_PARAMS = AIRFRAMES["tailsitter"].fixes
+"""The tailsitter's airspeed use and right elevon (``airframes.TAILSITTER_FIXES``)."""
 
-TAILSITTER_FLIES_ON = ("1.18.0-beta1-head",)
-"""Where SIH's tailsitter climbs in OFFBOARD: on 1.15.4, 1.16.2 and 1.17.0 it rose 0.1-1.3 m at
-most, PX4 counted it landed (a transition on the ground, no failsafe on a stream stop)."""
+TAILSITTER_FLIES_ON: tuple[str, ...] | None = None
+"""Every bundle (with the parameters above)."""
 
 AIRPLANE_FLIES_ON = ("1.16.2", "1.17.0")
-"""Where SIH's airplane takes off by itself (docs/sitl.md: on the 1.18 head its ground run
-stalls at about 6 m/s; 1.14.4 and 1.15.4 have no valid position estimate at the arm)."""
+"""Where SIH's airplane takes off by itself (docs/sitl.md: on 1.18.0-alpha1, the 1.18 head and
+main its ground run stalls at 4-6 m/s on full throttle; on 1.14.4 and 1.15.4, its outputs
+mapped as SIH reads them, it rolls past 60 degrees as it rotates at 12-14 m/s and PX4's failure
+detector disarms it)."""
 
 FW_CLIMB_TO_M = 15.0
 """The airplane's runway takeoff (AUTO_TAKEOFF) climbs this high before the switch."""
@@ -327,6 +325,10 @@ def _fw_takeoff(d: Driver) -> None:
     deadline = d.now() + 25.0
     while (d.link.view.relative_alt_m or 0.0) < FW_CLIMB_TO_M and d.now() < deadline:
         d.wait(0.5)
+        if not d.link.view.armed:
+            # 1.14.4/1.15.4: "Attitude failure (roll)" at rotation, disarmed by failsafe; the
+            # estimate of the tumbling airframe may still read 15 m
+            raise LinkError("PX4 disarmed the airplane during its takeoff")
     if (d.link.view.relative_alt_m or 0.0) < FW_CLIMB_TO_M:
         raise LinkError(f"the airplane did not climb to {FW_CLIMB_TO_M:g} m in AUTO_TAKEOFF")
     d.note(f"{FW_CLIMB_TO_M:g} m up")
@@ -353,6 +355,33 @@ def fw_loss(d: Driver) -> None:
     d.note("stream resumes")
     d.stream(d.position(*FW_POINT), 4.0)
     _fw_hold(d)
+
+
+AIRPLANE_OUTPUTS = AIRFRAMES["fw"].fixes
+"""The airplane's outputs where SIH reads them (``airframes.AIRPLANE_OUTPUTS``)."""
+
+FW_GROUND_POINT = (0.0, 0.0, 0.0)
+"""Where the airplane's ground gate run holds: where it stands, on the ground."""
+
+
+def fw_gate(d: Driver) -> None:
+    """The airplane's gate on the ground, for the builds where it cannot take off: a position
+    stream, the switch to OFFBOARD and the arm, a 3 s stream stop (the loss and its action),
+    the stream again, a disarm (forced when PX4 counts the rolling airplane as flying)."""
+    d.stream(d.position(*FW_GROUND_POINT), 1.5)
+    d.set_mode(NAV_OFFBOARD, "OFFBOARD")
+    d.stream(d.position(*FW_GROUND_POINT), 0.5)
+    d.arm()
+    d.stream(d.position(*FW_GROUND_POINT), 3.0)
+    d.note("stream stops")
+    d.wait(3.0)
+    d.note("stream resumes")
+    d.stream(d.position(*FW_GROUND_POINT), 3.0)
+    if d.link.view.armed:
+        ack = d.disarm()
+        if ack is None or ack.result != 0:
+            d.force_disarm()
+    d.wait(1.0)
 
 
 def _rover_start(d: Driver) -> None:
@@ -573,7 +602,7 @@ SCENARIOS: dict[str, Scenario] = {
         Scenario(
             "tailsitter_offboard",
             "tailsitter: as vtol_offboard, with FW_USE_AIRSPD 0 (the transition timed, not on"
-            " the airspeed SIH's tailsitter never shows)",
+            " the airspeed SIH's tailsitter never shows) and the 1.18 airframe's right elevon",
             vtol_offboard,
             "clean",
             params=TAILSITTER_PARAMS,
@@ -582,7 +611,8 @@ SCENARIOS: dict[str, Scenario] = {
         ),
         Scenario(
             "tailsitter_loss",
-            "tailsitter: the stream stops 2 s hovering in MC, then 2 s in FW (FW_USE_AIRSPD 0)",
+            "tailsitter: the stream stops 2 s hovering in MC, then 2 s in FW (FW_USE_AIRSPD 0,"
+            " the 1.18 airframe's right elevon)",
             vtol_loss,
             "hazard",
             "stream lost in OFFBOARD in each VTOL phase (failsafe, then back to OFFBOARD)",
@@ -609,6 +639,17 @@ SCENARIOS: dict[str, Scenario] = {
             ("OFB103",),
             vehicle="fw",
             flies_on=AIRPLANE_FLIES_ON,
+        ),
+        Scenario(
+            "fw_gate",
+            "airplane on the ground: stream, switch to OFFBOARD, arm, the stream stops 3 s and"
+            " resumes, disarm (forced if PX4 counts it flying)",
+            fw_gate,
+            "hazard",
+            "stream lost in OFFBOARD (failsafe, then back to OFFBOARD)",
+            ("OFB103",),
+            params=AIRPLANE_OUTPUTS,
+            vehicle="fw",
         ),
         Scenario(
             "rover_offboard",
@@ -667,15 +708,19 @@ RELEASE_DEPENDENT = (
 
 
 VEHICLE_RELEASES = (
+    "1.14.4",
+    "1.15.4",
     "1.16.2",
     "1.17.0",
     "1.17.0-ros2-rover",
+    "1.18.0-alpha1",
     "1.18.0-beta1-head",
     "main-2026-08-13",
 )
-"""The bundles the other vehicles' scenarios run on (the standard VTOL came with 1.16's SIH,
-the hexacopter and the rover with 1.17.0's; the rover flies only where the bundle has its
-module: ``airframes.why_not``; a program only on its ``flies_on``)."""
+"""The bundles the other vehicles' scenarios run on: every bundle with the airframe (the
+airplane and the tailsitter are in all; the standard VTOL came with 1.16's SIH, the hexacopter
+and the rover with 1.17.0's; the rover flies only where the bundle has its module:
+``airframes.why_not``; a program only on its ``flies_on``)."""
 
 
 SIM_STALLS = (

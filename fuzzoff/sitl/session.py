@@ -24,6 +24,12 @@ BOOT_TIMEOUT_S = 30.0
 READY_TIMEOUT_S = 90.0
 """PX4 1.15 passes its arming checks 35-42 s after boot on an idle machine; slack for a busy one."""
 LOGGER_SETTLE_S = 0.5
+RENAMED: dict[str, tuple[str, Callable[[float], float]]] = {
+    "FW_USE_AIRSPD": ("FW_ARSP_MODE", lambda use: 0.0 if use else 1.0),
+}
+"""A parameter a run sets -> its name and value on a PX4 that predates the name: 1.15 renamed
+``FW_ARSP_MODE`` (1: do not use the airspeed) to ``FW_USE_AIRSPD`` and inverted it (PX4's
+``param_translation.cpp``, 2023-12-06)."""
 
 
 @dataclass(slots=True)
@@ -34,6 +40,24 @@ class RunResult:
     steps: list[Step]
     error: str | None = None
     params: dict[str, float] = field(default_factory=dict)
+
+
+def apply_params(link: Link, params: dict[str, float]) -> dict[str, float]:
+    """Set ``params`` with read-back (under its older name where PX4 predates one, ``RENAMED``):
+    the names and values PX4 holds now."""
+    applied: dict[str, float] = {}
+    for name, value in params.items():
+        if name in RENAMED:
+            try:
+                applied[name] = link.set_param(name, value)
+                continue
+            except LinkError as exc:
+                if "has no parameter" not in str(exc):
+                    raise
+            old, convert = RENAMED[name]
+            name, value = old, convert(value)
+        applied[name] = link.set_param(name, value)
+    return applied
 
 
 class Session:
@@ -105,7 +129,7 @@ class Session:
     ) -> RunResult:
         link = self._link()
         self.starting_state()
-        applied = {k: link.set_param(k, v) for k, v in (params or {}).items()}
+        applied = apply_params(link, params or {})
         recorder = TlogRecorder(tlog, clock=link.clock.now)
         driver = Driver(link, manual=manual)
         error = None

@@ -20,6 +20,7 @@ TOPICS = [
     "vehicle_status",
     "failsafe_flags",
     "offboard_control_mode",
+    "vehicle_land_detected",
 ]
 ARMED = 2
 ACK_WINDOW_S = 0.1
@@ -54,6 +55,17 @@ class Truth:
     """(time, lost) at every change of ``failsafe_flags.offboard_control_signal_lost``."""
     keepalives: list[float] = field(default_factory=list)
     texts: list[tuple[float, str]] = field(default_factory=list)
+    landed: list[tuple[float, bool]] = field(default_factory=list)
+    """(time, landed or maybe_landed) at every change of PX4's land detector (ULog only)."""
+
+    def landed_since(self, t: float) -> tuple[bool, float] | None:
+        """PX4's land verdict at ``t`` and when it last changed (None: not recorded)."""
+        found = None
+        for change in self.landed:
+            if change[0] > t:
+                break
+            found = change
+        return None if found is None else (found[1], found[0])
 
     def mode_at(self, t: float) -> Mode | None:
         found = None
@@ -126,6 +138,15 @@ def read_truth(path: Path, client_sysid: int | None = None) -> Truth:
     ocm = data.get("offboard_control_mode")
     if ocm is not None:
         truth.keepalives = sorted({int(t) / 1e6 for t in ocm["timestamp"]})
+    land = data.get("vehicle_land_detected")
+    if land is not None and "landed" in land:
+        maybe = land.get("maybe_landed", land["landed"])
+        was: bool | None = None
+        for t, landed, maybe_landed in zip(land["timestamp"], land["landed"], maybe, strict=True):
+            now = bool(landed) or bool(maybe_landed)
+            if now != was:
+                truth.landed.append((int(t) / 1e6, now))
+                was = now
     truth.texts = [(m.timestamp / 1e6, m.message) for m in log.logged_messages]
     return truth
 

@@ -194,7 +194,7 @@ def compare(
 def _gate_disagreements(verdict: Verdict, rows: list[dict[str, Any]]) -> None:
     """``fuzzoff gate``'s own disagreements (recorded mode or ack vs the model) not already
     judged above."""
-    judged = [i.t for i in verdict.items if i.agree is False]
+    judged = [i.t for i in verdict.items if i.agree is False or i.note.startswith("not judged")]
     for row in rows:
         if row["what"] != "disagreement":
             continue
@@ -223,7 +223,35 @@ def _requests(verdict: Verdict, truth: Truth, rows: list[dict[str, Any]]) -> Non
         model_ok = _model_accepts(row)
         model = ("accepted" if model_ok else "rejected") + f": {row['message']}"
         agree = None if request.result is None else (request.result == 0) == model_ok
-        verdict.items.append(Item(label, request.t, px4, model, agree))
+        note = _land_sample_lag(truth, request.t, label, row) if agree is False else ""
+        if note:
+            agree = None
+        verdict.items.append(Item(label, request.t, px4, model, agree, note))
+
+
+LAND_SAMPLE_S = 0.25
+"""A tlog shows PX4's land detector only in EXTENDED_SYS_STATE, 5 Hz on these links: a change
+of PX4's verdict this close before a request may not have reached the tlog yet."""
+
+
+def _land_sample_lag(truth: Truth, t: float, label: str, row: dict[str, Any]) -> str:
+    """Why a disarm the model judged from the tlog's land detector cannot be judged: PX4's own
+    land detector (ULog) changed to the verdict PX4 acted on within one EXTENDED_SYS_STATE
+    period before the request, so the tlog had not shown it yet ("" when that is not so)."""
+    if label != "disarm" or "land detector:" not in row["message"]:
+        return ""
+    at = truth.landed_since(t)
+    if at is None:
+        return ""
+    landed, since = at
+    model_landed = _model_accepts(row)
+    if landed == model_landed or t - since > LAND_SAMPLE_S:
+        return ""
+    state = "landed" if landed else "not landed"
+    return (
+        f"not judged: PX4's land detector said {state} {1000 * (t - since):.0f} ms before the"
+        " disarm, after the tlog's last EXTENDED_SYS_STATE (5 Hz)"
+    )
 
 
 STICK_OVERRIDE = "stick override"
