@@ -152,3 +152,26 @@ def test_a_terminal_report_off_a_terminal_loads_no_rich() -> None:
     assert "fuzzoff.report.plain" in modules
     rarely = ("difflib", "fuzzoff.report.terminal", "fuzzoff.fuzz")
     assert heavy(modules, NOT_FOR_A_ULOG_LINT + rarely) == []
+
+
+def test_the_cli_keeps_numpy_to_one_blas_thread_unless_told() -> None:
+    """numpy's OpenBLAS starts a thread per core at import, half of numpy's import CPU; no
+    command multiplies large matrices (issue 31). A number the user set is kept."""
+    code = (
+        "import os\n"
+        "from fuzzoff.cli import main\n"
+        "main(['profiles'])\n"
+        "print(os.environ['OPENBLAS_NUM_THREADS'])\n"
+    )
+    base = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
+    for preset, expected in ((None, "1"), ("3", "3")):
+        env = base if preset is None else {**base, "OPENBLAS_NUM_THREADS": preset}
+        result = subprocess.run(
+            [sys.executable, "-c", code],
+            capture_output=True,
+            text=True,
+            check=True,
+            cwd=ROOT,
+            env=env,
+        )
+        assert result.stdout.splitlines()[-1] == expected
