@@ -310,3 +310,15 @@ def test_a_lint_off_a_terminal_prints_what_rich_printed(
     drawn = run_cli(["lint", *args], cwd=root)
     assert plain.stdout and plain.stdout == drawn.stdout
     assert plain.returncode == drawn.returncode
+
+
+def test_a_report_written_to_a_file_is_what_rich_wrote(
+    tmp_path: Path, no_colour_env: None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``--output FILE``: the plain text at rich's file width (160), without rich."""
+    args = ["lint", str(CORPORA / "tlog"), "--verbose", "--exit-zero"]
+    run_cli([*args, "--format", "terminal", "--output", str(tmp_path / "plain.txt")])
+    monkeypatch.setattr("fuzzoff.report.plain.plain_width", lambda to_file: None)
+    run_cli([*args, "--format", "terminal", "--output", str(tmp_path / "rich.txt")])
+    plain = (tmp_path / "plain.txt").read_text()
+    assert plain and plain == (tmp_path / "rich.txt").read_text()

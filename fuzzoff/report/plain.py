@@ -46,10 +46,10 @@ def plain_width(to_file: bool) -> int | None:
     environ = os.environ
     if "TTY_COMPATIBLE" in environ or "FORCE_COLOR" in environ:
         return None
+    if "ipykernel" in sys.modules or "IPython" in sys.modules or sys.platform == "win32":
+        return None  # a notebook, or a Windows console's width: as rich works them out
     if to_file:
         return FILE_WIDTH
-    if "ipykernel" in sys.modules or "IPython" in sys.modules:
-        return None  # rich's notebook detection: leave it to rich
     stream = sys.stdout
     isatty = getattr(stream, "isatty", None)
     try:
