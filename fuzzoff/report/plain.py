@@ -2,13 +2,14 @@
 
 There the report has no colour, a finding is one line however long and the summary is an ASCII
 table: text that plain Python writes as well, without importing rich and building its consoles
-(a third of a one-file lint's start-up, issue 31). ``plain_report`` writes exactly what
+(a fifth of a one-file lint's instructions, issue 31). ``plain_report`` writes exactly what
 ``terminal.print_report`` draws through a console that is not a terminal
-(``tests/test_report_text.py`` compares the two), and returns None for what it does not draw
+(``tests/test_terminal_report.py`` compares the two), and returns None for what it does not draw
 itself (``--statistics``, a line that the console's width would wrap): rich draws those.
 
-On a terminal, or where ``FORCE_COLOR`` or ``TTY_COMPATIBLE=1`` asks rich for a terminal's
-output, ``plain_width`` says so and rich draws the report as before.
+On a terminal, where ``FORCE_COLOR`` or ``TTY_COMPATIBLE`` is set (either can ask rich for a
+terminal's output), in a notebook and on Windows, ``plain_width`` says None and rich draws the
+report as before.
 """
 
 from __future__ import annotations
