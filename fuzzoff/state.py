@@ -12,7 +12,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
+from operator import attrgetter
 
 from fuzzoff.events import (
     KEEPALIVE_ROS,
@@ -81,6 +82,15 @@ class VehicleState:
     _pending: dict[int, _PendingSwitch] = field(default_factory=dict)
     _left: tuple[float, int | None] | None = None
     """(ack time, the mode before) of the newest accepted switch that changed ``nav_state``."""
+
+    def __copy__(self) -> VehicleState:
+        """The shallow copy ``copy.copy`` makes (the dicts shared), built slot by slot: a run
+        of stream messages takes one (``StreamBatch``), and copy's generic path for a slots
+        class (``__reduce_ex__``, a state dict, a ``setattr`` per slot) cost ~10 µs of it."""
+        new = object.__new__(VehicleState)
+        for store, value in zip(_STATE_STORES, _STATE_VALUES(self), strict=True):
+            store(new, value)
+        return new
 
     @property
     def mode_source(self) -> str:
@@ -218,3 +228,11 @@ def _updater_for(cls: type) -> Callable[[VehicleState, Event], None]:
 
 
 assert {ControlMode, LegacyControlMode} == set(KEEPALIVE_ROS)  # _UPDATERS marks both keep-alive
+
+_STATE_SLOTS: tuple[str, ...] = tuple(f.name for f in fields(VehicleState))
+_STATE_VALUES = attrgetter(*_STATE_SLOTS)
+_STATE_STORES: tuple[Callable[[VehicleState, object], None], ...] = tuple(
+    getattr(VehicleState, name).__set__ for name in _STATE_SLOTS
+)
+"""``VehicleState.__copy__``'s slots, read at once and stored through their descriptors."""
+assert set(_STATE_SLOTS) == set(VehicleState.__slots__)  # every slot is a field: all copied

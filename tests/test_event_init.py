@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import inspect
 import math
+import pickle
+from typing import Any
 
 import pytest
 
@@ -21,6 +24,7 @@ from fuzzoff.events import (
     event_from_dict,
     event_to_dict,
 )
+from fuzzoff.gate.transitions import GateTransition
 
 
 @pytest.mark.parametrize("cls", ALL_EVENT_TYPES, ids=lambda c: c.__name__)
@@ -76,3 +80,38 @@ def test_where_keeps_its_positional_fields() -> None:
     assert Where("x") == Where(topic="x", index=None, offset=None)
     with pytest.raises(dataclasses.FrozenInstanceError):
         where.index = 5  # type: ignore[misc]
+
+
+def _reference(cls: type[Event]) -> type:
+    """The class as ``@dataclass(frozen=True, slots=True, kw_only=True)`` would make it."""
+    spec = [(f.name, f.type, dataclasses.field(default=f.default)) for f in dataclasses.fields(cls)]
+    ref = dataclasses.make_dataclass(cls.__name__, spec, frozen=True, slots=True, kw_only=True)
+    ref.__qualname__ = cls.__qualname__
+    return ref
+
+
+@pytest.mark.parametrize("cls", [*ALL_EVENT_TYPES, GateTransition], ids=lambda c: c.__name__)
+def test_repr_eq_hash_and_state_are_what_the_dataclass_gives(cls: type[Event]) -> None:
+    """``events.event_type`` shares these methods between the classes instead of compiling
+    them per class (issue 31): the same text, equality, hash, copy and pickle."""
+    ref = _reference(cls)
+    values: dict[str, Any] = {f.name: f.default for f in dataclasses.fields(cls)}
+    values.update(t=2.5, vehicle="/px4_1", where=Where("x", 3, 40), sender_time_us=7)
+    for f in dataclasses.fields(cls):
+        if values[f.name] is dataclasses.MISSING:
+            values[f.name] = f"{f.name}-value"
+    event, twin = cls(**values), ref(**values)
+    assert repr(event) == repr(twin)
+    assert hash(event) == hash(twin)
+    assert event.__getstate__() == twin.__getstate__()
+    assert event == cls(**values) and event != cls(**{**values, "t": 3.0})
+    assert event != twin and event.__eq__(twin) is NotImplemented
+    assert copy.copy(event) == event
+    assert repr(pickle.loads(pickle.dumps(event))) == repr(event)  # NaN != NaN once unpickled
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        event.t = 1.0  # type: ignore[misc]
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        del event.t
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        event.not_a_field = 1  # type: ignore[attr-defined]
+    assert dataclasses.replace(event, t=4.0).t == 4.0

@@ -7,6 +7,7 @@ fresh interpreter and lists the modules it left in ``sys.modules``.
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 
@@ -46,14 +47,16 @@ ENGINE = (
 
 
 def loaded_after(code: str) -> list[str]:
-    """The modules a fresh interpreter holds after running ``code``."""
+    """The modules a fresh interpreter holds after running ``code`` (standard output a pipe,
+    nothing in the environment asking for a terminal's output)."""
     probe = (
         "import sys, json\n"
         f"{code}\n"
         "print(json.dumps(sorted(m for m in sys.modules if sys.modules[m] is not None)))\n"
     )
+    env = {k: v for k, v in os.environ.items() if k not in ("FORCE_COLOR", "TTY_COMPATIBLE")}
     result = subprocess.run(
-        [sys.executable, "-c", probe], capture_output=True, text=True, check=True, cwd=ROOT
+        [sys.executable, "-c", probe], capture_output=True, text=True, check=True, cwd=ROOT, env=env
     )
     modules: list[str] = json.loads(result.stdout.splitlines()[-1])
     return modules
@@ -132,3 +135,43 @@ def test_a_one_file_lint_loads_only_its_reader_and_its_report() -> None:
     modules = loaded_after(code)
     assert "pyulog" in modules and "fuzzoff.report.json_report" in modules
     assert heavy(modules, NOT_FOR_A_ULOG_LINT) == []
+
+
+def test_a_terminal_report_off_a_terminal_loads_no_rich() -> None:
+    """The default report into a pipe or a file (a hook, CI) is plain text written without
+    rich (``report/plain.py``); the rarely used parts of the lint path load on use."""
+    ulog = ROOT / "corpora" / "real" / "sample_log_small.ulg"
+    code = (
+        "import io, contextlib\n"
+        "from fuzzoff.cli import main\n"
+        "with contextlib.redirect_stdout(io.StringIO()) as out:\n"
+        f"    main(['lint', {str(ulog)!r}])\n"
+        "assert 'fuzzoff summary' in out.getvalue()\n"
+    )
+    modules = loaded_after(code)
+    assert "fuzzoff.report.plain" in modules
+    rarely = ("difflib", "fuzzoff.report.terminal", "fuzzoff.fuzz")
+    assert heavy(modules, NOT_FOR_A_ULOG_LINT + rarely) == []
+
+
+def test_the_cli_keeps_numpy_to_one_blas_thread_unless_told() -> None:
+    """numpy's OpenBLAS starts a thread per core at import, half of numpy's import CPU; no
+    command multiplies large matrices (issue 31). A number the user set is kept."""
+    code = (
+        "import os\n"
+        "from fuzzoff.cli import main\n"
+        "main(['profiles'])\n"
+        "print(os.environ['OPENBLAS_NUM_THREADS'])\n"
+    )
+    base = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
+    for preset, expected in ((None, "1"), ("3", "3")):
+        env = base if preset is None else {**base, "OPENBLAS_NUM_THREADS": preset}
+        result = subprocess.run(
+            [sys.executable, "-c", code],
+            capture_output=True,
+            text=True,
+            check=True,
+            cwd=ROOT,
+            env=env,
+        )
+        assert result.stdout.splitlines()[-1] == expected

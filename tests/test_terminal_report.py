@@ -5,14 +5,17 @@ from __future__ import annotations
 import io
 import json
 import re
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import pytest
 from rich.console import Console
 
 from fuzzoff.events import Where
-from fuzzoff.findings import FileReport, Finding, Report, Severity, shorten
+from fuzzoff.findings import FileReport, Finding, Report, Severity, Suppression, shorten
 from fuzzoff.profiles import Profile
+from fuzzoff.report.plain import plain_report
 from fuzzoff.report.terminal import print_report
 from tests.helpers import CORPORA, run_cli
 from tests.report_fixtures import gap_recording, hostile_report
@@ -220,3 +223,102 @@ def test_shorten_takes_the_first_statement_and_never_cuts_a_word() -> None:
     short = shorten(long, 60)
     assert len(short) <= 60 and short.endswith("\u2026") and "aside" not in short
     assert all(w == "a" or w == "setpoint" or w.startswith("word") for w in short[:-1].split())
+
+
+def _rich_text(report: Report, width: int, **options: Any) -> str:
+    """What ``print_report`` draws on a console of ``width`` that is not a terminal."""
+    buffer = io.StringIO()
+    console = Console(file=buffer, highlight=False, force_terminal=False, width=width)
+    print_report(console, report, options.pop("fail_on", Severity.WARNING), **options)
+    return buffer.getvalue()
+
+
+def _many_kinds() -> Report:
+    """Several vehicles, suppressed findings, an incomplete file, a file without findings."""
+    suppressed = Suppression(kind="config", reason="known", source="fuzzoff.toml")
+    baseline = Suppression(kind="baseline", reason="old", source="base.json")
+    one = Finding("OFB101", "x", Severity.ERROR, "a gap of 2.0 s in the stream", time_s=1234.5)
+    busy = FileReport(
+        path="flights/two vehicles.tlog",
+        format="tlog",
+        profile=Profile("1.15", "mc"),
+        findings=[
+            Finding("OFB101", "x", Severity.ERROR, "short " * 40, time_s=1.0, vehicle="1"),
+            Finding("OFB203", "y", Severity.WARNING, "warn", time_s=2.0, end_s=4.5, vehicle="2"),
+            Finding("OFB005", "z", Severity.INFO, "info", where=Where("HEARTBEAT", 3, 99)),
+        ],
+        suppressed=[(one, suppressed), (one, baseline), (one, baseline)],
+    )
+    quiet_file = FileReport(path="clean.ulg", format="ulog", profile=Profile("1.16", "rover"))
+    broken = FileReport(path="cut.mcap", format="mcap", profile=Profile(), complete=False)
+    return Report(files=[busy, quiet_file, broken])
+
+
+@pytest.mark.parametrize("width", [80, 160, 50, 20])
+@pytest.mark.parametrize(
+    "options",
+    [
+        {},
+        {"verbose": True},
+        {"quiet": True},
+        {"exit_zero": True},
+        {"fail_on": Severity.INFO},
+        {"fail_on": Severity.ERROR, "verbose": True},
+    ],
+    ids=repr,
+)
+@pytest.mark.parametrize("make", [hostile_report, _many_kinds])
+def test_the_plain_text_is_what_rich_draws_off_a_terminal(
+    make: Callable[[], Report], options: dict[str, Any], width: int
+) -> None:
+    """Off a terminal the report is written without rich (issue 31): the same text, or rich
+    draws it (None) where a line would wrap at the console's width."""
+    report = make()
+    plain = plain_report(
+        report,
+        options.get("fail_on", Severity.WARNING),
+        width,
+        **{k: v for k, v in options.items() if k != "fail_on"},
+    )
+    if plain is None:
+        assert width < 80  # only a narrow console is left to rich
+    else:
+        assert plain == _rich_text(report, width, **dict(options))
+    assert plain_report(report, Severity.WARNING, width, statistics=True) is None
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["corpora/real/sample_log_small.ulg", "--verbose"],
+        ["corpora/tlog", "--quiet"],
+        ["corpora/rules", "--exit-zero"],
+        [
+            "corpora/ros2bridge/example_agent_restart-1.16.2-ros2-mcap",
+            "--with",
+            "corpora/ros2bridge/example_agent_restart-1.16.2-ros2.ulg",
+        ],
+    ],
+    ids=lambda a: a[0],
+)
+def test_a_lint_off_a_terminal_prints_what_rich_printed(
+    args: list[str], no_colour_env: None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    root = Path(__file__).resolve().parent.parent
+    plain = run_cli(["lint", *args], cwd=root)
+    monkeypatch.setattr("fuzzoff.report.plain.plain_width", lambda to_file: None)
+    drawn = run_cli(["lint", *args], cwd=root)
+    assert plain.stdout and plain.stdout == drawn.stdout
+    assert plain.returncode == drawn.returncode
+
+
+def test_a_report_written_to_a_file_is_what_rich_wrote(
+    tmp_path: Path, no_colour_env: None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``--output FILE``: the plain text at rich's file width (160), without rich."""
+    args = ["lint", str(CORPORA / "tlog"), "--verbose", "--exit-zero"]
+    run_cli([*args, "--format", "terminal", "--output", str(tmp_path / "plain.txt")])
+    monkeypatch.setattr("fuzzoff.report.plain.plain_width", lambda to_file: None)
+    run_cli([*args, "--format", "terminal", "--output", str(tmp_path / "rich.txt")])
+    plain = (tmp_path / "plain.txt").read_text()
+    assert plain and plain == (tmp_path / "rich.txt").read_text()

@@ -171,6 +171,26 @@ _ROS_KEEPALIVES: frozenset[type[Event]] = frozenset(KEEPALIVE_ROS)
 _MAVLINK_KEEPALIVES: frozenset[type[Event]] = frozenset(MAVLINK_SETPOINTS)
 _TARGET_SYSTEM = attrgetter("target_system")
 
+_HELD: dict[
+    tuple[frozenset[type[Event]], tuple[type[Event], ...]], frozenset[type[Event]] | bool
+] = {}
+"""(classes of a run, types asked) -> True (all of the run), False (none), or the classes
+wanted: ``StreamBatch.of``'s answer for a run's classes, worked out once per process (a few
+dozen pairs occur; the ten-minute real ULog asks 35k times, mostly of one- and two-message
+runs)."""
+
+
+def _held(
+    present: frozenset[type[Event]], types: tuple[type[Event], ...]
+) -> frozenset[type[Event]] | bool:
+    key = (present, types)
+    held = _HELD.get(key)
+    if held is None:
+        wanted = frozenset(cls for cls in present if issubclass(cls, types))
+        held = True if len(wanted) == len(present) else (wanted if wanted else False)
+        _HELD[key] = held
+    return held
+
 
 class StreamBatch:
     """A run of consecutive stream messages of one vehicle, in time order.
@@ -233,10 +253,10 @@ class StreamBatch:
         found = self._of.get(types)
         if found is None:
             present = self.classes()
-            held = frozenset(cls for cls in present if issubclass(cls, types))
-            if len(held) == len(present):
+            held = _held(present, types)
+            if held is True:
                 found = self.events
-            elif not held:
+            elif held is False:
                 found = []
             else:
                 found = [e for e in self.events if type(e) in held]

@@ -11,7 +11,7 @@ from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 
-from fuzzoff.commands._common import render_rich, write_output
+from fuzzoff.commands._common import _output_file, render_rich, write_output
 from fuzzoff.config import ConfigError, Settings
 from fuzzoff.findings import Report
 from fuzzoff.report import renderer
@@ -83,6 +83,22 @@ def write_report(
 def _terminal(
     args: argparse.Namespace, report: Report, settings: Settings, output: str | None
 ) -> None:
+    from fuzzoff.report.plain import plain_report, plain_width
+
+    width = plain_width(to_file=_output_file(output) is not None)
+    if width is not None:  # not a terminal: the same text without rich (issue 31)
+        text = plain_report(
+            report,
+            settings.fail_on,
+            width,
+            quiet=args.quiet,
+            statistics=args.statistics,
+            verbose=args.verbose,
+            exit_zero=settings.exit_zero,
+        )
+        if text is not None:
+            write_output(text, output)
+            return
     from rich.console import Console
 
     from fuzzoff.report.terminal import print_report

@@ -9,7 +9,6 @@ import os
 import re
 from collections.abc import Mapping
 from dataclasses import replace
-from difflib import get_close_matches
 from pathlib import Path
 from typing import Any
 
@@ -170,6 +169,8 @@ def _param_name(name: str, where: str) -> str:
     that changes nothing."""
     upper = name.upper()
     if upper not in GATE_PARAMS:
+        from difflib import get_close_matches  # only for a typo: not loaded by every lint
+
         close = get_close_matches(upper, GATE_PARAMS, n=1)
         hint = f"did you mean {close[0]}? " if close else ""
         raise ConfigError(

@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import ClassVar, Literal
 
-from fuzzoff.events import Event, Origin
+from fuzzoff.events import Event, Origin, event_type
 
 TransitionKind = Literal[
     "signal_available",
@@ -31,7 +30,7 @@ model did not predict (recorded mode or ack vs the model's), see ``recorded_nav_
 not show (``reason`` names both outcomes)."""
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@event_type
 class GateTransition(Event):
     """One change the gate model predicts, at ``t``, caused by ``cause`` (None for a timeout).
 

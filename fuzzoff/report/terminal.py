@@ -27,28 +27,19 @@ from fuzzoff.catalog import get_rule
 from fuzzoff.findings import FileReport, Finding, Report, Severity
 from fuzzoff.fuzz.known import KNOWN
 from fuzzoff.report import CampaignReport, campaign_seeds
+from fuzzoff.report.plain import DETAIL_LIMIT, HEAD_WIDTH, VERDICT
+from fuzzoff.report.plain import location as _location
 from fuzzoff.report.sanitize import printable
 
 if TYPE_CHECKING:
     from fuzzoff.fuzz.campaign import CampaignResult, PropertyResult
 
 STYLE = {Severity.ERROR: "bold red", Severity.WARNING: "yellow", Severity.INFO: "cyan"}
-VERDICT = {0: "passed", 1: "failed", 2: "incomplete input"}
 
 
 def table_box(console: Console) -> box.Box:
     """Heavy lines on a terminal; ASCII in a file or a pipe (CI logs, editors)."""
     return box.SIMPLE_HEAVY if console.is_terminal else box.ASCII
-
-
-def _location(finding: Finding, full: bool) -> str:
-    """Topic or message type and index (``#140``); ``full`` adds the byte offset (``@10714``)."""
-    where = finding.where
-    if where is None or not where.topic:
-        return ""
-    if full:
-        return str(where)
-    return where.topic if where.index is None else f"{where.topic} #{where.index}"
 
 
 def finding_parts(finding: Finding, *, vehicle: bool = True) -> tuple[Text, Text, Text]:
@@ -78,11 +69,6 @@ def finding_line(finding: Finding, *, vehicle: bool = True) -> Text:
     return line
 
 
-DETAIL_LIMIT = 1000
-"""Longest message ``--verbose`` shows (a recording can make one any length; fuzzoff's own
-longest, the OFB002 lines, stay under it)."""
-
-
 def finding_detail(finding: Finding) -> Text:
     """``--verbose``: the whole message, then the time window and the exact place."""
     text = Text(printable(finding.message, DETAIL_LIMIT))
@@ -95,10 +81,6 @@ def finding_detail(finding: Finding) -> Text:
     if extra:
         text.append("\n" + ", ".join(extra), style="dim")
     return text
-
-
-HEAD_WIDTH = 26
-"""Columns before a finding's text: time (10), code (6), severity (7) and their spaces."""
 
 
 def _print_findings(

@@ -135,7 +135,6 @@ class UlogSource(Source):
         if every_row is not None:
             self.every_row = every_row
         self._loaded: Loaded | None = None
-        self._header_info: RecordingInfo | None = None
         self._failed: SourceError | None = None
         self._info: RecordingInfo | None = None
         self._yielded = 0
@@ -144,8 +143,15 @@ class UlogSource(Source):
     # -- loading ---------------------------------------------------------------------------
 
     def open(self) -> None:
-        """Read the definition section: a file that is not a ULog fails here, at once."""
-        self._header_info = self.probe_header()
+        """Read the file: one that is not a ULog fails here, at once. The filtered data load
+        (kept for ``probe`` and ``events``) reads the definition section on its way, which
+        pyulog parsed a second time when ``open`` read it alone (issue 31); where that load
+        fails, the definition section alone decides, as before, whether the file opens, and
+        ``probe`` raises the load's error."""
+        try:
+            self._load()
+        except SourceError:
+            self.probe_header()
 
     def probe_header(self) -> RecordingInfo:
         """Version, parameters and vehicle type from the definition section only (instant)."""
