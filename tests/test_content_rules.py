@@ -688,6 +688,23 @@ def test_ofb404_one_climb_in_enu_on_the_ground_is_one_finding() -> None:
     assert [f.time_s for f in codes(lint_events(flew), "OFB404")] == [7.0]
 
 
+def test_ofb404_a_setpoint_at_the_origin_is_not_enu_when_the_estimate_drifted_up() -> None:
+    """PX4 1.14.4 SITL, the airplane at rest: its estimate read 0.56 m up. A ground setpoint at
+    the origin (z = 0) is 0.56 m below that estimate but not below the origin: no finding, on
+    the ground or after a takeoff; a height in ENU is still one."""
+    head: list[Event] = [status(0.0, LOITER, armed=False), ControlMode(t=0.0, position=True)]
+    head += [VehiclePosition(t=0.5 * k, x=0.0, y=0.0, z=-0.56) for k in range(6)]
+    at_origin = [TrajectorySetpoint(t=2.6 + 0.1 * k, position=(0.0, 0.0, 0.0)) for k in range(10)]
+    assert codes(lint_events([*head, *at_origin]), "OFB404") == []
+    flown = [*head, status(3.0, TAKEOFF, armed=True), status(8.0, OFFBOARD), *at_origin[:1]]
+    flown[-1] = TrajectorySetpoint(t=8.1, position=(0.0, 0.0, 0.0))
+    assert codes(lint_events(flown), "OFB404") == []
+    (found,) = codes(
+        lint_events([*head, TrajectorySetpoint(t=2.6, position=(0, 0, 1.0))]), "OFB404"
+    )
+    assert "1.56 m below the vehicle (its local z = -0.56 m)" in found.message
+
+
 def test_ofb404_in_the_air_a_target_is_judged_against_the_ground_it_took_off_from() -> None:
     events = _drifted_ground(
         status(3.0, TAKEOFF, armed=True),

@@ -181,7 +181,11 @@ class FrameConventionSuspect(Check):
         return any(map(gt, map(_position_z, events), repeat(limit)))
 
     def _ground(self) -> float:
-        """The ground's local z: where the vehicle last was on the ground, else the origin."""
+        """The ground's local z: where the vehicle last was on the ground, else the origin.
+
+        A target is judged below the vehicle or the ground only when it is below the local
+        origin too: an estimate that drifted upwards on the ground (PX4 1.14's airplane read
+        0.56 m up at rest) would otherwise make a setpoint at the origin, z = 0, look like ENU."""
         return 0.0 if self.ground_z is None else self.ground_z
 
     def _mine(self, events: list[Event]) -> list[Event]:
@@ -253,7 +257,7 @@ class FrameConventionSuspect(Check):
     def _from_ground(self, event: Event) -> None:
         z, vz = vertical_command(event)
         here = 0.0 if self.vehicle_z is None else self.vehicle_z
-        below = math.isfinite(z) and z > here + self.z_m
+        below = math.isfinite(z) and z > max(here, 0.0) + self.z_m
         down = below or (math.isfinite(vz) and vz > self.vz_mps)
         up = (math.isfinite(z) and z < here - self.z_m) or (math.isfinite(vz) and vz < -self.vz_mps)
         if not (down or up):
@@ -285,7 +289,7 @@ class FrameConventionSuspect(Check):
     def _in_the_air(self, event: Event) -> None:
         z = vertical_command(event)[0]
         ground = self._ground()
-        if not (math.isfinite(z) and z > ground + self.z_m):
+        if not (math.isfinite(z) and z > max(ground, 0.0) + self.z_m):
             self.below.good(event.kind)
             return
         if self.ground_z is None:
