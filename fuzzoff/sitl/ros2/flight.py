@@ -19,6 +19,7 @@ import argparse
 import json
 import subprocess
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -277,29 +278,61 @@ def fly_mode(
     return summary
 
 
+def send_plan(
+    participant: DomainParticipant,
+    plan: ReplayPlan,
+    now: Callable[[], float] = time.monotonic,
+    wait_until: Callable[[float], None] | None = None,
+    target_system: int | None = None,
+) -> list[float]:
+    """Send ``plan``'s messages at their offsets from ``now()`` at the start; the ``now()``
+    each one went out. Each ``timestamp`` (and ``timestamp_sample``) is moved onto this host's
+    clock, keeping its distance from the first stamped message's as recorded: a sender whose
+    clock ran with the recording stamps the sending time, one whose stamps lagged or jumped
+    (PX4 ages an OffboardControlMode by its stamp) still does; 0 (PX4: "stamp it on receipt")
+    stays 0. ``target_system``: a command addressed to a system (not 0, every system) goes to
+    this one, the PX4 it is sent to (its ``MAV_SYS_ID``: ``PX4_INSTANCE`` + 1), as ``fuzzoff
+    replay --to`` readdresses MAVLink."""
+    publishers: dict[str, tuple[BridgeTopic, Publisher]] = {}
+    samples = []
+    for message in plan.messages:
+        if message.topic not in publishers:
+            topic = BridgeTopic(message.message, message.topic, message.msgdef)
+            publishers[message.topic] = (topic, Publisher(participant, topic))
+        topic, publisher = publishers[message.topic]
+        samples.append((message.offset_s, publisher, idl_type(topic).deserialize(message.data)))
+    reference = next(
+        ((offset, s.timestamp) for offset, _, s in samples if getattr(s, "timestamp", 0)), None
+    )
+    wait = wait_until or (lambda t: time.sleep(max(0.0, t - now())))
+    start = now()
+    shift = 0 if reference is None else now_us() + round(reference[0] * 1e6) - reference[1]
+    sent = []
+    for offset, publisher, sample in samples:
+        wait(start + offset)
+        if target_system is not None and getattr(sample, "target_system", 0):
+            sample.target_system = target_system
+        for name in ("timestamp", "timestamp_sample"):
+            stamp = getattr(sample, name, 0)
+            if stamp:
+                setattr(sample, name, max(1, stamp + shift))
+        publisher.write(sample)
+        sent.append(now())
+    return sent
+
+
 def replay(
     release: str, out: Path, stem: str, plan: ReplayPlan, log: Log = print
 ) -> dict[str, Any]:
-    """Send a recorded bag's ``/fmu/in`` messages to PX4 at their recorded times (each one's
-    ``timestamp`` restamped to the sending time, as the sending node stamped it)."""
+    """Send a recorded bag's ``/fmu/in`` messages to PX4 at their recorded times (``send_plan``:
+    the stamps on this host's clock, as the sending node stamped them)."""
     with BridgeFlight(release, None, log) as flight:
         flight.wait_ready()
         flight.record()
         time.sleep(LEAD_S)
         node_participant = DomainParticipant(0)
-        publishers: dict[str, tuple[BridgeTopic, Publisher]] = {}
-        for message in plan.messages:
-            if message.topic not in publishers:
-                topic = BridgeTopic(message.message, message.topic, message.msgdef)
-                publishers[message.topic] = (topic, Publisher(node_participant, topic))
         flight.t0 = t0 = time.monotonic()
-        for message in plan.messages:
-            time.sleep(max(0.0, t0 + message.offset_s - time.monotonic()))
-            topic, publisher = publishers[message.topic]
-            sample = idl_type(topic).deserialize(message.data)
-            if hasattr(sample, "timestamp"):
-                sample.timestamp = now_us()
-            publisher.write(sample)
+        send_plan(node_participant, plan, target_system=flight.px4.sysid)
         time.sleep(REPLAY_TAIL_S)
         flight.stop_recording()
         note = f"replayed {len(plan.messages)} messages of {plan.source}"
