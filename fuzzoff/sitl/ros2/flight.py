@@ -310,7 +310,8 @@ def send_plan(
     sent = []
     for offset, publisher, sample in samples:
         wait(start + offset)
-        if target_system is not None and getattr(sample, "target_system", 0):
+        addressed: int = getattr(sample, "target_system", 0)
+        if target_system is not None and addressed:
             sample.target_system = target_system
         for name in ("timestamp", "timestamp_sample"):
             stamp = getattr(sample, name, 0)
