@@ -112,17 +112,17 @@ def run(args: argparse.Namespace) -> int:
 
     vehicle = _checked(args)
     release = _release(args.against, args.px4_build)
+    transport: Transport = "ros2" if args.transport == "ros2" else "mavlink"
     try:
         build = bundle.find_build(release, args.px4_build)
+        if transport == "ros2":
+            _check_bridge(args.against, build)
         airframes.boot_env(build, vehicle)  # refused here when the build cannot fly it
     except airframes.AirframeError as exc:
         raise ConfigError(str(exc)) from None
     except bundle.BundleError as exc:
         reason = str(exc).removeprefix(f"--release {release}: ")
         raise ConfigError(f"--against {args.against}: {reason}") from None
-    transport: Transport = "ros2" if args.transport == "ros2" else "mavlink"
-    if transport == "ros2":
-        _check_bridge(args.against, build)
     save_dir = None
     if not args.no_save:
         save_dir = Path(args.save_dir) if args.save_dir else DEFAULT_DIR

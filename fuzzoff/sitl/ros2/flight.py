@@ -278,6 +278,29 @@ def fly_mode(
     return summary
 
 
+def stamp_shift(samples: list[tuple[float, Any]], start_us: int) -> int:
+    """What ``send_plan`` adds to each stamp: the first stamped message (offset, sample) is
+    stamped with its sending time, ``start_us`` plus its offset; 0 when none is stamped."""
+    for offset, sample in samples:
+        stamp: int = getattr(sample, "timestamp", 0)
+        if stamp:
+            return start_us + round(offset * 1e6) - stamp
+    return 0
+
+
+def readdressed(sample: Any, shift: int, target_system: int | None) -> Any:
+    """``sample`` as ``send_plan`` sends it: stamps moved by ``shift`` (0 stays 0: PX4 stamps
+    it on receipt), a command addressed to a system (not 0, all) sent to ``target_system``."""
+    addressed: int = getattr(sample, "target_system", 0)
+    if target_system is not None and addressed:
+        sample.target_system = target_system
+    for name in ("timestamp", "timestamp_sample"):
+        stamp: int = getattr(sample, name, 0)
+        if stamp:
+            setattr(sample, name, max(1, stamp + shift))
+    return sample
+
+
 def send_plan(
     participant: DomainParticipant,
     plan: ReplayPlan,
@@ -287,12 +310,11 @@ def send_plan(
 ) -> list[float]:
     """Send ``plan``'s messages at their offsets from ``now()`` at the start; the ``now()``
     each one went out. Each ``timestamp`` (and ``timestamp_sample``) is moved onto this host's
-    clock, keeping its distance from the first stamped message's as recorded: a sender whose
-    clock ran with the recording stamps the sending time, one whose stamps lagged or jumped
-    (PX4 ages an OffboardControlMode by its stamp) still does; 0 (PX4: "stamp it on receipt")
-    stays 0. ``target_system``: a command addressed to a system (not 0, every system) goes to
-    this one, the PX4 it is sent to (its ``MAV_SYS_ID``: ``PX4_INSTANCE`` + 1), as ``fuzzoff
-    replay --to`` readdresses MAVLink."""
+    clock, keeping its distance from the first stamped message's as recorded (``stamp_shift``):
+    a sender whose clock ran with the recording stamps the sending time, one whose stamps
+    lagged or jumped (PX4 ages an OffboardControlMode by its stamp) still does. A command goes
+    to ``target_system`` (the PX4 it is sent to: ``MAV_SYS_ID``, ``PX4_INSTANCE`` + 1), as
+    ``fuzzoff replay --to`` readdresses MAVLink (``readdressed``)."""
     publishers: dict[str, tuple[BridgeTopic, Publisher]] = {}
     samples = []
     for message in plan.messages:
@@ -301,23 +323,13 @@ def send_plan(
             publishers[message.topic] = (topic, Publisher(participant, topic))
         topic, publisher = publishers[message.topic]
         samples.append((message.offset_s, publisher, idl_type(topic).deserialize(message.data)))
-    reference = next(
-        ((offset, s.timestamp) for offset, _, s in samples if getattr(s, "timestamp", 0)), None
-    )
     wait = wait_until or (lambda t: time.sleep(max(0.0, t - now())))
     start = now()
-    shift = 0 if reference is None else now_us() + round(reference[0] * 1e6) - reference[1]
+    shift = stamp_shift([(offset, sample) for offset, _, sample in samples], now_us())
     sent = []
     for offset, publisher, sample in samples:
         wait(start + offset)
-        addressed: int = getattr(sample, "target_system", 0)
-        if target_system is not None and addressed:
-            sample.target_system = target_system
-        for name in ("timestamp", "timestamp_sample"):
-            stamp = getattr(sample, name, 0)
-            if stamp:
-                setattr(sample, name, max(1, stamp + shift))
-        publisher.write(sample)
+        publisher.write(readdressed(sample, shift, target_system))
         sent.append(now())
     return sent
 
