@@ -224,9 +224,9 @@ def test_the_report_says_the_transport_and_how_to_send_a_disagreement_over_dds(
     assert text.startswith(
         f"fuzzoff fuzz --against sitl:{LIVE_RELEASE} --vehicle quad --transport ros2, seed 0\n"
     )
-    bag = tmp_path / "out" / "px4-x.px4-mcap"
+    path = tmp_path / "out" / "px4-x.expected.json"
     assert (
-        f"    again:     fuzzoff sitl replay {bag} --transport ros2 --release {LIVE_RELEASE}\n"
+        f"    again:     fuzzoff sitl replay {path} --transport ros2 --release {LIVE_RELEASE}\n"
         in text
     )
     data = json.loads(to_json(result))
@@ -254,16 +254,76 @@ def test_a_disagreement_over_dds_is_saved_with_its_bag_and_replay_says_how_to_se
     assert "exchange_tlog" not in against
     assert (tmp_path / "out" / f"{name}.px4-mcap" / "metadata.yaml").exists()
     assert against["replay"] == (
-        f"fuzzoff sitl replay NAME.px4-mcap --transport ros2 --release {LIVE_RELEASE}"
+        f"fuzzoff sitl replay NAME.expected.json --transport ros2 --release {LIVE_RELEASE}"
     )
     out = run_cli(["replay", str(case.reproducer)])
     assert out.returncode == 0, out.stdout + out.stderr
     assert f"against PX4 {LIVE_RELEASE} (confirmed): it and the model differed" in out.stdout
-    bag = tmp_path / "out" / f"{name}.px4-mcap"
     assert (
-        f"send it to PX4 over DDS again: fuzzoff sitl replay {bag} --transport ros2"
+        f"send it to PX4 over DDS again: fuzzoff sitl replay {case.reproducer} --transport ros2"
         f" --release {LIVE_RELEASE}"
     ) in out.stdout
+
+
+def test_sitl_replay_over_dds_sends_a_ros2_reproducers_stream_with_its_parameters(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``fuzzoff sitl replay NAME.expected.json --transport ros2``: the reproducer's MCAP, its
+    setup's parameters (set at PX4's boot), and a line saying no manual control is sent."""
+    from fuzzoff.fuzz.reproducers import save
+
+    stream = _ros2_stream()
+    stream = Scenario(
+        stream.px4, "mc", "ros2", stream.events, {**stream.params, "FUZZOFF_RC_PRESENT": 1.0}
+    )
+    path = save("explained", with_start(stream), [], tmp_path / "out")
+    _fake_bundle(tmp_path, "build", bridge=True)
+    seen: dict[str, object] = {}
+
+    def fake(recording: Path, build: object, save_dir: Path, log: object, params: object) -> object:
+        seen.update(recording=recording, params=params)
+        raise __import__("fuzzoff.sitl.ros2.run", fromlist=["x"]).FlightError("stop here")
+
+    monkeypatch.setattr("fuzzoff.sitl.ros2.run.replay_bag", fake)
+    args = [
+        "sitl",
+        "replay",
+        str(path),
+        "--transport",
+        "ros2",
+        "--px4-build",
+        str(tmp_path / "build"),
+    ]
+    out = run_cli(args)
+    assert out.returncode == 2 and "error: stop here" in out.stderr
+    assert seen["recording"] == path.with_name(path.name.replace(".expected.json", ".mcap"))
+    assert seen["params"] == {"COM_OF_LOSS_T": 0.5}
+    assert "a ROS 2 replay sends none" in out.stderr
+
+
+@pytest.mark.parametrize(
+    ("name", "says"),
+    [
+        ("stream.tlog", "a ROS 2 replay takes a bag folder (metadata.yaml), an .mcap file or"),
+        ("mav.expected.json", "a mavlink reproducer: replay it without --transport ros2"),
+    ],
+)
+def test_sitl_replay_over_dds_refuses_what_it_cannot_send(
+    name: str, says: str, tmp_path: Path
+) -> None:
+    from fuzzoff.fuzz.reproducers import save
+
+    if name.endswith(".json"):
+        from tests.test_fuzz_against import PLAN, TEN_HZ, _stream
+
+        path = save("explained", _stream(TEN_HZ, PLAN), [], tmp_path)
+    else:
+        path = tmp_path / name
+        path.write_bytes(b"")
+    out = run_cli(["sitl", "replay", str(path), "--transport", "ros2", "--release", "1.18"])
+    assert out.returncode == 2
+    (line,) = out.stderr.strip().splitlines()
+    assert says in line
 
 
 # ------------------------------------------------------------------------- live

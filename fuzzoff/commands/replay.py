@@ -210,10 +210,8 @@ def _against_text(against: dict[str, Any], path: str) -> str:
             f" model {printable(str(d.get('model')), 200)}"
         )
     if against.get("transport") == "ros2":
-        bag = against.get("exchange_bag")
-        folder = Path(path).parent / str(bag) if bag else Path("NAME.px4-mcap")
         lines.append(
-            f"  send it to PX4 over DDS again: fuzzoff sitl replay {printable(str(folder))}"
+            f"  send it to PX4 over DDS again: fuzzoff sitl replay {printable(path)}"
             f" --transport ros2 --release {printable(str(against.get('px4')))}"
         )
     else:

@@ -24,8 +24,9 @@ namespace (``ros2.netns.enter``), the streams are drawn as a ROS 2 companion pub
 Micro XRCE-DDS Agent (``ros2.bench.BridgeBench``), recorded as a bag (``ros2.recorder``), and
 judged as ``sitl run --transport ros2`` judges a flight (``ros2.verdict.compare``: the bag's
 times put on PX4's clock as ``lint --with`` puts them). A reproducer is the MCAP stream as any
-ROS 2 reproducer, with the exchange's bag folder (``NAME.px4-mcap``) beside it, which ``fuzzoff
-sitl replay NAME.px4-mcap --transport ros2`` sends over DDS again.
+ROS 2 reproducer, with the exchange's bag folder (``NAME.px4-mcap``) beside it; ``fuzzoff sitl
+replay NAME.expected.json --transport ros2`` sends its stream over DDS to a fresh PX4 again, with
+the setup's parameters set at boot.
 """
 
 from __future__ import annotations
@@ -508,7 +509,7 @@ def against_block(
     bag = config.transport == "ros2"
     exchange = "-mcap" if bag else ".tlog"
     replay = (
-        f"fuzzoff sitl replay NAME.px4-mcap --transport ros2 --release {config.build.release}"
+        f"fuzzoff sitl replay NAME.expected.json --transport ros2 --release {config.build.release}"
         if bag
         else f"fuzzoff replay NAME.expected.json --to udp:127.0.0.1:{port}"
     )

@@ -104,9 +104,9 @@ def _disagreement(number: int, case: Disagreement, config: AgainstConfig) -> lis
     if case.reproducer is not None:
         path = printable(str(case.reproducer))
         lines.append(f"    reproducer {path}")
-        if config.transport == "ros2":  # the exchange's bag, sent over DDS again
-            bag = path.removesuffix(".expected.json") + ".px4-mcap"
-            again = f"fuzzoff sitl replay {bag} --transport ros2 --release {config.build.release}"
+        if config.transport == "ros2":  # its stream over DDS to a fresh PX4
+            release = config.build.release
+            again = f"fuzzoff sitl replay {path} --transport ros2 --release {release}"
         else:
             again = f"fuzzoff replay {path} --to udp:127.0.0.1:{14580 + config.instance}"
         lines.append(f"    again:     {again}")

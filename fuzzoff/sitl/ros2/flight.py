@@ -88,8 +88,10 @@ class BridgeFlight:
         program: Program | None,
         log: Log = print,
         vehicle: str | None = None,
+        params: dict[str, float] | None = None,
     ) -> None:
-        """``vehicle``: the SIH airframe (``airframes``; None: the program's, else the quad)."""
+        """``vehicle``: the SIH airframe (``airframes``; None: the program's, else the quad);
+        ``params``: PX4 parameters set at boot (``PX4_PARAM_<NAME>``)."""
         if "/" in release:  # a build folder (--px4-build)
             self.build = bundle.find_build(None, Path(release))
         else:
@@ -108,6 +110,7 @@ class BridgeFlight:
         self.received = [bridge_topic(release_name, m) for m in received]
         self.sent = [bridge_topic(release_name, m) for m in sent]
         env = {"PX4_AGENT": str(bundle.default_root() / "agent"), "PX4_PARAM_SDLOG_MODE": "2"}
+        env |= {f"PX4_PARAM_{name}": f"{value:g}" for name, value in (params or {}).items()}
         self.vehicle = vehicle or (program.vehicle if program is not None else None)
         if self.vehicle is not None:
             env = airframes.boot_env(self.build, self.vehicle, env)
@@ -335,11 +338,16 @@ def send_plan(
 
 
 def replay(
-    release: str, out: Path, stem: str, plan: ReplayPlan, log: Log = print
+    release: str,
+    out: Path,
+    stem: str,
+    plan: ReplayPlan,
+    log: Log = print,
+    params: dict[str, float] | None = None,
 ) -> dict[str, Any]:
     """Send a recorded bag's ``/fmu/in`` messages to PX4 at their recorded times (``send_plan``:
     the stamps on this host's clock, as the sending node stamped them)."""
-    with BridgeFlight(release, None, log) as flight:
+    with BridgeFlight(release, None, log, params=params) as flight:
         flight.wait_ready()
         flight.record()
         time.sleep(LEAD_S)
@@ -360,10 +368,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("release", help="a bundle with the bridge (1.16.2-ros2) or a build folder")
     parser.add_argument("stem", help="the outputs' name")
     parser.add_argument("--vehicle", help="the SIH airframe (fuzzoff.sitl.airframes)")
+    parser.add_argument("--param", action="append", default=[], help="NAME=VALUE, at boot")
     args = parser.parse_args(argv)
+    params = {k: float(v) for k, _, v in (p.partition("=") for p in args.param)}
     out = Path(".")  # the caller's folder: netns binds it at its own path and enters it
     if args.program.endswith(".json"):
-        summary = replay(args.release, out, args.stem, load_plan(Path(args.program)))
+        plan = load_plan(Path(args.program))
+        summary = replay(args.release, out, args.stem, plan, params=params)
     elif args.program in PROGRAMS:
         summary = fly(args.release, out, args.stem, PROGRAMS[args.program], vehicle=args.vehicle)
     else:
