@@ -140,33 +140,36 @@ def test_every_generated_stream_goes_out_on_the_bridges_own_topics(
     assert plan.messages[-1].offset_s == pytest.approx(sent[-1].t - sent[0].t, abs=2e-6)
 
 
-def test_stamps_keep_their_distances_and_commands_go_to_the_px4_sent_to() -> None:
-    """A keep-alive whose stamps lag 0.3 s behind its sending still lags once sent; 0 (PX4
-    stamps it on receipt) stays 0; a command to system 1 goes to PX4 instance 4 (system 5), a
-    broadcast (0) stays one."""
-    from fuzzoff.sitl.ros2.flight import readdressed, stamp_shift
+def test_stamps_keep_their_distances_per_topic_and_commands_go_to_the_px4_sent_to() -> None:
+    """A keep-alive whose clock runs 1.96 s ahead and then stops (as fuzzoff's streams draw
+    it) still stops once sent, its first stamp the sending time; commands stamped with the
+    sending time keep it (not moved by the keep-alive's clock); 0 (PX4 stamps it on receipt)
+    stays 0; a command to system 1 goes to PX4 instance 4 (system 5), a broadcast (0) stays."""
+    from fuzzoff.sitl.ros2.flight import readdressed, stamp_shifts
 
     def sample(timestamp: int, target: int | None = None) -> types.SimpleNamespace:
         fields = {"timestamp": timestamp, "timestamp_sample": timestamp}
-        return types.SimpleNamespace(
-            **fields, **({} if target is None else {"target_system": target})
-        )
+        addressed = {} if target is None else {"target_system": target}
+        return types.SimpleNamespace(**fields, **addressed)
 
+    ocm, command, setpoint = "/fmu/in/offboard_control_mode", "/fmu/in/vehicle_command", "sp"
     samples = [
-        (0.0, sample(0)),
-        (0.1, sample(1_000_000)),
-        (0.2, sample(800_000)),
-        (0.3, sample(1_200_000, 1)),
+        (setpoint, 0.0, sample(0)),
+        (ocm, 0.0001, sample(1_958_093)),
+        (command, 0.0003, sample(300, 1)),
+        (ocm, 0.5001, sample(1_958_093)),
+        (command, 16.6251, sample(16_625_100, 1)),
     ]
     start = 5_000_000_000
-    shift = stamp_shift(samples, start)
-    out = [readdressed(s, shift, 5) for _, s in samples]
+    shifts = stamp_shifts(samples, start)
+    out = [readdressed(s, shifts.get(topic, 0), 5) for topic, _, s in samples]
     assert out[0].timestamp == 0 and out[0].timestamp_sample == 0
-    assert out[1].timestamp == start + 100_000  # the first stamped one: its sending time
-    assert out[2].timestamp == start + 100_000 - 200_000  # lagged 0.3 s behind its send
-    assert out[3].timestamp == start + 300_000 and out[3].target_system == 5
+    assert out[1].timestamp == start + 100  # the keep-alive's first: its sending time
+    assert out[3].timestamp == start + 100  # stopped, as sent: PX4 ages it
+    assert out[2].timestamp == start + 300 and out[2].target_system == 5
+    assert out[4].timestamp == start + 16_625_100  # the sending time, 16.6 s on
     assert readdressed(sample(7, 0), 0, 5).target_system == 0
-    assert stamp_shift([(0.0, sample(0))], start) == 0
+    assert stamp_shifts([(ocm, 0.0, sample(0))], start) == {}
 
 
 # ------------------------------------------------------------------------- report, reproducer

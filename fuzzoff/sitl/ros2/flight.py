@@ -281,14 +281,19 @@ def fly_mode(
     return summary
 
 
-def stamp_shift(samples: list[tuple[float, Any]], start_us: int) -> int:
-    """What ``send_plan`` adds to each stamp: the first stamped message (offset, sample) is
-    stamped with its sending time, ``start_us`` plus its offset; 0 when none is stamped."""
-    for offset, sample in samples:
+def stamp_shifts(samples: list[tuple[str, float, Any]], start_us: int) -> dict[str, int]:
+    """What ``send_plan`` adds to the stamps of each topic: a topic's first stamped message
+    (topic, offset, sample) is stamped with its sending time, ``start_us`` plus its offset, and
+    the topic's later ones keep their distance from it. Per topic, since a node's topics need
+    not share one clock: fuzzoff's streams stamp the keep-alive with a clock of its own (lagging,
+    stuck, jumping: PX4 ages an OffboardControlMode by its stamp, and the gate model takes the
+    first as fresh) and the rest with the sending time."""
+    shifts: dict[str, int] = {}
+    for topic, offset, sample in samples:
         stamp: int = getattr(sample, "timestamp", 0)
-        if stamp:
-            return start_us + round(offset * 1e6) - stamp
-    return 0
+        if stamp and topic not in shifts:
+            shifts[topic] = start_us + round(offset * 1e6) - stamp
+    return shifts
 
 
 def readdressed(sample: Any, shift: int, target_system: int | None) -> Any:
@@ -313,11 +318,11 @@ def send_plan(
 ) -> list[float]:
     """Send ``plan``'s messages at their offsets from ``now()`` at the start; the ``now()``
     each one went out. Each ``timestamp`` (and ``timestamp_sample``) is moved onto this host's
-    clock, keeping its distance from the first stamped message's as recorded (``stamp_shift``):
-    a sender whose clock ran with the recording stamps the sending time, one whose stamps
-    lagged or jumped (PX4 ages an OffboardControlMode by its stamp) still does. A command goes
-    to ``target_system`` (the PX4 it is sent to: ``MAV_SYS_ID``, ``PX4_INSTANCE`` + 1), as
-    ``fuzzoff replay --to`` readdresses MAVLink (``readdressed``)."""
+    clock, keeping its distance from its topic's first stamped message's as recorded
+    (``stamp_shifts``): a sender whose clock ran with the recording stamps the sending time,
+    one whose stamps lagged or jumped (PX4 ages an OffboardControlMode by its stamp) still
+    does. A command goes to ``target_system`` (the PX4 it is sent to: ``MAV_SYS_ID``,
+    ``PX4_INSTANCE`` + 1), as ``fuzzoff replay --to`` readdresses MAVLink (``readdressed``)."""
     publishers: dict[str, tuple[BridgeTopic, Publisher]] = {}
     samples = []
     for message in plan.messages:
@@ -328,11 +333,17 @@ def send_plan(
         samples.append((message.offset_s, publisher, idl_type(topic).deserialize(message.data)))
     wait = wait_until or (lambda t: time.sleep(max(0.0, t - now())))
     start = now()
-    shift = stamp_shift([(offset, sample) for offset, _, sample in samples], now_us())
+    shifts = stamp_shifts(
+        [
+            (m.topic, m.offset_s, sample)
+            for m, (_, _, sample) in zip(plan.messages, samples, strict=True)
+        ],
+        now_us(),
+    )
     sent = []
-    for offset, publisher, sample in samples:
+    for message, (offset, publisher, sample) in zip(plan.messages, samples, strict=True):
         wait(start + offset)
-        publisher.write(readdressed(sample, shift, target_system))
+        publisher.write(readdressed(sample, shifts.get(message.topic, 0), target_system))
         sent.append(now())
     return sent
 
