@@ -295,7 +295,11 @@ class Campaign:
             shapes.add(shape(scenario))
             if self.spent():
                 raise _Stop
-            self.searched(self.send(scenario, "search"))
+            try:
+                self.searched(self.send(scenario, "search"))
+            except (LinkError, bundle.BundleError) as exc:  # PX4 cannot be run any more
+                self.result.stopped = str(exc)
+                raise _Stop from None
 
         strategy: st.SearchStrategy[Scenario] = scenarios(
             self.config.profile, self.config.judged_as, self.config.transport

@@ -25,7 +25,9 @@ from cyclonedds.domain import DomainParticipant
 from fuzzoff.sitl import bundle
 from fuzzoff.sitl.bench import LOGGER_OPEN_S, STATUS_WAIT_S, Bench, LiveRun, Log, _wait_ready
 from fuzzoff.sitl.link import LinkError
+from fuzzoff.sitl.ros2 import agent
 from fuzzoff.sitl.ros2.bag import Recording, write_bag
+from fuzzoff.sitl.ros2.dds import Publisher
 from fuzzoff.sitl.ros2.flight import READY_TIMEOUT_S, send_plan
 from fuzzoff.sitl.ros2.names import RECEIVED, BridgeTopic, NamesError, bridge_topic
 from fuzzoff.sitl.ros2.recorder import Recorder
@@ -48,6 +50,8 @@ STREAMED = (
     "RoverSteeringSetpoint",
 )
 """What a generated ROS 2 stream may publish (those the release defines are recorded)."""
+MATCH_TIMEOUT_S = 10.0
+"""How long the stream's writers may take to match PX4's bridge readers after a boot."""
 
 
 class BridgeBench(Bench):
@@ -73,8 +77,18 @@ class BridgeBench(Bench):
         self.participant: DomainParticipant | None = None
         self.sender: DomainParticipant | None = None
         self.recorder: Recorder | None = None
+        self.writers: dict[str, Publisher] = {}
+        """One writer per topic for the whole campaign, as a node keeps its publishers: each
+        matched by PX4's reader before a stream goes out (a new one would lose its first
+        messages to DDS discovery)."""
+        self.unmatched: list[str] = []
 
     def start(self) -> None:
+        # each boot's agent on a port of its own: the agent of the PX4 just stopped may hold
+        # its port for a moment (run-px4.sh stops it within 0.5 s of PX4), and a new agent
+        # that cannot bind it exits ("bind error ... errno: 98"); PX4_UXRCE_DDS_PORT is the
+        # client's port too (rcS, 1.16 and later)
+        self.env["PX4_UXRCE_DDS_PORT"] = str(agent.PORT + len(self.boots) % 100)
         super().start()
         if self.participant is None:
             self.participant = DomainParticipant(0)
@@ -82,7 +96,9 @@ class BridgeBench(Bench):
             topics = [*self.streamed.values(), *self.received]
             self.recorder = Recorder(self.participant, topics)
             self.recorder.start()
+            self.writers = {t.ros_topic: Publisher(self.sender, t) for t in self.streamed.values()}
         self._wait_on_dds()
+        self._wait_matched()
 
     def _wait_on_dds(self) -> None:
         """Until PX4's status arrives over DDS (the agent and the bridge are up)."""
@@ -99,6 +115,18 @@ class BridgeBench(Bench):
                     f" {READY_TIMEOUT_S:.0f} s (is the agent running?): {tail}"
                 )
             time.sleep(0.1)
+
+    def _wait_matched(self) -> None:
+        """Until PX4's bridge (through the agent) has matched every writer: two readers each,
+        the campaign's recorder and the agent's (a topic PX4 does not subscribe to stays at
+        one, and is noted)."""
+        deadline = time.monotonic() + MATCH_TIMEOUT_S
+        while time.monotonic() < deadline:
+            self.unmatched = [t for t, w in self.writers.items() if w.matched() < 2]
+            if not self.unmatched:
+                return
+            time.sleep(0.1)
+        self.log(f"PX4's bridge did not match the writers of {', '.join(self.unmatched)}")
 
     def shutdown(self) -> None:
         """The end of the campaign: PX4 and the DDS side."""
@@ -144,7 +172,7 @@ class BridgeBench(Bench):
                 link.sleep_until(t, driver.tick)
 
             sysid = session.px4.sysid
-            sent = send_plan(self.sender, plan, link.clock.now, wait_until, sysid)
+            sent = send_plan(self.sender, plan, link.clock.now, wait_until, sysid, self.writers)
             driver.wait(params.get("COM_OF_LOSS_T", 1.0) + TAIL_S)
         finally:
             recording.stop()

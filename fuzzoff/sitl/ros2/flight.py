@@ -315,6 +315,7 @@ def send_plan(
     now: Callable[[], float] = time.monotonic,
     wait_until: Callable[[float], None] | None = None,
     target_system: int | None = None,
+    writers: dict[str, Publisher] | None = None,
 ) -> list[float]:
     """Send ``plan``'s messages at their offsets from ``now()`` at the start; the ``now()``
     each one went out. Each ``timestamp`` (and ``timestamp_sample``) is moved onto this host's
@@ -322,13 +323,17 @@ def send_plan(
     (``stamp_shifts``): a sender whose clock ran with the recording stamps the sending time,
     one whose stamps lagged or jumped (PX4 ages an OffboardControlMode by its stamp) still
     does. A command goes to ``target_system`` (the PX4 it is sent to: ``MAV_SYS_ID``,
-    ``PX4_INSTANCE`` + 1), as ``fuzzoff replay --to`` readdresses MAVLink (``readdressed``)."""
+    ``PX4_INSTANCE`` + 1), as ``fuzzoff replay --to`` readdresses MAVLink (``readdressed``).
+    ``writers``: writers made (and matched by PX4's bridge) before, by ROS 2 topic; a topic
+    without one gets a new writer here (whose first messages go out before PX4's reader may
+    have matched it: a node that makes a publisher and writes at once, OFB208)."""
     publishers: dict[str, tuple[BridgeTopic, Publisher]] = {}
     samples = []
     for message in plan.messages:
         if message.topic not in publishers:
             topic = BridgeTopic(message.message, message.topic, message.msgdef)
-            publishers[message.topic] = (topic, Publisher(participant, topic))
+            made = (writers or {}).get(message.topic)
+            publishers[message.topic] = (topic, made or Publisher(participant, topic))
         topic, publisher = publishers[message.topic]
         samples.append((message.offset_s, publisher, idl_type(topic).deserialize(message.data)))
     wait = wait_until or (lambda t: time.sleep(max(0.0, t - now())))
