@@ -392,3 +392,29 @@ def test_a_live_campaign_over_the_bridge_sends_a_stream_over_dds_and_judges_it(
         assert list(saved.glob("px4-*-ros2-*.px4-mcap")), out.stderr
     else:
         assert not saved.exists()
+
+
+def test_a_time_sync_jump_mid_stream_does_not_move_the_models_times() -> None:
+    """A real exchange (the 1.18 head, COM_OF_LOSS_T 0.2, seed 0's campaign): PX4's bridge kept
+    one time sync offset, then jumped to one 212 ms away (a simulated PX4 off the host's pace)
+    after the stream. Each of PX4's outputs the bag holds is read with the offset in effect
+    when PX4 published it; reading some with the later one paired them with the wrong samples
+    and moved every model time 216 ms early (three loss times 'differed')."""
+    from fuzzoff.bridge.bag import read_bag
+    from fuzzoff.bridge.clock import measure
+    from fuzzoff.bridge.ulog import read_ulog
+    from fuzzoff.sitl.ros2 import verdict as ros2_verdict
+
+    exchanges = Path(__file__).resolve().parent.parent / "corpora" / "against" / "exchanges"
+    bag = exchanges / "timesync_jump_mid_stream-1.18.0-beta1-head-mcap"
+    ulog = exchanges / "timesync_jump_mid_stream-1.18.0-beta1-head.ulg"
+    log = read_ulog(ulog, ros2_verdict.STATUS)
+    (_, first), (_, second) = log.syncs
+    assert abs(second - first) > 200_000
+    clock = measure(read_bag(bag), log)
+    assert clock.pairs >= 20 and clock.residual_us < 20_000
+    verdict = ros2_verdict.compare(bag, "1.18.0", ulog, {"COM_OF_LOSS_T": 0.2})
+    losses = [i for i in verdict.items if i.what == "loss time"]
+    assert len(losses) >= 3
+    assert all(i.agree for i in losses), [i.note for i in losses]
+    assert not [i for i in verdict.items if i.agree is False]
