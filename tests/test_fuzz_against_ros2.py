@@ -418,3 +418,43 @@ def test_a_time_sync_jump_mid_stream_does_not_move_the_models_times() -> None:
     assert len(losses) >= 3
     assert all(i.agree for i in losses), [i.note for i in losses]
     assert not [i for i in verdict.items if i.agree is False]
+
+
+MATRIX = os.environ.get("FUZZOFF_SITL_MATRIX") == "1"
+CAMPAIGN_RELEASES = ("1.16.2-ros2", "1.18.0-beta1-head")
+
+
+@pytest.mark.skipif(WHY_NOT is not None, reason=f"live ROS 2 campaign: {WHY_NOT}")
+@pytest.mark.skipif(not MATRIX, reason="the long campaigns run with make test-sitl")
+@pytest.mark.parametrize("release", CAMPAIGN_RELEASES)
+def test_a_campaign_over_the_bridge_judges_every_stream_it_sends(
+    release: str, tmp_path: Path
+) -> None:
+    """Two minutes of streams over DDS on each bridge bundle: every stream sent is judged
+    (none 'not run'), PX4 answered switches over the bridge, the campaign ran its course."""
+    if release not in bundle.releases():
+        pytest.skip(f"no bundle {release}")
+    out = run_cli_process(
+        [
+            "fuzz",
+            "--against",
+            f"sitl:{release}",
+            "--transport",
+            "ros2",
+            "--budget",
+            "120",
+            "--instance",
+            str(_instance()),
+            "--save-dir",
+            str(tmp_path / "reproducers"),
+            "--format",
+            "json",
+        ],
+        timeout=600,
+    )
+    assert out.returncode in (0, 1), out.stdout + out.stderr
+    data = json.loads(out.stdout)
+    assert data["stopped"] is None
+    assert data["streams_sent"] >= 3
+    assert data["verdicts"]["failed"] == 0
+    assert any(k.startswith("switch to OFFBOARD: ") for k in data["px4_outcomes"])
