@@ -458,3 +458,21 @@ def test_a_campaign_over_the_bridge_judges_every_stream_it_sends(
     assert data["streams_sent"] >= 3
     assert data["verdicts"]["failed"] == 0
     assert any(k.startswith("switch to OFFBOARD: ") for k in data["px4_outcomes"])
+
+
+def test_the_bridges_namespace_is_the_one_each_release_gives_an_instance(tmp_path: Path) -> None:
+    """1.18's rcS clears the namespace for PX4_UXRCE_DDS_NS=""; 1.16's and 1.17's take only a
+    namespace that is not empty, so instance 4 publishes under /px4_4 there."""
+    from fuzzoff.sitl.ros2.bench import bridge_namespace
+
+    def build(name: str, rcs: str) -> bundle.Build:
+        folder = tmp_path / name / "etc" / "init.d-posix"
+        folder.mkdir(parents=True)
+        (folder / "rcS").write_text(rcs)
+        return bundle.Build(tmp_path / name, name)
+
+    newer = build("1.18.0-beta1-head", 'if [ "${PX4_UXRCE_DDS_NS+x}" ]; then\n')
+    older = build("1.16.2-ros2", 'if [ -n "$PX4_UXRCE_DDS_NS" ]\n')
+    assert bridge_namespace(newer, 4) == ""
+    assert bridge_namespace(older, 4) == "/px4_4"
+    assert bridge_namespace(older, 0) == ""

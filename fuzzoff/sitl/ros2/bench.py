@@ -18,6 +18,7 @@ Everything here runs inside the private network namespace the campaign entered
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 from pathlib import Path
 
 from cyclonedds.domain import DomainParticipant
@@ -54,6 +55,17 @@ MATCH_TIMEOUT_S = 10.0
 """How long the stream's writers may take to match PX4's bridge readers after a boot."""
 
 
+def bridge_namespace(build: bundle.Build, instance: int) -> str:
+    """The ROS 2 namespace PX4's rcS gives the bridge: none for instance 0, or where
+    ``PX4_UXRCE_DDS_NS=""`` clears it (the 1.18 rcS); ``/px4_N`` for instance N on 1.16 and 1.17,
+    whose rcS only takes a namespace that is not empty."""
+    if instance == 0:
+        return ""
+    rcs = build.folder / "etc" / "init.d-posix" / "rcS"
+    text = rcs.read_text(errors="replace") if rcs.exists() else ""
+    return "" if "PX4_UXRCE_DDS_NS+x" in text else f"/px4_{instance}"
+
+
 class BridgeBench(Bench):
     def __init__(
         self,
@@ -63,17 +75,19 @@ class BridgeBench(Bench):
         env: dict[str, str] | None = None,
         lands: bool = True,
     ) -> None:
-        agent = {"PX4_AGENT": str(bundle.default_root() / "agent"), "PX4_UXRCE_DDS_NS": ""}
-        super().__init__(build, instance, log, {**(env or {}), **agent}, lands)
+        bridge = {"PX4_AGENT": str(bundle.default_root() / "agent"), "PX4_UXRCE_DDS_NS": ""}
+        super().__init__(build, instance, log, {**(env or {}), **bridge}, lands)
         release = build.profile_release
+        self.namespace = bridge_namespace(build, instance)
         self.streamed: dict[str, BridgeTopic] = {}
+        """The stream's topic as a bag names it (``/fmu/in/...``) -> PX4's, in its namespace."""
         for message in STREAMED:
             try:
-                topic = bridge_topic(release, message)
+                plain = bridge_topic(release, message)
             except NamesError:
                 continue  # not in this release (the rover setpoints before 1.17)
-            self.streamed[topic.ros_topic] = topic
-        self.received = [bridge_topic(release, m) for m in RECEIVED]
+            self.streamed[plain.ros_topic] = bridge_topic(release, message, self.namespace)
+        self.received = [bridge_topic(release, m, self.namespace) for m in RECEIVED]
         self.participant: DomainParticipant | None = None
         self.sender: DomainParticipant | None = None
         self.recorder: Recorder | None = None
@@ -144,6 +158,10 @@ class BridgeBench(Bench):
         unknown = sorted({m.topic for m in plan.messages} - set(self.streamed))
         if unknown:  # a harness bug: the writer named a topic the bridge does not carry
             raise LinkError(f"PX4 {self.build.release} has no bridge topic {', '.join(unknown)}")
+        plan = Plan(
+            plan.source,
+            tuple(replace(m, topic=self.streamed[m.topic].ros_topic) for m in plan.messages),
+        )
         link = self._link()
         driver = self._driver()
         before = set(session.px4.ulogs())
