@@ -202,3 +202,23 @@ def test_the_html_report_shows_what_was_sent_against_what_was_received(tmp_path:
     ) in section
     assert "<img src=x>" not in html
     assert "&lt;img src=x&gt;&amp;flight-mcap" in html
+
+
+def test_a_flight_without_the_bridges_time_sync_is_refused_in_one_line_saying_so() -> None:
+    """PX4 1.16.2 with UXRCE_DDS_SYNCT 0 (the corpus example's bag replayed over the bridge,
+    ``sitl replay --transport ros2 --param UXRCE_DDS_SYNCT=0``): PX4 logs no time sync and its
+    outputs carry its own boot time, so the bag's host times cannot be put on PX4's clock.
+    One line, exit 2, naming the parameter (not 'it was not on the bridge')."""
+    folder = CORPUS / "nosync"
+    bag, ulog = (
+        folder / "example_synct0-1.16.2-ros2-mcap",
+        folder / "example_synct0-1.16.2-ros2.ulg",
+    )
+    out = run_cli(["lint", str(bag), "--with", str(ulog), "--format", "json"])
+    assert out.returncode == 2
+    assert not out.stdout
+    assert out.stderr.strip().splitlines() == [
+        f"error: {ulog}: PX4 ran its ROS 2 bridge without time sync (UXRCE_DDS_SYNCT 0): the"
+        " bag's times, on the host's clock, cannot be put on PX4's; nothing compared (set"
+        " UXRCE_DDS_SYNCT 1 to compare a flight)"
+    ]
