@@ -113,24 +113,8 @@ def test_one_lint_writes_several_reports(tmp_path: Path) -> None:
     findings on standard output, from one lint, each the report a run of its own gives."""
     sarif, html, data = tmp_path / "out" / "f.sarif", tmp_path / "f.html", tmp_path / "f.json"
     both = run_cli(
-        [
-            "lint",
-            str(LOST),
-            "--format",
-            "sarif",
-            "-o",
-            str(sarif),
-            "--format",
-            "html",
-            "-o",
-            str(html),
-            "--format",
-            "json",
-            "-o",
-            str(data),
-            "--format",
-            "terminal",
-        ]
+        ["lint", str(LOST), "--format", "sarif", "-o", str(sarif), "--format", "html",
+         "-o", str(html), "--format", "json", "-o", str(data), "--format", "terminal"]
     )
     alone = run_cli(["lint", str(LOST), "--format", "json"])
     assert both.returncode == alone.returncode == 1

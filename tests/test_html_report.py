@@ -206,13 +206,10 @@ def test_loss_timeout_from_the_recording_when_the_engine_records_it() -> None:
 
 def test_each_vehicle_has_its_plot_and_its_own_markers() -> None:
     file = FileReport("fleet.mcap", "mcap", Profile(), stats={"duration_s": 10.0})
-    with_plots(
-        file,
-        {
-            "/px4_1": Timeline(keepalive=[0.1 * i for i in range(100)]),
-            "/px4_2": Timeline(keepalive=[0.1 * i for i in range(50)]),
-        },
-    )
+    with_plots(file, {
+        "/px4_1": Timeline(keepalive=[0.1 * i for i in range(100)]),
+        "/px4_2": Timeline(keepalive=[0.1 * i for i in range(50)]),
+    })
     file.findings = [
         Finding("OFB001", "x", Severity.ERROR, "one", time_s=2.0, vehicle="/px4_1"),
         Finding("OFB001", "x", Severity.ERROR, "two", time_s=6.0, vehicle="/px4_2"),

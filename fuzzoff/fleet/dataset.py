@@ -186,7 +186,9 @@ class Writer:
         recordings = pa.Table.from_pylist(
             [self._recording_row(o) for o in outcomes], schema=RECORDING_SCHEMA
         )
-        findings = pa.Table.from_pylist(list(self._finding_rows(outcomes)), schema=FINDING_SCHEMA)
+        findings = pa.Table.from_pylist(
+            list(self._finding_rows(outcomes)), schema=FINDING_SCHEMA
+        )
         self._write(RECORDINGS, recordings)
         if findings.num_rows:
             self._write(FINDINGS, findings)
