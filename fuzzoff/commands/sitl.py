@@ -210,9 +210,15 @@ def _ros2_recording(path: Path) -> tuple[Path, dict[str, float], bool]:
     """What a ROS 2 replay sends: a bag folder, an MCAP file, or a ROS 2 reproducer's
     recording with its setup (PX4 parameters, set at boot; whether it assumed manual
     control)."""
+    reproducer_file = path.name.endswith(".expected.json")
+    if not reproducer_file and not path.is_dir() and path.suffix.lower() != ".mcap":
+        raise ConfigError(
+            f"{path}: a ROS 2 replay takes a bag folder (metadata.yaml), an .mcap file or a"
+            " ROS 2 reproducer's .expected.json"
+        )
     if not path.exists():
         raise ConfigError(f"no such file: {path}")
-    if path.name.endswith(".expected.json"):
+    if reproducer_file:
         from fuzzoff.fuzz.reproducers import ReproducerError, load
 
         try:
@@ -227,11 +233,6 @@ def _ros2_recording(path: Path) -> tuple[Path, dict[str, float], bool]:
         setup = reproducer.setup
         params = dict(setup.params) if setup else {}
         return reproducer.recording, params, setup is not None and setup.manual_control
-    if not path.is_dir() and path.suffix.lower() != ".mcap":
-        raise ConfigError(
-            f"{path}: a ROS 2 replay takes a bag folder (metadata.yaml), an .mcap file or a"
-            " ROS 2 reproducer's .expected.json"
-        )
     return path, {}, False
 
 
