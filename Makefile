@@ -59,7 +59,7 @@ test-lowest:
 # about a minute a run, 1.15 adds 40 s of boot).
 # `make test` runs only the short live check.
 test-sitl: $(STAMP)
-	FUZZOFF_SITL_MATRIX=1 $(BIN)/python -m pytest -q -n 2 tests/test_sitl_live.py tests/test_sitl.py tests/test_ros2_live.py
+	FUZZOFF_SITL_MATRIX=1 $(BIN)/python -m pytest -q -n 2 tests/test_sitl_live.py tests/test_sitl.py tests/test_ros2_live.py tests/test_fuzz_against_ros2.py
 
 check: $(STAMP)
 	$(BIN)/ruff check fuzzoff tests bench corpora docs scripts

@@ -163,3 +163,62 @@ def test_a_log_started_after_the_bridge_connected_is_aligned_by_timesync_status(
     (finding,) = [f for f in file["findings"] if f["code"] == "OFB108"]
     assert 6.0 < finding["time_s"] < 7.0
     assert file["delivery"]["clock"]["source"] == "px4_outputs"
+
+
+def test_the_html_report_shows_what_was_sent_against_what_was_received(tmp_path: Path) -> None:
+    """The agent restart in ``--format html``: per topic sent, in PX4's log, never received
+    and latency; PX4's loss the companion saw 9.6 s late; every recording text escaped (a
+    bag folder named with markup)."""
+    import shutil
+
+    flight = "example_agent_restart-1.16.2-ros2"
+    bag = tmp_path / "<img src=x>&flight-mcap"
+    shutil.copytree(CORPUS / f"{flight}-mcap", bag)
+    page = tmp_path / "report.html"
+    args = ["lint", str(bag), "--with", str(CORPUS / f"{flight}.ulg")]
+    out = run_cli([*args, "--format", "html", "--output", str(page)])
+    assert out.returncode == 1, out.stderr
+    html = page.read_text()
+    section = html[html.index("<h3>Sent against received</h3>") :]
+    section = section[: section.index("</section>")]
+    assert f"With PX4's ULog {CORPUS / flight}.ulg: PX4's clock runs at 0.982 of the host's" in (
+        section
+    )
+    assert (
+        "PX4 flagged the offboard signal lost once; of those losses the companion never saw 0"
+        " and saw 1 only 1 s or more later. 0 of PX4's 6 status changes never reached it."
+    ) in section
+    assert (
+        '<tr class="undelivered"><td>/fmu/in/offboard_control_mode</td><td>to PX4</td>'
+        "<td>170</td><td>58</td><td>106</td><td>4.9 ms</td><td>71.6 ms</td><td></td></tr>"
+    ) in section
+    assert (
+        "<tr><td>/fmu/in/vehicle_command</td><td>to PX4</td><td>2</td><td>2</td><td>0</td>"
+        "<td>5.5 ms</td><td>5.5 ms</td><td></td></tr>"
+    ) in section
+    assert "none reached the companion 6.23-17.32 s" in section
+    assert (
+        "<tr><td>13.59 s</td><td>7.55 s</td><td>offboard signal lost</td><td>9.59 s later</td></tr>"
+    ) in section
+    assert "<img src=x>" not in html
+    assert "&lt;img src=x&gt;&amp;flight-mcap" in html
+
+
+def test_a_flight_without_the_bridges_time_sync_is_refused_in_one_line_saying_so() -> None:
+    """PX4 1.16.2 with UXRCE_DDS_SYNCT 0 (the corpus example's bag replayed over the bridge,
+    ``sitl replay --transport ros2 --param UXRCE_DDS_SYNCT=0``): PX4 logs no time sync and its
+    outputs carry its own boot time, so the bag's host times cannot be put on PX4's clock.
+    One line, exit 2, naming the parameter (not 'it was not on the bridge')."""
+    folder = CORPUS / "nosync"
+    bag, ulog = (
+        folder / "example_synct0-1.16.2-ros2-mcap",
+        folder / "example_synct0-1.16.2-ros2.ulg",
+    )
+    out = run_cli(["lint", str(bag), "--with", str(ulog), "--format", "json"])
+    assert out.returncode == 2
+    assert not out.stdout
+    assert out.stderr.strip().splitlines() == [
+        f"error: {ulog}: PX4 ran its ROS 2 bridge without time sync (UXRCE_DDS_SYNCT 0): the"
+        " bag's times, on the host's clock, cannot be put on PX4's; nothing compared (set"
+        " UXRCE_DDS_SYNCT 1 to compare a flight)"
+    ]

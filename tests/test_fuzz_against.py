@@ -78,7 +78,6 @@ PLAN = CommandPlan(arm=0.5, switch=1.0, leave=None, disarm=None)
         (["--against", "sitl:9.9"], "no such bundle"),
         (["--against", "sitl:1.15", "--from", "x.tlog"], "--from does not go with --against"),
         (["--against", "sitl:1.15", "--px4", "1.16"], "--px4 (the release is the one of"),
-        (["--against", "sitl:1.15", "--transport", "ros2"], "--against sends MAVLink"),
         (["--against", "sitl:1.15", "--vehicle", "rover"], "no SIH airframe flies it"),
         (["--against", "sitl:1.15", "--vehicle", "boat"], "no SIH airframe flies it"),
         (["--against", "sitl:1.15", "--format", "sarif"], "terminal or json"),

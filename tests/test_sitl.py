@@ -361,9 +361,13 @@ def test_sitl_run_over_ros2_names_an_unknown_program_or_a_mavlink_only_option() 
     out = run_cli(["sitl", "run", "clean_offboard", "--transport", "ros2", "--release", "1.16.2"])
     assert out.returncode == 2 and "no ROS 2 program 'clean_offboard'" in out.stderr
     out = run_cli(
-        ["sitl", "run", "example", "--transport", "ros2", "--release", "1.16.2", "--param", "A=1"]
+        ["sitl", "run", "example", "--transport", "ros2", "--release", "1.16.2", "--instance", "3"]
     )
     assert out.returncode == 2 and "MAVLink-only" in out.stderr
+    out = run_cli(
+        ["sitl", "run", "example", "--transport", "ros2", "--release", "1.16.2", "--param", "A=1"]
+    )
+    assert out.returncode == 2 and "--param goes with a ROS 2 replay" in out.stderr
     listed = run_cli(["sitl", "list"]).stdout
     assert "ROS 2 programs (--transport ros2):" in listed and "example_stops" in listed
 

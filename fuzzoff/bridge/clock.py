@@ -27,6 +27,8 @@ PAIR_TOLERANCE_US = 20_000
 OUTLIER_US = 10_000
 """A pair further than this from its neighbours' running median is left out (a late receipt)."""
 SMOOTH = 5
+IN_EFFECT_SLACK_US = 1_100_000
+"""PX4 logs ``timesync_status`` at 1 Hz: a new offset shows up to this late."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -65,8 +67,21 @@ class Clock:
         }
 
 
+def _in_effect(syncs: list[tuple[int, int]], index: int, px4_us: int) -> bool:
+    """Whether the ``index``-th time sync's offset was PX4's at ``px4_us``: from its own time
+    (less ``IN_EFFECT_SLACK_US``: a ``timesync_status`` sample shows a new offset up to a
+    second late) until the next sync's. The first one also covers the time before it."""
+    start = syncs[index][0] - IN_EFFECT_SLACK_US if index else -(2**62)
+    end = syncs[index + 1][0] if index + 1 < len(syncs) else 2**62
+    return start <= px4_us < end
+
+
 def pairs(bag: Bag, log: Px4Log) -> tuple[np.ndarray, np.ndarray]:
-    """(host receive times, PX4 publish times) of the bag's PX4 outputs found in the ULog."""
+    """(host receive times, PX4 publish times) of the bag's PX4 outputs found in the ULog.
+    Each output is read with the offset PX4 stamped it with: the time sync in effect when it
+    was published (PX4's client keeps one offset and jumps to a new one at a new sync, 0.2 s
+    at once on a simulated PX4 off the host's pace; another sync's offset would pair an output
+    with a sample it is not)."""
     hosts: list[int] = []
     px4: list[int] = []
     offsets = [offset for _, offset in log.syncs]
@@ -77,8 +92,10 @@ def pairs(bag: Bag, log: Px4Log) -> tuple[np.ndarray, np.ndarray]:
         times = logged.timestamps
         for sample in topic.samples:
             best: int | None = None
-            for offset in offsets:
+            for index, offset in enumerate(offsets):
                 meant = sample.stamp_us - offset
+                if not _in_effect(log.syncs, index, meant):
+                    continue
                 i = int(np.searchsorted(times, meant))
                 for j in (i - 1, i):
                     if not 0 <= j < len(times):

@@ -278,6 +278,12 @@ def _heard_topic(
 
 def compare(bag: Bag, log: Px4Log) -> Delivery:
     """BridgeError when the two are not one flight."""
+    if not log.syncs and log.synct == 0:
+        raise BridgeError(
+            f"{log.path}: PX4 ran its ROS 2 bridge without time sync (UXRCE_DDS_SYNCT 0): the"
+            " bag's times, on the host's clock, cannot be put on PX4's; nothing compared (set"
+            " UXRCE_DDS_SYNCT 1 to compare a flight)"
+        )
     if not log.syncs:
         raise BridgeError(
             f"{log.path}: PX4 logged no time sync with a Micro XRCE-DDS agent: it was not on the"

@@ -44,6 +44,8 @@ class Px4Log:
     syncs: list[tuple[int, int]]
     """(PX4 time, offset µs) of each time sync with an agent, in order."""
     topics: dict[str, ULogTopic]
+    synct: int | None = None
+    """PX4's ``UXRCE_DDS_SYNCT`` (0: the bridge ran without time sync), None when unlogged."""
 
 
 def read_ulog(path: Path, names: set[str]) -> Px4Log:
@@ -71,7 +73,15 @@ def read_ulog(path: Path, names: set[str]) -> Px4Log:
         topics[dataset.name] = ULogTopic(
             dataset.name, sorted_data["timestamp"].astype(np.int64), sorted_data
         )
-    return Px4Log(str(path), int(log.start_timestamp), int(log.last_timestamp), syncs, topics)
+    synct = log.initial_parameters.get("UXRCE_DDS_SYNCT")
+    return Px4Log(
+        str(path),
+        int(log.start_timestamp),
+        int(log.last_timestamp),
+        syncs,
+        topics,
+        None if synct is None else int(synct),
+    )
 
 
 def _from_status(datasets: list[Any]) -> list[tuple[int, int]]:

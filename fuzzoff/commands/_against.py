@@ -1,5 +1,8 @@
 """``fuzzoff fuzz --against sitl:RELEASE``: the options and the run (``fuzzoff.sitl.against``).
 
+``--transport ros2`` sends the streams over PX4's ROS 2 bridge (a bundle built with it): the
+campaign moves into a private network namespace first (root), then runs as over MAVLink.
+
 Exit status: 0 PX4 and the gate model agreed on every stream judged, 1 a disagreement was
 found (saved as a reproducer), 2 a usage error, no PX4 build, a PX4 that could not be run, a
 budget that sent no stream, or a reproducer that could not be saved.
@@ -24,8 +27,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     live.add_argument(
         "--against",
         metavar="sitl:RELEASE",
-        help="send generated MAVLink streams to a PX4 SITL this campaign starts, and compare "
-        "what PX4 does with the gate model (default budget 300 s)",
+        help="send generated streams (MAVLink, or ROS 2 over PX4's bridge with --transport ros2)"
+        " to a PX4 SITL this campaign starts, and compare what PX4 does with the gate model"
+        " (default budget 300 s)",
     )
     live.add_argument(
         "--px4-build", metavar="DIR", type=Path, help="with --against: your own PX4 SITL build"
@@ -73,8 +77,10 @@ def _checked(args: argparse.Namespace) -> str:
     for name, option in NOT_WITH_AGAINST.items():
         if getattr(args, name, None):
             raise ConfigError(f"{option} does not go with --against")
-    if args.transport not in (None, "mavlink"):
-        raise ConfigError(f"--transport {args.transport}: --against sends MAVLink")
+    if args.transport not in (None, "mavlink", "ros2"):
+        raise ConfigError(
+            f"--transport {args.transport}: --against sends MAVLink, or ROS 2 over PX4's bridge"
+        )
     if args.format not in ("terminal", "json"):
         raise ConfigError(f"--format {args.format}: --against reports as terminal or json")
     if args.examples is not None and args.examples < 1:
@@ -95,13 +101,22 @@ def run(args: argparse.Namespace) -> int:
     from fuzzoff.commands._common import check_save_dir, settings_from_args, write_output
     from fuzzoff.fuzz.reproducers import DEFAULT_DIR
     from fuzzoff.sitl import airframes, bundle
-    from fuzzoff.sitl.against import DEFAULT_BUDGET_S, SHRINK_RUNS, AgainstConfig, run_against
+    from fuzzoff.sitl.against import (
+        DEFAULT_BUDGET_S,
+        SHRINK_RUNS,
+        AgainstConfig,
+        Transport,
+        run_against,
+    )
     from fuzzoff.sitl.against_report import to_json, to_terminal
 
     vehicle = _checked(args)
     release = _release(args.against, args.px4_build)
+    transport: Transport = "ros2" if args.transport == "ros2" else "mavlink"
     try:
         build = bundle.find_build(release, args.px4_build)
+        if transport == "ros2":
+            _check_bridge(args.against, build)
         airframes.boot_env(build, vehicle)  # refused here when the build cannot fly it
     except airframes.AirframeError as exc:
         raise ConfigError(str(exc)) from None
@@ -123,12 +138,15 @@ def run(args: argparse.Namespace) -> int:
         shrink_runs=SHRINK_RUNS if args.shrink_runs is None else args.shrink_runs,
         settings=settings_from_args(argparse.Namespace(ignore=args.ignore)),
         save_dir=save_dir,
+        transport=transport,
     )
 
     def log(line: str) -> None:
         if not args.quiet:
             print(f"fuzzoff: {printable(line, 400)}", file=sys.stderr, flush=True)
 
+    if transport == "ros2":
+        _enter_namespace()
     try:
         result = run_against(config, log)
     except OSError as exc:  # a reproducer that could not be written
@@ -138,6 +156,34 @@ def run(args: argparse.Namespace) -> int:
     text = to_json(result) if args.format == "json" else to_terminal(result)
     write_output(text, args.output)
     return _status(result)
+
+
+def _check_bridge(against: str, build: Any) -> None:
+    """A ROS 2 campaign needs a build with the bridge, cyclonedds and a private network."""
+    from fuzzoff.sitl import bundle
+    from fuzzoff.sitl.ros2.run import missing
+
+    if not bundle.has_bridge(build):
+        root = build.folder.parent
+        bridged = [r for r in bundle.releases(root) if bundle.has_bridge(bundle.Build(root / r, r))]
+        have = f"; bundles with it: {', '.join(bridged)}" if bridged else ""
+        raise ConfigError(
+            f"--against {against} --transport ros2: PX4 {build.release} is built without the"
+            f" ROS 2 bridge (uxrce_dds_client){have}"
+        )
+    why = missing()
+    if why is not None:
+        raise ConfigError(f"--against {against} --transport ros2: {why}")
+
+
+def _enter_namespace() -> None:
+    """This process moves into a private network namespace (DDS must stay on this machine)."""
+    from fuzzoff.sitl.ros2 import netns
+
+    try:
+        netns.enter()
+    except netns.NamespaceError as exc:
+        raise ConfigError(f"--transport ros2: a private network namespace: {exc}") from None
 
 
 def _status(result: Any) -> int:

@@ -209,10 +209,16 @@ def _against_text(against: dict[str, Any], path: str) -> str:
             f"    {printable(str(d.get('what')))}: PX4 {printable(str(d.get('px4')))};"
             f" model {printable(str(d.get('model')), 200)}"
         )
-    lines.append(
-        f"  send it to a running PX4 again: fuzzoff replay {printable(path)} --to"
-        " udp:127.0.0.1:14580"
-    )
+    if against.get("transport") == "ros2":
+        lines.append(
+            f"  send it to PX4 over DDS again: fuzzoff sitl replay {printable(path)}"
+            f" --transport ros2 --release {printable(str(against.get('px4')))}"
+        )
+    else:
+        lines.append(
+            f"  send it to a running PX4 again: fuzzoff replay {printable(path)} --to"
+            " udp:127.0.0.1:14580"
+        )
     return "\n".join(lines) + "\n"
 
 

@@ -154,12 +154,18 @@ def _run_ros2(args: argparse.Namespace) -> int:
         raise ConfigError(
             f"no ROS 2 program {args.scenario!r}; have {', '.join(PROGRAMS)} ('fuzzoff sitl list')"
         )
-    if args.param or args.speed_factor is not None or args.instance:
-        raise ConfigError("--param, --speed-factor and --instance are MAVLink-only for now")
+    if args.speed_factor is not None or args.instance:
+        raise ConfigError("--speed-factor and --instance are MAVLink-only for now")
+    if args.param and args.action == "run":
+        raise ConfigError("--param goes with a ROS 2 replay (set at PX4's boot), not a program")
     if getattr(args, "speed", 1.0) != 1.0:
         raise ConfigError("--speed is MAVLink-only for now: a ROS 2 replay keeps the bag's times")
-    if args.action == "replay" and not Path(args.path).is_dir():
-        raise ConfigError(f"{args.path}: a ROS 2 replay takes a bag folder (metadata.yaml)")
+    params: dict[str, float] = {}
+    manual = False
+    path = Path(args.path) if args.action == "replay" else Path()
+    if args.action == "replay":
+        path, params, manual = _ros2_recording(Path(args.path))
+        params = {**params, **parse_params(args.param)}
     if getattr(args, "vehicle", None):
         from fuzzoff.sitl.airframes import AirframeError, airframe_for
 
@@ -180,7 +186,12 @@ def _run_ros2(args: argparse.Namespace) -> int:
         if args.action == "run":
             outcome = ros2_run.fly(args.scenario, build, save_dir, log, args.vehicle)
         else:
-            outcome = ros2_run.replay_bag(Path(args.path), build, save_dir, log)
+            if manual:
+                log(
+                    "the reproducer assumed a manual control (RC or joystick); a ROS 2 replay"
+                    " sends none, so PX4's loss failsafe may differ from the campaign's"
+                )
+            outcome = ros2_run.replay_bag(path, build, save_dir, log, params)
     except ros2_run.FlightError as exc:
         print(f"error: {printable(str(exc))}", file=sys.stderr)
         return 2
@@ -193,6 +204,36 @@ def _run_ros2(args: argparse.Namespace) -> int:
     else:
         write_output(ros2_run.render(outcome), args.output)
     return 0
+
+
+def _ros2_recording(path: Path) -> tuple[Path, dict[str, float], bool]:
+    """What a ROS 2 replay sends: a bag folder, an MCAP file, or a ROS 2 reproducer's
+    recording with its setup (PX4 parameters, set at boot; whether it assumed manual
+    control)."""
+    reproducer_file = path.name.endswith(".expected.json")
+    if not reproducer_file and not path.is_dir() and path.suffix.lower() != ".mcap":
+        raise ConfigError(
+            f"{path}: a ROS 2 replay takes a bag folder (metadata.yaml), an .mcap file or a"
+            " ROS 2 reproducer's .expected.json"
+        )
+    if not path.exists():
+        raise ConfigError(f"no such file: {path}")
+    if reproducer_file:
+        from fuzzoff.fuzz.reproducers import ReproducerError, load
+
+        try:
+            reproducer = load(path)
+        except ReproducerError as exc:
+            raise ConfigError(str(exc)) from None
+        if reproducer.scenario is not None and reproducer.scenario.transport != "ros2":
+            raise ConfigError(
+                f"{path}: a {reproducer.scenario.transport} reproducer: replay it without"
+                " --transport ros2"
+            )
+        setup = reproducer.setup
+        params = dict(setup.params) if setup else {}
+        return reproducer.recording, params, setup is not None and setup.manual_control
+    return path, {}, False
 
 
 def _recording(path: Path, params: dict[str, float]) -> tuple[Path, dict[str, float], bool]:

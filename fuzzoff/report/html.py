@@ -20,6 +20,7 @@ from pathlib import Path
 from markdown_it import MarkdownIt
 
 from fuzzoff import __version__
+from fuzzoff.bridge.changes import LATE_S
 from fuzzoff.catalog import Rule, get_rule, render_page
 from fuzzoff.config import Settings
 from fuzzoff.findings import FileReport, Finding, Report, Severity
@@ -206,6 +207,88 @@ def _suppressed_table(file: FileReport) -> str:
     )
 
 
+DELIVERY_COLUMNS = (
+    "topic",
+    "direction",
+    "in the bag",
+    "in PX4's log",
+    "never received",
+    "latency median",
+    "latency max",
+    "note",
+)
+
+
+def _times(n: int) -> str:
+    return "once" if n == 1 else f"{n} times"
+
+
+def _ms(value: float | None) -> str:
+    return "" if value is None else f"{value:.1f} ms"
+
+
+def _delivery_section(file: FileReport) -> str:
+    """``lint BAG --with ULOG``: per topic what was sent and what arrived (both ways), and
+    PX4's status changes the companion saw late or never (``fuzzoff.bridge``)."""
+    delivery = file.delivery
+    if delivery is None:
+        return ""
+    clock = delivery.clock
+    source = (
+        f"{clock.pairs} of PX4's outputs, within {clock.residual_us / 1000:.1f} ms"
+        if clock.pairs
+        else "the bridge's time sync offset alone (the bag holds no PX4 output)"
+    )
+    rows = []
+    for topic in delivery.topics:
+        to_px4 = topic.direction == "in"
+        median, worst = (None, None) if topic.latency_ms is None else topic.latency_ms[:2]
+        never = topic.undelivered if to_px4 else len(topic.windows)
+        cls = ' class="undelivered"' if never else ""
+        notes = (
+            []
+            if to_px4
+            else [
+                f"none reached the companion {w.start_s:.2f}-{w.end_s:.2f} s" for w in topic.windows
+            ]
+        )
+        notes += [topic.note] if topic.note else []
+        rows.append(
+            f"<tr{cls}><td>{e(topic.topic)}</td>"
+            f"<td>{'to PX4' if to_px4 else 'from PX4'}</td>"
+            f"<td>{topic.recorded}</td><td>{topic.logged}</td>"
+            f"<td>{never if to_px4 else ''}</td>"
+            f"<td>{_ms(median)}</td><td>{_ms(worst)}</td><td>{e('; '.join(notes))}</td></tr>"
+        )
+    head = "".join(f"<th>{name}</th>" for name in DELIVERY_COLUMNS)
+    unseen = [c for c in delivery.changes if c.seen_after_s is None]
+    losses = [c for c in delivery.changes if c.lost_signal]
+    missed = [c for c in losses if c.seen_after_s is None]
+    late = [c for c in losses if c.seen_after_s is not None and c.seen_after_s >= LATE_S]
+    changes = []
+    for change in delivery.changes:
+        seen = "never" if change.seen_after_s is None else f"{change.seen_after_s:.2f} s later"
+        cls = ' class="undelivered"' if change.seen_after_s is None else ""
+        changes.append(
+            f"<tr{cls}><td>{change.px4_s:.2f} s</td><td>{change.time_s:.2f} s</td>"
+            f"<td>{e(change.what)}</td><td>{e(seen)}</td></tr>"
+        )
+    note = f"<p>PX4's status: {e(delivery.changes_note)}</p>" if delivery.changes_note else ""
+    return (
+        "<h3>Sent against received</h3>"
+        f"<p>With PX4's ULog {e(delivery.ulog)}: PX4's clock runs at {clock.rate:.3f} of the"
+        f" host's, measured by {e(source)}. PX4 flagged the offboard signal lost"
+        f" {_times(len(losses))}; of those losses the companion never saw {len(missed)} and saw"
+        f" {len(late)} only {LATE_S:g} s or more later. {len(unseen)} of PX4's"
+        f" {len(delivery.changes)} status changes never reached it.</p>"
+        f'<table class="findings delivery"><thead><tr>{head}</tr></thead>'
+        f"<tbody>{''.join(rows)}</tbody></table>"
+        '<table class="findings delivery-changes"><thead><tr><th>PX4 time</th>'
+        "<th>bag time</th><th>PX4's status</th><th>the companion saw it</th></tr></thead>"
+        f"<tbody>{''.join(changes)}</tbody></table>{note}"
+    )
+
+
 def _file_section(index: int, file: FileReport) -> str:
     timelines = file.timelines
     markers = [Marker(f"{index}-{i}", f) for i, f in enumerate(file.findings)]
@@ -214,7 +297,8 @@ def _file_section(index: int, file: FileReport) -> str:
         f'<section class="file" id="file-{index}"><h2>{e(file.path)}</h2>'
         f"{_summary(file, timelines)}<h3>Timeline</h3>"
         f"{_plots(index, file, markers, timelines)}"
-        f"<h3>Findings</h3>{_findings_table(markers, timed)}{_suppressed_table(file)}</section>"
+        f"<h3>Findings</h3>{_findings_table(markers, timed)}{_suppressed_table(file)}"
+        f"{_delivery_section(file)}</section>"
     )
 
 

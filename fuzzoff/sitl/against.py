@@ -17,6 +17,16 @@ back), then shrunk by sending simpler variants (``variants``, a few runs at most
 a reproducer in the campaign's format with an ``against`` block: what PX4 did, what the model
 predicted, the exchange's tlog and ULog beside it. ``fuzzoff replay NAME.expected.json --to
 udp:127.0.0.1:14580`` sends it to a running PX4 again.
+
+``transport="ros2"`` (a bundle with the ROS 2 bridge): the campaign moves into a private network
+namespace (``ros2.netns.enter``), the streams are drawn as a ROS 2 companion publishes them
+(``OffboardControlMode``, the setpoint topics, ``VehicleCommand``), sent over DDS through the
+Micro XRCE-DDS Agent (``ros2.bench.BridgeBench``), recorded as a bag (``ros2.recorder``), and
+judged as ``sitl run --transport ros2`` judges a flight (``ros2.verdict.compare``: the bag's
+times put on PX4's clock as ``lint --with`` puts them). A reproducer is the MCAP stream as any
+ROS 2 reproducer, with the exchange's bag folder (``NAME.px4-mcap``) beside it; ``fuzzoff sitl
+replay NAME.expected.json --transport ros2`` sends its stream over DDS to a fresh PX4 again, with
+the setup's parameters set at boot.
 """
 
 from __future__ import annotations
@@ -41,7 +51,7 @@ from fuzzoff.profiles import px4_profile_for
 from fuzzoff.recording import SourceError
 from fuzzoff.releases import PX4Profile
 from fuzzoff.sitl import airframes, bundle, delivery
-from fuzzoff.sitl.bench import Bench
+from fuzzoff.sitl.bench import Bench, LiveRun
 from fuzzoff.sitl.classify import edge_note, health_refusals, own_changes, shape, signature
 from fuzzoff.sitl.driver import NAV_LOITER
 from fuzzoff.sitl.link import COMPANION_SYSID, LinkError
@@ -49,6 +59,8 @@ from fuzzoff.sitl.run import load_plan
 from fuzzoff.sitl.truth import read_truth
 from fuzzoff.sitl.variants import variants
 from fuzzoff.sitl.verdict import Item, Verdict, compare
+
+Transport = Literal["mavlink", "ros2"]
 
 Status = Literal["agree", "differ", "outside", "noise", "failed"]
 Log = Callable[[str], None]
@@ -61,6 +73,8 @@ OWN_CHANGE_SLACK_S = 0.1
 dates a loss by PX4's flag, the ULog's vehicle_status follows)."""
 CONFIRM_TRIES = 2
 """Sends to confirm a disagreement when a try cannot tell (noise, or not run)."""
+START_LEAD_S = 0.0001
+"""The starting status comes this long before the stream's first message."""
 REPRODUCER_PREFIX = "px4"
 """Reproducer names start ``px4-``: a live disagreement, not a property of the model."""
 
@@ -78,6 +92,8 @@ class AgainstConfig:
     settings: Settings = field(default_factory=Settings)
     save_dir: Path | None = None
     """None: no reproducer saved (``--no-save``)."""
+    transport: Transport = "mavlink"
+    """``ros2``: the streams go over PX4's ROS 2 bridge (DDS), in a private network namespace."""
 
     @property
     def profile(self) -> PX4Profile:
@@ -180,8 +196,18 @@ def with_start(scenario: Scenario) -> Scenario:
     puts PX4 (the model's own start: disarmed, not in OFFBOARD). In the tlog it is PX4's
     HEARTBEAT before the stream, from which ``replay --to`` brings PX4 there first."""
     first = scenario.events[0].t if scenario.events else 0.0
+    vehicle = "1" if scenario.transport == "mavlink" else ""  # a ROS 2 namespace: none
+    if vehicle == "" and first < START_LEAD_S:
+        # a bag's log times cannot go below its start: the stream moves, its stamps do not
+        shift = START_LEAD_S - first
+        moved = tuple(replace(e, t=round(e.t + shift, 6)) for e in scenario.events)
+        scenario, first = replace(scenario, events=moved), START_LEAD_S
     start = ev.VehicleStatus(
-        t=first - 0.0001, vehicle="1", nav_state=NAV_LOITER, mode="AUTO_LOITER", armed=False
+        t=first - START_LEAD_S,
+        vehicle=vehicle,
+        nav_state=NAV_LOITER,
+        mode="AUTO_LOITER",
+        armed=False,
     )
     return replace(scenario, events=(start, *scenario.events))
 
@@ -211,7 +237,13 @@ class Campaign:
         quad = config.vehicle == airframes.DEFAULT  # PX4's own default: nothing to check
         env = {} if quad else airframes.boot_env(config.build, config.vehicle)
         fixes = airframes.airframe_for(config.vehicle).fixes
-        self.bench = Bench(config.build, config.instance, log, env, config.judged_as != "fw", fixes)
+        bench: type[Bench] = Bench
+        if config.transport == "ros2":
+            from fuzzoff.sitl.ros2.bench import BridgeBench
+
+            bench = BridgeBench
+        lands = config.judged_as != "fw"
+        self.bench = bench(config.build, config.instance, log, env, lands, fixes)
         self.known: dict[tuple[str, str, str], Disagreement] = {}
         """Disagreements followed up, by signature (a confirmed one is not followed again)."""
         self.work = Path(tempfile.gettempdir())
@@ -240,6 +272,8 @@ class Campaign:
             self.result.stopped = str(exc)
         finally:
             self.bench.close()
+            if self.config.transport == "ros2":
+                self.bench.shutdown()  # type: ignore[attr-defined]  # BridgeBench's DDS side
             self.result.boots = list(self.bench.boots)
             self.result.seconds = self.elapsed()
             shutil.rmtree(self.work, ignore_errors=True)
@@ -263,10 +297,14 @@ class Campaign:
             shapes.add(shape(scenario))
             if self.spent():
                 raise _Stop
-            self.searched(self.send(scenario, "search"))
+            try:
+                self.searched(self.send(scenario, "search"))
+            except (LinkError, bundle.BundleError) as exc:  # PX4 cannot be run any more
+                self.result.stopped = str(exc)
+                raise _Stop from None
 
         strategy: st.SearchStrategy[Scenario] = scenarios(
-            self.config.profile, self.config.judged_as, "mavlink"
+            self.config.profile, self.config.judged_as, self.config.transport
         )
         test = given(strategy)(one)
         test = settings(
@@ -305,16 +343,45 @@ class Campaign:
             self.log(_line(example))
         return example
 
-    def _send(self, example: Example, stem: Path) -> None:
+    def _exchange(self, example: Example, stem: Path) -> LiveRun:
+        """Send the stream as its transport goes (PX4 prepared first): the run."""
         live = with_start(example.scenario)
+        setup = setup_for(example.scenario)
+        if self.config.transport == "ros2":
+            from fuzzoff.sitl.ros2.bench import BridgeBench
+            from fuzzoff.sitl.ros2.replay import ReplayError, plan_from_bag
+
+            assert isinstance(self.bench, BridgeBench)
+            stream = recordings.write(live, stem.with_suffix(".stream-bag"), "rosbag2")
+            try:
+                bag_plan = plan_from_bag(stream, self.config.build.profile_release)
+            except ReplayError:
+                raise LinkError("nothing to send: the stream has no /fmu/in message") from None
+            example.notes += self.bench.prepare(setup.params, setup.manual_control)
+            return self.bench.send_bag(
+                bag_plan, setup.params, stem.with_suffix(".px4-mcap"), stem.with_suffix(".px4.ulg")
+            )
         recordings.write(live, stem.with_suffix(".stream.tlog"), "tlog")
         plan = load_plan(stem.with_suffix(".stream.tlog"))
+        example.notes += self.bench.prepare(setup.params, setup.manual_control)
+        return self.bench.send(
+            plan, setup.params, stem.with_suffix(".px4.tlog"), stem.with_suffix(".px4.ulg")
+        )
+
+    def _judge(self, run: LiveRun, params: dict[str, float]) -> Verdict:
+        release = self.config.build.profile_release
+        if self.config.transport == "ros2":
+            from fuzzoff.sitl.ros2 import verdict as ros2_verdict
+
+            if run.ulog is None:
+                raise SourceError(run.tlog, "PX4 wrote no ULog for this stream")
+            return ros2_verdict.compare(run.tlog, release, run.ulog, params, self.config.judged_as)
+        return compare(run.tlog, release, run.ulog, params, COMPANION_SYSID, self.config.judged_as)
+
+    def _send(self, example: Example, stem: Path) -> None:
         setup = setup_for(example.scenario)
         try:
-            example.notes += self.bench.prepare(setup.params, setup.manual_control)
-            run = self.bench.send(
-                plan, setup.params, stem.with_suffix(".px4.tlog"), stem.with_suffix(".px4.ulg")
-            )
+            run = self._exchange(example, stem)
         except LinkError as exc:
             example.reason = str(exc)
             if self.bench.session is None:
@@ -324,11 +391,8 @@ class Campaign:
         example.tlog, example.ulog = run.tlog, run.ulog
         example.first_sent_px4 = run.sent[0] if run.sent else None
         example.delivery = delivery.check(run.meant, run.sent)
-        release = self.config.build.profile_release
         try:
-            verdict = compare(
-                run.tlog, release, run.ulog, setup.params, COMPANION_SYSID, self.config.judged_as
-            )
+            verdict = self._judge(run, setup.params)
             truth = None if run.ulog is None else read_truth(run.ulog)
         except SourceError as exc:  # PX4 killed while writing its log, say
             example.reason = f"the run's recordings cannot be judged: {exc.line()}"
@@ -360,8 +424,13 @@ class Campaign:
 
     def stream_time(self, example: Example, item: Item) -> float:
         """PX4's time of ``item`` as a time of the stream (its first companion message)."""
+        ros2 = self.config.transport == "ros2"
         first = next(
-            (e.t for e in example.scenario.events if isinstance(e, ev.Command | ev.MavlinkTarget)),
+            (
+                e.t
+                for e in example.scenario.events
+                if (e.origin == "sent" if ros2 else isinstance(e, ev.Command | ev.MavlinkTarget))
+            ),
             0.0,
         )
         return first + item.t - (example.first_sent_px4 or item.t)
@@ -418,11 +487,18 @@ class Campaign:
         if not case.confirmed and case.second is not None:
             runs.append((case.second, ".second.px4"))
         evidence = {}
+        exchange = "-mcap" if self.config.transport == "ros2" else ".tlog"
         for run, infix in runs:
-            for source, suffix in ((run.tlog, ".tlog"), (run.ulog, ".ulg")):
-                if source is not None and source.exists():
-                    shutil.copyfile(source, directory / f"{name}{infix}{suffix}")
-                    evidence[infix + suffix] = f"{name}{infix}{suffix}"
+            for source, suffix in ((run.tlog, exchange), (run.ulog, ".ulg")):
+                if source is None or not source.exists():
+                    continue
+                target = directory / f"{name}{infix}{suffix}"
+                if source.is_dir():  # a bag folder
+                    shutil.rmtree(target, ignore_errors=True)
+                    shutil.copytree(source, target)
+                else:
+                    shutil.copyfile(source, target)
+                evidence[infix + suffix] = f"{name}{infix}{suffix}"
         spec = json.loads(path.read_text())
         spec["property"] = None  # nothing the model alone can check again: PX4 must answer
         spec["against"] = against_block(self.config, case, evidence)
@@ -436,14 +512,23 @@ def against_block(
     """The ``against`` object of a live disagreement's reproducer."""
     kept = case.kept
     port = 14580 + config.instance
+    bag = config.transport == "ros2"
+    exchange = "-mcap" if bag else ".tlog"
+    replay = (
+        f"fuzzoff sitl replay NAME.expected.json --transport ros2 --release {config.build.release}"
+        if bag
+        else f"fuzzoff replay NAME.expected.json --to udp:127.0.0.1:{port}"
+    )
+    key = "exchange_bag" if bag else "exchange_tlog"
     return {
         "px4": config.build.release,
+        "transport": config.transport,
         "differ": [i.to_json() for i in kept.differing],
         "confirmed": case.confirmed,
         "shrunk_by": case.shrunk_by,
         "edge": kept.edge,
         "delivery": None if kept.delivery is None else kept.delivery.to_json(),
-        "exchange_tlog": evidence.get(".px4.tlog"),
+        key: evidence.get(".px4" + exchange),
         "px4_ulog": evidence.get(".px4.ulg"),
         "second_run": None
         if case.second is None or case.confirmed
@@ -451,10 +536,10 @@ def against_block(
             "status": case.second.status,
             "reason": case.second.reason or None,
             "differ": [i.to_json() for i in case.second.differing],
-            "exchange_tlog": evidence.get(".second.px4.tlog"),
+            key: evidence.get(".second.px4" + exchange),
             "px4_ulog": evidence.get(".second.px4.ulg"),
         },
-        "replay": f"fuzzoff replay NAME.expected.json --to udp:127.0.0.1:{port}",
+        "replay": replay,
     }
 
 

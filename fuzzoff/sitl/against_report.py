@@ -7,7 +7,13 @@ from collections import Counter
 from typing import Any
 
 from fuzzoff.report.sanitize import printable
-from fuzzoff.sitl.against import AgainstResult, Disagreement, Example, describe_item
+from fuzzoff.sitl.against import (
+    AgainstConfig,
+    AgainstResult,
+    Disagreement,
+    Example,
+    describe_item,
+)
 
 STATUS_TEXT = {
     "agree": "agree",
@@ -27,8 +33,8 @@ def to_terminal(result: AgainstResult) -> str:
     search = result.search
     follow = len(result.examples) - len(search)
     lines = [
-        f"fuzzoff fuzz --against sitl:{config.build.release} --vehicle {config.vehicle},"
-        f" seed {config.seed}"
+        f"fuzzoff fuzz --against sitl:{config.build.release} --vehicle {config.vehicle}"
+        f" --transport {config.transport}, seed {config.seed}"
     ]
     boots = ", ".join(f"{b:.0f} s" for b in result.boots) or "-"
     lines.append(
@@ -53,7 +59,7 @@ def to_terminal(result: AgainstResult) -> str:
         for key, n in sorted(outcomes.items()):
             lines.append(f"    {printable(key):<{width}}  {n}")
     for number, case in enumerate(result.disagreements, 1):
-        lines += _disagreement(number, case, config.instance)
+        lines += _disagreement(number, case, config)
     for e in (e for e in search if e.status in ("outside", "noise")):
         lines.append(f"  {e.status}: stream {e.index}: {printable(e.reason)}")
     for e in (e for e in result.examples if e.status == "failed"):
@@ -74,7 +80,7 @@ def to_terminal(result: AgainstResult) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _disagreement(number: int, case: Disagreement, instance: int) -> list[str]:
+def _disagreement(number: int, case: Disagreement, config: AgainstConfig) -> list[str]:
     state = {True: "confirmed", False: "seen once (the second run agreed)", None: "unconfirmed"}
     head = f"  disagreement {number} (stream {case.found.index}, {state[case.confirmed]}"
     if case.shrunk_by:
@@ -96,11 +102,14 @@ def _disagreement(number: int, case: Disagreement, instance: int) -> list[str]:
             f"    second run (stream {second.index}, {second.status}): {printable(again, 300)}"
         )
     if case.reproducer is not None:
-        lines.append(f"    reproducer {printable(str(case.reproducer))}")
-        lines.append(
-            f"    again:     fuzzoff replay {printable(str(case.reproducer))}"
-            f" --to udp:127.0.0.1:{14580 + instance}"
-        )
+        path = printable(str(case.reproducer))
+        lines.append(f"    reproducer {path}")
+        if config.transport == "ros2":  # its stream over DDS to a fresh PX4
+            release = config.build.release
+            again = f"fuzzoff sitl replay {path} --transport ros2 --release {release}"
+        else:
+            again = f"fuzzoff replay {path} --to udp:127.0.0.1:{14580 + config.instance}"
+        lines.append(f"    again:     {again}")
     return lines
 
 
@@ -144,6 +153,7 @@ def to_json(result: AgainstResult) -> str:
     data = {
         "campaign": {
             "against": f"sitl:{config.build.release}",
+            "transport": config.transport,
             "px4_build": str(config.build.folder),
             "instance": config.instance,
             "vehicle": config.vehicle,

@@ -167,6 +167,10 @@ class Publisher:
         """A sample of this topic's type as it is (a replayed message)."""
         self._writer.write(sample)
 
+    def matched(self) -> int:
+        """How many readers this writer has matched (DDS discovery)."""
+        return len(self._writer.get_matched_subscriptions())
+
 
 Received = Callable[[BridgeTopic, bytes, int], None]
 """(topic, the sample's bytes, receive time in ns since the epoch)"""

@@ -19,6 +19,7 @@ import argparse
 import json
 import subprocess
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -87,8 +88,10 @@ class BridgeFlight:
         program: Program | None,
         log: Log = print,
         vehicle: str | None = None,
+        params: dict[str, float] | None = None,
     ) -> None:
-        """``vehicle``: the SIH airframe (``airframes``; None: the program's, else the quad)."""
+        """``vehicle``: the SIH airframe (``airframes``; None: the program's, else the quad);
+        ``params``: PX4 parameters set at boot (``PX4_PARAM_<NAME>``)."""
         if "/" in release:  # a build folder (--px4-build)
             self.build = bundle.find_build(None, Path(release))
         else:
@@ -107,6 +110,7 @@ class BridgeFlight:
         self.received = [bridge_topic(release_name, m) for m in received]
         self.sent = [bridge_topic(release_name, m) for m in sent]
         env = {"PX4_AGENT": str(bundle.default_root() / "agent"), "PX4_PARAM_SDLOG_MODE": "2"}
+        env |= {f"PX4_PARAM_{name}": f"{value:g}" for name, value in (params or {}).items()}
         self.vehicle = vehicle or (program.vehicle if program is not None else None)
         if self.vehicle is not None:
             env = airframes.boot_env(self.build, self.vehicle, env)
@@ -277,29 +281,95 @@ def fly_mode(
     return summary
 
 
+def stamp_shifts(samples: list[tuple[str, float, Any]], start_us: int) -> dict[str, int]:
+    """What ``send_plan`` adds to the stamps of each topic: a topic's first stamped message
+    (topic, offset, sample) is stamped with its sending time, ``start_us`` plus its offset, and
+    the topic's later ones keep their distance from it. Per topic, since a node's topics need
+    not share one clock: fuzzoff's streams stamp the keep-alive with a clock of its own (lagging,
+    stuck, jumping: PX4 ages an OffboardControlMode by its stamp, and the gate model takes the
+    first as fresh) and the rest with the sending time."""
+    shifts: dict[str, int] = {}
+    for topic, offset, sample in samples:
+        stamp: int = getattr(sample, "timestamp", 0)
+        if stamp and topic not in shifts:
+            shifts[topic] = start_us + round(offset * 1e6) - stamp
+    return shifts
+
+
+def readdressed(sample: Any, shift: int, target_system: int | None) -> Any:
+    """``sample`` as ``send_plan`` sends it: stamps moved by ``shift`` (0 stays 0: PX4 stamps
+    it on receipt), a command addressed to a system (not 0, all) sent to ``target_system``."""
+    addressed: int = getattr(sample, "target_system", 0)
+    if target_system is not None and addressed:
+        sample.target_system = target_system
+    for name in ("timestamp", "timestamp_sample"):
+        stamp: int = getattr(sample, name, 0)
+        if stamp:
+            setattr(sample, name, max(1, stamp + shift))
+    return sample
+
+
+def send_plan(
+    participant: DomainParticipant,
+    plan: ReplayPlan,
+    now: Callable[[], float] = time.monotonic,
+    wait_until: Callable[[float], None] | None = None,
+    target_system: int | None = None,
+    writers: dict[str, Publisher] | None = None,
+) -> list[float]:
+    """Send ``plan``'s messages at their offsets from ``now()`` at the start; the ``now()``
+    each one went out. Each ``timestamp`` (and ``timestamp_sample``) is moved onto this host's
+    clock, keeping its distance from its topic's first stamped message's as recorded
+    (``stamp_shifts``): a sender whose clock ran with the recording stamps the sending time,
+    one whose stamps lagged or jumped (PX4 ages an OffboardControlMode by its stamp) still
+    does. A command goes to ``target_system`` (the PX4 it is sent to: ``MAV_SYS_ID``,
+    ``PX4_INSTANCE`` + 1), as ``fuzzoff replay --to`` readdresses MAVLink (``readdressed``).
+    ``writers``: writers made (and matched by PX4's bridge) before, by ROS 2 topic; a topic
+    without one gets a new writer here (whose first messages go out before PX4's reader may
+    have matched it: a node that makes a publisher and writes at once, OFB208)."""
+    publishers: dict[str, tuple[BridgeTopic, Publisher]] = {}
+    samples = []
+    for message in plan.messages:
+        if message.topic not in publishers:
+            topic = BridgeTopic(message.message, message.topic, message.msgdef)
+            made = (writers or {}).get(message.topic)
+            publishers[message.topic] = (topic, made or Publisher(participant, topic))
+        topic, publisher = publishers[message.topic]
+        samples.append((message.offset_s, publisher, idl_type(topic).deserialize(message.data)))
+    wait = wait_until or (lambda t: time.sleep(max(0.0, t - now())))
+    start = now()
+    shifts = stamp_shifts(
+        [
+            (m.topic, m.offset_s, sample)
+            for m, (_, _, sample) in zip(plan.messages, samples, strict=True)
+        ],
+        now_us(),
+    )
+    sent = []
+    for message, (offset, publisher, sample) in zip(plan.messages, samples, strict=True):
+        wait(start + offset)
+        publisher.write(readdressed(sample, shifts.get(message.topic, 0), target_system))
+        sent.append(now())
+    return sent
+
+
 def replay(
-    release: str, out: Path, stem: str, plan: ReplayPlan, log: Log = print
+    release: str,
+    out: Path,
+    stem: str,
+    plan: ReplayPlan,
+    log: Log = print,
+    params: dict[str, float] | None = None,
 ) -> dict[str, Any]:
-    """Send a recorded bag's ``/fmu/in`` messages to PX4 at their recorded times (each one's
-    ``timestamp`` restamped to the sending time, as the sending node stamped it)."""
-    with BridgeFlight(release, None, log) as flight:
+    """Send a recorded bag's ``/fmu/in`` messages to PX4 at their recorded times (``send_plan``:
+    the stamps on this host's clock, as the sending node stamped them)."""
+    with BridgeFlight(release, None, log, params=params) as flight:
         flight.wait_ready()
         flight.record()
         time.sleep(LEAD_S)
         node_participant = DomainParticipant(0)
-        publishers: dict[str, tuple[BridgeTopic, Publisher]] = {}
-        for message in plan.messages:
-            if message.topic not in publishers:
-                topic = BridgeTopic(message.message, message.topic, message.msgdef)
-                publishers[message.topic] = (topic, Publisher(node_participant, topic))
         flight.t0 = t0 = time.monotonic()
-        for message in plan.messages:
-            time.sleep(max(0.0, t0 + message.offset_s - time.monotonic()))
-            topic, publisher = publishers[message.topic]
-            sample = idl_type(topic).deserialize(message.data)
-            if hasattr(sample, "timestamp"):
-                sample.timestamp = now_us()
-            publisher.write(sample)
+        send_plan(node_participant, plan, target_system=flight.px4.sysid)
         time.sleep(REPLAY_TAIL_S)
         flight.stop_recording()
         note = f"replayed {len(plan.messages)} messages of {plan.source}"
@@ -314,10 +384,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("release", help="a bundle with the bridge (1.16.2-ros2) or a build folder")
     parser.add_argument("stem", help="the outputs' name")
     parser.add_argument("--vehicle", help="the SIH airframe (fuzzoff.sitl.airframes)")
+    parser.add_argument("--param", action="append", default=[], help="NAME=VALUE, at boot")
     args = parser.parse_args(argv)
+    params = {k: float(v) for k, _, v in (p.partition("=") for p in args.param)}
     out = Path(".")  # the caller's folder: netns binds it at its own path and enters it
     if args.program.endswith(".json"):
-        summary = replay(args.release, out, args.stem, load_plan(Path(args.program)))
+        plan = load_plan(Path(args.program))
+        summary = replay(args.release, out, args.stem, plan, params=params)
     elif args.program in PROGRAMS:
         summary = fly(args.release, out, args.stem, PROGRAMS[args.program], vehicle=args.vehicle)
     else:

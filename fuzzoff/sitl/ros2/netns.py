@@ -7,10 +7,18 @@ from other PX4 instances on the machine. Needs root (or user namespaces) and ``u
 
 The flight's outputs reach the caller's folder at the same path: the namespace's ``/tmp`` hides
 the caller's, so the folder is entered before ``/tmp`` is replaced and bound again at its path.
+
+A live campaign (``fuzzoff fuzz --against sitl:R --transport ros2``) runs for minutes and keeps
+its own state (Hypothesis, the bench), so it moves *itself* into a new network namespace
+(``enter``: ``unshare(CLONE_NEWNET)``, loopback with multicast as ``SETUP`` sets it); PX4, the
+agent and the campaign's DDS participant all live there. Its files stay where they were (no
+private ``/tmp``: PX4's lock file is per ``--instance``).
 """
 
 from __future__ import annotations
 
+import ctypes
+import ctypes.util
 import os
 import shutil
 import subprocess
@@ -26,6 +34,30 @@ SETUP = (
 """A private /tmp; the caller's folder bound again at its own path (the shell's working
 directory still reaches it under the new /tmp; ``--no-canonicalize`` keeps mount from turning
 ``.`` into a path, which would name the new /tmp); loopback with multicast; the flight."""
+LOOPBACK = (
+    ("ip", "link", "set", "lo", "up"),
+    ("ip", "link", "set", "lo", "multicast", "on"),
+    ("ip", "route", "add", "224.0.0.0/4", "dev", "lo"),
+)
+"""The network ``SETUP`` gives a flight: loopback up, multicast routed to it."""
+CLONE_NEWNET = 0x40000000
+
+
+class NamespaceError(Exception):
+    """This process could not move to a private network namespace: one line for the user."""
+
+
+def enter() -> None:
+    """Move this process (its calling thread, and every thread and process it starts after)
+    into a new network namespace with loopback only, set up as ``SETUP`` does. Needs root."""
+    libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
+    if libc.unshare(CLONE_NEWNET) != 0:
+        errno = ctypes.get_errno()
+        raise NamespaceError(f"unshare(CLONE_NEWNET): {os.strerror(errno)}")
+    for command in LOOPBACK:
+        done = subprocess.run(command, capture_output=True, text=True, check=False)
+        if done.returncode != 0:
+            raise NamespaceError(f"{' '.join(command)}: {done.stderr.strip() or done.returncode}")
 
 
 def available() -> str | None:

@@ -69,8 +69,10 @@ def replay_bag(
     build: bundle.Build,
     save_dir: Path,
     log: Callable[[str], None] = print,
+    params: dict[str, float] | None = None,
 ) -> FlightOutcome:
-    """A recorded bag's ``/fmu/in`` messages sent to a fresh PX4 at their recorded times."""
+    """A recorded bag's ``/fmu/in`` messages sent to a fresh PX4 at their recorded times;
+    ``params``: PX4 parameters set at its boot (``PX4_PARAM_<NAME>``, 1.16 and later)."""
     try:
         plan = replay.plan_from_bag(path, build.profile_release)
     except replay.ReplayError as exc:
@@ -79,7 +81,8 @@ def replay_bag(
     stem = f"{path.name}-on-{build.release}"
     plan_file = replay.save_plan(plan, save_dir.resolve() / f"{stem}.plan.json")
     log(f"{len(plan.messages)} messages of {path} to PX4 {build.release} over its ROS 2 bridge")
-    return _flight(str(plan_file), "replay", build, save_dir, stem)
+    extra = [f"--param={name}={value!r}" for name, value in sorted((params or {}).items())]
+    return _flight(str(plan_file), "replay", build, save_dir, stem, extra)
 
 
 def _flight(
