@@ -85,7 +85,8 @@ longest, the OFB002 lines, stay under it)."""
 
 
 def _detail_lines(finding: Finding) -> list[str]:
-    lines = [printable(finding.message, DETAIL_LIMIT)]
+    # without trailing blanks, which rich 14 and 15 write differently at a line's end
+    lines = [printable(finding.message, DETAIL_LIMIT).rstrip()]
     extra = []
     if finding.end_s is not None and finding.time_s is not None:
         extra.append(f"until {finding.end_s:.3f}s")

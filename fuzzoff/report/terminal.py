@@ -71,7 +71,7 @@ def finding_line(finding: Finding, *, vehicle: bool = True) -> Text:
 
 def finding_detail(finding: Finding) -> Text:
     """``--verbose``: the whole message, then the time window and the exact place."""
-    text = Text(printable(finding.message, DETAIL_LIMIT))
+    text = Text(printable(finding.message, DETAIL_LIMIT).rstrip())
     extra = []
     if finding.end_s is not None and finding.time_s is not None:
         extra.append(f"until {finding.end_s:.3f}s")
