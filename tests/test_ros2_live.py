@@ -89,6 +89,13 @@ def _matrix() -> list[object]:
     return params
 
 
+ARM = 400  # MAV_CMD_COMPONENT_ARM_DISARM
+LOST_ARM_ATTEMPTS = 3
+"""The lost ARM (``example_arm_lost``) goes through a publisher made just before it: PX4 never
+gets it while DDS discovery has not matched that publisher, which a loaded machine can delay
+past the write. A flight where PX4 answered the ARM did not fly the hazard: it is flown again."""
+
+
 @pytest.mark.skipif(WHY_NOT is not None, reason=f"live ROS 2 flight: {WHY_NOT}")
 @pytest.mark.skipif(not MATRIX, reason="the whole matrix runs with make test-sitl")
 @pytest.mark.parametrize(("program", "release"), _matrix())
@@ -101,9 +108,17 @@ def test_every_ros2_program_flies_and_its_bags_say_what_it_is(
 
     spec = PROGRAMS[program]
     args = ["sitl", "run", program, "--transport", "ros2", "--release", release]
-    out = run_cli_process([*args, "--save-dir", str(tmp_path), "--format", "json"], timeout=300)
-    assert out.returncode == 0, out.stdout + out.stderr
-    bag = next(Path(p) for p in json.loads(out.stdout)["recordings"] if p.endswith("-mcap"))
+    for attempt in range(LOST_ARM_ATTEMPTS):
+        save = tmp_path / str(attempt)
+        out = run_cli_process([*args, "--save-dir", str(save), "--format", "json"], timeout=300)
+        assert out.returncode == 0, out.stdout + out.stderr
+        summary = json.loads(out.stdout)
+        arm_answered = any(a["command"] == ARM for a in summary["acks"])
+        if not (spec.plan.arm_from_new_publisher and arm_answered):
+            break
+    else:  # discovery beat the ARM every time: the hazard was never flown
+        pytest.fail(f"PX4 answered the ARM in {LOST_ARM_ATTEMPTS} flights of {program}")
+    bag = next(Path(p) for p in summary["recordings"] if p.endswith("-mcap"))
     lint = run_cli(["lint", str(bag), *spec.lint_args, "--format", "json"])
     (report,) = json.loads(lint.stdout)["files"]
     if spec.missed is not None:
