@@ -1,6 +1,7 @@
 """Real PX4 over its ROS 2 bridge (``corpora/ros2bridge``): px4_ros_com's offboard_control
 flown on PX4 1.16.2 and the 1.18 head through the Micro XRCE-DDS Agent (and an Ackermann
-rover on its rover setpoints, 1.17.0 and the 1.18 head, issue 33), recorded as
+rover on its rover setpoints, 1.17.0 and the 1.18 head, and the standard VTOL through its
+transition to FW, 1.16.2, 1.17.0 and the 1.18 head, issue 33), recorded as
 ``ros2 bag record`` records (mcap and sqlite3) beside PX4's ULog (issue 28 item 1).
 
 - every *clean* recording lints with exit 0 and nothing at warning or above (where today's
@@ -106,8 +107,9 @@ def test_both_storages_of_a_flight_hold_the_same_records_and_findings(stem: str)
 def test_the_release_of_a_bridge_bag_is_detected_from_its_topics(stem: str) -> None:
     profile = _lint(HERE / f"{stem}-mcap")[2]
     release = RUNS[stem]["release"]
-    # a rover's status says rover, not which kind: differential is assumed (docs/ros2.md)
-    vehicle = "rover-differential" if stem.startswith("rover_") else "mc"
+    # a rover's status says rover, not which kind: differential is assumed (docs/ros2.md); a
+    # standard VTOL's says VTOL (is_vtol) from the first status on, whatever it flies as
+    vehicle = {"rover": "rover-differential", "vtol": "vtol"}.get(stem.split("_")[0], "mc")
     assert profile["detected"] and profile["vehicle"] == vehicle
     # the 1.18 head's bags are 1.18, as its ULog says (main's messages are 1.18's); 1.17.0's
     # are 1.17 (its ArmingCheckRequest has the mask, its registration topics no _v2)
