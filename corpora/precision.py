@@ -180,9 +180,8 @@ BRIDGE = "ros2bridge"
 def bridge_agreement() -> Counter[tuple[str, str, bool | None]]:
     """(``BRIDGE``, kind, agree) over every ROS 2 bridge flight: the model run on the bag
     against PX4's ULog (``fuzzoff.sitl.ros2.verdict``)."""
-    from fuzzoff.sitl.ros2.verdict import compare
-
     from fuzzoff.sitl.airframes import DEFAULT, airframe_for
+    from fuzzoff.sitl.ros2.verdict import compare
 
     folder = CORPORA / "ros2bridge"
     runs: dict[str, Any] = json.loads((folder / "runs.json").read_text())
@@ -191,9 +190,7 @@ def bridge_agreement() -> Counter[tuple[str, str, bool | None]]:
         release = run["release"].split("-")[0]
         # judged as the vehicle it flew (the standard VTOL as a VTOL), as over MAVLink
         vehicle = airframe_for(run.get("vehicle", DEFAULT)).fuzzoff_vehicle
-        verdict = compare(
-            folder / f"{stem}-mcap", release, folder / f"{stem}.ulg", vehicle=vehicle
-        )
+        verdict = compare(folder / f"{stem}-mcap", release, folder / f"{stem}.ulg", vehicle=vehicle)
         for item in verdict.items:
             counts[(BRIDGE, _kind(item.what), item.agree)] += 1
     return counts
