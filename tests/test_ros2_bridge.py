@@ -316,3 +316,31 @@ def test_a_vtol_program_climbs_then_asks_the_fw_transition_in_offboard_and_stops
     for release in ("1.16.2", "1.17.0", "1.18.0"):  # the releases it flies on have its topics
         for message in names:
             assert bridge_topic(release, message).ros_topic.startswith("/fmu/in/")
+
+
+@pytest.mark.parametrize("still_armed", [True, False])
+def test_the_airplane_ground_gate_disarms_and_forces_it_only_while_px4_shows_armed(
+    still_armed: bool,
+) -> None:
+    """Issue 33: ``fw_ground_gate`` (the MAVLink ``fw_gate`` over the bridge): no transition,
+    the point where it stands, a 3 s stop, a DISARM 9 s after the arm and, half a second later,
+    a forced one (param2 21196) only if PX4's status still says armed."""
+    from fuzzoff.sitl.ros2.programs import PROGRAMS
+    from fuzzoff.sitl.ros2.vtol import VtolNode
+
+    program = PROGRAMS["fw_ground_gate"]
+    assert program.vtol is not None and program.vehicle == "fw"
+    sent: list[tuple[str, dict[str, Any]]] = []
+    names = ("OffboardControlMode", "TrajectorySetpoint", "VehicleCommand")
+    node = VtolNode({n: _Sink(n, sent) for n in names}, program.vtol, armed=lambda: still_armed)
+    for i in range(int((1.0 + program.fly_s) / 0.1)):
+        node.tick(round(i * 0.1, 1))
+    commands = [(v["command"], v["param1"], v["param2"]) for n, v in sent if n == "VehicleCommand"]
+    forced = [(400, 0.0, 21196.0)] if still_armed else []
+    assert commands == [(176, 1.0, 6.0), (400, 1.0, 0.0), (400, 0.0, 0.0), *forced]
+    assert {tuple(v["position"]) for n, v in sent if n == "TrajectorySetpoint"} == {(0.0, 0.0, 0.0)}
+    assert [n for _, n in node.notes][:3] == [
+        "DO_SET_MODE offboard and ARM sent",
+        "stream stops",
+        "stream resumes",
+    ]

@@ -43,6 +43,8 @@ from fuzzoff.sitl.ros2.vtol import VtolNode
 from fuzzoff.sitl.trim import trim
 
 READY_TIMEOUT_S = 90.0
+ARMED = 2
+"""VehicleStatus ``arming_state`` ARMING_STATE_ARMED."""
 LEAD_S = 0.5
 """The recording starts this long before the node (``ros2 bag record`` started first)."""
 REPLAY_TAIL_S = 2.0
@@ -217,7 +219,9 @@ def fly(
         if program.vtol is not None:
             wanted = {"OffboardControlMode", "TrajectorySetpoint", "VehicleCommand"}
             node = VtolNode(
-                {m: Publisher(node_participant, by_message[m]) for m in wanted}, program.vtol
+                {m: Publisher(node_participant, by_message[m]) for m in wanted},
+                program.vtol,
+                armed=lambda: flight.watch.watch.status.get("arming_state") == ARMED,
             )
         elif program.rover is not None:
             wanted = {"OffboardControlMode", "VehicleCommand", *program.rover.messages}

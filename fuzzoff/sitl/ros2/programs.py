@@ -226,6 +226,29 @@ VTOL_PROGRAMS = (
 )
 """Issue 33: the standard VTOL (``sihsim_standard_vtol``, 1.16.2 on) over the bridge."""
 
+FW_PROGRAMS = (
+    Program(
+        "fw_ground_gate",
+        "airplane on the ground (the MAVLink fw_gate): position stream where it stands, switch"
+        " and arm, the stream stops 3 s 3 s after the arm and resumes, disarm 9 s after the"
+        " arm (forced if PX4 still shows it armed)",
+        Plan(),
+        10.5,
+        "hazard",
+        ("OFB103",),
+        hazard="stream lost in OFFBOARD (failsafe, then back to OFFBOARD)",
+        vtol=v.VtolPlan(
+            transition_after_arm_s=None,
+            mc_point=(0.0, 0.0, 0.0),
+            stops=((3.0, 3.0),),
+            disarm_after_arm_s=9.0,
+        ),
+        vehicle="fw",
+    ),
+)
+"""Issue 33: the airplane's gate over the bridge (``sihsim_airplane``, its outputs as SIH reads
+them: ``airframes.AIRPLANE_OUTPUTS``, set at boot)."""
+
 
 PROGRAMS: dict[str, Program] = {
     p.name: p
@@ -357,5 +380,6 @@ PROGRAMS: dict[str, Program] = {
         ),
         *ROVER_PROGRAMS,
         *VTOL_PROGRAMS,
+        *FW_PROGRAMS,
     )
 }
