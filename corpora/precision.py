@@ -142,7 +142,7 @@ def ros2bridge_rows(gate: Counter[tuple[str, str, bool | None]]) -> list[Row]:
                 " companion's bags (mcap, sqlite3) and PX4's ULog, px4_ros_com's"
                 " offboard_control and px4-ros2-interface-lib's mode registration reproduced, an"
                 " Ackermann rover on its rover setpoints, a standard VTOL through its transition"
-                " to FW",
+                " to FW, the airplane's gate on the ground",
                 alone,
             ),
             gate=f"{agree}/{judged}" if judged else "-",

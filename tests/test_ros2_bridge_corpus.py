@@ -108,8 +108,10 @@ def test_the_release_of_a_bridge_bag_is_detected_from_its_topics(stem: str) -> N
     profile = _lint(HERE / f"{stem}-mcap")[2]
     release = RUNS[stem]["release"]
     # a rover's status says rover, not which kind: differential is assumed (docs/ros2.md); a
-    # standard VTOL's says VTOL (is_vtol) from the first status on, whatever it flies as
-    vehicle = {"rover": "rover-differential", "vtol": "vtol"}.get(stem.split("_")[0], "mc")
+    # standard VTOL's says VTOL (is_vtol) from the first status on, whatever it flies as, and
+    # the airplane's fixed-wing
+    kinds = {"rover": "rover-differential", "vtol": "vtol", "fw": "fw"}
+    vehicle = kinds.get(stem.split("_")[0], "mc")
     assert profile["detected"] and profile["vehicle"] == vehicle
     # the 1.18 head's bags are 1.18, as its ULog says (main's messages are 1.18's); 1.17.0's
     # are 1.17 (its ArmingCheckRequest has the mask, its registration topics no _v2)
@@ -264,3 +266,31 @@ def test_the_gate_model_agrees_with_px4_on_each_vtol_loss_over_the_bridge(stem: 
     ]
     action = "POSCTL" if release == "1.16.2" else "AUTO_RTL"
     assert [i.px4 for i in verdict.items if i.what == "failsafe action"] == [action, action]
+
+
+@pytest.mark.parametrize("stem", sorted(s for s in RUNS if s.startswith("fw_ground_gate-")))
+def test_the_gate_model_judges_the_airplanes_disarm_by_the_land_detector_the_bag_holds(
+    stem: str,
+) -> None:
+    """Issue 33: the airplane's gate on the ground over the bridge. PX4 refuses the plain
+    disarm while it counts the rolling airplane as flying; the bag holds PX4's
+    ``VehicleLandDetected`` (as a tlog holds EXTENDED_SYS_STATE), so the model refuses it too,
+    then takes the forced one; the loss, its action and the return agree as well."""
+    from fuzzoff.sitl.ros2.verdict import compare
+
+    with Reader(HERE / f"{stem}-mcap") as reader:
+        assert "/fmu/out/vehicle_land_detected" in {c.topic for c in reader.connections}
+    release = RUNS[stem]["release"].split("-")[0]
+    verdict = compare(HERE / f"{stem}-mcap", release, HERE / f"{stem}.ulg", vehicle="fw")
+    assert [(i.what, i.agree) for i in verdict.items] == [
+        ("switch to OFFBOARD", True),
+        ("arm", True),
+        ("loss time", True),
+        ("failsafe action", True),
+        ("automatic return", True),
+        ("disarm", True),
+        ("disarm", True),
+    ]
+    plain, forced = (i for i in verdict.items if i.what == "disarm")
+    assert plain.px4 == "rejected (1)" and "not landed" in plain.model
+    assert forced.px4 == "accepted" and "forced" in forced.model

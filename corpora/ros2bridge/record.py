@@ -67,7 +67,7 @@ RUNS: tuple[tuple[str, str], ...] = (
     ("ext_mode_old_api", "1.17.0-ros2-rover"),
     *(
         (program, bundle_name)
-        for program in ("vtol_transition", "vtol_stops")
+        for program in ("vtol_transition", "vtol_stops", "fw_ground_gate")
         for bundle_name in ("1.18.0-beta1-head", "1.16.2-ros2", "1.17.0-ros2-rover")
     ),
 )
