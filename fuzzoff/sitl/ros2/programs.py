@@ -230,8 +230,8 @@ FW_PROGRAMS = (
     Program(
         "fw_ground_gate",
         "airplane on the ground (the MAVLink fw_gate): position stream where it stands, switch"
-        " and arm, the stream stops 3 s 3 s after the arm and resumes, disarm 9 s after the"
-        " arm (forced if PX4 still shows it armed)",
+        " and arm, the stream stops for 3 s from 3 s after the arm and resumes, disarm 9 s"
+        " after the arm (forced if PX4 still shows it armed)",
         Plan(),
         10.5,
         "hazard",
