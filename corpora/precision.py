@@ -140,7 +140,9 @@ def ros2bridge_rows(gate: Counter[tuple[str, str, bool | None]]) -> list[Row]:
                 "`corpora/ros2bridge/`",
                 f"real PX4 SITL {', '.join(releases)} over its ROS 2 bridge (uXRCE-DDS): the"
                 " companion's bags (mcap, sqlite3) and PX4's ULog, px4_ros_com's"
-                " offboard_control and px4-ros2-interface-lib's mode registration reproduced",
+                " offboard_control and px4-ros2-interface-lib's mode registration reproduced, an"
+                " Ackermann rover on its rover setpoints, a standard VTOL through its transition"
+                " to FW, the airplane's gate on the ground",
                 alone,
             ),
             gate=f"{agree}/{judged}" if judged else "-",
@@ -178,6 +180,7 @@ BRIDGE = "ros2bridge"
 def bridge_agreement() -> Counter[tuple[str, str, bool | None]]:
     """(``BRIDGE``, kind, agree) over every ROS 2 bridge flight: the model run on the bag
     against PX4's ULog (``fuzzoff.sitl.ros2.verdict``)."""
+    from fuzzoff.sitl.airframes import DEFAULT, airframe_for
     from fuzzoff.sitl.ros2.verdict import compare
 
     folder = CORPORA / "ros2bridge"
@@ -185,7 +188,9 @@ def bridge_agreement() -> Counter[tuple[str, str, bool | None]]:
     counts: Counter[tuple[str, str, bool | None]] = Counter()
     for stem, run in sorted(runs.items()):
         release = run["release"].split("-")[0]
-        verdict = compare(folder / f"{stem}-mcap", release, folder / f"{stem}.ulg")
+        # judged as the vehicle it flew (the standard VTOL as a VTOL), as over MAVLink
+        vehicle = airframe_for(run.get("vehicle", DEFAULT)).fuzzoff_vehicle
+        verdict = compare(folder / f"{stem}-mcap", release, folder / f"{stem}.ulg", vehicle=vehicle)
         for item in verdict.items:
             counts[(BRIDGE, _kind(item.what), item.agree)] += 1
     return counts

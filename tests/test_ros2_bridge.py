@@ -268,3 +268,79 @@ def test_the_rover_on_main_is_refused_saying_why() -> None:
     args = ["sitl", "run", "rover_position", "--transport", "ros2"]
     out = run_cli([*args, "--release", "main-2026-08-13"])
     assert out.returncode == 2 and "stalls PX4's simulated clock" in out.stderr
+
+
+def test_a_vtol_program_climbs_then_asks_the_fw_transition_in_offboard_and_stops_where_told() -> (
+    None
+):
+    """Issue 33: the standard VTOL over the bridge (``vtol.py``): the example's switch and arm,
+    the MC point, DO_VTOL_TRANSITION to FW (param1 4) at its time, the FW point after; the loss
+    program publishes nothing in each stop window and resumes after it."""
+    from fuzzoff.sitl.ros2.programs import PROGRAMS
+    from fuzzoff.sitl.ros2.vtol import VtolNode
+
+    program = PROGRAMS["vtol_stops"]
+    assert program.vtol is not None and program.vehicle == "vtol" and program.codes == ("OFB103",)
+    sent: list[tuple[str, dict[str, Any]]] = []
+    names = ("OffboardControlMode", "TrajectorySetpoint", "VehicleCommand")
+    node = VtolNode({n: _Sink(n, sent) for n in names}, program.vtol)
+    ticks = [round(i * 0.1, 1) for i in range(int((1.0 + program.fly_s) / 0.1))]
+    published: dict[float, list[tuple[str, dict[str, Any]]]] = {}
+    for t in ticks:
+        before = len(sent)
+        node.tick(t)
+        published[t] = sent[before:]
+    commands = [(v["command"], v["param1"], v["param2"]) for n, v in sent if n == "VehicleCommand"]
+    assert commands == [(176, 1.0, 6.0), (400, 1.0, 0.0), (3000, 4.0, 0.0)]
+    assert node.armed_at == 1.0
+    # silent 3 s in MC (10-13 s after the arm) and in FW (24-27 s), streaming on either side
+    assert not published[11.0] and not published[13.9]
+    assert not published[25.0] and not published[27.9]
+    assert published[10.9] and published[14.0] and published[24.9] and published[28.0]
+    position = {t: v["position"] for t, out in published.items() for n, v in out if "position" in v}
+    assert position[5.0] == [0.0, 0.0, -20.0] and position[20.0] == [400.0, 0.0, -30.0]
+    transition = next(
+        t for t, out in published.items() if any(v.get("command") == 3000 for _, v in out)
+    )
+    assert transition == 17.0 and position[16.9] == [0.0, 0.0, -20.0]
+    assert [n for _, n in node.notes] == [
+        "DO_SET_MODE offboard and ARM sent",
+        "stream stops (MC)",
+        "stream resumes (MC)",
+        "DO_VTOL_TRANSITION to FW sent",
+        "stream stops (FW)",
+        "stream resumes (FW)",
+    ]
+    modes = [v for n, v in sent if n == "OffboardControlMode"]
+    assert all(m["position"] and not m["velocity"] for m in modes)
+    for release in ("1.16.2", "1.17.0", "1.18.0"):  # the releases it flies on have its topics
+        for message in names:
+            assert bridge_topic(release, message).ros_topic.startswith("/fmu/in/")
+
+
+@pytest.mark.parametrize("still_armed", [True, False])
+def test_the_airplane_ground_gate_disarms_and_forces_it_only_while_px4_shows_armed(
+    still_armed: bool,
+) -> None:
+    """Issue 33: ``fw_ground_gate`` (the MAVLink ``fw_gate`` over the bridge): no transition,
+    the point where it stands, a 3 s stop, a DISARM 9 s after the arm and, half a second later,
+    a forced one (param2 21196) only if PX4's status still says armed."""
+    from fuzzoff.sitl.ros2.programs import PROGRAMS
+    from fuzzoff.sitl.ros2.vtol import VtolNode
+
+    program = PROGRAMS["fw_ground_gate"]
+    assert program.vtol is not None and program.vehicle == "fw"
+    sent: list[tuple[str, dict[str, Any]]] = []
+    names = ("OffboardControlMode", "TrajectorySetpoint", "VehicleCommand")
+    node = VtolNode({n: _Sink(n, sent) for n in names}, program.vtol, armed=lambda: still_armed)
+    for i in range(int((1.0 + program.fly_s) / 0.1)):
+        node.tick(round(i * 0.1, 1))
+    commands = [(v["command"], v["param1"], v["param2"]) for n, v in sent if n == "VehicleCommand"]
+    forced = [(400, 0.0, 21196.0)] if still_armed else []
+    assert commands == [(176, 1.0, 6.0), (400, 1.0, 0.0), (400, 0.0, 0.0), *forced]
+    assert {tuple(v["position"]) for n, v in sent if n == "TrajectorySetpoint"} == {(0.0, 0.0, 0.0)}
+    assert [n for _, n in node.notes][:3] == [
+        "DO_SET_MODE offboard and ARM sent",
+        "stream stops",
+        "stream resumes",
+    ]

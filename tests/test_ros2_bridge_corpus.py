@@ -1,6 +1,7 @@
 """Real PX4 over its ROS 2 bridge (``corpora/ros2bridge``): px4_ros_com's offboard_control
 flown on PX4 1.16.2 and the 1.18 head through the Micro XRCE-DDS Agent (and an Ackermann
-rover on its rover setpoints, 1.17.0 and the 1.18 head, issue 33), recorded as
+rover on its rover setpoints, 1.17.0 and the 1.18 head, and the standard VTOL through its
+transition to FW, 1.16.2, 1.17.0 and the 1.18 head, issue 33), recorded as
 ``ros2 bag record`` records (mcap and sqlite3) beside PX4's ULog (issue 28 item 1).
 
 - every *clean* recording lints with exit 0 and nothing at warning or above (where today's
@@ -106,8 +107,11 @@ def test_both_storages_of_a_flight_hold_the_same_records_and_findings(stem: str)
 def test_the_release_of_a_bridge_bag_is_detected_from_its_topics(stem: str) -> None:
     profile = _lint(HERE / f"{stem}-mcap")[2]
     release = RUNS[stem]["release"]
-    # a rover's status says rover, not which kind: differential is assumed (docs/ros2.md)
-    vehicle = "rover-differential" if stem.startswith("rover_") else "mc"
+    # a rover's status says rover, not which kind: differential is assumed (docs/ros2.md); a
+    # standard VTOL's says VTOL (is_vtol) from the first status on, whatever it flies as, and
+    # the airplane's fixed-wing
+    kinds = {"rover": "rover-differential", "vtol": "vtol", "fw": "fw"}
+    vehicle = kinds.get(stem.split("_")[0], "mc")
     assert profile["detected"] and profile["vehicle"] == vehicle
     # the 1.18 head's bags are 1.18, as its ULog says (main's messages are 1.18's); 1.17.0's
     # are 1.17 (its ArmingCheckRequest has the mask, its registration topics no _v2)
@@ -242,3 +246,51 @@ def test_a_bag_started_just_before_the_first_command_gives_no_false_disagreement
     ]
     findings, _ = run_events(sorted(events, key=lambda e: e.t), info, profile, Settings())
     assert not [f for f in findings if f.severity is not Severity.INFO]
+
+
+@pytest.mark.parametrize("stem", sorted(s for s in RUNS if s.startswith("vtol_stops-")))
+def test_the_gate_model_agrees_with_px4_on_each_vtol_loss_over_the_bridge(stem: str) -> None:
+    """Issue 33: the standard VTOL's stream stops 3 s hovering in MC and 3 s in FW (in MC again
+    on 1.16.2, whose transition quad-chutes back): the model, run on the bag, gives PX4's loss
+    time, its failsafe action (Position on 1.16.2, Return on 1.17.0 and later: no manual
+    control) and the return to OFFBOARD on resume, each time."""
+    from fuzzoff.sitl.ros2.verdict import compare
+
+    release = RUNS[stem]["release"].split("-")[0]
+    verdict = compare(HERE / f"{stem}-mcap", release, HERE / f"{stem}.ulg", vehicle="vtol")
+    assert not verdict.problems
+    assert [(i.what, i.agree) for i in verdict.items] == [
+        ("switch to OFFBOARD", True),
+        ("arm", True),
+        *[("loss time", True), ("failsafe action", True), ("automatic return", True)] * 2,
+    ]
+    action = "POSCTL" if release == "1.16.2" else "AUTO_RTL"
+    assert [i.px4 for i in verdict.items if i.what == "failsafe action"] == [action, action]
+
+
+@pytest.mark.parametrize("stem", sorted(s for s in RUNS if s.startswith("fw_ground_gate-")))
+def test_the_gate_model_judges_the_airplanes_disarm_by_the_land_detector_the_bag_holds(
+    stem: str,
+) -> None:
+    """Issue 33: the airplane's gate on the ground over the bridge. PX4 refuses the plain
+    disarm while it counts the rolling airplane as flying; the bag holds PX4's
+    ``VehicleLandDetected`` (as a tlog holds EXTENDED_SYS_STATE), so the model refuses it too,
+    then takes the forced one; the loss, its action and the return agree as well."""
+    from fuzzoff.sitl.ros2.verdict import compare
+
+    with Reader(HERE / f"{stem}-mcap") as reader:
+        assert "/fmu/out/vehicle_land_detected" in {c.topic for c in reader.connections}
+    release = RUNS[stem]["release"].split("-")[0]
+    verdict = compare(HERE / f"{stem}-mcap", release, HERE / f"{stem}.ulg", vehicle="fw")
+    assert [(i.what, i.agree) for i in verdict.items] == [
+        ("switch to OFFBOARD", True),
+        ("arm", True),
+        ("loss time", True),
+        ("failsafe action", True),
+        ("automatic return", True),
+        ("disarm", True),
+        ("disarm", True),
+    ]
+    plain, forced = (i for i in verdict.items if i.what == "disarm")
+    assert plain.px4 == "rejected (1)" and "not landed" in plain.model
+    assert forced.px4 == "accepted" and "forced" in forced.model

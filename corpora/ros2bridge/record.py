@@ -31,6 +31,7 @@ from pyulog import ULog  # noqa: E402
 
 from fuzzoff.formats.ulog.reader import LOADED_TOPICS  # noqa: E402
 from fuzzoff.sitl.ros2.netns import run_flight  # noqa: E402
+from fuzzoff.sitl.trim import ALIGN_TOPICS  # noqa: E402
 
 RUNS: tuple[tuple[str, str], ...] = (
     ("example", "1.16.2-ros2"),
@@ -64,6 +65,11 @@ RUNS: tuple[tuple[str, str], ...] = (
     ("ext_mode_dies", "1.18.0-beta1-head"),
     ("ext_mode", "1.17.0-ros2-rover"),
     ("ext_mode_old_api", "1.17.0-ros2-rover"),
+    *(
+        (program, bundle_name)
+        for program in ("vtol_transition", "vtol_stops", "fw_ground_gate")
+        for bundle_name in ("1.18.0-beta1-head", "1.16.2-ros2", "1.17.0-ros2-rover")
+    ),
 )
 """(program of ``fuzzoff.sitl.ros2.programs``, bundle): one PX4 boot each."""
 MAX_BYTES = 1_000_000
@@ -73,7 +79,10 @@ at 100 Hz; the bags keep it."""
 
 
 def cut_more(ulog: Path) -> None:
-    log = ULog(str(ulog), message_name_filter_list=sorted(set(LOADED_TOPICS) - LEFT_OUT))
+    """Without ``LEFT_OUT``, keeping what ``trim`` keeps beside the topics fuzzoff reads (the
+    bridge's ``timesync_status``: the offsets PX4 applied, which explain its loss times)."""
+    kept = (set(LOADED_TOPICS) | set(ALIGN_TOPICS)) - LEFT_OUT
+    log = ULog(str(ulog), message_name_filter_list=sorted(kept))
     log.write_ulog(str(ulog))
 
 

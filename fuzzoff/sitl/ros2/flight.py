@@ -39,9 +39,12 @@ from fuzzoff.sitl.ros2.recorder import Recorder
 from fuzzoff.sitl.ros2.replay import Plan as ReplayPlan
 from fuzzoff.sitl.ros2.replay import load_plan
 from fuzzoff.sitl.ros2.rover import ROVER_MESSAGES, RoverNode
+from fuzzoff.sitl.ros2.vtol import VtolNode
 from fuzzoff.sitl.trim import trim
 
 READY_TIMEOUT_S = 90.0
+ARMED = 2
+"""VehicleStatus ``arming_state`` ARMING_STATE_ARMED."""
 LEAD_S = 0.5
 """The recording starts this long before the node (``ros2 bag record`` started first)."""
 REPLAY_TAIL_S = 2.0
@@ -110,8 +113,10 @@ class BridgeFlight:
         self.received = [bridge_topic(release_name, m) for m in received]
         self.sent = [bridge_topic(release_name, m) for m in sent]
         env = {"PX4_AGENT": str(bundle.default_root() / "agent"), "PX4_PARAM_SDLOG_MODE": "2"}
-        env |= {f"PX4_PARAM_{name}": f"{value:g}" for name, value in (params or {}).items()}
         self.vehicle = vehicle or (program.vehicle if program is not None else None)
+        fixes = {} if self.vehicle is None else airframes.airframe_for(self.vehicle).fixes
+        # the airframe's fixes (what makes SIH fly it as PX4 means it), then the caller's
+        env |= {f"PX4_PARAM_{k}": f"{v:g}" for k, v in {**fixes, **(params or {})}.items()}
         if self.vehicle is not None:
             env = airframes.boot_env(self.build, self.vehicle, env)
         self.px4 = bundle.start(self.build, 0, env)
@@ -210,8 +215,15 @@ def fly(
             time.sleep(LEAD_S)
         node_participant = DomainParticipant(0)
         by_message = {t.message: t for t in flight.sent}
-        node: OffboardControl | RoverNode
-        if program.rover is not None:
+        node: OffboardControl | RoverNode | VtolNode
+        if program.vtol is not None:
+            wanted = {"OffboardControlMode", "TrajectorySetpoint", "VehicleCommand"}
+            node = VtolNode(
+                {m: Publisher(node_participant, by_message[m]) for m in wanted},
+                program.vtol,
+                armed=lambda: flight.watch.watch.status.get("arming_state") == ARMED,
+            )
+        elif program.rover is not None:
             wanted = {"OffboardControlMode", "VehicleCommand", *program.rover.messages}
             sinks = {m: Publisher(node_participant, by_message[m]) for m in wanted}
             node = RoverNode(sinks, program.rover)

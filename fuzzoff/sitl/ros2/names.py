@@ -21,8 +21,11 @@ RECEIVED = (
     "VehicleControlMode",
     "FailsafeFlags",
     "VehicleLocalPosition",
+    "VehicleLandDetected",
 )
-"""PX4's outputs a recording of the flight keeps (those fuzzoff reads)."""
+"""PX4's outputs a recording of the flight keeps (those fuzzoff reads; the land detector says
+whether PX4 takes a plain disarm, as EXTENDED_SYS_STATE does over MAVLink: issue 33's airplane
+rolling on the ground counts as flying)."""
 
 
 class NamesError(Exception):

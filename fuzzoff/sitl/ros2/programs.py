@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 from fuzzoff.sitl.ros2 import rover as r
+from fuzzoff.sitl.ros2 import vtol as v
 from fuzzoff.sitl.ros2.example import Plan
 from fuzzoff.sitl.ros2.external_mode import ModePlan
 
@@ -50,6 +51,8 @@ class Program:
     """The node is an external mode (``external_mode.py``), not the offboard example: it
     registers, answers PX4's arming checks and flies nothing; ``fly_s`` counts from its
     start."""
+    vtol: v.VtolPlan | None = None
+    """A standard VTOL node (``vtol.py``) instead of the example's; ``plan`` is then unused."""
 
 
 ROVER = "rover-ackermann"
@@ -195,6 +198,58 @@ ROVER_PROGRAMS = (
 """Issue 33 item 1: the rover setpoints of 1.17 and the 1.18 head, each release has all six."""
 
 
+VTOL = "vtol"
+
+VTOL_PROGRAMS = (
+    Program(
+        "vtol_transition",
+        "standard VTOL: position stream, switch and arm, climb to 20 m in MC, DO_VTOL_TRANSITION"
+        " to FW 11 s after the arm while in OFFBOARD, FW position setpoint 400 m ahead",
+        Plan(),
+        25.0,
+        "clean",
+        vtol=v.VtolPlan(),
+        vehicle=VTOL,
+    ),
+    Program(
+        "vtol_stops",
+        "standard VTOL: as vtol_transition, the stream stops 3 s hovering in MC and 3 s cruising"
+        " in FW, resuming each time",
+        Plan(),
+        31.0,
+        "hazard",
+        ("OFB103",),
+        hazard="stream lost in OFFBOARD in each VTOL phase (failsafe, then back to OFFBOARD)",
+        vtol=v.VtolPlan(transition_after_arm_s=16.0, stops=((10.0, 3.0), (24.0, 3.0))),
+        vehicle=VTOL,
+    ),
+)
+"""Issue 33: the standard VTOL (``sihsim_standard_vtol``, 1.16.2 on) over the bridge."""
+
+FW_PROGRAMS = (
+    Program(
+        "fw_ground_gate",
+        "airplane on the ground (the MAVLink fw_gate): position stream where it stands, switch"
+        " and arm, the stream stops for 3 s from 3 s after the arm and resumes, disarm 9 s"
+        " after the arm (forced if PX4 still shows it armed)",
+        Plan(),
+        10.5,
+        "hazard",
+        ("OFB103",),
+        hazard="stream lost in OFFBOARD (failsafe, then back to OFFBOARD)",
+        vtol=v.VtolPlan(
+            transition_after_arm_s=None,
+            mc_point=(0.0, 0.0, 0.0),
+            stops=((3.0, 3.0),),
+            disarm_after_arm_s=9.0,
+        ),
+        vehicle="fw",
+    ),
+)
+"""Issue 33: the airplane's gate over the bridge (``sihsim_airplane``, its outputs as SIH reads
+them: ``airframes.AIRPLANE_OUTPUTS``, set at boot)."""
+
+
 PROGRAMS: dict[str, Program] = {
     p.name: p
     for p in (
@@ -324,5 +379,7 @@ PROGRAMS: dict[str, Program] = {
             topics="in",
         ),
         *ROVER_PROGRAMS,
+        *VTOL_PROGRAMS,
+        *FW_PROGRAMS,
     )
 }
