@@ -160,9 +160,8 @@ def _table(title: str, headers: list[str], row: list[str], width: int) -> list[s
     return lines
 
 
-def _summary(
-    out: list[str], report: Report, fail_on: Severity, verbose: bool, exit_zero: bool, width: int
-) -> None:
+def summary_row(report: Report) -> tuple[list[str], list[str]]:
+    """The summary table's headers and its one row (``suppressed`` only when there are any)."""
     counts = Counter(f.severity for f in report.findings)
     headers = ["files", "errors", "warnings", "info", "unreadable"]
     row = [
@@ -176,18 +175,32 @@ def _summary(
     if suppressed:
         headers.append("suppressed")
         row.append(str(suppressed))
-    out.extend(_table("fuzzoff summary", headers, row, width))
+    return headers, row
+
+
+def verdict_text(report: Report, fail_on: Severity, exit_zero: bool) -> tuple[int, str]:
+    """The exit status and the summary's ``result:`` text."""
     status = report.exit_status(fail_on)
     verdict = VERDICT[status]
     if status == 1:
         verdict += f" (findings at or above {fail_on.label})"
         if exit_zero:
             verdict += "; exit status 0 (--exit-zero)"
+    return status, verdict
+
+
+HINT = "--verbose shows each finding in full; fuzzoff rule CODE explains a rule, with a fix"
+
+
+def _summary(
+    out: list[str], report: Report, fail_on: Severity, verbose: bool, exit_zero: bool, width: int
+) -> None:
+    headers, row = summary_row(report)
+    out.extend(_table("fuzzoff summary", headers, row, width))
+    verdict = verdict_text(report, fail_on, exit_zero)[1]
     out.append(_short(f"result: {verdict}", width))
     if report.findings and not verbose:
-        out.append(
-            "--verbose shows each finding in full; fuzzoff rule CODE explains a rule, with a fix"
-        )
+        out.append(HINT)
 
 
 def plain_report(

@@ -27,7 +27,7 @@ from fuzzoff.catalog import get_rule
 from fuzzoff.findings import FileReport, Finding, Report, Severity
 from fuzzoff.fuzz.known import KNOWN
 from fuzzoff.report import CampaignReport, campaign_seeds
-from fuzzoff.report.plain import DETAIL_LIMIT, HEAD_WIDTH, VERDICT
+from fuzzoff.report.plain import DETAIL_LIMIT, HEAD_WIDTH, HINT, summary_row, verdict_text
 from fuzzoff.report.plain import location as _location
 from fuzzoff.report.sanitize import printable
 
@@ -165,36 +165,19 @@ def print_summary(
     verbose: bool = False,
     exit_zero: bool = False,
 ) -> None:
-    counts = Counter(f.severity for f in report.findings)
+    headers, row = summary_row(report)
     table = Table(title="fuzzoff summary", box=table_box(console), show_edge=False)
-    table.add_column("files", justify="right")
-    table.add_column("errors", justify="right", style=STYLE[Severity.ERROR])
-    table.add_column("warnings", justify="right", style=STYLE[Severity.WARNING])
-    table.add_column("info", justify="right", style=STYLE[Severity.INFO])
-    table.add_column("unreadable", justify="right")
-    suppressed = sum(len(f.suppressed) for f in report.files)
-    if suppressed:
-        table.add_column("suppressed", justify="right", style="dim")
-    table.add_row(
-        str(len(report.files)),
-        str(counts[Severity.ERROR]),
-        str(counts[Severity.WARNING]),
-        str(counts[Severity.INFO]),
-        str(sum(1 for f in report.files if not f.complete)),
-        *([str(suppressed)] if suppressed else []),
-    )
+    styles = {"errors": STYLE[Severity.ERROR], "warnings": STYLE[Severity.WARNING]}
+    styles.update({"info": STYLE[Severity.INFO], "suppressed": "dim"})
+    for header in headers:
+        table.add_column(header, justify="right", style=styles.get(header))
+    table.add_row(*row)
     console.print(table)
-    status = report.exit_status(fail_on)
-    verdict = VERDICT[status]
-    if status == 1:
-        verdict += f" (findings at or above {fail_on.label})"
-        if exit_zero:
-            verdict += "; exit status 0 (--exit-zero)"
+    status, verdict = verdict_text(report, fail_on, exit_zero)
     style = "bold green" if status == 0 else ("bold yellow" if exit_zero else "bold red")
     console.print(Text(f"result: {verdict}", style=style))
     if report.findings and not verbose:
-        hint = "--verbose shows each finding in full; fuzzoff rule CODE explains a rule, with a fix"
-        console.print(Text(hint, style="dim"), soft_wrap=True)
+        console.print(Text(HINT, style="dim"), soft_wrap=True)
 
 
 def print_statistics(console: Console, report: Report) -> None:

@@ -33,6 +33,7 @@ from fuzzoff.sitl.ros2.flight import READY_TIMEOUT_S, send_plan
 from fuzzoff.sitl.ros2.names import RECEIVED, BridgeTopic, NamesError, bridge_topic
 from fuzzoff.sitl.ros2.recorder import Recorder
 from fuzzoff.sitl.ros2.replay import Plan
+from fuzzoff.sitl.ros2.rover import ROVER_MESSAGES
 from fuzzoff.sitl.run import TAIL_S
 from fuzzoff.sitl.session import LOGGER_SETTLE_S
 from fuzzoff.sitl.trim import trim
@@ -43,12 +44,7 @@ STREAMED = (
     "VehicleAttitudeSetpoint",
     "VehicleRatesSetpoint",
     "VehicleCommand",
-    "RoverPositionSetpoint",
-    "RoverSpeedSetpoint",
-    "RoverAttitudeSetpoint",
-    "RoverRateSetpoint",
-    "RoverThrottleSetpoint",
-    "RoverSteeringSetpoint",
+    *ROVER_MESSAGES,
 )
 """What a generated ROS 2 stream may publish (those the release defines are recorded)."""
 MATCH_TIMEOUT_S = 10.0

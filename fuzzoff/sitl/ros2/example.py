@@ -118,14 +118,21 @@ class OffboardControl:
     def _vehicle_command(
         self, command: int, param1: float = 0.0, param2: float = 0.0, sink: Sink | None = None
     ) -> None:
-        (sink or self.command).publish(
-            timestamp=now_us(),
-            param1=param1,
-            param2=param2,
-            command=command,
-            target_system=1,
-            target_component=1,
-            source_system=1,
-            source_component=1,
-            from_external=True,
-        )
+        send_vehicle_command(sink or self.command, command, param1, param2)
+
+
+def send_vehicle_command(
+    sink: Sink, command: int, param1: float = 0.0, param2: float = 0.0
+) -> None:
+    """A ``VehicleCommand`` as the example sends it: to system 1, from an external component."""
+    sink.publish(
+        timestamp=now_us(),
+        param1=param1,
+        param2=param2,
+        command=command,
+        target_system=1,
+        target_component=1,
+        source_system=1,
+        source_component=1,
+        from_external=True,
+    )

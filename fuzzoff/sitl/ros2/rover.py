@@ -22,6 +22,7 @@ from fuzzoff.sitl.ros2.example import (
     VEHICLE_CMD_DO_SET_MODE,
     Sink,
     now_us,
+    send_vehicle_command,
 )
 
 NAN = math.nan
@@ -86,17 +87,7 @@ class RoverNode:
             self.counter += 1
 
     def _command(self, command: int, param1: float = 0.0, param2: float = 0.0) -> None:
-        self.sinks["VehicleCommand"].publish(
-            timestamp=now_us(),
-            param1=param1,
-            param2=param2,
-            command=command,
-            target_system=1,
-            target_component=1,
-            source_system=1,
-            source_component=1,
-            from_external=True,
-        )
+        send_vehicle_command(self.sinks["VehicleCommand"], command, param1, param2)
 
 
 POSITION_10M_NORTH: Mapping[str, Any] = {

@@ -28,6 +28,7 @@ from fuzzoff.sitl.ros2.example import (
     VEHICLE_CMD_DO_SET_MODE,
     Sink,
     now_us,
+    send_vehicle_command,
 )
 
 VEHICLE_CMD_DO_VTOL_TRANSITION = 3000
@@ -140,14 +141,4 @@ class VtolNode:
             self.notes.append((now, "still armed: forced DISARM sent"))
 
     def _command(self, command: int, param1: float = 0.0, param2: float = 0.0) -> None:
-        self.sinks["VehicleCommand"].publish(
-            timestamp=now_us(),
-            param1=param1,
-            param2=param2,
-            command=command,
-            target_system=1,
-            target_component=1,
-            source_system=1,
-            source_component=1,
-            from_external=True,
-        )
+        send_vehicle_command(self.sinks["VehicleCommand"], command, param1, param2)
