@@ -10,7 +10,7 @@ the caller's, so the folder is entered before ``/tmp`` is replaced and bound aga
 
 A live campaign (``fuzzoff fuzz --against sitl:R --transport ros2``) runs for minutes and keeps
 its own state (Hypothesis, the bench), so it moves *itself* into a new network namespace
-(``enter``: ``unshare(CLONE_NEWNET)``, loopback with multicast as ``SETUP`` sets it); PX4, the
+(``enter``: ``unshare(CLONE_NEWNET)``, loopback with multicast as ``LOOPBACK`` sets it); PX4, the
 agent and the campaign's DDS participant all live there. Its files stay where they were (no
 private ``/tmp``: PX4's lock file is per ``--instance``).
 """
@@ -25,21 +25,21 @@ import subprocess
 import sys
 from pathlib import Path
 
-SETUP = (
-    'mount -t tmpfs none /tmp && mkdir -p "$FUZZOFF_OUT"'
-    ' && mount --no-canonicalize --bind . "$FUZZOFF_OUT" && cd "$FUZZOFF_OUT"'
-    " && ip link set lo up && ip link set lo multicast on"
-    ' && ip route add 224.0.0.0/4 dev lo && exec "$@"'
-)
-"""A private /tmp; the caller's folder bound again at its own path (the shell's working
-directory still reaches it under the new /tmp; ``--no-canonicalize`` keeps mount from turning
-``.`` into a path, which would name the new /tmp); loopback with multicast; the flight."""
 LOOPBACK = (
     ("ip", "link", "set", "lo", "up"),
     ("ip", "link", "set", "lo", "multicast", "on"),
     ("ip", "route", "add", "224.0.0.0/4", "dev", "lo"),
 )
-"""The network ``SETUP`` gives a flight: loopback up, multicast routed to it."""
+"""The network a flight's namespace gets: loopback up, multicast routed to it."""
+SETUP = (
+    'mount -t tmpfs none /tmp && mkdir -p "$FUZZOFF_OUT"'
+    ' && mount --no-canonicalize --bind . "$FUZZOFF_OUT" && cd "$FUZZOFF_OUT"'
+    + "".join(f" && {' '.join(command)}" for command in LOOPBACK)
+    + ' && exec "$@"'
+)
+"""A private /tmp; the caller's folder bound again at its own path (the shell's working
+directory still reaches it under the new /tmp; ``--no-canonicalize`` keeps mount from turning
+``.`` into a path, which would name the new /tmp); loopback with multicast; the flight."""
 CLONE_NEWNET = 0x40000000
 
 
@@ -49,7 +49,7 @@ class NamespaceError(Exception):
 
 def enter() -> None:
     """Move this process (its calling thread, and every thread and process it starts after)
-    into a new network namespace with loopback only, set up as ``SETUP`` does. Needs root."""
+    into a new network namespace with loopback only (``LOOPBACK``). Needs root."""
     libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
     if libc.unshare(CLONE_NEWNET) != 0:
         errno = ctypes.get_errno()
