@@ -32,9 +32,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, BinaryIO
 
+import numpy as np
 from pyulog import ULog
 from pyulog.core import ULogException
 
+from fuzzoff.formats.ulog.framing import Framed, RowPlan, frame
 from fuzzoff.recording import SourceError, SourceProblem
 
 _unpack_header = struct.Struct("<HB").unpack
@@ -163,7 +165,22 @@ class _TrackedULog(ULog):  # type: ignore[misc]
     MessageLoggingTagged = _whole(ULog.MessageLoggingTagged)
     MessageDropout = _whole(ULog.MessageDropout)
 
-    def __init__(self, path: str, topics: Sequence[str] | None, header_only: bool) -> None:
+    def __init__(
+        self,
+        path: str,
+        topics: Sequence[str] | None,
+        header_only: bool,
+        plan: RowPlan | None = None,
+    ) -> None:
+        self._plan = plan
+        self.framed: Framed | None = None
+        """What the framing pass handed pyulog (``framing``), None: pyulog read the file."""
+        self.framing_failed = False
+        """pyulog's read of the framed records disagreed with the framing (``load`` reads
+        the file again, whole)."""
+        self.rows_read: dict[tuple[str, int], Any] = {}
+        """(topic, instance) -> the rows decoded, where not every row was (the others hold
+        zeros)."""
         self._headers: list[tuple[str, _Header]] = []
         self._section = "definitions"
         self._corruption: _Corruption | None = None
@@ -247,7 +264,53 @@ class _TrackedULog(ULog):  # type: ignore[misc]
         handle = getattr(self, "_file_handle", None)
         if isinstance(handle, _DefinitionsHandle):
             self._file_handle = handle.file
+        if (
+            self._plan is not None
+            and message_name_filter_list is not None
+            and read_until is None
+            and not self.has_data_appended
+            and not self.damaged_formats
+            and self._corruption is None
+        ):
+            start = self._file_handle.tell()
+            framed = frame(
+                self._file_handle.read(),
+                self._message_formats,
+                self._start_timestamp,
+                message_name_filter_list,
+                self._plan,
+            )
+            if framed is not None:
+                self.framed = framed
+                self._file_handle = io.BytesIO(framed.data)
+                super()._read_file_data(message_name_filter_list)
+                self._expand(framed)
+                return
+            self._file_handle.seek(start)
         super()._read_file_data(message_name_filter_list, read_until)
+
+    def _expand(self, framed: Framed) -> None:
+        """The thinned topic instances to their full length: every row's timestamp, the rows
+        read in their places, zeros in the others (``rows_read`` says which are which)."""
+        found = 0
+        for data in self._data_list:
+            key = (data.name, data.multi_id)
+            if key not in framed.partial:
+                continue
+            found += 1
+            stamps, rows = framed.partial[key]
+            columns = data.data
+            if not np.array_equal(columns.get("timestamp"), stamps[rows]):
+                self.framing_failed = True
+                return
+            for name, column in columns.items():
+                full = np.zeros(len(stamps), dtype=column.dtype)
+                full[rows] = column
+                columns[name] = full
+            columns["timestamp"] = stamps
+            self.rows_read[key] = rows
+        if found != len(framed.partial) or self._last_timestamp != framed.last_timestamp:
+            self.framing_failed = True
 
     @property
     def corruption(self) -> _Corruption | None:
@@ -268,6 +331,8 @@ class Loaded:
     problems: list[SourceProblem] = field(default_factory=list)
     library_output: list[str] = field(default_factory=list)
     size: int = 0
+    rows_read: dict[tuple[str, int], Any] = field(default_factory=dict)
+    """(topic, instance) -> the rows pyulog decoded, where not all (``load``'s ``plan``)."""
 
 
 def load(
@@ -276,9 +341,15 @@ def load(
     *,
     header_only: bool = False,
     seconds: Callable[[int], float] | None = None,
+    plan: RowPlan | None = None,
 ) -> Loaded:
     """Read ``path`` with pyulog (only ``topics``; all when None). Raises ``SourceError`` when
-    the file is not a readable ULog at all; damage after the header becomes ``problems``."""
+    the file is not a readable ULog at all; damage after the header becomes ``problems``.
+
+    With a ``plan`` (and ``topics``), pyulog decodes only the rows the plan reads where the
+    framing pass can tell them (``framing``); ``Loaded.rows_read`` names the topic instances
+    not read whole. Where that read says anything at all is wrong, the file is read again
+    without the plan, so every problem is said as the plain read says it."""
     try:
         size = os.path.getsize(path)
     except OSError as exc:
@@ -286,7 +357,7 @@ def load(
     captured = io.StringIO()
     try:
         with contextlib.redirect_stdout(captured):
-            ulog = _TrackedULog(str(path), topics, header_only)
+            ulog = _TrackedULog(str(path), topics, header_only, plan)
     except ULogException as exc:
         raise SourceError(path, f"not a readable ULog: {_reason(exc)}", "byte 0") from None
     except OSError as exc:
@@ -301,6 +372,10 @@ def load(
     if not header_only:
         loaded.problems.extend(_drop_damaged_formats(ulog, topics))
     loaded.problems.extend(_drop_unreadable_parameters(ulog))
+    if ulog.framed is not None:
+        if ulog.framing_failed or loaded.problems or loaded.library_output:
+            return load(path, topics, header_only=header_only, seconds=seconds)
+        loaded.rows_read = ulog.rows_read
     return loaded
 
 

@@ -23,7 +23,7 @@ import numpy as np
 from fuzzoff import events as ev
 from fuzzoff import releases
 from fuzzoff.formats.ulog.load import Loaded, load, quoted
-from fuzzoff.formats.ulog.thinning import windows_for
+from fuzzoff.formats.ulog.thinning import Windows, windows_for
 from fuzzoff.formats.ulog.topics import (
     EXTRA_FIELDS,
     EXTRA_TOPICS,
@@ -139,6 +139,8 @@ class UlogSource(Source):
         self._info: RecordingInfo | None = None
         self._yielded = 0
         self._total = 0
+        self._whole = False
+        """Every row decoded, whatever ``every_row`` says (see ``events``)."""
 
     # -- loading ---------------------------------------------------------------------------
 
@@ -164,15 +166,23 @@ class UlogSource(Source):
         if self._failed is not None:
             raise self._failed
         if self._loaded is None:
+            # The rows a lint reads, told to the load (``framing``): not for a tool that wants
+            # every row, nor where the HTML report plots the positions the events leave out.
+            thin = not (self.every_row or self._whole) and self.aside.plot is None
             try:
-                self._loaded = load(self.path, LOADED_TOPICS)
+                loaded = load(self.path, LOADED_TOPICS, plan=_ReadRows() if thin else None)
+                renamed = _drop_renamed_fields(loaded.ulog)
+                if renamed and loaded.rows_read:  # the plan read the topics the lint drops
+                    loaded = load(self.path, LOADED_TOPICS)
+                    renamed = _drop_renamed_fields(loaded.ulog)
             except SourceError as exc:
                 self._failed = exc
                 raise
-            self.problems.extend(self._loaded.problems)
-            self.problems.extend(_drop_renamed_fields(self._loaded.ulog))
-            if self._loaded.library_output:
-                self.stats["pyulog_messages"] = self._loaded.library_output[:20]
+            self._loaded = loaded
+            self.problems.extend(loaded.problems)
+            self.problems.extend(renamed)
+            if loaded.library_output:
+                self.stats["pyulog_messages"] = loaded.library_output[:20]
         return self._loaded
 
     def _datasets(self) -> list[Any]:
@@ -276,20 +286,25 @@ class UlogSource(Source):
         self.set_start(_utc_start(datasets, t0))
         self.aside.read((int(ulog.last_timestamp) - t0) / 1e6)  # the last row, event or not
         windows = None if self.every_row else windows_for(datasets)
+        rows_read = self._load().rows_read
         for d in datasets:
             spec = specs.get(d.name)
             if spec is None:
                 continue
             rank = ranks[d.name] * 256 + d.multi_id
             topic = d.name if d.multi_id == 0 else f"{d.name}_{d.multi_id}"
-            keep = None
-            if windows is not None:
-                keep = windows.rows(d.data, spec.kind)
-            if spec.kind == ev.VehiclePosition.kind:
-                keep = _one_per_period(d.data["timestamp"], POSITION_PERIOD_S)
-                if self.aside.plot is not None:
-                    others = _others(keep, len(d.data["timestamp"]))
-                    self._plot(_stream(d.data, topic, rank, t0, spec.decode, context, others))
+            keep = _rows(windows, d, spec.kind)
+            read = rows_read.get((d.name, d.multi_id))
+            if read is not None and (keep is None or not bool(np.isin(keep, read).all())):
+                # ``_ReadRows`` decides as this loop does, so this is not expected: were it
+                # to happen, the file is read again, every row decoded (the load had found
+                # nothing wrong, so there is nothing to take back from ``problems``)
+                self._loaded, self._info, self._whole = None, None, True
+                yield from self.events()
+                return
+            if spec.kind == ev.VehiclePosition.kind and self.aside.plot is not None:
+                others = _others(keep, len(d.data["timestamp"]))
+                self._plot(_stream(d.data, topic, rank, t0, spec.decode, context, others))
             topics.append(_stream(d.data, topic, rank, t0, spec.decode, context, keep))
         legacy = _legacy_flags(datasets)
         if legacy is not None:
@@ -431,6 +446,44 @@ class UlogSource(Source):
         if not self._total:
             return None
         return min(1.0, self._yielded / self._total)
+
+
+def _rows(windows: Windows | None, d: Any, kind: str) -> Any:
+    """The rows of topic instance ``d`` (of event ``kind``) a lint reads; None: all."""
+    if kind == ev.VehiclePosition.kind:
+        return _one_per_period(d.data["timestamp"], POSITION_PERIOD_S)
+    return windows.rows(d.data, kind) if windows is not None else None
+
+
+class _ReadRows:
+    """The rows ``events`` reads, told to the load before pyulog decodes them (``framing``):
+    the windows come from the status and declarations, decoded first."""
+
+    first: tuple[str, ...] = ("vehicle_status", "offboard_control_mode")
+
+    def __init__(self) -> None:
+        self.windows: Windows | None = None
+
+    def prepare(self, datasets: list[Any]) -> None:
+        self.windows = windows_for(
+            [d for d in datasets if "timestamp" in d.data and len(d.data["timestamp"])]
+        )
+
+    def rows(self, name: str, timestamps: Any) -> Any:
+        spec = TOPICS.get(name)
+        if spec is None:
+            return None
+        return _rows(self.windows, _Columns(name, {"timestamp": timestamps}), spec.kind)
+
+
+class _Columns:
+    """A topic instance's columns, as pyulog's ``Data`` holds them (``name``, ``data``)."""
+
+    __slots__ = ("data", "name")
+
+    def __init__(self, name: str, data: dict[str, Any]) -> None:
+        self.name = name
+        self.data = data
 
 
 def _utc_start(datasets: list[Any], t0: int) -> float | None:
