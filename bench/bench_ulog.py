@@ -223,6 +223,7 @@ def main() -> None:
         f"{wall < 1.0}"
     )
     _real_verdict(files["real-10min"])
+    print(f"  (real-10min: {framing(files['real-10min'])})")
     for name in files:
         wall, cpu = ratio(name, "fuzzoff ulog reader alone")
         fwall, fcpu = ratio(name, "fuzzoff ulog reader alone", "pyulog, fuzzoff's filter list")
@@ -257,6 +258,20 @@ def _real_verdict(path: Path) -> None:
     )
 
 
+def framing(path: Path) -> str:
+    """How many of the log's data records the lint hands pyulog (``formats/ulog/framing.py``)."""
+    from fuzzoff.formats.ulog.load import load
+    from fuzzoff.formats.ulog.reader import _ReadRows
+
+    framed = load(path, LOADED_TOPICS, plan=_ReadRows()).ulog.framed
+    if framed is None:
+        return "no framing pass (pyulog read every record)"
+    return (
+        f"framing pass: pyulog decodes {framed.kept:,} of the {framed.records:,} records of "
+        f"the data section"
+    )
+
+
 def real_only() -> None:
     """Only the real-shaped ten-minute log (``BENCH_ULOG=real python -m bench ulog``)."""
     path = generate_real(DATA / "ulog_real_10min.ulg")
@@ -265,6 +280,7 @@ def real_only() -> None:
     print(f"real-10min: {path.stat().st_size / 1e6:.1f} MB, {reader_run.output.strip()} events")
     print(f"  pyulog, fuzzoff's filter list {filtered.cpu_s:.2f} s CPU (best of 3)")
     print(f"  fuzzoff ulog reader alone     {reader_run.cpu_s:.2f} s CPU (best of 3)")
+    print(f"  ({framing(path)})")
     _real_verdict(path)
 
 

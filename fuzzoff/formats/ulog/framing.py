@@ -68,6 +68,10 @@ class Framed:
     """(topic, instance) -> (every row's timestamp, the rows kept): the instances thinned."""
     last_timestamp: int
     """pyulog's ``last_timestamp`` had it read every record."""
+    records: int
+    """Records in the data section."""
+    kept: int
+    """Records handed to pyulog."""
 
 
 def frame(
@@ -154,7 +158,7 @@ def frame(
     partial = {key: (ts, np.flatnonzero(keep[numbers])) for key, numbers, ts in thinned}
     kept = np.flatnonzero(keep)
     data = b"".join(_runs(buf, starts[kept], ends[kept]))
-    return Framed(data, partial, last)
+    return Framed(data, partial, last, len(starts), len(kept))
 
 
 def _walk(buf: bytes) -> tuple[Any, Any, Any, Any] | None:

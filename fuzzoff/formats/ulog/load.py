@@ -18,6 +18,13 @@ data record whose size field reads 0) makes pyulog stop reading as if the file h
 such a record is made corruption, which pyulog skips; and a format record (``F``) whose text a
 flipped byte damaged still parses, so each one is checked against the ULog grammar
 (``_format_damage``) and the topics it describes are set aside.
+
+A fifth gap is speed: pyulog's per-record loop runs over every record of the data section
+whatever the filter. Given a reader's ``RowPlan``, ``_TrackedULog`` first walks the record framing
+(``framing``) and hands pyulog only the records the reader will read; at anything unusual it
+hands pyulog the file as it is, and ``load`` reads the file again without the plan whenever
+pyulog's read of the framed records reports anything, so every problem above is found and
+placed by the plain read.
 """
 
 from __future__ import annotations
