@@ -129,3 +129,11 @@ def test_a_sync_record_is_read_by_pyulog(tmp_path: Path) -> None:
     assert loaded.ulog.framed is None
     assert not loaded.problems
     assert _read(path, whole=False) == _read(path, whole=True)
+
+
+def test_a_log_past_the_limit_is_read_by_pyulog(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The framing pass holds the data section in memory: past ``LIMIT`` pyulog reads alone."""
+    monkeypatch.setattr("fuzzoff.formats.ulog.load.LIMIT", 1000)
+    loaded = load(BIGGEST, LOADED_TOPICS, plan=_ReadRows())
+    assert loaded.ulog.framed is None
+    assert not loaded.rows_read

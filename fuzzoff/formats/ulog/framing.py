@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import io
 import struct
+from array import array
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
@@ -42,6 +43,11 @@ _KINDS = np.frombuffer(b"DAIMPQLCO", dtype=np.uint8)
 """Record types of the data section this pass hands pyulog: data, and the others as they are
 (PX4's logger writes no others there but the sync record, which sends this pass back to
 pyulog's own read)."""
+
+
+LIMIT = 512 << 20
+"""The largest data section walked (bytes): it is held in memory whole, with some 40 bytes a
+record of arrays; a bigger log is read by pyulog alone, as before."""
 
 
 class RowPlan(Protocol):
@@ -167,7 +173,7 @@ def _walk(buf: bytes) -> tuple[Any, Any, Any, Any] | None:
     The one loop over every record: it reads a record's size (2 bytes, little-endian) and
     steps over the record, nothing else (about 0.14 µs a record, against pyulog's 1.3 µs)."""
     end = len(buf)
-    starts: list[int] = []
+    starts = array("q")  # 8 bytes a record, no object each
     add = starts.append
     pos = 0
     try:
@@ -178,7 +184,7 @@ def _walk(buf: bytes) -> tuple[Any, Any, Any, Any] | None:
         return None  # the file ends inside a record header
     if pos != end:
         return None  # the last record runs past the end of the file
-    s = np.array(starts, dtype=np.int64)
+    s = np.frombuffer(starts, dtype=np.int64) if len(starts) else np.zeros(0, np.int64)
     kinds = np.frombuffer(buf, dtype=np.uint8)[s + 2] if len(s) else np.zeros(0, np.uint8)
     if not bool(np.isin(kinds, _KINDS).all()):
         return None  # a record type the logger does not write in the data section

@@ -43,7 +43,7 @@ import numpy as np
 from pyulog import ULog
 from pyulog.core import ULogException
 
-from fuzzoff.formats.ulog.framing import Framed, RowPlan, frame
+from fuzzoff.formats.ulog.framing import LIMIT, Framed, RowPlan, frame
 from fuzzoff.recording import SourceError, SourceProblem
 
 _unpack_header = struct.Struct("<HB").unpack
@@ -280,13 +280,16 @@ class _TrackedULog(ULog):  # type: ignore[misc]
             and self._corruption is None
         ):
             start = self._file_handle.tell()
-            framed = frame(
-                self._file_handle.read(),
-                self._message_formats,
-                self._start_timestamp,
-                message_name_filter_list,
-                self._plan,
-            )
+            size = os.fstat(self._file_handle.fileno()).st_size
+            framed = None
+            if size - start <= LIMIT:
+                framed = frame(
+                    self._file_handle.read(),
+                    self._message_formats,
+                    self._start_timestamp,
+                    message_name_filter_list,
+                    self._plan,
+                )
             if framed is not None:
                 self.framed = framed
                 self._file_handle = io.BytesIO(framed.data)
