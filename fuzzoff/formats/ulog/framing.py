@@ -26,11 +26,12 @@ log's ``last_timestamp`` is the latest of all; the row that sets each of those i
 from __future__ import annotations
 
 import io
+import mmap
 import struct
 from array import array
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, Protocol
+from typing import Any, Protocol, TypeAlias
 
 import numpy as np
 from pyulog import ULog
@@ -45,9 +46,12 @@ _KINDS = np.frombuffer(b"DAIMPQLCO", dtype=np.uint8)
 pyulog's own read)."""
 
 
+Buffer: TypeAlias = bytes | mmap.mmap
+"""The file's bytes: indexing gives an int, slicing bytes."""
+
 LIMIT = 512 << 20
-"""The largest data section walked (bytes): it is held in memory whole, with some 40 bytes a
-record of arrays; a bigger log is read by pyulog alone, as before."""
+"""The largest data section walked (bytes): the file is mapped, not copied, but the pass keeps
+some 40 bytes of arrays a record; a bigger log is read by pyulog alone, as before."""
 
 
 class RowPlan(Protocol):
@@ -81,14 +85,16 @@ class Framed:
 
 
 def frame(
-    buf: bytes,
+    buf: Buffer,
+    start: int,
     formats: dict[str, Any],
     start_timestamp: int,
-    topics: Sequence[str],
     plan: RowPlan,
+    topics: Sequence[str],
 ) -> Framed | None:
-    """The kept records of data section ``buf`` (None: anything unusual, see the module)."""
-    walked = _walk(buf)
+    """The kept records of the data section, ``buf`` (the file, mapped) from byte ``start`` to
+    its end (None: anything unusual, see the module). No view of ``buf`` is kept."""
+    walked = _walk(buf, start)
     if walked is None:
         return None
     starts, kinds, sizes, ends = walked
@@ -167,7 +173,7 @@ def frame(
     return Framed(data, partial, last, len(starts), len(kept))
 
 
-def _walk(buf: bytes) -> tuple[Any, Any, Any, Any] | None:
+def _walk(buf: Buffer, pos: int) -> tuple[Any, Any, Any, Any] | None:
     """Every record's start, type, size and end, or None where the framing is not intact.
 
     The one loop over every record: it reads a record's size (2 bytes, little-endian) and
@@ -175,7 +181,6 @@ def _walk(buf: bytes) -> tuple[Any, Any, Any, Any] | None:
     end = len(buf)
     starts = array("q")  # 8 bytes a record, no object each
     add = starts.append
-    pos = 0
     try:
         while pos < end:
             add(pos)
@@ -196,7 +201,7 @@ def _walk(buf: bytes) -> tuple[Any, Any, Any, Any] | None:
 
 
 def _subscriptions(
-    buf: bytes, starts: Any, kinds: Any, sizes: Any, formats: dict[str, Any]
+    buf: Buffer, starts: Any, kinds: Any, sizes: Any, formats: dict[str, Any]
 ) -> dict[int, tuple[int, Any]] | None:
     """msg id -> (record number, pyulog's ``_MessageAddLogged``), or None (see the module)."""
     found: dict[int, tuple[int, Any]] = {}
@@ -228,7 +233,7 @@ class _Header:
 
 
 def _first(
-    buf: bytes,
+    buf: Buffer,
     starts: Any,
     ends: Any,
     subscriptions: dict[int, tuple[int, Any]],
@@ -272,7 +277,7 @@ def _keep_dating_rows(keep: Any, kinds: Any, read: Any, stamps: Any, start: int)
     return int(running[-1]) if n else start
 
 
-def _runs(buf: bytes, starts: Any, ends: Any) -> list[Any]:
+def _runs(buf: Buffer, starts: Any, ends: Any) -> list[Any]:
     """Slices of ``buf`` covering the records [starts[i], ends[i]), adjacent ones joined."""
     if not len(starts):
         return []

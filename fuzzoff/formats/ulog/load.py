@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import mmap
 import os
 import re
 import struct
@@ -279,25 +280,34 @@ class _TrackedULog(ULog):  # type: ignore[misc]
             and not self.damaged_formats
             and self._corruption is None
         ):
-            start = self._file_handle.tell()
-            size = os.fstat(self._file_handle.fileno()).st_size
-            framed = None
-            if size - start <= LIMIT:
-                framed = frame(
-                    self._file_handle.read(),
-                    self._message_formats,
-                    self._start_timestamp,
-                    message_name_filter_list,
-                    self._plan,
-                )
+            framed = self._frame(self._file_handle, message_name_filter_list)
             if framed is not None:
                 self.framed = framed
                 self._file_handle = io.BytesIO(framed.data)
                 super()._read_file_data(message_name_filter_list)
                 self._expand(framed)
                 return
-            self._file_handle.seek(start)
         super()._read_file_data(message_name_filter_list, read_until)
+
+    def _frame(self, file: BinaryIO, topics: Sequence[str]) -> Framed | None:
+        """The framing pass over the data section, from where ``file`` is (``framing``), on
+        the file mapped into memory (read in place: no copy of it)."""
+        assert self._plan is not None
+        start = file.tell()
+        try:
+            size = os.fstat(file.fileno()).st_size
+            if not 0 < size - start <= LIMIT:
+                return None
+            mapped = mmap.mmap(file.fileno(), 0, access=mmap.ACCESS_READ)
+        except (OSError, ValueError, io.UnsupportedOperation):
+            return None
+        try:
+            return frame(
+                mapped, start, self._message_formats, self._start_timestamp, self._plan, topics
+            )
+        finally:
+            with contextlib.suppress(BufferError):  # a view still held: closed when it goes
+                mapped.close()
 
     def _expand(self, framed: Framed) -> None:
         """The thinned topic instances to their full length: every row's timestamp, the rows
