@@ -13,7 +13,7 @@ import pytest
 
 from fuzzoff.formats.ulog.load import load
 from fuzzoff.formats.ulog.reader import LOADED_TOPICS, UlogSource, _ReadRows
-from fuzzoff.recording import SourceError
+from fuzzoff.recording import PlotSamples, SourceError
 
 ROOT = Path(__file__).resolve().parent.parent
 ULOGS = sorted((ROOT / "corpora").rglob("*.ulg"))
@@ -137,3 +137,20 @@ def test_a_log_past_the_limit_is_read_by_pyulog(monkeypatch: pytest.MonkeyPatch)
     loaded = load(BIGGEST, LOADED_TOPICS, plan=_ReadRows())
     assert loaded.ulog.framed is None
     assert not loaded.rows_read
+
+
+def test_plots_asked_for_after_open_get_every_position() -> None:
+    """The HTML report's plots show the positions the events leave out: a source opened
+    before the plots were asked for reads the file again, whole."""
+
+    def positions(plot_first: bool) -> list[Any]:
+        source = UlogSource(BIGGEST)
+        if plot_first:
+            source.aside.plot = PlotSamples()
+        with source:
+            source.probe()
+            source.aside.plot = source.aside.plot or PlotSamples()
+            events = [repr(e) for e in source.events()]
+        return [events, repr(vars(source.aside.plot))]
+
+    assert positions(plot_first=False) == positions(plot_first=True)

@@ -295,10 +295,14 @@ class UlogSource(Source):
             topic = d.name if d.multi_id == 0 else f"{d.name}_{d.multi_id}"
             keep = _rows(windows, d, spec.kind)
             read = rows_read.get((d.name, d.multi_id))
-            if read is not None and (keep is None or not bool(np.isin(keep, read).all())):
-                # ``_ReadRows`` decides as this loop does, so this is not expected: were it
-                # to happen, the file is read again, every row decoded (the load had found
-                # nothing wrong, so there is nothing to take back from ``problems``)
+            plotted = spec.kind == ev.VehiclePosition.kind and self.aside.plot is not None
+            if read is not None and (
+                keep is None or plotted or not bool(np.isin(keep, read).all())
+            ):
+                # ``_ReadRows`` decides as this loop does, and ``_load`` reads every row for
+                # the plots, so this is not expected (a plot asked for after ``open``): the
+                # file is read again, every row decoded (the load had found nothing wrong, so
+                # there is nothing to take back from ``problems``)
                 self._loaded, self._info, self._whole = None, None, True
                 yield from self.events()
                 return
