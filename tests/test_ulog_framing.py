@@ -154,3 +154,11 @@ def test_plots_asked_for_after_open_get_every_position() -> None:
         return [events, repr(vars(source.aside.plot))]
 
     assert positions(plot_first=False) == positions(plot_first=True)
+
+
+def test_a_log_with_little_to_leave_out_is_read_by_pyulog(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Where too few records could be left out (``WORTH``), the pass stops after its walk."""
+    monkeypatch.setattr("fuzzoff.formats.ulog.framing.WORTH", 1.01)
+    loaded = load(BIGGEST, LOADED_TOPICS, plan=_ReadRows())
+    assert loaded.ulog.framed is None
+    assert _read(BIGGEST, whole=False) == _read(BIGGEST, whole=True)

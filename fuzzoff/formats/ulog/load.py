@@ -296,7 +296,7 @@ class _TrackedULog(ULog):  # type: ignore[misc]
         start = file.tell()
         try:
             size = os.fstat(file.fileno()).st_size
-            if not 0 < size - start <= LIMIT:
+            if not 0 < size - start <= LIMIT or size >= 1 << 31:
                 return None
             mapped = mmap.mmap(file.fileno(), 0, access=mmap.ACCESS_READ)
         except (OSError, ValueError, io.UnsupportedOperation):

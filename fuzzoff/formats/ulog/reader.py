@@ -23,7 +23,7 @@ import numpy as np
 from fuzzoff import events as ev
 from fuzzoff import releases
 from fuzzoff.formats.ulog.load import Loaded, load, quoted
-from fuzzoff.formats.ulog.thinning import Windows, windows_for
+from fuzzoff.formats.ulog.thinning import THINNED_KINDS, Windows, windows_for
 from fuzzoff.formats.ulog.topics import (
     EXTRA_FIELDS,
     EXTRA_TOPICS,
@@ -471,6 +471,12 @@ class _ReadRows:
     def prepare(self, datasets: list[Any]) -> None:
         self.windows = windows_for(
             [d for d in datasets if "timestamp" in d.data and len(d.data["timestamp"])]
+        )
+
+    def thinned(self, name: str) -> bool:
+        spec = TOPICS.get(name)
+        return spec is not None and (
+            spec.kind == ev.VehiclePosition.kind or spec.kind in THINNED_KINDS
         )
 
     def rows(self, name: str, timestamps: Any) -> Any:
