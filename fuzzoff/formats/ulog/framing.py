@@ -16,7 +16,9 @@ file, a record type other than those PX4's logger writes in the data section (a 
 included), a data record too short for its message id or of a size pyulog would call corrupt,
 a message id with no subscription before it, a subscription pyulog cannot decode, one id or one
 topic instance subscribed twice, a timestamp that is not ``uint64_t``. So every damage report,
-position and truncation message is the one the plain read gives.
+position and truncation message is the one the plain read gives. It also stops after its walk
+where under half the records could be left out (``WORTH``), and on a data section over
+``LIMIT``.
 
 Rows dropped leave no trace pyulog would see, but for the times it dates records by: pyulog
 dates a parameter change and a dropout at the latest data timestamp read before it, and the
