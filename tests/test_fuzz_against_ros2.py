@@ -10,6 +10,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import time
 import types
 from pathlib import Path
 
@@ -418,6 +419,92 @@ def test_a_time_sync_jump_mid_stream_does_not_move_the_models_times() -> None:
     assert len(losses) >= 3
     assert all(i.agree for i in losses), [i.note for i in losses]
     assert not [i for i in verdict.items if i.agree is False]
+
+
+def test_an_output_near_a_time_sync_jump_is_paired_by_its_own_offsets_distance() -> None:
+    """A real exchange of the main-2026-08-13 campaign (COM_OF_LOSS_T 0.2, four losses):
+    PX4's bridge jumped to a time sync offset 213 ms away near the stream's end, and an output
+    published just before it could be read with either offset. The pairing compared the
+    first offset's exact match (0 ms) with the second's time, 213 ms away, so the second's
+    3 ms match won: the clock's residual rose to 12 ms and the last loss time 'differed' (the
+    model 24 ms after PX4's newest keep-alive, PX4 240 ms). Each candidate is now judged by
+    its distance from the time its own offset gives."""
+    from fuzzoff.bridge.bag import read_bag
+    from fuzzoff.bridge.clock import measure
+    from fuzzoff.bridge.ulog import read_ulog
+    from fuzzoff.sitl.ros2 import verdict as ros2_verdict
+
+    exchanges = Path(__file__).resolve().parent.parent / "corpora" / "against" / "exchanges"
+    bag = exchanges / "timesync_jump_pairing-main-2026-08-13-mcap"
+    ulog = exchanges / "timesync_jump_pairing-main-2026-08-13.ulg"
+    log = read_ulog(ulog, ros2_verdict.STATUS)
+    (_, first), (_, second) = log.syncs
+    assert abs(second - first) > 200_000
+    clock = measure(read_bag(bag), log)
+    assert clock.pairs >= 30 and clock.residual_us < 5_000
+    verdict = ros2_verdict.compare(bag, "main", ulog, {"COM_OF_LOSS_T": 0.2})
+    losses = [i for i in verdict.items if i.what == "loss time"]
+    assert len(losses) == 4 and all(i.agree for i in losses), [i.model for i in losses]
+    assert not [i for i in verdict.items if i.agree is False]
+
+
+STALL = "sim_stall_offboard_disarmed-main-2026-08-13"
+"""A stream of main-2026-08-13's ROS 2 campaign (seed 0): 20 s of keep-alives with no flag
+set, DO_SET_MODE OFFBOARD disarmed. PX4 took the switch, and its SIH stopped the clock ("SIH
+lockstep: timed out waiting for actuator_outputs_sim"): its log spans 0.6 s."""
+
+
+def test_a_stream_on_which_mains_sih_stopped_px4s_clock_is_not_run_saying_why(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The campaign judged it and met an IndexError (no time sync and no pair in a log of
+    0.6 s), which Hypothesis then hid as "Unreliable assumption". The stream is now not run,
+    with the reason: PX4 ran nothing after its clock stopped."""
+    pytest.importorskip("cyclonedds")
+    from fuzzoff.sitl.bench import LiveRun
+
+    exchanges = Path(__file__).resolve().parent.parent / "corpora" / "against" / "exchanges"
+    bag, ulog = exchanges / f"{STALL}-mcap", exchanges / f"{STALL}.ulg"
+    meant = [0.1 * i for i in range(201)]
+    run = LiveRun(bag, ulog, meant, meant, {}, False, 0.0, [])
+    campaign = Campaign(_config(tmp_path), log=lambda line: None)
+    monkeypatch.setattr(campaign, "_exchange", lambda example, stem: run)
+    example = Example(3, _ros2_stream(), "failed")
+    campaign._send(example, tmp_path / "0003")
+    assert example.status == "failed" and example.verdict is None
+    assert example.reason is not None
+    assert "PX4's simulated clock stopped" in example.reason
+    assert "SIH lockstep: timed out" in example.reason
+    assert "0.6 s of the 20.0 s sent" in example.reason
+
+
+def test_a_bag_and_a_log_with_nothing_to_align_by_are_refused_in_one_line() -> None:
+    """The stalled stream's log holds no time sync and none of PX4's outputs in the bag: the
+    ROS 2 verdict says it cannot put the bag on PX4's clock (it raised an IndexError)."""
+    from fuzzoff.bridge import BridgeError
+    from fuzzoff.sitl.ros2 import verdict as ros2_verdict
+
+    exchanges = Path(__file__).resolve().parent.parent / "corpora" / "against" / "exchanges"
+    with pytest.raises(BridgeError, match="cannot be put on PX4's clock"):
+        ros2_verdict.compare(exchanges / f"{STALL}-mcap", "main", exchanges / f"{STALL}.ulg")
+
+
+def test_an_error_of_fuzzoffs_own_in_a_campaign_is_raised_as_it_is(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Hypothesis runs a failing example again to confirm it; the campaign then rejects it as a
+    shape already sent and Hypothesis reported only "Unreliable assumption" (FlakyFailure),
+    hiding the error. The error now ends the search and is raised itself."""
+    pytest.importorskip("cyclonedds")
+    campaign = Campaign(_config(tmp_path), log=lambda line: None)
+
+    def send(scenario: Scenario, purpose: str) -> Example:
+        raise IndexError("the error itself")
+
+    monkeypatch.setattr(campaign, "send", send)
+    campaign.started = time.monotonic()
+    with pytest.raises(IndexError, match="the error itself"):
+        campaign._search()
 
 
 MATRIX = os.environ.get("FUZZOFF_SITL_MATRIX") == "1"

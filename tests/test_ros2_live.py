@@ -69,16 +69,22 @@ MATRIX = os.environ.get("FUZZOFF_SITL_MATRIX") == "1"
 MATRIX_BUNDLES = ("1.16.2", "1.18.0")
 ROVER_BUNDLES = ("1.17.0", "1.18.0")
 """The bridge bundles built with the rover modules that fly the rover (not main: see below)."""
+MAIN_BUNDLE = "main"
+"""main-2026-08-13 flies the standard VTOL and the airplane programs (issue 33)."""
 
 
 def _matrix() -> list[object]:
     from fuzzoff.sitl.airframes import DOES_NOT_FLY
-    from fuzzoff.sitl.ros2.programs import PROGRAMS
+    from fuzzoff.sitl.ros2.programs import FW_PROGRAMS, PROGRAMS, VTOL_PROGRAMS
 
     params = [
         pytest.param(name, release, id=f"{name}-{release}")
         for name, program in PROGRAMS.items()
         for release in (ROVER_BUNDLES if program.rover is not None else MATRIX_BUNDLES)
+    ]
+    params += [
+        pytest.param(p.name, MAIN_BUNDLE, id=f"{p.name}-{MAIN_BUNDLE}")
+        for p in (*VTOL_PROGRAMS, *FW_PROGRAMS)
     ]
     why = DOES_NOT_FLY[("main", "sihsim_rover_ackermann")]
     params += [
@@ -103,7 +109,9 @@ def test_every_ros2_program_flies_and_its_bags_say_what_it_is(
     program: str, release: str, tmp_path: Path
 ) -> None:
     """Each program on each bridge release: the flight is flown and recorded, and a clean one
-    lints clean, a hazard gives its error, where fuzzoff already reports it (``missed``)."""
+    lints clean, a hazard gives its error, where fuzzoff already reports it (``missed``); on
+    the VTOL and airplane flights the gate model, run on the bag, agrees with PX4's ULog on
+    every switch, arm, loss, failsafe action, return and disarm."""
     from fuzzoff.sitl.ros2.programs import PROGRAMS
 
     spec = PROGRAMS[program]
@@ -119,6 +127,14 @@ def test_every_ros2_program_flies_and_its_bags_say_what_it_is(
     else:  # discovery beat the ARM every time: the hazard was never flown
         pytest.fail(f"PX4 answered the ARM in {LOST_ARM_ATTEMPTS} flights of {program}")
     bag = next(Path(p) for p in summary["recordings"] if p.endswith("-mcap"))
+    if spec.vtol is not None:  # the VTOL and airplane programs: the model against PX4's ULog
+        from fuzzoff.sitl.ros2.verdict import compare
+
+        ulog = next(Path(p) for p in summary["recordings"] if p.endswith(".ulg"))
+        verdict = compare(bag, release, ulog, vehicle=spec.vehicle or "mc")
+        assert not [i for i in verdict.items if i.agree is False], [
+            (i.what, i.px4, i.model) for i in verdict.items
+        ]
     lint = run_cli(["lint", str(bag), *spec.lint_args, "--format", "json"])
     (report,) = json.loads(lint.stdout)["files"]
     if spec.missed is not None:

@@ -150,6 +150,21 @@ def test_a_land_verdict_older_than_one_sample_period_is_judged() -> None:
     assert _land_sample_lag(Truth(), 10.0, "disarm", refused) == ""
 
 
+def test_a_land_verdict_px4_published_between_the_disarm_and_its_answer_is_not_judged() -> None:
+    """fw_ground_gate over the ROS 2 bridge on main-2026-08-13 (a live run, not kept): PX4 took
+    the plain disarm, its land detector counting the rolling airplane landed in the Commander
+    cycle between the disarm's stamp and the answer; the bag had no such sample when the node
+    sent it, so the model refused it. That is not judged, saying why."""
+    from fuzzoff.sitl.truth import Truth
+    from fuzzoff.sitl.verdict import _land_sample_lag
+
+    truth = Truth(landed=[(0.0, True), (13.46, False), (16.64, True)])
+    refused = {"what": "disarm_rejected", "message": "land detector: not landed since 7.38 s"}
+    note = _land_sample_lag(truth, 16.628, "disarm", refused)
+    assert "said landed 12 ms after the disarm's stamp, before PX4 answered it" in note
+    assert _land_sample_lag(truth, 16.5, "disarm", refused) == ""  # 140 ms before: judged
+
+
 def test_thinning_cuts_the_fast_topics_and_keeps_the_stream_whole(tmp_path: Path) -> None:
     from pyulog import ULog
 

@@ -4,9 +4,13 @@ Run from the repository root with a Python that has the ``ros2live`` extra (cycl
 root (each flight runs in its own network namespace, ``fuzzoff.sitl.ros2.netns``):
 
     python corpora/ros2bridge/record.py [PROGRAM-BUNDLE ...]
+    python corpora/ros2bridge/record.py --from DIR PROGRAM-BUNDLE ...
 
-(when none is named: every run of ``RUNS``). Each run boots a fresh PX4 with the Micro
-XRCE-DDS Agent (``../shared/px4-sitl/``) and leaves beside this file:
+(when none is named: every run of ``RUNS``). ``--from DIR`` takes flights already flown by
+``fuzzoff sitl run PROGRAM --transport ros2 --release BUNDLE --save-dir DIR`` (the same flight,
+``netns.run_flight``, with the same outputs) instead of flying them again: a flight that showed
+something worth keeping (a time sync jump) is kept as it was. Each run boots a fresh PX4 with
+the Micro XRCE-DDS Agent (``../shared/px4-sitl/``) and leaves beside this file:
 
 - ``PROGRAM-BUNDLE-mcap/``, ``PROGRAM-BUNDLE-sqlite3/``: the bag of the flight, as
   ``ros2 bag record`` writes it, in both storages (``fuzzoff.sitl.ros2.bag``);
@@ -68,7 +72,12 @@ RUNS: tuple[tuple[str, str], ...] = (
     *(
         (program, bundle_name)
         for program in ("vtol_transition", "vtol_stops", "fw_ground_gate")
-        for bundle_name in ("1.18.0-beta1-head", "1.16.2-ros2", "1.17.0-ros2-rover")
+        for bundle_name in (
+            "1.18.0-beta1-head",
+            "1.16.2-ros2",
+            "1.17.0-ros2-rover",
+            "main-2026-08-13",
+        )
     ),
 )
 """(program of ``fuzzoff.sitl.ros2.programs``, bundle): one PX4 boot each."""
@@ -86,13 +95,20 @@ def cut_more(ulog: Path) -> None:
     log.write_ulog(str(ulog))
 
 
-def record(program: str, bundle_name: str) -> dict[str, object]:
+def record(program: str, bundle_name: str, flown: Path | None = None) -> dict[str, object]:
+    """One flight flown now, or taken from ``flown`` (a ``sitl run --save-dir`` folder)."""
     stem = f"{program}-{bundle_name}"
     for old in (HERE / f"{stem}-mcap", HERE / f"{stem}-sqlite3"):
         shutil.rmtree(old, ignore_errors=True)
-    done = run_flight(HERE, [program, bundle_name, stem])
-    if done.returncode != 0:
-        raise SystemExit(f"{stem}: the flight failed:\n{done.stdout}\n{done.stderr}")
+    if flown is not None:
+        for suffix in ("-mcap", "-sqlite3"):
+            shutil.copytree(flown / f"{stem}{suffix}", HERE / f"{stem}{suffix}")
+        for suffix in (".ulg", ".json"):
+            shutil.copyfile(flown / f"{stem}{suffix}", HERE / f"{stem}{suffix}")
+    else:
+        done = run_flight(HERE, [program, bundle_name, stem])
+        if done.returncode != 0:
+            raise SystemExit(f"{stem}: the flight failed:\n{done.stdout}\n{done.stderr}")
     summary_file = HERE / f"{stem}.json"
     summary: dict[str, object] = json.loads(summary_file.read_text())
     summary_file.unlink()
@@ -107,13 +123,20 @@ def record(program: str, bundle_name: str) -> dict[str, object]:
     return summary
 
 
-def main(names: list[str]) -> int:
+def main(args: list[str]) -> int:
+    flown: Path | None = None
+    if args[:1] == ["--from"]:
+        if len(args) < 3:
+            raise SystemExit("--from DIR takes the flights to keep: PROGRAM-BUNDLE ...")
+        flown, names = Path(args[1]), args[2:]
+    else:
+        names = args
     runs_file = HERE / "runs.json"
     runs = json.loads(runs_file.read_text()) if runs_file.exists() else {}
     chosen = [r for r in RUNS if not names or f"{r[0]}-{r[1]}" in names]
     for program, bundle_name in chosen:
         print(f"{program} on {bundle_name} ...", flush=True)
-        summary = record(program, bundle_name)
+        summary = record(program, bundle_name, flown)
         runs[f"{program}-{bundle_name}"] = summary
         runs_file.write_text(json.dumps(runs, indent=1, sort_keys=True) + "\n")
     return 0

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fuzzoff.bridge import BridgeError
 from fuzzoff.bridge.bag import Bag
 from fuzzoff.bridge.ulog import Px4Log
 
@@ -92,6 +93,7 @@ def pairs(bag: Bag, log: Px4Log) -> tuple[np.ndarray, np.ndarray]:
         times = logged.timestamps
         for sample in topic.samples:
             best: int | None = None
+            best_distance = PAIR_TOLERANCE_US + 1
             for index, offset in enumerate(offsets):
                 meant = sample.stamp_us - offset
                 if not _in_effect(log.syncs, index, meant):
@@ -100,11 +102,11 @@ def pairs(bag: Bag, log: Px4Log) -> tuple[np.ndarray, np.ndarray]:
                 for j in (i - 1, i):
                     if not 0 <= j < len(times):
                         continue
+                    # each candidate's distance from the time its own offset gives (against
+                    # another offset's, a match 0.2 s away beat an exact one)
                     distance = abs(int(times[j]) - meant)
-                    if distance <= PAIR_TOLERANCE_US and (
-                        best is None or distance < abs(best - meant)
-                    ):
-                        best = int(times[j])
+                    if distance < best_distance:
+                        best, best_distance = int(times[j]), distance
             if best is not None:
                 hosts.append(sample.received_us)
                 px4.append(best)
@@ -116,6 +118,12 @@ def measure(bag: Bag, log: Px4Log) -> Clock:
     hosts, px4 = pairs(bag, log)
     origin = bag.first_us
     if len(hosts) < 2:
+        if not log.syncs:
+            raise BridgeError(
+                f"{log.path}: PX4 logged no time sync with a Micro XRCE-DDS agent and none of"
+                " its outputs in the bag pair with its log: the bag's times cannot be put on"
+                " PX4's clock"
+            )
         offset = log.syncs[0][1]
         return Clock(origin, float(origin - offset), 1.0, 0, 0.0)
     order = np.argsort(hosts, kind="stable")

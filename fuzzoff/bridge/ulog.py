@@ -7,7 +7,9 @@ asked for, whole. PX4's ``uxrce_dds_client`` says each time it synchronizes with
 clock minus PX4's, the offset the bridge subtracts from an incoming ``timestamp`` and adds to an
 outgoing one (``min(value - offset, now)`` on receipt: a stamp in PX4's future becomes the
 receive time; spec 2.1.1, ``Tools/msg/templates/ucdr/msg.h.em``). A log without that line (its
-logging started after the client connected) may still hold the client's ``timesync_status``.
+logging started after the client connected) may still hold the client's ``timesync_status``,
+which also shows where the client jumped to a new offset within one session (its filter
+reset: a simulated PX4 off the host's pace, no new "synchronized" line).
 """
 
 from __future__ import annotations
@@ -61,8 +63,7 @@ def read_ulog(path: Path, names: set[str]) -> Px4Log:
         match = SYNCED.search(logged.message)
         if match is not None:
             syncs.append((int(logged.timestamp), int(match.group(1))))
-    if not syncs:
-        syncs = _from_status(log.data_list)
+    syncs = _with_jumps(syncs, log.data_list)
     topics: dict[str, ULogTopic] = {}
     for dataset in log.data_list:
         if dataset.multi_id != 0 or dataset.name in topics:
@@ -89,6 +90,41 @@ def _from_status(datasets: list[Any]) -> list[tuple[int, int]]:
     without the time sync line (one started after the client connected): its
     ``estimated_offset`` is PX4's clock less the agent's, the line's offset negated."""
     syncs: list[tuple[int, int]] = []
+    for t, offset in _status_offsets(datasets):
+        if not syncs or abs(offset - syncs[-1][1]) > SESSION_JUMP_US:
+            syncs.append((t, offset))
+    return syncs
+
+
+def _with_jumps(synced: list[tuple[int, int]], datasets: list[Any]) -> list[tuple[int, int]]:
+    """The logged time syncs (``synced``) with the offset jumps the bridge's
+    ``timesync_status`` shows within a session: the client's filter, converged on an offset
+    while a simulated PX4 drifted off the host's pace, resets to the observed one (0.23 s at
+    once on main, between two 1 Hz samples, with no "synchronized" line), and PX4's outputs
+    from then on carry the new offset. A jump is two consecutive samples more than
+    ``SESSION_JUMP_US`` apart (the estimate that follows a drifting PX4 moves a few ms a
+    second) to an offset no logged sync has. Without a logged sync the status's sessions are
+    the syncs (``_from_status``)."""
+    if not synced:
+        return _from_status(datasets)
+    merged = sorted(synced)
+    previous: int | None = None
+    for t, offset in _status_offsets(datasets):
+        jumped = previous is not None and abs(offset - previous) > SESSION_JUMP_US
+        previous = offset
+        if not jumped or t < merged[0][0]:
+            continue
+        current = [o for s, o in merged if s <= t][-1]
+        if abs(offset - current) > SESSION_JUMP_US:
+            merged.append((t, offset))
+            merged.sort()
+    return merged
+
+
+def _status_offsets(datasets: list[Any]) -> list[tuple[int, int]]:
+    """(PX4 time, offset µs as the "synchronized" line gives it) of each of the bridge's
+    ``timesync_status`` samples: its ``estimated_offset`` is PX4's clock less the agent's."""
+    found: list[tuple[int, int]] = []
     for dataset in datasets:
         data = dataset.data
         if dataset.name != "timesync_status" or "estimated_offset" not in data:
@@ -99,8 +135,6 @@ def _from_status(datasets: list[Any]) -> list[tuple[int, int]]:
             data.get("source_protocol", np.full(len(data["timestamp"]), -1)).tolist(),
             strict=True,
         ):
-            if source != SOURCE_PROTOCOL_DDS or offset == 0:
-                continue
-            if not syncs or abs(-int(offset) - syncs[-1][1]) > SESSION_JUMP_US:
-                syncs.append((int(t), -int(offset)))
-    return sorted(syncs)
+            if source == SOURCE_PROTOCOL_DDS and offset != 0:
+                found.append((int(t), -int(offset)))
+    return sorted(found)

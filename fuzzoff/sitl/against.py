@@ -43,6 +43,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 from fuzzoff import events as ev
+from fuzzoff.bridge import BridgeError
 from fuzzoff.config import Settings
 from fuzzoff.fuzz import recordings
 from fuzzoff.fuzz.reproducers import save, setup_for
@@ -56,7 +57,7 @@ from fuzzoff.sitl.classify import edge_note, health_refusals, own_changes, shape
 from fuzzoff.sitl.driver import NAV_LOITER
 from fuzzoff.sitl.link import COMPANION_SYSID, LinkError
 from fuzzoff.sitl.run import load_plan
-from fuzzoff.sitl.truth import read_truth
+from fuzzoff.sitl.truth import read_truth, sim_stalled
 from fuzzoff.sitl.variants import variants
 from fuzzoff.sitl.verdict import Item, Verdict, compare
 
@@ -246,6 +247,8 @@ class Campaign:
         self.bench = bench(config.build, config.instance, log, env, lands, fixes)
         self.known: dict[tuple[str, str, str], Disagreement] = {}
         """Disagreements followed up, by signature (a confirmed one is not followed again)."""
+        self.error: Exception | None = None
+        """An error of fuzzoff's own that stopped the search (raised once it is over)."""
         self.work = Path(tempfile.gettempdir())
         """The streams and exchanges of the runs (a temporary folder while ``run`` runs)."""
 
@@ -276,7 +279,10 @@ class Campaign:
                 self.bench.shutdown()  # type: ignore[attr-defined]  # BridgeBench's DDS side
             self.result.boots = list(self.bench.boots)
             self.result.seconds = self.elapsed()
-            shutil.rmtree(self.work, ignore_errors=True)
+            if self.error is None:
+                shutil.rmtree(self.work, ignore_errors=True)
+            else:  # what the stream that met fuzzoff's error sent and recorded
+                self.log(f"the runs' files are kept in {self.work}")
         return self.result
 
     def _search(self) -> None:
@@ -302,6 +308,12 @@ class Campaign:
             except (LinkError, bundle.BundleError) as exc:  # PX4 cannot be run any more
                 self.result.stopped = str(exc)
                 raise _Stop from None
+            except Exception as exc:
+                # fuzzoff's own error: raised as it is after the search. Hypothesis would run
+                # the stream again to confirm a failure, which now rejects it as a shape
+                # already sent, and report only "Unreliable assumption" (FlakyFailure)
+                self.error = exc
+                raise _Stop from None
 
         strategy: st.SearchStrategy[Scenario] = scenarios(
             self.config.profile, self.config.judged_as, self.config.transport
@@ -315,6 +327,8 @@ class Campaign:
         test = seed(self.config.seed)(test)
         with _hypothesis_storage(), contextlib.suppress(_Stop):
             test()
+        if self.error is not None:
+            raise self.error
 
     def searched(self, example: Example) -> None:
         """Follow a disagreement of the search up, unless it was confirmed before (then it is
@@ -392,10 +406,17 @@ class Campaign:
         example.first_sent_px4 = run.sent[0] if run.sent else None
         example.delivery = delivery.check(run.meant, run.sent)
         try:
-            verdict = self._judge(run, setup.params)
             truth = None if run.ulog is None else read_truth(run.ulog)
+            stalled = None if truth is None else sim_stalled(truth, max(run.meant, default=0.0))
+            if stalled is not None:  # main's SIH: nothing to judge (docs/sitl.md)
+                example.reason = stalled
+                return
+            verdict = self._judge(run, setup.params)
         except SourceError as exc:  # PX4 killed while writing its log, say
             example.reason = f"the run's recordings cannot be judged: {exc.line()}"
+            return
+        except BridgeError as exc:  # a ROS 2 run's bag and ULog cannot be put on one clock
+            example.reason = f"the run's recordings cannot be judged: {exc}"
             return
         verdict.items = [i for i in verdict.items if i.t >= run.recording_from]
         example.verdict = verdict

@@ -57,6 +57,8 @@ class Truth:
     texts: list[tuple[float, str]] = field(default_factory=list)
     landed: list[tuple[float, bool]] = field(default_factory=list)
     """(time, landed or maybe_landed) at every change of PX4's land detector (ULog only)."""
+    span: tuple[float, float] | None = None
+    """The first and the last timestamp of the ULog (PX4's clock), None from a tlog."""
 
     def landed_since(self, t: float) -> tuple[bool, float] | None:
         """PX4's land verdict at ``t`` and when it last changed (None: not recorded)."""
@@ -148,7 +150,32 @@ def read_truth(path: Path, client_sysid: int | None = None) -> Truth:
                 truth.landed.append((int(t) / 1e6, now))
                 was = now
     truth.texts = [(m.timestamp / 1e6, m.message) for m in log.logged_messages]
+    truth.span = (log.start_timestamp / 1e6, log.last_timestamp / 1e6)
     return truth
+
+
+SIM_STALL_TEXT = "SIH lockstep: timed out"
+"""What main-2026-08-13's SIH logs while its clock waits for actuator outputs that do not come
+(OFFBOARD disarmed without a setpoint PX4 takes, the Ackermann rover armed; docs/sitl.md)."""
+STALLED_SHARE = 0.5
+
+
+def sim_stalled(truth: Truth, sent_s: float) -> str | None:
+    """Why PX4's record of a stream of ``sent_s`` seconds cannot be judged, when SIH stopped
+    PX4's clock in it: the lockstep timeout logged and the ULog spanning less than half the
+    stream on PX4's clock (a lone timeout on a loaded host delays the clock without stopping
+    it). None when it ran."""
+    if truth.span is None or sent_s <= 0:
+        return None
+    first, last = truth.span
+    said = next((t for t, text in truth.texts if SIM_STALL_TEXT in text), None)
+    if said is None or last - first >= STALLED_SHARE * sent_s:
+        return None
+    return (
+        f"PX4's simulated clock stopped {said - first:.1f} s into its log of the stream (SIH:"
+        f" '{SIM_STALL_TEXT} waiting for actuator_outputs_sim'; its log spans {last - first:.1f}"
+        f" s of the {sent_s:.1f} s sent): PX4 ran nothing after it"
+    )
 
 
 def _result(acks: list[tuple[float, int, int]], t: float, command: int) -> int | None:

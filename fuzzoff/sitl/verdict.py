@@ -232,15 +232,21 @@ def _requests(verdict: Verdict, truth: Truth, rows: list[dict[str, Any]]) -> Non
 LAND_SAMPLE_S = 0.25
 """A tlog shows PX4's land detector only in EXTENDED_SYS_STATE, 5 Hz on these links: a change
 of PX4's verdict this close before a request may not have reached the tlog yet."""
+LAND_ANSWER_S = 0.05
+"""PX4 answers a command in a Commander cycle after its stamp (acks 8-16 ms after it here): a
+land verdict PX4 published in between is the one it acted on, and no recording of the
+companion held it when the command was sent (seen over the ROS 2 bridge on main-2026-08-13:
+the airplane counted landed just after the disarm's stamp, the plain disarm taken)."""
 
 
 def _land_sample_lag(truth: Truth, t: float, label: str, row: dict[str, Any]) -> str:
-    """Why a disarm the model judged from the tlog's land detector cannot be judged: PX4's own
-    land detector (ULog) changed to the verdict PX4 acted on within one EXTENDED_SYS_STATE
-    period before the request, so the tlog had not shown it yet ("" when that is not so)."""
+    """Why a disarm the model judged from the recording's land detector cannot be judged: PX4's
+    own land detector (ULog) changed to the verdict PX4 acted on within one EXTENDED_SYS_STATE
+    period before the request, or between its stamp and PX4's answer, so the recording had
+    not shown it yet ("" when that is not so)."""
     if label != "disarm" or "land detector:" not in row["message"]:
         return ""
-    at = truth.landed_since(t)
+    at = truth.landed_since(t + LAND_ANSWER_S)
     if at is None:
         return ""
     landed, since = at
@@ -248,9 +254,14 @@ def _land_sample_lag(truth: Truth, t: float, label: str, row: dict[str, Any]) ->
     if landed == model_landed or t - since > LAND_SAMPLE_S:
         return ""
     state = "landed" if landed else "not landed"
+    when = (
+        f"{1000 * (t - since):.0f} ms before the disarm"
+        if since <= t
+        else f"{1000 * (since - t):.0f} ms after the disarm's stamp, before PX4 answered it"
+    )
     return (
-        f"not judged: PX4's land detector said {state} {1000 * (t - since):.0f} ms before the"
-        " disarm, after the tlog's last EXTENDED_SYS_STATE (5 Hz)"
+        f"not judged: PX4's land detector said {state} {when}, after the recording's last"
+        " sample of it (a tlog's EXTENDED_SYS_STATE comes at 5 Hz)"
     )
 
 
