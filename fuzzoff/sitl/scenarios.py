@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 from fuzzoff.mavlink_ids import MAV_FRAME_LOCAL_ENU
-from fuzzoff.sitl.airframes import AIRFRAMES
+from fuzzoff.sitl.airframes import AIRFRAMES, AIRPLANE_OUTPUTS  # fw_gate: each build's thrust
 from fuzzoff.sitl.driver import (
     ATTITUDE_NO_THRUST,
     NAV_LOITER,
@@ -306,11 +306,20 @@ TAILSITTER_PARAMS = AIRFRAMES["tailsitter"].fixes
 TAILSITTER_FLIES_ON: tuple[str, ...] | None = None
 """Every bundle (with the parameters above)."""
 
-AIRPLANE_FLIES_ON = ("1.16.2", "1.17.0")
-"""Where SIH's airplane takes off by itself (docs/sitl.md: on 1.18.0-alpha1, the 1.18 head and
-main its ground run stalls at 4-6 m/s on full throttle; on 1.14.4 and 1.15.4, its outputs
-mapped as SIH reads them, it rolls past 60 degrees as it rotates at 12-14 m/s and PX4's failure
-detector disarms it)."""
+AIRPLANE_FLIES_ON = (
+    "1.16.2",
+    "1.17.0",
+    "1.18.0-alpha1",
+    "1.18.0-beta1-head",
+    "main-2026-08-13",
+)
+"""Where SIH's airplane takes off by itself, with ``AIRPLANE_PARAMS`` (docs/sitl.md: on 1.18
+only with the 6 N ``SIH_F_T_MAX``; on 1.14.4 and 1.15.4, its outputs mapped as SIH reads them,
+it rolls past 60 degrees as it rotates at 12-14 m/s and PX4's failure detector disarms it)."""
+
+AIRPLANE_PARAMS = AIRFRAMES["fw"].fixes
+"""The airplane's outputs where SIH reads them and its 6 N thrust (``airframes.AIRPLANE_OUTPUTS``,
+``airframes.AIRPLANE_THRUST``)."""
 
 FW_CLIMB_TO_M = 15.0
 """The airplane's runway takeoff (AUTO_TAKEOFF) climbs this high before the switch."""
@@ -322,6 +331,8 @@ def _fw_takeoff(d: Driver) -> None:
     stream and the switch to OFFBOARD in the air."""
     d.require(d.set_mode(NAV_TAKEOFF, "AUTO_TAKEOFF"), "switch to AUTO_TAKEOFF")
     d.require(d.arm(), "arm in AUTO_TAKEOFF")
+    # HEARTBEAT (1 Hz) shows the arm up to a second after its ack: judge a disarm after that
+    d.link.wait_for(lambda v: bool(v.armed), 2.0)
     deadline = d.now() + 25.0
     while (d.link.view.relative_alt_m or 0.0) < FW_CLIMB_TO_M and d.now() < deadline:
         d.wait(0.5)
@@ -356,9 +367,6 @@ def fw_loss(d: Driver) -> None:
     d.stream(d.position(*FW_POINT), 4.0)
     _fw_hold(d)
 
-
-AIRPLANE_OUTPUTS = AIRFRAMES["fw"].fixes
-"""The airplane's outputs where SIH reads them (``airframes.AIRPLANE_OUTPUTS``)."""
 
 FW_GROUND_POINT = (0.0, 0.0, 0.0)
 """Where the airplane's ground gate run holds: where it stands, on the ground."""
@@ -627,6 +635,7 @@ SCENARIOS: dict[str, Scenario] = {
             " air, a position setpoint 400 m ahead, Hold",
             fw_offboard,
             "clean",
+            params=AIRPLANE_PARAMS,
             vehicle="fw",
             flies_on=AIRPLANE_FLIES_ON,
         ),
@@ -637,6 +646,7 @@ SCENARIOS: dict[str, Scenario] = {
             "hazard",
             "stream lost in OFFBOARD (failsafe, then back to OFFBOARD)",
             ("OFB103",),
+            params=AIRPLANE_PARAMS,
             vehicle="fw",
             flies_on=AIRPLANE_FLIES_ON,
         ),
