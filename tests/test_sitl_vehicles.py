@@ -95,13 +95,15 @@ def test_the_multicopter_matrix_keeps_its_scenarios_and_the_others_fly_their_veh
 
 def test_the_airplane_and_the_tailsitter_fly_with_what_later_airframes_set() -> None:
     # docs/sitl.md: the 1.14/1.15 airplane arms only with its outputs where SIH reads them (the
-    # 1.16 airframe's); it takes off on 1.16.2 and 1.17.0 only; the tailsitter's transition
-    # waits for an airspeed SIH never shows unless FW_USE_AIRSPD is 0, and it climbs only with
-    # the 1.18 airframe's right elevon
+    # 1.16 airframe's); it takes off on every bundle, with each one's fixes; the tailsitter's
+    # transition waits for an airspeed SIH never shows unless FW_USE_AIRSPD is 0, and it climbs
+    # only with the 1.18 airframe's right elevon
     params = SCENARIOS["fw_gate"].params
     assert [params[f"PWM_MAIN_FUNC{n}"] for n in range(1, 7)] == [201, 202, 203, 101, 0, 0]
     assert SCENARIOS["fw_gate"].flies_on is None
     assert SCENARIOS["fw_loss"].flies_on == (
+        "1.14.4",
+        "1.15.4",
         "1.16.2",
         "1.17.0",
         "1.18.0-alpha1",
@@ -111,6 +113,10 @@ def test_the_airplane_and_the_tailsitter_fly_with_what_later_airframes_set() -> 
     # 1.18's SIH pulls the airplane with SIH_F_T_MAX (2 N unless set), not the airframe's 6 N
     assert SCENARIOS["fw_loss"].params["SIH_F_T_MAX"] == 6.0
     assert "SIH_F_T_MAX" not in SCENARIOS["fw_gate"].params
+    # 1.14's and 1.15's SIH pitch the other way and hold a grounded airplane level
+    assert SCENARIOS["fw_loss"].params_for("1.15.4")["CA_SV_CS1_TRQ_P"] == -1.0
+    assert SCENARIOS["fw_loss"].params_for("1.15.4")["FW_TKO_PITCH_MIN"] == 0.0
+    assert "CA_SV_CS1_TRQ_P" not in SCENARIOS["fw_loss"].params_for("1.16.2")
     assert SCENARIOS["tailsitter_loss"].params["FW_USE_AIRSPD"] == 0.0
     assert SCENARIOS["tailsitter_loss"].params["CA_SV_CS1_TRQ_P"] == -0.5
     assert SCENARIOS["vtol_loss"].flies_on is None
@@ -354,8 +360,8 @@ def test_a_live_campaign_boots_the_airframe_with_the_scenarios_fixes(
     tmp_path: Path, vehicle: str, fixed: str | None
 ) -> None:
     """A campaign on the airplane or the tailsitter sets what their scenarios set (the 1.14/1.15
-    airplane's outputs and the 1.18 airplane's thrust, the tailsitter's airspeed use and elevon)
-    at each boot of PX4."""
+    airplane's outputs, elevator and lift-off, the 1.18 airplane's thrust, the tailsitter's
+    airspeed use and elevon) at each boot of PX4."""
     from fuzzoff.sitl.against import AgainstConfig, Campaign
 
     build = _bundle(
@@ -370,4 +376,4 @@ def test_a_live_campaign_boots_the_airframe_with_the_scenarios_fixes(
         assert fixes == {}
     else:
         scenario = "fw_loss" if vehicle == "fw" else "tailsitter_loss"
-        assert fixed in fixes and fixes == SCENARIOS[scenario].params
+        assert fixed in fixes and fixes == SCENARIOS[scenario].params_for(build.release)

@@ -41,7 +41,11 @@ def record(release: str, instance: int, name: str) -> dict[str, object]:
     session = Session(build, instance, env=env)
     with session:
         result = session.run(
-            name, scenario.program, tlog, manual=scenario.manual, params=scenario.params
+            name,
+            scenario.program,
+            tlog,
+            manual=scenario.manual,
+            params=scenario.params_for(build.release),
         )
         session.finish(result)
     if result.ulog is None:

@@ -28,6 +28,8 @@ class Airframe:
     """Parameters every run sets so that SIH flies the airframe as PX4 means it, on every
     build (where a build's airframe has them right already, they are its own values): the
     scenarios of the vehicle and a live campaign on it (docs/sitl.md, "Other vehicles")."""
+    fixes_on: dict[str, dict[str, float]] = field(default_factory=dict)
+    """More ``fixes`` on the builds whose bundle name starts with the key (``fixes_for``)."""
     boot_params: dict[str, float] = field(default_factory=dict)
     """Parameters PX4 must have from its boot (``PX4_PARAM_<NAME>``, read by the rcS of 1.16 and
     later; 1.14 and 1.15 ignore it): what a module reads only when it starts."""
@@ -54,6 +56,36 @@ a tailsitter's and a pusher's thrust from ``SIH_F_T_MAX`` instead (default 2 N) 
 ``SIH_T_MAX`` for multicopter rotors, while the 1.18 airframe still sets only ``SIH_T_MAX``: with
 2 N the airplane rolled at 5.4 m/s and never rotated. On PX4 before 1.18 the run sets
 ``SIH_T_MAX`` (``session.RENAMED``)."""
+
+AIRPLANE_1_14 = {
+    "CA_SV_CS0_TRQ_R": 1.0,
+    "CA_SV_CS0_TYPE": 15.0,
+    "CA_SV_CS1_TRQ_P": -1.0,
+    "CA_ROTOR0_PX": 0.3,
+    "FW_TKO_PITCH_MIN": 0.0,
+    "FW_RR_P": 0.05,
+    "FW_RR_I": 2.0,
+    "FW_RR_FF": 0.0,
+    "FW_RR_IMAX": 1.0,
+    "FW_PR_P": 0.08,
+    "FW_PR_I": 2.5,
+    "FW_PR_FF": 0.0,
+    "FW_PR_IMAX": 1.0,
+    "FW_YR_P": 0.05,
+    "FW_YR_I": 3.0,
+    "FW_YR_FF": 0.0,
+    "FW_YR_IMAX": 1.0,
+}
+"""What makes the airplane of 1.14.4 and 1.15.4 take off and fly (docs/sitl.md). Their SIH
+pitches the nose up on a negative elevator output: with the airframe's ``CA_SV_CS1_TRQ_P`` +1
+the pitch loop ran away at the lift-off (10-11 m/s, the pitch rate 10 to 178 degrees/s in
+0.2 s against a full nose-down command) and PX4's failure detector disarmed it; the 1.16 SIH
+takes the same +1 the other way round. Their SIH also holds a grounded airplane level (roll and
+pitch 0, no rotation: ``equations_of_motion``), so a runway takeoff's rotation cannot happen
+and its nose-up elevator only pressed the airplane down (12 m/s for 30 s, no lift-off): with
+``FW_TKO_PITCH_MIN`` 0 it leaves the ground level at about 11 m/s and climbs. The aileron (one
+channel, +1 instead of the left aileron's -0.5), the rotor's position and the rate gains are
+the 1.16 airframe's."""
 
 AIRPLANE_BOOT = {"SIH_LOC_H0": 0.0}
 """SIH's ground at 0 m above sea level instead of 489.4 m (``SIH_LOC_H0``, read once when SIH
@@ -86,6 +118,7 @@ AIRFRAMES: dict[str, Airframe] = {
             "sihsim_airplane",
             "fw",
             fixes=AIRPLANE_OUTPUTS | AIRPLANE_THRUST,
+            fixes_on={"1.14.": AIRPLANE_1_14, "1.15.": AIRPLANE_1_14},
             boot_params=AIRPLANE_BOOT,
         ),
         Airframe("tailsitter", "sihsim_xvert", "vtol", fixes=TAILSITTER_FIXES),
@@ -104,6 +137,13 @@ DOES_NOT_FLY: dict[tuple[str, str], str] = {
     " PX4 time in 60 s); fly it on 1.17.0-ros2-rover or 1.18.0-beta1-head"
 }
 """(bundle name prefix, airframe) -> why that build cannot fly it, though it has it."""
+
+
+def fixes_for(airframe: Airframe, release: str) -> dict[str, float]:
+    """The fixes a run of ``airframe`` sets on the bundle ``release``: its own, then those of
+    the release (``Airframe.fixes_on``)."""
+    extra = [f for prefix, f in airframe.fixes_on.items() if release.startswith(prefix)]
+    return {k: v for fixes in (airframe.fixes, *extra) for k, v in fixes.items()}
 
 
 class AirframeError(bundle.BundleError):
