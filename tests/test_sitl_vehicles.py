@@ -38,6 +38,20 @@ def test_a_vehicle_boots_its_sih_airframe_and_the_quad_changes_nothing(tmp_path:
     }
 
 
+def test_the_airplane_boots_with_sihs_ground_at_sea_level(tmp_path: Path) -> None:
+    # docs/sitl.md: TECS starts its altitude reference at 0 m AMSL before the estimator's
+    # origin; SIH_LOC_H0 is read once when SIH starts, so it is a boot parameter
+    build = _bundle(tmp_path, "1.17.0", ["sihsim_airplane"], ["commander"])
+    assert airframes.boot_env(build, "fw") == {
+        "PX4_SIM_MODEL": "sihsim_airplane",
+        "PX4_PARAM_SIH_LOC_H0": "0",
+    }
+    assert (
+        airframes.boot_env(build, "fw", {"PX4_PARAM_SIH_LOC_H0": "489.4"})["PX4_PARAM_SIH_LOC_H0"]
+        == "489.4"
+    )
+
+
 def test_a_build_without_the_airframe_or_the_rover_module_says_why(tmp_path: Path) -> None:
     old = _bundle(tmp_path, "1.16.2", ["sihsim_quadx"], ["commander"])
     with pytest.raises(airframes.AirframeError, match="no SIH airframe sihsim_hex"):
@@ -81,13 +95,28 @@ def test_the_multicopter_matrix_keeps_its_scenarios_and_the_others_fly_their_veh
 
 def test_the_airplane_and_the_tailsitter_fly_with_what_later_airframes_set() -> None:
     # docs/sitl.md: the 1.14/1.15 airplane arms only with its outputs where SIH reads them (the
-    # 1.16 airframe's); it takes off on 1.16.2 and 1.17.0 only; the tailsitter's transition
-    # waits for an airspeed SIH never shows unless FW_USE_AIRSPD is 0, and it climbs only with
-    # the 1.18 airframe's right elevon
+    # 1.16 airframe's); it takes off on every bundle, with each one's fixes; the tailsitter's
+    # transition waits for an airspeed SIH never shows unless FW_USE_AIRSPD is 0, and it climbs
+    # only with the 1.18 airframe's right elevon
     params = SCENARIOS["fw_gate"].params
     assert [params[f"PWM_MAIN_FUNC{n}"] for n in range(1, 7)] == [201, 202, 203, 101, 0, 0]
     assert SCENARIOS["fw_gate"].flies_on is None
-    assert SCENARIOS["fw_loss"].flies_on == ("1.16.2", "1.17.0")
+    assert SCENARIOS["fw_loss"].flies_on == (
+        "1.14.4",
+        "1.15.4",
+        "1.16.2",
+        "1.17.0",
+        "1.18.0-alpha1",
+        "1.18.0-beta1-head",
+        "main-2026-08-13",
+    )
+    # 1.18's SIH pulls the airplane with SIH_F_T_MAX (2 N unless set), not the airframe's 6 N
+    assert SCENARIOS["fw_loss"].params["SIH_F_T_MAX"] == 6.0
+    assert "SIH_F_T_MAX" not in SCENARIOS["fw_gate"].params
+    # 1.14's and 1.15's SIH pitch the other way and hold a grounded airplane level
+    assert SCENARIOS["fw_loss"].params_for("1.15.4")["CA_SV_CS1_TRQ_P"] == -1.0
+    assert SCENARIOS["fw_loss"].params_for("1.15.4")["FW_TKO_PITCH_MIN"] == 0.0
+    assert "CA_SV_CS1_TRQ_P" not in SCENARIOS["fw_loss"].params_for("1.16.2")
     assert SCENARIOS["tailsitter_loss"].params["FW_USE_AIRSPD"] == 0.0
     assert SCENARIOS["tailsitter_loss"].params["CA_SV_CS1_TRQ_P"] == -0.5
     assert SCENARIOS["vtol_loss"].flies_on is None
@@ -313,7 +342,8 @@ def test_the_tailsitters_runs_agree_with_the_model_beside_a_parameter_it_does_no
 
 def test_a_parameter_is_set_under_its_old_name_on_a_px4_that_predates_it() -> None:
     """1.14.4 has FW_ARSP_MODE (1: airspeed not used) where 1.15 and later have FW_USE_AIRSPD
-    (0: not used): the tailsitter's runs set whichever PX4 has."""
+    (0: not used): the tailsitter's runs set whichever PX4 has. Before 1.18 SIH's airplane
+    takes its thrust from SIH_T_MAX, which 1.18 split off into SIH_F_T_MAX."""
     from typing import cast
 
     from fuzzoff.sitl.link import Link, LinkError
@@ -329,11 +359,11 @@ def test_a_parameter_is_set_under_its_old_name_on_a_px4_that_predates_it() -> No
             self.values[name] = value
             return value
 
-    old = FakeLink({"FW_ARSP_MODE", "CA_SV_CS1_TRQ_P"})
-    params = {"FW_USE_AIRSPD": 0.0, "CA_SV_CS1_TRQ_P": -0.5}
+    old = FakeLink({"FW_ARSP_MODE", "CA_SV_CS1_TRQ_P", "SIH_T_MAX"})
+    params = {"FW_USE_AIRSPD": 0.0, "CA_SV_CS1_TRQ_P": -0.5, "SIH_F_T_MAX": 6.0}
     applied = apply_params(cast(Link, old), params)
-    assert applied == {"FW_ARSP_MODE": 1.0, "CA_SV_CS1_TRQ_P": -0.5}
-    new = FakeLink({"FW_USE_AIRSPD", "CA_SV_CS1_TRQ_P"})
+    assert applied == {"FW_ARSP_MODE": 1.0, "CA_SV_CS1_TRQ_P": -0.5, "SIH_T_MAX": 6.0}
+    new = FakeLink({"FW_USE_AIRSPD", "CA_SV_CS1_TRQ_P", "SIH_F_T_MAX"})
     assert apply_params(cast(Link, new), params) == params
 
 
@@ -345,7 +375,8 @@ def test_a_live_campaign_boots_the_airframe_with_the_scenarios_fixes(
     tmp_path: Path, vehicle: str, fixed: str | None
 ) -> None:
     """A campaign on the airplane or the tailsitter sets what their scenarios set (the 1.14/1.15
-    airplane's outputs, the tailsitter's airspeed use and elevon) at each boot of PX4."""
+    airplane's outputs, elevator and lift-off, the 1.18 airplane's thrust, the tailsitter's
+    airspeed use and elevon) at each boot of PX4."""
     from fuzzoff.sitl.against import AgainstConfig, Campaign
 
     build = _bundle(
@@ -359,5 +390,5 @@ def test_a_live_campaign_boots_the_airframe_with_the_scenarios_fixes(
     if fixed is None:
         assert fixes == {}
     else:
-        scenario = "fw_gate" if vehicle == "fw" else "tailsitter_loss"
-        assert fixed in fixes and fixes == SCENARIOS[scenario].params
+        scenario = "fw_loss" if vehicle == "fw" else "tailsitter_loss"
+        assert fixed in fixes and fixes == SCENARIOS[scenario].params_for(build.release)

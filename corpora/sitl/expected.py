@@ -213,7 +213,9 @@ tlog of both directions), on the PX4 SITL bundles of `../shared/px4-sitl/` (SIH 
 tailsitter, airplane and Ackermann rover, whose ULogs keep PX4's fastest estimator and
 controller topics at 10 Hz; PX4's default parameters but those a scenario sets, listed per run
 in `runs.json`: the tailsitter's airspeed use and right elevon, the airplane's outputs in
-`fw_gate`, the stick override; no RC). Each run boots a fresh PX4.
+`fw_gate`, its outputs, thrust and (1.14, 1.15) elevator sign and lift-off pitch in
+`fw_offboard` and `fw_loss`, with `SIH_LOC_H0` 0 set at boot (`boot_params`), the stick
+override; no RC). Each run boots a fresh PX4.
 
 - `NAME-RELEASE.tlog`: the exchange as the client saw it, on PX4's clock (`docs/sitl.md`);
 - `NAME-RELEASE.ulg`: PX4's log from boot to exit, cut with pyulog to the topics fuzzoff reads

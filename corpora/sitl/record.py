@@ -8,7 +8,8 @@ leaves beside this file:
 - ``NAME-RELEASE.tlog``: both directions of the offboard link as the client saw them, stamped
   on PX4's clock (``fuzzoff.sitl.recorder``);
 - ``NAME-RELEASE.ulg``: PX4's own log, cut to the topics fuzzoff reads (``fuzzoff.sitl.trim``);
-- an entry in ``runs.json``: the steps with PX4's time and PX4's answer, the parameters set.
+- an entry in ``runs.json``: the steps with PX4's time and PX4's answer, the parameters set
+  (and those set at boot, ``boot_params``).
 
 The expected findings are written separately (``expected.py``), from what the recordings hold.
 """
@@ -40,7 +41,11 @@ def record(release: str, instance: int, name: str) -> dict[str, object]:
     session = Session(build, instance, env=env)
     with session:
         result = session.run(
-            name, scenario.program, tlog, manual=scenario.manual, params=scenario.params
+            name,
+            scenario.program,
+            tlog,
+            manual=scenario.manual,
+            params=scenario.params_for(build.release),
         )
         session.finish(result)
     if result.ulog is None:
@@ -57,6 +62,11 @@ def record(release: str, instance: int, name: str) -> dict[str, object]:
         "ready_s": round(session.ready_s, 1),
         "error": result.error,
         "params": result.params,
+        **(
+            {"boot_params": boot}
+            if (boot := airframes.airframe_for(scenario.vehicle).boot_params)
+            else {}
+        ),
         "steps": [
             {"px4_t": round(s.px4_t, 3), "what": s.what, "result": s.result} for s in result.steps
         ],

@@ -237,7 +237,7 @@ class Campaign:
         self.started = 0.0
         quad = config.vehicle == airframes.DEFAULT  # PX4's own default: nothing to check
         env = {} if quad else airframes.boot_env(config.build, config.vehicle)
-        fixes = airframes.airframe_for(config.vehicle).fixes
+        fixes = airframes.fixes_for(airframes.airframe_for(config.vehicle), config.build.release)
         bench: type[Bench] = Bench
         if config.transport == "ros2":
             from fuzzoff.sitl.ros2.bench import BridgeBench

@@ -60,7 +60,7 @@ def run_scenario(
     scenario = SCENARIOS[name]
     airframe = airframes.airframe_for(vehicle or scenario.vehicle)
     env = airframes.boot_env(build, airframe.vehicle, env)
-    params = {**scenario.params, **(params or {})}
+    params = {**scenario.params_for(build.release), **(params or {})}
     out_dir.mkdir(parents=True, exist_ok=True)
     stem = f"{name}-{build.release}"
     tlog = out_dir / f"{stem}.tlog"

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 from fuzzoff.mavlink_ids import MAV_FRAME_LOCAL_ENU
-from fuzzoff.sitl.airframes import AIRFRAMES
+from fuzzoff.sitl.airframes import AIRFRAMES, AIRPLANE_OUTPUTS  # fw_gate: each build's thrust
 from fuzzoff.sitl.driver import (
     ATTITUDE_NO_THRUST,
     NAV_LOITER,
@@ -52,6 +52,13 @@ class Scenario:
     """The SIH airframe it flies (``fuzzoff.sitl.airframes``; ``sitl run --vehicle`` overrides)."""
     flies_on: tuple[str, ...] | None = None
     """The bundles whose PX4 can fly the program (None: every bundle with the airframe)."""
+    params_on: dict[str, dict[str, float]] = field(default_factory=dict)
+    """More ``params`` on the bundles whose name starts with the key (``params_for``)."""
+
+    def params_for(self, release: str) -> dict[str, float]:
+        """The parameters the run sets on the bundle ``release``."""
+        extra = [p for prefix, p in self.params_on.items() if release.startswith(prefix)]
+        return {k: v for params in (self.params, *extra) for k, v in params.items()}
 
 
 def _offboard_takeoff(d: Driver, z: float = ALT, climb_s: float = 6.0) -> None:
@@ -306,32 +313,59 @@ TAILSITTER_PARAMS = AIRFRAMES["tailsitter"].fixes
 TAILSITTER_FLIES_ON: tuple[str, ...] | None = None
 """Every bundle (with the parameters above)."""
 
-AIRPLANE_FLIES_ON = ("1.16.2", "1.17.0")
-"""Where SIH's airplane takes off by itself (docs/sitl.md: on 1.18.0-alpha1, the 1.18 head and
-main its ground run stalls at 4-6 m/s on full throttle; on 1.14.4 and 1.15.4, its outputs
-mapped as SIH reads them, it rolls past 60 degrees as it rotates at 12-14 m/s and PX4's failure
-detector disarms it)."""
+AIRPLANE_FLIES_ON = (
+    "1.14.4",
+    "1.15.4",
+    "1.16.2",
+    "1.17.0",
+    "1.18.0-alpha1",
+    "1.18.0-beta1-head",
+    "main-2026-08-13",
+)
+"""Where SIH's airplane takes off by itself: every bundle, with ``AIRPLANE_PARAMS`` (docs/sitl.md:
+on 1.18 only with the 6 N ``SIH_F_T_MAX``; on 1.14 and 1.15 only with ``AIRPLANE_PARAMS_ON``)."""
+
+AIRPLANE_PARAMS = AIRFRAMES["fw"].fixes
+"""The airplane's outputs where SIH reads them and its 6 N thrust (``airframes.AIRPLANE_OUTPUTS``,
+``airframes.AIRPLANE_THRUST``); on 1.14 and 1.15 also ``AIRPLANE_PARAMS_ON``."""
+AIRPLANE_PARAMS_ON = AIRFRAMES["fw"].fixes_on
+"""1.14's and 1.15's elevator sign, level lift-off and the 1.16 airframe's aileron and gains
+(``airframes.AIRPLANE_1_14``)."""
 
 FW_CLIMB_TO_M = 15.0
-"""The airplane's runway takeoff (AUTO_TAKEOFF) climbs this high before the switch."""
+"""The airplane's runway takeoff (AUTO_TAKEOFF) climbs at least this high before the switch."""
+FW_TAKEOFF_S = 30.0
+"""How long the runway takeoff may take, from the arm to Hold at the takeoff altitude (25 m):
+10-15 s of PX4's time on 1.16.2 to main."""
 FW_POINT = (400.0, 0.0, -30.0)
 
 
 def _fw_takeoff(d: Driver) -> None:
-    """AUTO_TAKEOFF (the SIH airplane's runway takeoff, RWTO_TKOFF 1) until 15 m up, then the
-    stream and the switch to OFFBOARD in the air."""
+    """AUTO_TAKEOFF (the SIH airplane's runway takeoff, RWTO_TKOFF 1) until PX4 ends it in Hold,
+    at least 15 m up, then the stream and the switch to OFFBOARD in the air. Switching while
+    the takeoff ends races it: on main a switch 0.14 s before Hold was acknowledged and never
+    flown (the navigator's Hold came after it, ``fw_loss`` 2026-12-03, not kept)."""
     d.require(d.set_mode(NAV_TAKEOFF, "AUTO_TAKEOFF"), "switch to AUTO_TAKEOFF")
     d.require(d.arm(), "arm in AUTO_TAKEOFF")
-    deadline = d.now() + 25.0
-    while (d.link.view.relative_alt_m or 0.0) < FW_CLIMB_TO_M and d.now() < deadline:
+    # HEARTBEAT (1 Hz) shows the arm up to a second after its ack: judge a disarm after that
+    d.link.wait_for(lambda v: bool(v.armed), 2.0)
+    deadline = d.now() + FW_TAKEOFF_S
+
+    def climbing() -> bool:
+        view = d.link.view
+        return (view.relative_alt_m or 0.0) < FW_CLIMB_TO_M or view.nav_state == NAV_TAKEOFF
+
+    while climbing() and d.now() < deadline:
         d.wait(0.5)
         if not d.link.view.armed:
             # 1.14.4/1.15.4: "Attitude failure (roll)" at rotation, disarmed by failsafe; the
             # estimate of the tumbling airframe may still read 15 m
             raise LinkError("PX4 disarmed the airplane during its takeoff")
-    if (d.link.view.relative_alt_m or 0.0) < FW_CLIMB_TO_M:
-        raise LinkError(f"the airplane did not climb to {FW_CLIMB_TO_M:g} m in AUTO_TAKEOFF")
-    d.note(f"{FW_CLIMB_TO_M:g} m up")
+    if climbing():
+        raise LinkError(
+            f"the airplane did not end its takeoff {FW_CLIMB_TO_M:g} m up in {FW_TAKEOFF_S:g} s"
+        )
+    d.note("takeoff done (Hold)")
     d.stream(d.position(*FW_POINT), 1.5)
     d.require(d.set_mode(NAV_OFFBOARD, "OFFBOARD"), "switch to OFFBOARD")
 
@@ -356,9 +390,6 @@ def fw_loss(d: Driver) -> None:
     d.stream(d.position(*FW_POINT), 4.0)
     _fw_hold(d)
 
-
-AIRPLANE_OUTPUTS = AIRFRAMES["fw"].fixes
-"""The airplane's outputs where SIH reads them (``airframes.AIRPLANE_OUTPUTS``)."""
 
 FW_GROUND_POINT = (0.0, 0.0, 0.0)
 """Where the airplane's ground gate run holds: where it stands, on the ground."""
@@ -623,12 +654,14 @@ SCENARIOS: dict[str, Scenario] = {
         ),
         Scenario(
             "fw_offboard",
-            "airplane: runway takeoff (AUTO_TAKEOFF) to 15 m, stream, switch to OFFBOARD in the"
-            " air, a position setpoint 400 m ahead, Hold",
+            "airplane: runway takeoff (AUTO_TAKEOFF) to Hold at 25 m, stream, switch to OFFBOARD"
+            " in the air, a position setpoint 400 m ahead, Hold",
             fw_offboard,
             "clean",
+            params=AIRPLANE_PARAMS,
             vehicle="fw",
             flies_on=AIRPLANE_FLIES_ON,
+            params_on=AIRPLANE_PARAMS_ON,
         ),
         Scenario(
             "fw_loss",
@@ -637,8 +670,10 @@ SCENARIOS: dict[str, Scenario] = {
             "hazard",
             "stream lost in OFFBOARD (failsafe, then back to OFFBOARD)",
             ("OFB103",),
+            params=AIRPLANE_PARAMS,
             vehicle="fw",
             flies_on=AIRPLANE_FLIES_ON,
+            params_on=AIRPLANE_PARAMS_ON,
         ),
         Scenario(
             "fw_gate",

@@ -26,10 +26,12 @@ READY_TIMEOUT_S = 90.0
 LOGGER_SETTLE_S = 0.5
 RENAMED: dict[str, tuple[str, Callable[[float], float]]] = {
     "FW_USE_AIRSPD": ("FW_ARSP_MODE", lambda use: 0.0 if use else 1.0),
+    "SIH_F_T_MAX": ("SIH_T_MAX", lambda newtons: newtons),
 }
 """A parameter a run sets -> its name and value on a PX4 that predates the name: 1.15 renamed
 ``FW_ARSP_MODE`` (1: do not use the airspeed) to ``FW_USE_AIRSPD`` and inverted it (PX4's
-``param_translation.cpp``, 2023-12-06)."""
+``param_translation.cpp``, 2023-12-06); 1.18's SIH takes a fixed wing's propeller thrust from
+``SIH_F_T_MAX``, where earlier SIH took it from ``SIH_T_MAX`` (``airframes.AIRPLANE_THRUST``)."""
 
 
 @dataclass(slots=True)

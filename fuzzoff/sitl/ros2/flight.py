@@ -114,7 +114,11 @@ class BridgeFlight:
         self.sent = [bridge_topic(release_name, m) for m in sent]
         env = {"PX4_AGENT": str(bundle.default_root() / "agent"), "PX4_PARAM_SDLOG_MODE": "2"}
         self.vehicle = vehicle or (program.vehicle if program is not None else None)
-        fixes = {} if self.vehicle is None else airframes.airframe_for(self.vehicle).fixes
+        fixes = (
+            {}
+            if self.vehicle is None
+            else airframes.fixes_for(airframes.airframe_for(self.vehicle), self.build.release)
+        )
         # the airframe's fixes (what makes SIH fly it as PX4 means it), then the caller's
         env |= {f"PX4_PARAM_{k}": f"{v:g}" for k, v in {**fixes, **(params or {})}.items()}
         if self.vehicle is not None:
