@@ -91,6 +91,11 @@ def test_the_airplane_and_the_tailsitter_fly_with_what_later_airframes_set() -> 
     assert SCENARIOS["tailsitter_loss"].params["FW_USE_AIRSPD"] == 0.0
     assert SCENARIOS["tailsitter_loss"].params["CA_SV_CS1_TRQ_P"] == -0.5
     assert SCENARIOS["vtol_loss"].flies_on is None
+    # the standard VTOL's transition on 1.16.2 ends back in MC (quad-chute): the programs
+    # about FW flight are run where it reaches FW
+    for name in ("vtol_fw_glide", "vtol_fw_types", "vtol_fw_takeoff_type", "vtol_fw_velocity"):
+        flies_on = SCENARIOS[name].flies_on
+        assert flies_on is not None and "1.16.2" not in flies_on and "1.17.0" in flies_on
 
 
 def _verdict_of(stem: str) -> list[tuple[str, bool | None, str]]:
