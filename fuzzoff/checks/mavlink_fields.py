@@ -475,12 +475,17 @@ class PositionTargetFields(Check):
         if kind not in ACTION_TYPES or self.ctx.profile.release.legacy_receiver:
             return {}
         value = event.type_mask & tmask.SETPOINT_TYPE_BITS
+        how = (
+            " (with its velocity: path following)"
+            if "velocity" in tm.selected_groups(event.type_mask)
+            else ""
+        )
         return {
             f"action:{value}": Offence(
                 f"fixed-wing {tm.MESSAGE_NAMES[event.kind]} with the {kind} setpoint type "
                 f"({value}): PX4 {self.ctx.profile.px4}'s receiver does not read the type bits "
                 f"(v1.12+), so there is no {ACTION_TYPES[kind]}: the fixed-wing controller flies "
-                "the setpoint as a position (with zero velocity: path following)",
+                f"the setpoint as a position{how}",
                 short=f"fixed-wing {kind} type ({value}): PX4 does not read it, flies a position",
             )
         }
