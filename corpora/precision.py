@@ -72,7 +72,8 @@ VEHICLE_ROWS = {
     "tailsitter": "tailsitter VTOL (`sihsim_xvert`, FW_USE_AIRSPD 0, the right elevon's torques"
     " of the 1.18 airframe): MC, transition, FW",
     "fw": "airplane (`sihsim_airplane`): runway takeoff, then OFFBOARD in the air; the gate on"
-    " the ground (`fw_gate`) on every bundle",
+    " the ground (`fw_gate`) on every bundle; the takeoff setpoint type on the ground"
+    " (`fw_takeoff_type`)",
     "rover-ackermann": "Ackermann rover (`sihsim_rover_ackermann`)",
 }
 """The SITL vehicles, one row each (``fuzzoff.sitl.airframes``)."""

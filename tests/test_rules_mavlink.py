@@ -257,10 +257,20 @@ def test_rules_do_not_apply_without_a_page() -> None:
     + [(tm.GLOBAL, v) for v in tm.FIXEDWING_TYPES_GLOBAL],
 )
 def test_fixedwing_setpoint_types_are_accepted(kind: str, value: int) -> None:
+    """Every documented type answers the docs' rule; the takeoff, land and idle types ask for
+    an action PX4 (v1.12+) does not take: an error saying so (fw_takeoff_type-*: no runway
+    takeoff on 1.16.2, 1.17.0 or the 1.18 head)."""
     mask = value if value != 292 else value | NO_YAW
     frame = 1 if kind == tm.LOCAL else 5
-    found = lint([setpoint(kind, type_mask=mask, coordinate_frame=frame)], vehicle="fw")
-    assert not codes(found, "OFB603")
+    event = setpoint(kind, type_mask=mask, coordinate_frame=frame)
+    found = codes(lint([event], vehicle="fw"), "OFB603")
+    if tm.FIXEDWING_TYPES_LOCAL[value] in ("takeoff", "land", "idle"):
+        assert [f.severity for f in found] == [Severity.ERROR]
+        assert "does not read the type bits" in found[0].message
+        assert "flower" not in found[0].message
+        assert not codes(lint([event], "legacy", "fw"), "OFB603")  # OFB609's there
+    else:
+        assert not found
 
 
 @pytest.mark.parametrize(
@@ -291,6 +301,17 @@ def test_fixedwing_type_not_needed_without_position_or_on_a_copter() -> None:
     assert not codes(lint([velocity_only], vehicle="fw"), "OFB603")
     copter = setpoint(tm.LOCAL, type_mask=3576, coordinate_frame=1)
     assert not codes(lint([copter], vehicle="mc"), "OFB603")
+
+
+def test_a_fixedwing_velocity_without_a_position_is_an_error_beside_one_a_warning() -> None:
+    """OFB604: a velocity alone is not flown in FW flight (vtol_fw_velocity-*: no turn); beside
+    a position the docs say it is ignored (1.14-1.17 follow a path along it)."""
+    alone = setpoint(tm.LOCAL, type_mask=3527, coordinate_frame=1, velocity=(0, 10.0, 0))
+    (finding,) = codes(lint([alone], vehicle="fw"), "OFB604")
+    assert finding.severity == Severity.ERROR and "does not fly it" in finding.message
+    beside = setpoint(tm.LOCAL, type_mask=12288, coordinate_frame=1, velocity=(15.0, 0, 0))
+    (finding,) = codes(lint([beside], vehicle="fw"), "OFB604")
+    assert finding.severity == Severity.WARNING
 
 
 def test_fixedwing_velocity_and_acceleration_values_are_reported_as_ignored() -> None:

@@ -120,6 +120,11 @@ def test_the_airplane_and_the_tailsitter_fly_with_what_later_airframes_set() -> 
     assert SCENARIOS["tailsitter_loss"].params["FW_USE_AIRSPD"] == 0.0
     assert SCENARIOS["tailsitter_loss"].params["CA_SV_CS1_TRQ_P"] == -0.5
     assert SCENARIOS["vtol_loss"].flies_on is None
+    # the standard VTOL's transition on 1.16.2 ends back in MC (quad-chute): the programs
+    # about FW flight are run where it reaches FW
+    for name in ("vtol_fw_glide", "vtol_fw_types", "vtol_fw_takeoff_type", "vtol_fw_velocity"):
+        flies_on = SCENARIOS[name].flies_on
+        assert flies_on is not None and "1.16.2" not in flies_on and "1.17.0" in flies_on
 
 
 def _verdict_of(stem: str) -> list[tuple[str, bool | None, str]]:
@@ -392,3 +397,64 @@ def test_a_live_campaign_boots_the_airframe_with_the_scenarios_fixes(
     else:
         scenario = "fw_loss" if vehicle == "fw" else "tailsitter_loss"
         assert fixed in fixes and fixes == SCENARIOS[scenario].params_for(build.release)
+
+
+def _trajectory_between(stem: str, start: str, end: str) -> list[tuple[float, ...]]:
+    """PX4's trajectory_setpoint (x, y, z, vx, vy, vz) between two steps of the run, PX4's
+    time (the ULog keeps the setpoint topics whole)."""
+    from pyulog import ULog
+
+    runs = json.loads((SITL / "runs.json").read_text())
+    steps = {s["what"]: s["px4_t"] for s in runs[stem]["steps"]}
+    (data,) = [d.data for d in ULog(str(SITL / f"{stem}.ulg"), ["trajectory_setpoint"]).data_list]
+    fields = [f"position[{i}]" for i in range(3)] + [f"velocity[{i}]" for i in range(3)]
+    return [
+        tuple(float(data[f][i]) for f in fields)
+        for i, t in enumerate(data["timestamp"] / 1e6)
+        if steps[start] + 0.5 < t < steps[end] - 0.3
+    ]
+
+
+@pytest.mark.parametrize(
+    "stem", ["vtol_fw_takeoff_type-1.17.0", "vtol_fw_takeoff_type-1.18.0-beta1-head"]
+)
+def test_the_takeoff_setpoint_type_in_fw_flight_reaches_px4_as_a_plain_position(stem: str) -> None:
+    """type_mask 4096 clears every ignore bit and PX4's receiver (1.12+) reads no type bits:
+    PX4's trajectory_setpoint is the position with zero velocity, and the VTOL flew on to it
+    at its altitude (docs/sitl.md). Nothing in it is a hazard for lint."""
+    assert SCENARIOS["vtol_fw_takeoff_type"].kind == "clean"
+    setpoints = set(
+        _trajectory_between(stem, "type_mask 4096 (takeoff)", "position setpoint again")
+    )
+    assert setpoints == {(400.0, 0.0, -30.0, 0.0, 0.0, 0.0)}
+    assert run_cli(["lint", str(SITL / f"{stem}.tlog")]).returncode == 0
+
+
+@pytest.mark.parametrize("stem", ["fw_takeoff_type-1.16.2", "fw_takeoff_type-1.17.0"])
+def test_the_airplanes_takeoff_type_on_the_ground_is_flown_as_a_position(stem: str) -> None:
+    """fw_takeoff_type: 4096 200 m ahead and 30 m up, armed in OFFBOARD on the ground. PX4
+    reads no type bits: the setpoint is a position with zero velocity (path following), not a
+    runway takeoff; the disarm is refused (PX4 counts the airplane as flying) and forced."""
+    scenario = SCENARIOS["fw_takeoff_type"]
+    assert scenario.params == SCENARIOS["fw_gate"].params
+    assert scenario.flies_on == ("1.16.2", "1.17.0", "1.18.0-beta1-head")
+    setpoints = set(_trajectory_between(stem, "arm", "disarm"))
+    assert setpoints == {(200.0, 0.0, -30.0, 0.0, 0.0, 0.0)}
+    steps = json.loads((SITL / "runs.json").read_text())[stem]["steps"]
+    assert [(s["what"], s["result"]) for s in steps][-2:] == [
+        ("disarm", 1),
+        ("disarm (forced)", 0),
+    ]
+
+
+@pytest.mark.parametrize("stem", ["vtol_fw_velocity-1.17.0", "vtol_fw_velocity-1.18.0-beta1-head"])
+def test_a_velocity_only_setpoint_in_fw_flight_gives_ofb604(stem: str) -> None:
+    """The standard VTOL in FW flight on 10 m/s east without a position: PX4 did not turn to
+    it (docs/sitl.md). OFB604 judges a VTOL's setpoints in FW flight by the docs' fixed-wing
+    table, an error where the message has no position; not in MC flight."""
+    out = run_cli(["lint", str(SITL / f"{stem}.tlog"), "--format", "json"])
+    found = [f for f in json.loads(out.stdout)["files"][0]["findings"] if f["code"] == "OFB604"]
+    assert [f["severity"] for f in found] == ["error"]
+    assert "VTOL in FW flight" in found[0]["message"] and "vy" in found[0]["message"]
+    assert out.returncode == 1
+    assert SCENARIOS["vtol_fw_velocity"].codes == ("OFB604",)

@@ -100,6 +100,10 @@ def set_components(event: PositionTarget, group: str) -> list[str]:
     return out
 
 
+ACTION_TYPES = {"takeoff": "takeoff", "land": "landing", "idle": "idle throttle"}
+"""The fixed-wing setpoint types that ask for an action PX4 (1.12+) does not take (OFB603)."""
+
+
 class PositionTargetFields(Check):
     codes = ("OFB601", "OFB602", "OFB603", "OFB604", "OFB605")
     wants = (SetPositionTargetLocal, SetPositionTargetGlobal)
@@ -194,12 +198,22 @@ class PositionTargetFields(Check):
         if self._copter_axes() and self.rx is not None:
             offences = self._mc_axes(event, self.rx)
             self.episodes.update("OFB602", event.kind, event.t, event.where, offences)
+        rules = self._fw_rules(event.kind)
+        if rules is not None:
+            name = tm.MESSAGE_NAMES[event.kind]
+            offences = self._fw_ignored(event, name, rules)
+            self.episodes.update("OFB604", event.kind, event.t, event.where, offences)
+
+    def _fw_rules(self, kind: str) -> tm.PositionTargetRules | None:
+        """The docs' fixed-wing table, where a fixed wing takes the setpoint: an airplane, or a
+        VTOL in FW flight (its fixed-wing controllers fly it; seen on the standard VTOL,
+        ``vtol_fw_velocity-*``). None where no docs page covers the release."""
         if self.group == "fixedwing":
-            rules = tm.position_rules(self.ctx.profile, event.kind)
-            if rules is not None:
-                name = tm.MESSAGE_NAMES[event.kind]
-                offences = self._fw_ignored(event, name, rules)
-                self.episodes.update("OFB604", event.kind, event.t, event.where, offences)
+            return tm.position_rules(self.ctx.profile, kind)
+        if self.group == "copter" and self.ctx.state.vtol_phase == "fw":
+            page = tm.page_for(self.ctx.profile)
+            return None if page is None else page.position_rules(kind, "fixedwing")
+        return None
 
     def _judge_mask(self, event: PositionTarget) -> list[tuple[str, dict[str, Offence]]]:
         """The verdicts that depend only on the message, its type_mask and its frame."""
@@ -433,8 +447,9 @@ class PositionTargetFields(Check):
     def _setpoint_type(self, event: PositionTarget, name: str) -> dict[str, Offence]:
         if self.group != "fixedwing" or "position" not in tm.selected_groups(event.type_mask):
             return {}
-        if tm.setpoint_type(event.type_mask, event.kind) is not None:
-            return {}
+        kind = tm.setpoint_type(event.type_mask, event.kind)
+        if kind is not None:
+            return self._type_not_read(event, kind)
         values = tm.FIXEDWING_TYPES_LOCAL if event.kind == tm.LOCAL else tm.FIXEDWING_TYPES_GLOBAL
         listed = ", ".join(f"{v} {n}" for v, n in values.items())
         message = (
@@ -451,6 +466,30 @@ class PositionTargetFields(Check):
             return {"type": Offence(message, Severity.INFO, short + " (PX4 ignores it)")}
         return {"type": Offence(message, short=short)}
 
+    def _type_not_read(self, event: PositionTarget, kind: str) -> dict[str, Offence]:
+        """A takeoff, land or idle type asks for an action; from v1.12 PX4's receiver reads no
+        type bit and its fixed-wing controllers fly the setpoint as a position (with zero
+        velocity, as the type clears every ignore bit: path following). Seen (SITL,
+        ``fw_takeoff_type-*``): 4096 on the ground gave no runway takeoff on 1.16.2, 1.17.0
+        or the 1.18 head."""
+        if kind not in ACTION_TYPES or self.ctx.profile.release.legacy_receiver:
+            return {}
+        value = event.type_mask & tmask.SETPOINT_TYPE_BITS
+        how = (
+            " (with its velocity: path following)"
+            if "velocity" in tm.selected_groups(event.type_mask)
+            else ""
+        )
+        return {
+            f"action:{value}": Offence(
+                f"fixed-wing {tm.MESSAGE_NAMES[event.kind]} with the {kind} setpoint type "
+                f"({value}): PX4 {self.ctx.profile.px4}'s receiver does not read the type bits "
+                f"(v1.12+), so there is no {ACTION_TYPES[kind]}: the fixed-wing controller flies "
+                f"the setpoint as a position{how}",
+                short=f"fixed-wing {kind} type ({value}): PX4 does not read it, flies a position",
+            )
+        }
+
     # -- OFB604 -------------------------------------------------------------------------
 
     def _fw_ignored(
@@ -464,10 +503,22 @@ class PositionTargetFields(Check):
         ]
         if not fields:
             return {}
+        who = "fixed-wing" if self.group == "fixedwing" else "VTOL in FW flight,"
+        message = (
+            f"{who} {name} sets {', '.join(fields)}: the docs say fixed-wing uses the "
+            "position only and ignores velocity and acceleration"
+        )
+        short = f"{who} {', '.join(fields)} set: fixed-wing takes the position only"
+        if "position" in tm.selected_groups(event.type_mask):
+            return {"ignored": Offence(message, Severity.WARNING, short)}
+        # no position to fly: seen on 1.17.0 and the 1.18 head (vtol_fw_velocity-*), the
+        # VTOL in FW flight neither turned to a velocity-only setpoint nor held its height
         return {
             "ignored": Offence(
-                f"fixed-wing {name} sets {', '.join(fields)}: the docs say fixed-wing uses the "
-                "position only and ignores velocity and acceleration"
+                message + "; with no position in it PX4 does not fly it (seen: no turn to the "
+                "velocity, the heading held, height lost)",
+                Severity.ERROR,
+                short + ": no position, PX4 does not fly it",
             )
         }
 
@@ -492,8 +543,9 @@ class PositionTargetFields(Check):
 # -- OFB609: the legacy receiver (PX4 legacy and 1.11) --------------------------------------
 
 LEGACY_SETPOINT_TYPES = {0x1000: "takeoff", 0x2000: "land"}
-"""Setpoint-type values the legacy receiver classifies as LOITER (it tests ``mask & 0x3000``
-first, gate.md#receiver, #docs-vs-code)."""
+"""Setpoint-type values the legacy receiver classifies as LOITER (v1.6.4-v1.11: it tests
+``mask & 0x3000`` first; v1.5-v1.6.3 tested takeoff first, not modelled apart:
+gate.md#receiver, #docs-vs-code)."""
 
 
 def _nonfinite(names: tuple[str, ...], values: tuple[float, ...]) -> list[str]:
@@ -578,9 +630,10 @@ class LegacySetpointDropped(Check):
             return {
                 f"type:{value}": Offence(
                     f"{head} carries the setpoint type {kind} ({value}): PX4 {self.px4}'s "
-                    "receiver tests the loiter value (mask & 0x3000) first, so it forwards a "
-                    f"LOITER setpoint instead of a {kind} (only 12288 loiter and 16384 idle "
-                    "work as documented)"
+                    "receiver (v1.6.4-v1.11) tests the loiter value (mask & 0x3000) first, so "
+                    f"it forwards a LOITER setpoint instead of a {kind} (only 12288 loiter and "
+                    "16384 idle work as documented; v1.5-v1.6.3 tested takeoff first: there "
+                    "4096 and 8192 worked and 12288 loiter became a TAKEOFF)"
                 )
             }
         return {}

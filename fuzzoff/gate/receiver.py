@@ -310,5 +310,6 @@ def _legacy(msg: MavlinkTarget, ctx: ReceiverContext) -> Result:
         value = mask & SETPOINT_LOITER
         kind = _LEGACY_KINDS[value]
         if kind != "loiter":
+            # v1.6.4-v1.11; v1.5-v1.6.3 tested takeoff first (docs/gate.md, the receiver row)
             reason = f"setpoint type {kind} ({value}) is classified as LOITER in legacy"
     return ocm, axes, reason, "6.5"

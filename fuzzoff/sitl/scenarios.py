@@ -232,6 +232,18 @@ VTOL_FW_POINT = (400.0, 0.0, -30.0)
 VTOL_FW_S = 15.0
 
 
+VTOL_FW_FLIES_ON = (
+    "1.17.0",
+    "1.17.0-ros2-rover",
+    "1.18.0-alpha1",
+    "1.18.0-beta1-head",
+    "main-2026-08-13",
+)
+"""Where the standard VTOL reaches FW flight: on 1.16.2 its transition ends back in MC (the
+pusher did not move it, PX4 quad-chuted 6.4-6.6 s in; docs/sitl.md), so the programs about FW
+flight fly there in MC only."""
+
+
 def _vtol_to_fw(d: Driver) -> None:
     """MC offboard takeoff to 20 m, then DO_VTOL_TRANSITION to FW while in OFFBOARD, streaming
     a full position setpoint (x, y and z: a NaN z glides on 1.18, ``vtol_fw_glide``)."""
@@ -302,6 +314,37 @@ def vtol_fw_types(d: Driver) -> None:
     for mask, label in FW_SETPOINT_TYPES:
         d.note(f"type_mask {mask} ({label})")
         d.stream(_typed(mask, VTOL_FW_POINT), 4.0)
+    d.note("position setpoint again")
+    d.stream(d.position(*VTOL_FW_POINT), 4.0)
+    _vtol_back_and_land(d)
+
+
+FW_TAKEOFF_TYPE = 4096
+"""The docs' takeoff setpoint type (``type_mask`` 0x1000, every ignore bit clear)."""
+
+
+def vtol_fw_takeoff_type(d: Driver) -> None:
+    """In FW flight, the takeoff setpoint type (4096) at the cruise point for 6 s, then the
+    plain position setpoint again: does PX4 read it as a takeoff (a climb, full throttle) or
+    take the position?"""
+    _vtol_to_fw(d)
+    d.note(f"type_mask {FW_TAKEOFF_TYPE} (takeoff)")
+    d.stream(_typed(FW_TAKEOFF_TYPE, VTOL_FW_POINT), 6.0)
+    d.note("position setpoint again")
+    d.stream(d.position(*VTOL_FW_POINT), 4.0)
+    _vtol_back_and_land(d)
+
+
+VTOL_FW_VELOCITY = (0.0, 10.0, 0.0)
+"""10 m/s east (NED), the velocity-only setpoint flown in FW."""
+
+
+def vtol_fw_velocity(d: Driver) -> None:
+    """In FW flight, a velocity-only setpoint (10 m/s east) for 8 s, then the position setpoint
+    again: the docs say fixed-wing takes the position only (OFB604)."""
+    _vtol_to_fw(d)
+    d.note("velocity only: 10 m/s east")
+    d.stream(d.velocity(*VTOL_FW_VELOCITY), 8.0)
     d.note("position setpoint again")
     d.stream(d.position(*VTOL_FW_POINT), 4.0)
     _vtol_back_and_land(d)
@@ -408,11 +451,36 @@ def fw_gate(d: Driver) -> None:
     d.wait(3.0)
     d.note("stream resumes")
     d.stream(d.position(*FW_GROUND_POINT), 3.0)
+    _fw_ground_end(d)
+
+
+FW_TAKEOFF_TYPE_ON = ("1.16.2", "1.17.0", "1.18.0-beta1-head")
+"""The bundles ``fw_takeoff_type`` was flown on."""
+
+FW_TAKEOFF_POINT = (200.0, 0.0, -30.0)
+"""Where the airplane's takeoff setpoint points: 200 m ahead (north, the way it faces), 30 m up."""
+
+
+def _fw_ground_end(d: Driver) -> None:
+    """A disarm, forced when PX4 counts the airplane as flying (``fw_gate``'s end)."""
     if d.link.view.armed:
         ack = d.disarm()
         if ack is None or ack.result != 0:
             d.force_disarm()
     d.wait(1.0)
+
+
+def fw_takeoff_type(d: Driver) -> None:
+    """The airplane on the ground: the takeoff setpoint type (4096) 200 m ahead and 30 m up,
+    the switch to OFFBOARD, the arm, 15 s of the stream, a disarm (forced if PX4 counts it
+    flying). Does PX4 run a runway takeoff in OFFBOARD, or take a plain position?"""
+    takeoff = _typed(FW_TAKEOFF_TYPE, FW_TAKEOFF_POINT)
+    d.stream(takeoff, 1.5)
+    d.require(d.set_mode(NAV_OFFBOARD, "OFFBOARD"), "switch to OFFBOARD")
+    d.stream(takeoff, 0.5)
+    d.require(d.arm(), "arm in OFFBOARD")
+    d.stream(takeoff, 15.0)
+    _fw_ground_end(d)
 
 
 def _rover_start(d: Driver) -> None:
@@ -621,6 +689,7 @@ SCENARIOS: dict[str, Scenario] = {
             vtol_fw_glide,
             "clean",
             vehicle="vtol",
+            flies_on=VTOL_FW_FLIES_ON,
         ),
         Scenario(
             "vtol_fw_types",
@@ -629,6 +698,29 @@ SCENARIOS: dict[str, Scenario] = {
             vtol_fw_types,
             "clean",
             vehicle="vtol",
+            flies_on=VTOL_FW_FLIES_ON,
+        ),
+        Scenario(
+            "vtol_fw_takeoff_type",
+            "standard VTOL in FW flight: the takeoff setpoint type (4096) 6 s, then the position"
+            " setpoint again",
+            vtol_fw_takeoff_type,
+            "clean",
+            vehicle="vtol",
+            flies_on=VTOL_FW_FLIES_ON,
+        ),
+        Scenario(
+            "vtol_fw_velocity",
+            "standard VTOL in FW flight: a velocity-only setpoint (10 m/s east) 8 s, then the"
+            " position setpoint again",
+            vtol_fw_velocity,
+            "hazard",
+            "a velocity-only setpoint in FW flight: the docs say fixed-wing takes the position"
+            " only (PX4 did not turn to it)",
+            ("OFB604",),
+            shown_in=(".tlog",),
+            vehicle="vtol",
+            flies_on=VTOL_FW_FLIES_ON,
         ),
         Scenario(
             "tailsitter_offboard",
@@ -685,6 +777,20 @@ SCENARIOS: dict[str, Scenario] = {
             ("OFB103",),
             params=AIRPLANE_OUTPUTS,
             vehicle="fw",
+        ),
+        Scenario(
+            "fw_takeoff_type",
+            "airplane on the ground: the takeoff setpoint type (4096) 200 m ahead and 30 m up,"
+            " switch to OFFBOARD, arm, 15 s, disarm (forced if PX4 counts it flying)",
+            fw_takeoff_type,
+            "hazard",
+            "the takeoff setpoint type is not read (PX4 1.12+): no runway takeoff, the setpoint"
+            " is flown as a position with zero velocity (full throttle on the ground)",
+            ("OFB603",),
+            params=AIRPLANE_OUTPUTS,
+            shown_in=(".tlog",),
+            vehicle="fw",
+            flies_on=FW_TAKEOFF_TYPE_ON,
         ),
         Scenario(
             "rover_offboard",
