@@ -19,6 +19,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from fuzzoff import events as ev
+from fuzzoff.bridge.clock import Clock
 from fuzzoff.fuzz import recordings
 from fuzzoff.fuzz.scenario import Scenario
 from fuzzoff.fuzz.strategies import CommandPlan
@@ -401,18 +402,9 @@ def test_a_time_sync_jump_mid_stream_does_not_move_the_models_times() -> None:
     after the stream. Each of PX4's outputs the bag holds is read with the offset in effect
     when PX4 published it; reading some with the later one paired them with the wrong samples
     and moved every model time 216 ms early (three loss times 'differed')."""
-    from fuzzoff.bridge.bag import read_bag
-    from fuzzoff.bridge.clock import measure
-    from fuzzoff.bridge.ulog import read_ulog
     from fuzzoff.sitl.ros2 import verdict as ros2_verdict
 
-    exchanges = Path(__file__).resolve().parent.parent / "corpora" / "against" / "exchanges"
-    bag = exchanges / "timesync_jump_mid_stream-1.18.0-beta1-head-mcap"
-    ulog = exchanges / "timesync_jump_mid_stream-1.18.0-beta1-head.ulg"
-    log = read_ulog(ulog, ros2_verdict.STATUS)
-    (_, first), (_, second) = log.syncs
-    assert abs(second - first) > 200_000
-    clock = measure(read_bag(bag), log)
+    bag, ulog, clock = _exchange_with_a_sync_jump("timesync_jump_mid_stream-1.18.0-beta1-head")
     assert clock.pairs >= 20 and clock.residual_us < 20_000
     verdict = ros2_verdict.compare(bag, "1.18.0", ulog, {"COM_OF_LOSS_T": 0.2})
     losses = [i for i in verdict.items if i.what == "loss time"]
@@ -429,18 +421,9 @@ def test_an_output_near_a_time_sync_jump_is_paired_by_its_own_offsets_distance()
     3 ms match won: the clock's residual rose to 12 ms and the last loss time 'differed' (the
     model 24 ms after PX4's newest keep-alive, PX4 240 ms). Each candidate is now judged by
     its distance from the time its own offset gives."""
-    from fuzzoff.bridge.bag import read_bag
-    from fuzzoff.bridge.clock import measure
-    from fuzzoff.bridge.ulog import read_ulog
     from fuzzoff.sitl.ros2 import verdict as ros2_verdict
 
-    exchanges = Path(__file__).resolve().parent.parent / "corpora" / "against" / "exchanges"
-    bag = exchanges / "timesync_jump_pairing-main-2026-08-13-mcap"
-    ulog = exchanges / "timesync_jump_pairing-main-2026-08-13.ulg"
-    log = read_ulog(ulog, ros2_verdict.STATUS)
-    (_, first), (_, second) = log.syncs
-    assert abs(second - first) > 200_000
-    clock = measure(read_bag(bag), log)
+    bag, ulog, clock = _exchange_with_a_sync_jump("timesync_jump_pairing-main-2026-08-13")
     assert clock.pairs >= 30 and clock.residual_us < 5_000
     verdict = ros2_verdict.compare(bag, "main", ulog, {"COM_OF_LOSS_T": 0.2})
     losses = [i for i in verdict.items if i.what == "loss time"]
@@ -563,3 +546,19 @@ def test_the_bridges_namespace_is_the_one_each_release_gives_an_instance(tmp_pat
     assert bridge_namespace(newer, 4) == ""
     assert bridge_namespace(older, 4) == "/px4_4"
     assert bridge_namespace(older, 0) == ""
+
+
+def _exchange_with_a_sync_jump(stem: str) -> tuple[Path, Path, Clock]:
+    """A kept exchange's bag and ULog, checked to hold a time sync jump of over 200 ms, and the
+    clock measured between them."""
+    from fuzzoff.bridge.bag import read_bag
+    from fuzzoff.bridge.clock import measure
+    from fuzzoff.bridge.ulog import read_ulog
+    from fuzzoff.sitl.ros2 import verdict as ros2_verdict
+
+    exchanges = Path(__file__).resolve().parent.parent / "corpora" / "against" / "exchanges"
+    bag, ulog = exchanges / f"{stem}-mcap", exchanges / f"{stem}.ulg"
+    log = read_ulog(ulog, ros2_verdict.STATUS)
+    (_, first), (_, second) = log.syncs
+    assert abs(second - first) > 200_000
+    return bag, ulog, measure(read_bag(bag), log)

@@ -142,8 +142,16 @@ DOES_NOT_FLY: dict[tuple[str, str], str] = {
 def fixes_for(airframe: Airframe, release: str) -> dict[str, float]:
     """The fixes a run of ``airframe`` sets on the bundle ``release``: its own, then those of
     the release (``Airframe.fixes_on``)."""
-    extra = [f for prefix, f in airframe.fixes_on.items() if release.startswith(prefix)]
-    return {k: v for fixes in (airframe.fixes, *extra) for k, v in fixes.items()}
+    return on_release(airframe.fixes, airframe.fixes_on, release)
+
+
+def on_release(
+    base: dict[str, float], on: dict[str, dict[str, float]], release: str
+) -> dict[str, float]:
+    """``base``, then the parameters of ``on`` whose key (a bundle name prefix) ``release``
+    starts with, later ones winning."""
+    extra = [params for prefix, params in on.items() if release.startswith(prefix)]
+    return {k: v for params in (base, *extra) for k, v in params.items()}
 
 
 class AirframeError(bundle.BundleError):

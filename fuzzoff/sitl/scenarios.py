@@ -14,7 +14,11 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 from fuzzoff.mavlink_ids import MAV_FRAME_LOCAL_ENU
-from fuzzoff.sitl.airframes import AIRFRAMES, AIRPLANE_OUTPUTS  # fw_gate: each build's thrust
+from fuzzoff.sitl.airframes import (  # fw_gate: each build's thrust
+    AIRFRAMES,
+    AIRPLANE_OUTPUTS,
+    on_release,
+)
 from fuzzoff.sitl.driver import (
     ATTITUDE_NO_THRUST,
     NAV_LOITER,
@@ -57,8 +61,7 @@ class Scenario:
 
     def params_for(self, release: str) -> dict[str, float]:
         """The parameters the run sets on the bundle ``release``."""
-        extra = [p for prefix, p in self.params_on.items() if release.startswith(prefix)]
-        return {k: v for params in (self.params, *extra) for k, v in params.items()}
+        return on_release(self.params, self.params_on, release)
 
 
 def _offboard_takeoff(d: Driver, z: float = ALT, climb_s: float = 6.0) -> None:
