@@ -10,10 +10,12 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from fuzzoff import releases
+from fuzzoff import engine, releases
+from fuzzoff.checks.base import STREAM_TYPES
 from fuzzoff.cli import build_parser
 from fuzzoff.commands._common import settings_from_args
 from fuzzoff.engine import VehicleRun, lint_file
+from fuzzoff.events import Event
 from fuzzoff.fuzz.properties import FuzzContext, runs_match_single_messages
 from fuzzoff.fuzz.scenario import Scenario
 from fuzzoff.fuzz.streams import scenarios
@@ -22,10 +24,17 @@ CORPORA = Path(__file__).resolve().parent.parent / "corpora"
 EXPECTED = sorted(CORPORA.rglob("*.expected.json"))
 
 
+@pytest.mark.parametrize("short_runs", ["every run as a run", "short runs one at a time"])
 @pytest.mark.parametrize(
     "expected_file", EXPECTED, ids=[str(p.relative_to(CORPORA)) for p in EXPECTED]
 )
-def test_corpus_findings_are_the_same_as_runs_and_one_at_a_time(expected_file: Path) -> None:
+def test_corpus_findings_are_the_same_as_runs_and_one_at_a_time(
+    expected_file: Path, short_runs: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Batching gives what one message at a time gives: with every run handed over as a run,
+    and as a lint runs (short runs one message at a time, ``engine.SHORT_RUNS``)."""
+    if short_runs == "every run as a run":
+        monkeypatch.setattr(engine, "SHORT_RUNS", 0.0)
     spec = json.loads(expected_file.read_text())
     recording = expected_file.parent / spec["recording"]
     args = build_parser("lint").parse_args(["lint", str(recording), *spec.get("args", [])])
@@ -33,6 +42,41 @@ def test_corpus_findings_are_the_same_as_runs_and_one_at_a_time(expected_file: P
     single = lint_file(recording, lint_settings, batching=False)
     runs = lint_file(recording, lint_settings, batching=True)
     assert runs.findings == single.findings
+
+
+def _runs_handed_over(recording: Path, monkeypatch: pytest.MonkeyPatch) -> tuple[int, int]:
+    """(runs handed to the checks as runs, stream messages) in a lint of ``recording``."""
+    counted = [0, 0]
+    flush, feed = VehicleRun._flush, VehicleRun.feed
+
+    def counting_flush(run: VehicleRun) -> None:
+        counted[0] += run._batch is not None
+        flush(run)
+
+    def counting_feed(run: VehicleRun, event: Event) -> None:
+        counted[1] += type(event) in STREAM_TYPES
+        feed(run, event)
+
+    monkeypatch.setattr(VehicleRun, "_flush", counting_flush)
+    monkeypatch.setattr(VehicleRun, "feed", counting_feed)
+    lint_file(recording)
+    return counted[0], counted[1]
+
+
+def test_a_stream_between_status_messages_goes_one_message_at_a_time(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """PX4's ULog logs its status, flags and positions between every one or two setpoints: a
+    run there would cost more than it saves. A companion's own stream (ROS 2 bag) runs long,
+    and goes as runs."""
+    ulog = CORPORA / "sitl" / "hold_with_unknown_sub_mode-1.16.2.ulg"
+    runs, messages = _runs_handed_over(ulog, monkeypatch)
+    assert messages > 100
+    assert runs < messages / 20
+    bag = next(p for p in sorted((CORPORA / "examples").rglob("*.mcap")))
+    runs, messages = _runs_handed_over(bag, monkeypatch)
+    assert messages > 100
+    assert 0 < runs < messages / 8
 
 
 def test_runs_are_used_on_the_hot_path() -> None:

@@ -89,6 +89,9 @@ def local_cluster(workers: int) -> Any:
         "distributed.scheduler.work-stealing": False,
         "distributed.worker.profile.enabled": False,
         "distributed.admin.tick.interval": "1s",
+        # psutil's look at the machine's CPU, memory, network and disks, every 500 ms in
+        # the scheduler and every worker: a dashboard's plots, which a lint run does not show
+        "distributed.admin.system-monitor.interval": "10s",
     }
     with dask.config.set(local):
         return LocalCluster(
@@ -97,6 +100,12 @@ def local_cluster(workers: int) -> Any:
             processes=True,
             dashboard_address=":0",  # any free port: no warning when 8787 is taken
             silence_logs=logging.ERROR,
+            # no memory management: a lint's memory is flat, there is nothing to spill, and
+            # the monitors behind it (every 100 ms in each worker and its nanny) woke the
+            # worker's event loop into the lint's thread some 200 times a second (issue 31).
+            # A worker that runs out of memory is still ended by the kernel, restarted by its
+            # nanny, and its recording reported as OFB001.
+            memory_limit=0,
         )
 
 

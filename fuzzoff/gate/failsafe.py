@@ -309,10 +309,50 @@ def _legacy(vehicle: str, params: dict[str, float], est: Estimates, stage: int) 
     return _finish(chosen, final, "5.3", False, note, rc)
 
 
+READ_PARAMS: tuple[str, ...] = (
+    "COM_OBL_ACT",
+    "COM_OBL_RC_ACT",
+    "COM_POS_FS_ACT",
+    "COM_POSCTL_NAVL",
+    "COM_RCL_EXCEPT",
+    "NAV_RCL_ACT",
+    RC_PRESENT,
+)
+"""Every parameter the loss action reads (``tests/test_gate_failsafe_memo.py`` holds the
+functions above to this list): the memo's key."""
+
+_MEMO_LIMIT = 256
+_memo: dict[tuple[object, ...], tuple[Release, LossAction]] = {}
+
+
 def loss_action(
     release: Release, vehicle: str, params: dict[str, float], est: Estimates, stage: int = 2
 ) -> LossAction:
-    """The action on offboard loss now. ``stage`` is legacy's: 1 = lost, 2 = loss timeout."""
+    """The action on offboard loss now. ``stage`` is legacy's: 1 = lost, 2 = loss timeout.
+
+    Remembered by everything it reads (a check asks at every status and flags message while
+    offboard, issue 31); the answer is frozen, so sharing it is safe."""
+    key = (
+        id(release),
+        vehicle,
+        stage,
+        est.bits,
+        est.rc_recorded,
+        tuple(map(params.get, READ_PARAMS)),
+    )
+    found = _memo.get(key)
+    if found is not None and found[0] is release:
+        return found[1]
+    action = _loss_action(release, vehicle, params, est, stage)
+    if len(_memo) >= _MEMO_LIMIT:
+        _memo.clear()
+    _memo[key] = (release, action)
+    return action
+
+
+def _loss_action(
+    release: Release, vehicle: str, params: dict[str, float], est: Estimates, stage: int
+) -> LossAction:
     if release.loss_failsafe == "state_machine_legacy":
         return _legacy(vehicle, params, est, stage)
     if release.loss_failsafe == "state_machine":

@@ -207,7 +207,7 @@ def _walk(buf: Buffer, pos: int) -> tuple[Any, Any, Any, Any] | None:
         return None  # the last record runs past the end of the file
     s = np.frombuffer(starts, dtype=np.int32) if len(starts) else np.zeros(0, np.int32)
     kinds = np.frombuffer(buf, dtype=np.uint8)[s + 2] if len(s) else np.zeros(0, np.uint8)
-    if not bool(np.isin(kinds, _KINDS).all()):
+    if not bool(np.isin(kinds, _KINDS, kind="table").all()):
         return None  # a record type the logger does not write in the data section
     ends = np.empty_like(s)
     ends[:-1] = s[1:]
@@ -281,7 +281,7 @@ def _keep_dating_rows(keep: Any, kinds: Any, read: Any, stamps: Any, start: int)
     """Keep the data rows pyulog's running ``last_timestamp`` takes its value from where it
     dates a record (parameter changes, dropouts) and at the end; that value at the end.
     Worked out over the records that matter only (the rows read and the records dated)."""
-    at = np.flatnonzero(read | np.isin(kinds, _DATED))
+    at = np.flatnonzero(read | np.isin(kinds, _DATED, kind="table"))
     n = len(at)
     if not n:
         return start

@@ -297,7 +297,7 @@ class UlogSource(Source):
             read = rows_read.get((d.name, d.multi_id))
             plotted = spec.kind == ev.VehiclePosition.kind and self.aside.plot is not None
             if read is not None and (
-                keep is None or plotted or not bool(np.isin(keep, read).all())
+                keep is None or plotted or not bool(np.isin(keep, read, kind="table").all())
             ):
                 # ``_ReadRows`` decides as this loop does, and ``_load`` reads every row for
                 # the plots, so this is not expected (a plot asked for after ``open``): the
