@@ -10,6 +10,9 @@ import json
 import os
 import subprocess
 import sys
+from pathlib import Path
+
+import pytest
 
 from tests.helpers import ROOT
 
@@ -119,13 +122,22 @@ NOT_FOR_A_ULOG_LINT = (
     "fuzzoff.formats.mcap.",
     "fuzzoff.formats.rosbag1.",
     "fuzzoff.formats.rosbag2.",
+    "fuzzoff.formats.ros2msgs.",
+    "numpy.ma.",
 )
 """What a JSON lint of one ULog (a pre-commit hook's run) never reaches: the other formats'
 readers and libraries, the fuzz, fleet and SITL machinery, the other reports."""
 
 
-def test_a_one_file_lint_loads_only_its_reader_and_its_report() -> None:
-    ulog = ROOT / "corpora" / "real" / "sample_log_small.ulg"
+@pytest.mark.parametrize(
+    "ulog",
+    [
+        ROOT / "corpora" / "real" / "sample_log_small.ulg",
+        ROOT / "corpora" / "sitl" / "hold_with_unknown_sub_mode-1.16.2.ulg",
+    ],
+    ids=["real", "sitl"],
+)
+def test_a_one_file_lint_loads_only_its_reader_and_its_report(ulog: Path) -> None:
     code = (
         "import io, contextlib\n"
         "from fuzzoff.cli import main\n"

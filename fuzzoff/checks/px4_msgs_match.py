@@ -16,6 +16,7 @@ subscription nobody serves).
 from __future__ import annotations
 
 from collections import Counter, defaultdict
+from typing import TYPE_CHECKING
 
 from fuzzoff.checks.base import Check, CheckContext
 from fuzzoff.events import (
@@ -27,7 +28,18 @@ from fuzzoff.events import (
     VehiclePosition,
     VehicleStatus,
 )
-from fuzzoff.formats.ros2msgs.topics import parse_topic
+
+if TYPE_CHECKING:
+    from fuzzoff.formats.ros2msgs.topics import TopicRef
+
+
+def parse_topic(topic: str) -> TopicRef | None:
+    """``ros2msgs.topics.parse_topic``, imported when a ROS 2 recording first needs it: a lint of
+    another format does not load the ROS 2 topic tables (issue 31)."""
+    from fuzzoff.formats.ros2msgs.topics import parse_topic as parse
+
+    return parse(topic)
+
 
 CODE = "OFB006"
 

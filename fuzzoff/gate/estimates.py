@@ -7,9 +7,13 @@ Manual control (RC or joystick) starts from the ``FUZZOFF_RC_PRESENT`` assumptio
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from operator import attrgetter
 
 from fuzzoff.events import ESTIMATES, FailsafeFlags
+
+_READ = attrgetter(*(name + "_valid" for name in ESTIMATES), "manual_control_signal_lost")
+"""Every field of a ``FailsafeFlags`` event that ``Estimates.update`` applies."""
 
 
 @dataclass(slots=True)
@@ -28,12 +32,18 @@ class Estimates:
     """True once the recording carried any estimate flag."""
     bits: int = 255
     """Every flag the gate reads as one small integer (cheap change detection and memo keys)."""
+    last_read: tuple[bool | None, ...] | None = field(default=None, compare=False, repr=False)
+    """The fields of the last ``FailsafeFlags`` applied, as ``_READ`` reads them."""
 
     def __post_init__(self) -> None:
         self.bits = self._compute_key()
 
     def update(self, flags: FailsafeFlags) -> bool:
         """Apply a ``FailsafeFlags`` event; True when anything the gate reads changed."""
+        read = _READ(flags)
+        if read == self.last_read:  # PX4 logs the same flags at 10 Hz: nothing to apply
+            return False
+        self.last_read = read
         before = self.bits
         for name in ESTIMATES:
             value = getattr(flags, name + "_valid")
