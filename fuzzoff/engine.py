@@ -236,8 +236,9 @@ class VehicleRun:
     def feed(self, event: Event) -> None:
         """The hot path: runs once per event of a recording, so it is kept flat.
 
-        Stream messages also join the open run for the checks that take runs; the run is
-        handed over before any other event, before a gate transition, and before a change of
+        Stream messages also join the open run for the checks that take runs (while runs are
+        short, ``SHORT_RUNS``, they go to those checks' ``on_event`` at once instead); the run
+        is handed over before any other event, before a gate transition, and before a change of
         the declared control mode, so that it never spans a change of what checks read."""
         cls = type(event)
         stream = cls in STREAM_TYPES
