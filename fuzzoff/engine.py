@@ -201,10 +201,10 @@ class VehicleRun:
         return handlers
 
     def _one_by_one_for(self, cls: type) -> list[Callable[[Event], None]]:
-        handlers = self._one_by_one.get(cls)
-        if handlers is None:
-            handlers = [c.on_event for c in self.batched if issubclass(cls, c.subscriptions)]
-            self._one_by_one[cls] = handlers
+        handlers: list[Callable[[Event], None]] = [
+            c.on_event for c in self.batched if issubclass(cls, c.subscriptions)
+        ]
+        self._one_by_one[cls] = handlers
         return handlers
 
     def _flush(self) -> None:
@@ -275,7 +275,10 @@ class VehicleRun:
             self._run_length += 1
             batch = self._batch
             if batch is None and self._average_run < SHORT_RUNS:
-                for handler in self._one_by_one.get(cls) or self._one_by_one_for(cls):
+                one_by_one = self._one_by_one.get(cls)
+                if one_by_one is None:
+                    one_by_one = self._one_by_one_for(cls)
+                for handler in one_by_one:
                     handler(event)
                 return
             if batch is not None and state.declared_flag != batch.state.declared_flag:

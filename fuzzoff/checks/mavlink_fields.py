@@ -208,12 +208,11 @@ class PositionTargetFields(Check):
         """The docs' fixed-wing table, where a fixed wing takes the setpoint: an airplane, or a
         VTOL in FW flight (its fixed-wing controllers fly it; seen on the standard VTOL,
         ``vtol_fw_velocity-*``). None where no docs page covers the release."""
-        if self.group == "fixedwing":
-            return tm.position_rules(self.ctx.profile, kind)
-        if self.group == "copter" and self.ctx.state.vtol_phase == "fw":
-            page = tm.page_for(self.ctx.profile)
-            return None if page is None else page.position_rules(kind, "fixedwing")
-        return None
+        in_fw = self.group == "fixedwing" or (
+            self.group == "copter" and self.ctx.state.vtol_phase == "fw"
+        )
+        page = tm.page_for(self.ctx.profile) if in_fw else None
+        return None if page is None else page.position_rules(kind, "fixedwing")
 
     def _judge_mask(self, event: PositionTarget) -> list[tuple[str, dict[str, Offence]]]:
         """The verdicts that depend only on the message, its type_mask and its frame."""
