@@ -25,13 +25,14 @@ import json
 import os
 import zlib
 from collections.abc import Iterable
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 from typing import Any, Literal, get_args
 
 from fuzzoff import releases
 from fuzzoff._version import __version__
 from fuzzoff.findings import Severity
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.profiles import VEHICLE_TYPES, seen_running_text
 
 PROJECT_URL = "https://github.com/fuzzoff/fuzzoff"

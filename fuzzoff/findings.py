@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
+from dataclasses import field
 from enum import IntEnum
 from typing import TYPE_CHECKING, Any, TypedDict
 
 from fuzzoff.events import Where
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.profiles import Profile
 
 if TYPE_CHECKING:

@@ -7,9 +7,8 @@ PX4 profile does is its record in ``fuzzoff/releases.py`` (``Profile.release``).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from fuzzoff import releases
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.releases import PX4Profile, Release
 
 VEHICLE_TYPES: tuple[str, ...] = (

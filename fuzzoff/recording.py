@@ -13,12 +13,13 @@ import math
 import os
 import re
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 from types import TracebackType
 
 from fuzzoff.events import Event, VehiclePosition
 from fuzzoff.findings import RecordingStats
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.releases import Release
 
 

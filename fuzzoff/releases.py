@@ -17,9 +17,11 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 from types import MappingProxyType
 from typing import Literal
+
+from fuzzoff.lean_dataclass import dataclass
 
 PX4Profile = Literal["legacy", "1.11", "1.13", "1.14", "1.15", "1.16", "1.17", "1.18", "main"]
 """The names of the modelled releases (``--px4`` values), oldest first."""

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field, fields
+from dataclasses import field, fields
 from operator import attrgetter
 
 from fuzzoff.events import (
@@ -31,6 +31,7 @@ from fuzzoff.events import (
     VehicleStatus,
     VtolPhase,
 )
+from fuzzoff.lean_dataclass import dataclass
 
 STALE_STATUS_S = 0.05
 """A status that still shows the mode an accepted switch left, this soon after its ack, was

@@ -4,10 +4,11 @@ in a module of its own so that what reads it need not import the engine."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 
 from fuzzoff.events import Event
 from fuzzoff.gate.transitions import GateTransition
+from fuzzoff.lean_dataclass import dataclass
 
 
 @dataclass(slots=True)

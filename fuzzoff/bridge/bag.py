@@ -10,13 +10,14 @@ bridge's offset for PX4's outputs) and its other fields, flattened as PX4's ULog
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
 
 from fuzzoff.bridge import BridgeError
+from fuzzoff.lean_dataclass import dataclass
 
 BRIDGE_TOPIC = re.compile(r"/fmu/(in|out)/([a-z0-9_]+?)(?:_v\d+)?$")
 """``/fmu/in/trajectory_setpoint``, ``/fmu/out/vehicle_status_v4`` (any namespace before)."""

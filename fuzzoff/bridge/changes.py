@@ -8,12 +8,12 @@ within ``GAP_US`` after), or that it never did.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 from fuzzoff.bridge.bag import Bag
 from fuzzoff.bridge.clock import Clock
 from fuzzoff.bridge.ulog import Px4Log, ULogTopic
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.modes import nav_state_name
 
 TOLERANCE_US = 30_000

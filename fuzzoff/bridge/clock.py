@@ -13,13 +13,12 @@ Without such outputs (a bag of ``/fmu/in`` topics only) the offset alone maps, a
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from fuzzoff.bridge import BridgeError
 from fuzzoff.bridge.bag import Bag
 from fuzzoff.bridge.ulog import Px4Log
+from fuzzoff.lean_dataclass import dataclass
 
 PAIR_TOPICS = ("vehicle_status", "failsafe_flags", "vehicle_control_mode", "vehicle_command_ack")
 """PX4 outputs logged whole and published at most a few times a second: one ULog sample near

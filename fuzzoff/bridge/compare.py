@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -30,6 +29,7 @@ from fuzzoff.bridge.bag import Bag, BagTopic
 from fuzzoff.bridge.changes import Change, changes_of, signal_lost
 from fuzzoff.bridge.clock import Clock, measure, pairs
 from fuzzoff.bridge.ulog import Px4Log, ULogTopic
+from fuzzoff.lean_dataclass import dataclass
 
 TOLERANCE_US = 30_000
 """Slack between a send time mapped onto PX4's clock and PX4's record of it."""

@@ -15,13 +15,13 @@ reset: a simulated PX4 off the host's pace, no new "synchronized" line).
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from fuzzoff.bridge import BridgeError
+from fuzzoff.lean_dataclass import dataclass
 
 SYNCED = re.compile(r"synchronized with time offset (-?\d+)\s*us")
 SOURCE_PROTOCOL_DDS = 2

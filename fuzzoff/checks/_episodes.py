@@ -11,11 +11,10 @@ first message, with ``end`` = its last) when it is closed: by a longer pause in 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from fuzzoff.checks.base import CheckContext
 from fuzzoff.events import Where
 from fuzzoff.findings import Severity
+from fuzzoff.lean_dataclass import dataclass
 
 MERGE_GAP_S = 1.0
 """Offending messages closer than this belong to one stretch."""

@@ -12,13 +12,13 @@ and only when the declared first true field selects its topic
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from operator import attrgetter
 
 from fuzzoff.checks._runs import first_of_each
 from fuzzoff.checks.base import CheckContext
 from fuzzoff.events import NAV_STATE_OFFBOARD, Event, Where
 from fuzzoff.findings import Severity
+from fuzzoff.lean_dataclass import dataclass
 
 
 def declared_flag(ctx: CheckContext) -> str | None:

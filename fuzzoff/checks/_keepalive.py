@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from operator import attrgetter, sub
 
 from fuzzoff.checks.base import CheckContext, StreamBatch
@@ -14,6 +13,7 @@ from fuzzoff.events import (
     Event,
     VehicleStatus,
 )
+from fuzzoff.lean_dataclass import dataclass
 
 KEEPALIVE_EVENTS: tuple[type[Event], ...] = (*KEEPALIVE_TYPES, Dropout)
 """What a stream rule subscribes to: the keep-alive kinds, and logger dropouts (ULog)."""

@@ -20,7 +20,6 @@ Direct actuator outputs cannot be judged without the vehicle's mixer: never a mo
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Literal
 
 from fuzzoff import type_mask as tmask
@@ -39,6 +38,7 @@ from fuzzoff.events import (
     TorqueSetpoint,
     TrajectorySetpoint,
 )
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.mavlink_ids import MAV_FRAME_BODY_NED, MAV_FRAME_LOCAL_NED
 from fuzzoff.tables import mavlink as tm
 

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import copy
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import field
 from operator import attrgetter
 from typing import Any, ClassVar
 
@@ -36,6 +36,7 @@ from fuzzoff.events import (
 )
 from fuzzoff.findings import Finding, Severity
 from fuzzoff.gate import GateView
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.profiles import Profile
 from fuzzoff.recording import RecordingInfo
 from fuzzoff.state import VehicleState

@@ -10,8 +10,6 @@ command for a system the recording shows no autopilot of is judged at the end.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from fuzzoff import releases
 from fuzzoff.checks.base import Check, CheckContext
 from fuzzoff.events import (
@@ -29,6 +27,7 @@ from fuzzoff.findings import Severity
 from fuzzoff.gate.addressing import command_addressing, wrong_address
 from fuzzoff.gate.commander import request_name
 from fuzzoff.gate.requests import decode_mode
+from fuzzoff.lean_dataclass import dataclass
 
 REQUESTS = frozenset({MAV_CMD_DO_SET_MODE, MAV_CMD_COMPONENT_ARM_DISARM})
 """The commands the gate model judges (mode switches, arming and disarming)."""

@@ -18,12 +18,11 @@ judged; nor a command sent less than ``answer_s`` before the recording ends.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from fuzzoff.checks.base import Check, CheckContext
 from fuzzoff.checks.first_ack import step_name
 from fuzzoff.events import Command, CommandAck, Event
 from fuzzoff.gate.addressing import command_addressing
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.mavlink_ids import MAV_COMP_ID_AUTOPILOT1
 from fuzzoff.tables.answered import always_answered
 

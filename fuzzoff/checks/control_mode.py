@@ -6,7 +6,6 @@ Seed 000 "The OffboardControlMode PX4 message" (1.15+; rover table in "Рове�
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from itertools import chain
 from operator import attrgetter
 
@@ -29,6 +28,7 @@ from fuzzoff.events import (
 )
 from fuzzoff.gate import GateTransition, ocm
 from fuzzoff.gate.receiver import DROPPED, SHAPES, ReceiverContext, Shape, receive
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.state import VehicleState
 from fuzzoff.tables.control_mode import (
     SETPOINT_NAMES,

@@ -26,8 +26,6 @@ then judged by the release (``--px4``).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from fuzzoff.checks.base import Check, CheckContext
 from fuzzoff.events import (
     ArmingCheckReply,
@@ -37,6 +35,7 @@ from fuzzoff.events import (
     ExtComponentRequest,
     ExtComponentUnregister,
 )
+from fuzzoff.lean_dataclass import dataclass
 
 CODE = "OFB209"
 

@@ -16,12 +16,11 @@ are no step.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from fuzzoff.checks._keepalive import px4_label
 from fuzzoff.checks.base import Check, CheckContext
 from fuzzoff.events import MAV_CMD_DO_SET_MODE, Command, CommandAck, Event, whole
 from fuzzoff.findings import Severity
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.modes import custom_mode_to_nav_state, nav_state_name
 from fuzzoff.state import DOUBLE_ACK_WINDOW_S
 

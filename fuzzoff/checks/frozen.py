@@ -14,7 +14,7 @@ from __future__ import annotations
 import marshal
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, fields
+from dataclasses import fields
 from itertools import chain, repeat
 from operator import attrgetter, eq, itemgetter, le, ne, sub
 from typing import Any
@@ -25,6 +25,7 @@ from fuzzoff.checks._motion import ROVER_TURNS, Hover, Motion, held_motion, rove
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import MAVLINK_SETPOINTS, PX4_SETPOINTS, Event, VehicleStatus, Where
 from fuzzoff.gate import GateTransition
+from fuzzoff.lean_dataclass import dataclass
 
 HEADER_FIELDS = frozenset({"t", "vehicle", "where", "sender_time_us", "origin"})
 """Fields that change with every message and say nothing about the setpoint."""

@@ -13,13 +13,12 @@ want of a keep-alive. This rule names the messages themselves, once per stretch.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from fuzzoff.catalog import get_rule
 from fuzzoff.checks._episodes import MERGE_GAP_S
 from fuzzoff.checks._keepalive import px4_label
 from fuzzoff.checks.base import Check, CheckContext
 from fuzzoff.events import Event, SetActuatorControlTarget
+from fuzzoff.lean_dataclass import dataclass
 
 IGNORED: tuple[type[Event], ...] = (SetActuatorControlTarget,)
 """The messages a release of OFB608's profiles has no handler for."""

@@ -13,8 +13,6 @@ link (1 Hz HEARTBEAT, ``/mavros/state``), between the last sample still in OFFBO
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from fuzzoff.checks._keepalive import (
     KEEPALIVE_EVENTS,
     TIME_EPSILON_S,
@@ -26,6 +24,7 @@ from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import NAV_STATE_OFFBOARD, Event, VehicleStatus, Where
 from fuzzoff.gate import GateTransition
 from fuzzoff.gate.compare import over_a_link
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.modes import nav_state_name
 
 RECORDED_ANSWER_WINDOW_S = 2.5

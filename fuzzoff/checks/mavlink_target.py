@@ -10,13 +10,13 @@ recording shows: the system id its own messages come from (HEARTBEAT and the res
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from operator import attrgetter
 
 from fuzzoff.checks._episodes import Episodes, Offence
 from fuzzoff.checks._runs import commit_alike, first_of_each, sent_only
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import Event, MavlinkTarget, SetAttitudeTarget, Where
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.tables import mavlink as tm
 
 AUTOPILOT_COMPONENT = 1

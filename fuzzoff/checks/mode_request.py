@@ -7,13 +7,12 @@ sub-mode it does not know is refused on every release; ALTITUDE_CRUISE exists fr
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from fuzzoff import releases
 from fuzzoff.checks.base import Check, CheckContext
 from fuzzoff.events import MAV_CMD_DO_SET_MODE, Command, Event, Where, whole
 from fuzzoff.findings import Severity
 from fuzzoff.gate.requests import mode_request, unknown_mode_decision
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.modes import nav_state_name
 
 

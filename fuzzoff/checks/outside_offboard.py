@@ -19,7 +19,7 @@ px4-ros2-interface-lib) is the companion's own: its setpoints are what PX4 flies
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 from operator import attrgetter
 
 from fuzzoff.checks._external import is_armed
@@ -28,6 +28,7 @@ from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import PX4_SETPOINTS, Command, Event, VehicleStatus, Where
 from fuzzoff.findings import Severity
 from fuzzoff.gate import GateTransition
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.modes import nav_state_name
 from fuzzoff.tables.control_mode import SETPOINT_KINDS, SETPOINT_NAMES
 

@@ -17,8 +17,6 @@ PX4's status shows OFFBOARD only after it answered both (issue 28 miss 2).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from fuzzoff.checks._keepalive import px4_label
 from fuzzoff.checks.base import Check, CheckContext
 from fuzzoff.events import (
@@ -28,6 +26,7 @@ from fuzzoff.events import (
 )
 from fuzzoff.findings import Severity
 from fuzzoff.gate import GateTransition
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.state import DOUBLE_ACK_WINDOW_S
 
 ACK_WAIT_S = 1.0

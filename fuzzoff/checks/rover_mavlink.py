@@ -10,7 +10,6 @@ is 0 (the parameter as recorded, or as given in ``params``; without it, OFB002).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 from fuzzoff import type_mask as tmask
 from fuzzoff.checks._episodes import Episodes, Offence
@@ -27,6 +26,7 @@ from fuzzoff.events import (
     Where,
 )
 from fuzzoff.findings import Severity
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.tables import mavlink as tm
 
 TILT_TOLERANCE_RAD = math.radians(1.0)

@@ -12,7 +12,6 @@ from __future__ import annotations
 import math
 from bisect import bisect_left
 from collections import Counter
-from dataclasses import dataclass
 from functools import cache
 
 from fuzzoff.checks._keepalive import (
@@ -40,6 +39,7 @@ from fuzzoff.events import (
 from fuzzoff.findings import Severity
 from fuzzoff.gate import GateTransition
 from fuzzoff.gate.commander import SAME_ITERATION_S
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.state import DOUBLE_ACK_WINDOW_S
 
 NEAR_LOSS_FRACTION = 0.8

@@ -9,7 +9,6 @@ freshest sender-to-recording offset seen so far.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from itertools import repeat
 from operator import attrgetter, le, sub, truediv
 
@@ -17,6 +16,7 @@ from fuzzoff.checks._keepalive import control_modes, keepalive_run
 from fuzzoff.checks.base import Check, CheckContext, StreamBatch
 from fuzzoff.events import ControlMode, Event, Where
 from fuzzoff.findings import Severity
+from fuzzoff.lean_dataclass import dataclass
 
 _STAMP = attrgetter("sender_time_us")
 _ORIGIN = attrgetter("origin")

@@ -10,8 +10,9 @@ from __future__ import annotations
 import functools
 import os
 import re
-from dataclasses import dataclass
 from pathlib import Path
+
+from fuzzoff.lean_dataclass import dataclass
 
 
 @dataclass(frozen=True, slots=True)

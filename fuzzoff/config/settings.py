@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -13,6 +13,7 @@ from fuzzoff import releases
 from fuzzoff.catalog import get_rule
 from fuzzoff.config.globs import FileIgnore
 from fuzzoff.findings import Finding, Report, Severity
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.releases import PX4Profile, Release
 
 

@@ -25,7 +25,6 @@ import time
 import uuid
 from collections.abc import Callable, Collection, Iterator, Sequence
 from contextlib import contextmanager
-from dataclasses import dataclass
 from typing import Any
 
 from fuzzoff.config import ConfigError, Settings
@@ -33,6 +32,7 @@ from fuzzoff.engine import lint_file
 from fuzzoff.fleet import require
 from fuzzoff.fleet.batches import plan, recording_bytes
 from fuzzoff.fleet.task import CRASHED, FAILED, TIMED_OUT, Lint, Outcome, failed_report, lint_target
+from fuzzoff.lean_dataclass import dataclass
 
 LOCAL = "local"
 DEFAULT_TIMEOUT_S = 600.0

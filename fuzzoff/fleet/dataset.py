@@ -16,7 +16,6 @@ not finish (crashed, timed out, fuzzoff failed) are not known: the next run trie
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass
 from datetime import UTC, date, datetime
 from pathlib import Path
 from typing import Any
@@ -29,6 +28,7 @@ import pyarrow.parquet as pq
 from fuzzoff import __version__
 from fuzzoff.findings import Severity
 from fuzzoff.fleet.task import LINTED, SKIPPED, Outcome
+from fuzzoff.lean_dataclass import dataclass
 
 RECORDINGS = "recordings"
 FINDINGS = "findings"

@@ -13,7 +13,7 @@ Each recording counts once, with its newest row (a ``--force`` run supersedes ol
 from __future__ import annotations
 
 import hashlib
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 
 import pyarrow as pa
@@ -22,6 +22,7 @@ import pyarrow.compute as pc
 from fuzzoff import __version__
 from fuzzoff.catalog import get_rule
 from fuzzoff.fleet.dataset import FINDINGS, RECORDINGS, latest, read
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.report.html import CSP, e
 from fuzzoff.report.html_style import CSS
 

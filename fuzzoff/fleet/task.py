@@ -12,7 +12,6 @@ from __future__ import annotations
 import dataclasses
 import time
 from collections.abc import Callable, Collection
-from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
 
@@ -23,6 +22,7 @@ from fuzzoff.findings import FileReport, Finding, Severity
 from fuzzoff.fleet import is_url
 from fuzzoff.fleet.inputs import FetchError, content_hash, fetched
 from fuzzoff.fleet.wallclock import start_time
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.recording import RecordingInfo, path_text
 
 Lint = Callable[[str, Settings], FileReport]

@@ -9,11 +9,11 @@ from __future__ import annotations
 
 import importlib
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from fuzzoff.events import Event
+from fuzzoff.lean_dataclass import dataclass
 
 if TYPE_CHECKING:
     from fuzzoff.recording import Source

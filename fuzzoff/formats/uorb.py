@@ -7,9 +7,8 @@ reaches into a reader for it.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from fuzzoff import events as ev
+from fuzzoff.lean_dataclass import dataclass
 
 ARMING_STATE_DISARMED = 1
 """STANDBY in 1.13/1.14, DISARMED from 1.15: 1 in both numberings."""

@@ -18,7 +18,7 @@ import tempfile
 import time
 from collections import Counter
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
 
 from hypothesis import HealthCheck, Phase, given, seed, settings, target
@@ -33,6 +33,7 @@ from fuzzoff.fuzz.properties import PROPERTIES, FuzzContext, PropertySpec
 from fuzzoff.fuzz.scenario import Scenario, TransportName
 from fuzzoff.fuzz.streams import scenarios
 from fuzzoff.gate.params import default_params, loss_timeout
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.releases import PX4Profile
 
 PROFILE_CI = "fuzzoff-ci"

@@ -20,12 +20,12 @@ keep-alive...). Each rule says which kinds it explains in its page (``rules/CODE
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 
 from fuzzoff.catalog import HAZARD_KINDS, CatalogError, Rule, load_catalog
 from fuzzoff.events import Command
 from fuzzoff.gate import GateTransition
 from fuzzoff.gate.sections import cite
+from fuzzoff.lean_dataclass import dataclass
 
 HOLD_S = 0.2
 """A controller hazard must last this long (PX4 1.16's last-valid reuse window)."""

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 
 from hypothesis import strategies as st
@@ -27,6 +27,7 @@ from fuzzoff.fuzz.hazards import hazards
 from fuzzoff.fuzz.recordings import read_with_info
 from fuzzoff.fuzz.scenario import Scenario, TransportName, run
 from fuzzoff.fuzz.streams import settle
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.profiles import DEFAULT_PX4, DEFAULT_VEHICLE, ProfileError, px4_profile_for
 from fuzzoff.releases import PX4Profile
 from fuzzoff.timeline import Timeline

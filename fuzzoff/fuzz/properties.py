@@ -33,7 +33,7 @@ import shutil
 import tempfile
 from collections import Counter
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field, fields
+from dataclasses import field, fields
 from pathlib import Path
 from typing import Any
 
@@ -48,6 +48,7 @@ from fuzzoff.fuzz.hazards import EXPLAINED_BY, OUTCOME_RULE, Hazard, hazards
 from fuzzoff.fuzz.invariants import invariant_violations
 from fuzzoff.fuzz.scenario import Scenario, run
 from fuzzoff.gate.params import default_params, loss_timeout
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.timeline import Timeline
 
 TOLERANCE_S = 0.15

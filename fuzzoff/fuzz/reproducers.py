@@ -27,7 +27,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 from pathlib import Path
 from typing import Any
 
@@ -39,6 +39,7 @@ from fuzzoff.fuzz import recordings, stream_file
 from fuzzoff.fuzz.properties import PROPERTIES, FuzzContext
 from fuzzoff.fuzz.scenario import AUTOPILOT, COMPANION, RECORDING_FORMAT, TRANSPORTS, Scenario
 from fuzzoff.gate.params import RC_PRESENT
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.profiles import (
     DEFAULT_PX4,
     DEFAULT_VEHICLE,

@@ -9,7 +9,7 @@ status as it reaches that recording, see ``as_recorded``).
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 from typing import Any, Literal
 
 from fuzzoff.config import Settings
@@ -17,6 +17,7 @@ from fuzzoff.engine import run_events
 from fuzzoff.events import Event, VehicleStatus, Where, event_from_dict, event_to_dict
 from fuzzoff.findings import Finding
 from fuzzoff.formats.registry import written_for
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.profiles import Profile, px4_profile_for
 from fuzzoff.recording import RecordingInfo
 from fuzzoff.releases import PX4Profile

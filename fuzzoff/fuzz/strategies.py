@@ -15,13 +15,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
 from typing import Any, Literal, TypedDict
 
 from hypothesis import strategies as st
 
 from fuzzoff import releases
 from fuzzoff.events import Quat, Vec3
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.profiles import VEHICLE_TYPES
 from fuzzoff.releases import PX4Profile
 

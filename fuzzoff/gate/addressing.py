@@ -11,10 +11,10 @@ only a MAVLink message as recorded (``Command.message``, a tlog) is judged.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Literal
 
 from fuzzoff.events import Command
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.releases import Release
 
 Answer = Literal["handled", "ack_failed", "ignored"]

@@ -10,8 +10,6 @@ until the recording settles it (``resolve``).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from fuzzoff.events import MAV_CMD_COMPONENT_ARM_DISARM, NAV_STATE_OFFBOARD, Command
 from fuzzoff.gate.addressing import Addressing, command_addressing
 from fuzzoff.gate.effective import TERMINATION, EffectiveMode
@@ -27,6 +25,7 @@ from fuzzoff.gate.requests import (
 )
 from fuzzoff.gate.signal import estimate_failure
 from fuzzoff.gate.state import GateState
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.modes import nav_state_name
 
 NO_STREAM_SWITCH = "1.14+: no stream needed while disarmed, checked at arming"

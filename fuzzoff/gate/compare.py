@@ -18,10 +18,9 @@ outcome if armed as ``alternative``: its ack is handed back whatever it says, to
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from fuzzoff.events import Command, CommandAck, VehicleStatus
 from fuzzoff.gate.requests import Decision
+from fuzzoff.lean_dataclass import dataclass
 
 INF = float("inf")
 ACK_WINDOW = 0.1

@@ -7,10 +7,11 @@ Manual control (RC or joystick) starts from the ``FUZZOFF_RC_PRESENT`` assumptio
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 from operator import attrgetter
 
 from fuzzoff.events import ESTIMATES, FailsafeFlags
+from fuzzoff.lean_dataclass import dataclass
 
 _READ = attrgetter(*(name + "_valid" for name in ESTIMATES), "manual_control_signal_lost")
 """Every field of a ``FailsafeFlags`` event that ``Estimates.update`` applies."""

@@ -8,10 +8,11 @@ them are marked ``unverified``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 from fuzzoff.gate.estimates import Estimates
 from fuzzoff.gate.params import RC_PRESENT
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.modes import nav_state_name
 from fuzzoff.releases import Release
 

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any
 
 from fuzzoff.events import (
@@ -23,6 +22,7 @@ from fuzzoff.events import (
 )
 from fuzzoff.gate.estimates import Estimates
 from fuzzoff.gate.ocm import ACCELERATION, ATTITUDE, BODY_RATE, POSITION, VELOCITY
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.releases import Release
 from fuzzoff.type_mask import (
     ACCELERATION_BITS,

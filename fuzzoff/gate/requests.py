@@ -8,8 +8,6 @@ reason, spec, ack result).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from fuzzoff.events import (
     MAV_CMD_DO_SET_MODE,
     NAV_STATE_OFFBOARD,
@@ -18,6 +16,7 @@ from fuzzoff.events import (
     nearest,
     whole,
 )
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.modes import custom_mode_to_nav_state, nav_state_name
 from fuzzoff.releases import Release
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
 
 from fuzzoff.events import NAV_STATE_OFFBOARD, Event, FailsafeFlags, Parameter
@@ -25,6 +25,7 @@ from fuzzoff.gate.receiver import ReceiverContext
 from fuzzoff.gate.signal import INF, LOOP_PERIOD, Signal, UnseenSignal, make_signal, slack
 from fuzzoff.gate.tracker import ControllerTracker
 from fuzzoff.gate.transitions import GateTransition, TransitionKind
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.profiles import Profile
 from fuzzoff.releases import Release
 

@@ -26,11 +26,12 @@ reaches and a step or a swing never satisfies. Where the recording logs PX4's ow
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import field
 
 from fuzzoff.events import NAV_STATE_OFFBOARD, ManualControl
 from fuzzoff.gate.effective import EffectiveMode
 from fuzzoff.gate.state import GateState
+from fuzzoff.lean_dataclass import dataclass
 
 NAV_STATE_POSCTL = 2
 SAME_DIRECTION_SAMPLES = 3

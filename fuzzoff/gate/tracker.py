@@ -8,11 +8,11 @@ text. The tables themselves are in ``controllers``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 from fuzzoff.gate import controllers, ocm
 from fuzzoff.gate.estimates import Estimates
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.modes import nav_state_name
 from fuzzoff.releases import Release
 

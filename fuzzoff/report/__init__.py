@@ -10,12 +10,12 @@ from __future__ import annotations
 
 import importlib
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from fuzzoff.config import Settings
 from fuzzoff.findings import Report
+from fuzzoff.lean_dataclass import dataclass
 
 if TYPE_CHECKING:  # the fuzz extra (Hypothesis) is not needed to lint
     from fuzzoff.fuzz.campaign import CampaignResult

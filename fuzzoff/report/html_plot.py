@@ -15,7 +15,6 @@ import json
 import math
 import re
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
 from typing import Any
 
 from fuzzoff.events import (
@@ -28,6 +27,7 @@ from fuzzoff.events import (
     StatusText,
 )
 from fuzzoff.findings import Finding
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.modes import NAV_STATE_NAMES, custom_mode_to_nav_state, nav_state_name
 from fuzzoff.profiles import Profile
 from fuzzoff.report.sanitize import printable, show_bidi

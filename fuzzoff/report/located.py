@@ -7,10 +7,10 @@ from __future__ import annotations
 import hashlib
 import os
 from collections.abc import Iterator
-from dataclasses import dataclass
 from pathlib import Path
 
 from fuzzoff.findings import FileReport, Finding, Report
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.report.marks import marks
 
 

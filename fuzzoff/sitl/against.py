@@ -38,7 +38,7 @@ import tempfile
 import time
 from collections import Counter
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 from pathlib import Path
 from typing import Any, Literal
 
@@ -48,6 +48,7 @@ from fuzzoff.config import Settings
 from fuzzoff.fuzz import recordings
 from fuzzoff.fuzz.reproducers import save, setup_for
 from fuzzoff.fuzz.scenario import Scenario
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.profiles import px4_profile_for
 from fuzzoff.recording import SourceError
 from fuzzoff.releases import PX4Profile

@@ -8,8 +8,9 @@ builds have an airframe that does not fly, each said here with the reason.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.profiles import ProfileError, vehicle_type_for
 from fuzzoff.sitl import bundle
 

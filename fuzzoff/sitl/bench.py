@@ -18,9 +18,10 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.mavlink_ids import MAV_CMD_COMPONENT_ARM_DISARM
 from fuzzoff.sitl import bundle, replay
 from fuzzoff.sitl.driver import NAV_LAND, NAV_LOITER, Driver

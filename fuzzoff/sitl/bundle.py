@@ -18,8 +18,10 @@ import signal
 import subprocess
 import tempfile
 import time
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
+
+from fuzzoff.lean_dataclass import dataclass
 
 API_LISTEN_PORT = 14580
 """PX4's onboard (API) link listens here (+ instance): where a client sends."""

@@ -17,11 +17,11 @@ from __future__ import annotations
 
 import itertools
 import re
-from dataclasses import dataclass
 
 from fuzzoff import events as ev
 from fuzzoff.fuzz.scenario import Scenario
 from fuzzoff.gate.params import default_params, loss_timeout
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.mavlink_ids import MAV_CMD_COMPONENT_ARM_DISARM
 from fuzzoff.modes import nav_state_name
 from fuzzoff.sitl.truth import Truth

@@ -8,8 +8,9 @@ went out; ``check`` compares those gaps with the stream's own.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
+
+from fuzzoff.lean_dataclass import dataclass
 
 TOLERANCE_S = 0.02
 """A gap may leave this much longer or shorter than meant (the 10 ms Commander loop and the

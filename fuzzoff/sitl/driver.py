@@ -9,8 +9,9 @@ run can say what it did and when.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import field
 
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.mavlink_ids import (
     MAV_CMD_COMPONENT_ARM_DISARM,
     MAV_CMD_DO_VTOL_TRANSITION,

@@ -16,8 +16,10 @@ import struct
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
+
+from fuzzoff.lean_dataclass import dataclass
 
 os.environ.setdefault("MAVLINK20", "1")  # formats.md 7.2: before any pymavlink import
 

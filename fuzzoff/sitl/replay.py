@@ -15,10 +15,11 @@ from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 from typing import Any
 
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.mavlink_ids import MAV_AUTOPILOT_PX4
 from fuzzoff.modes import nav_state_name
 from fuzzoff.recording import SourceError

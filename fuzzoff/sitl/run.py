@@ -12,9 +12,10 @@ The verdict compares what PX4 did with the gate model's prediction for the relea
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.sitl import airframes, bundle, replay
 from fuzzoff.sitl.driver import Driver, Step
 from fuzzoff.sitl.link import COMPANION_SYSID, Link, LinkError

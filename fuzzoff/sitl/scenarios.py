@@ -10,9 +10,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Literal
 
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.mavlink_ids import MAV_FRAME_LOCAL_ENU
 from fuzzoff.sitl.airframes import (  # fw_gate: each build's thrust
     AIRFRAMES,

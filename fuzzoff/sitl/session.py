@@ -12,9 +12,10 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.sitl import bundle
 from fuzzoff.sitl.driver import NAV_LOITER, Driver, Step
 from fuzzoff.sitl.link import Link, LinkError

@@ -6,8 +6,9 @@ PX4 SITL listens on 14580 (+ instance) and sends to 14540: a client sends to 145
 from __future__ import annotations
 
 import socket
-from dataclasses import dataclass
 from typing import Any
+
+from fuzzoff.lean_dataclass import dataclass
 
 
 class TargetError(ValueError):

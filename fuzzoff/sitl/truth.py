@@ -6,12 +6,13 @@ is shifted onto (``fuzzoff.sitl.verdict``). Read with pyulog, only the topics ne
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 from struct import error as struct_error
 
 from pyulog import ULog
 
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.recording import SourceError
 
 TOPICS = [

@@ -18,12 +18,13 @@ Judged, item by item:
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 from typing import Any
 
 from fuzzoff.config import load_settings
 from fuzzoff.gate.params import GATE_PARAMS
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.modes import custom_mode_to_nav_state, nav_state_name
 from fuzzoff.sitl.truth import Mode, Truth, read_tlog, read_truth
 

@@ -10,9 +10,9 @@ gate.md#control-mode (legacy). Everything version-dependent about the declaratio
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass
 
 from fuzzoff.events import FailsafeFlags, LegacyControlMode, SetPositionTargetLocal
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.profiles import Profile
 from fuzzoff.type_mask import (
     ACCELERATION_BITS,

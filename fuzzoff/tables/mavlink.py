@@ -16,8 +16,9 @@ receiver accepts in v1.12-main, so OFB601 can say where the docs and the code di
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.profiles import Profile
 from fuzzoff.type_mask import (
     ACCELERATION_BITS,

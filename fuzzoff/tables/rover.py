@@ -8,7 +8,6 @@ The rover setpoint topics exist from PX4 1.16; before that no page documents the
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 from fuzzoff.events import (
     Event,
@@ -19,6 +18,7 @@ from fuzzoff.events import (
     RoverSteeringSetpoint,
     RoverThrottleSetpoint,
 )
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.profiles import Profile
 
 POSITION = RoverPositionSetpoint.kind

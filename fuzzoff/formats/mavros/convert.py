@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import field
 from math import atan2 as _atan2
 from math import cos as _cos
 from math import sin as _sin
@@ -47,6 +47,7 @@ from fuzzoff.formats.mavros.frames import (
     yaw_enu_to_ned,
     yaw_flu_to_frd,
 )
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.modes import mavros_mode_to_nav_state
 from fuzzoff.recording import POSITION_PERIOD_S, Aside
 from fuzzoff.type_mask import (

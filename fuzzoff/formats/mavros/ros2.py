@@ -8,7 +8,6 @@ they use (``std_msgs``, ``geometry_msgs``) come from rosbags' ROS 2 Humble store
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from functools import cache
 from typing import Any
 
@@ -19,6 +18,7 @@ from fuzzoff.events import Event
 from fuzzoff.formats.mavros.convert import TOPIC_KINDS, Handler, MavrosTopic
 from fuzzoff.formats.mavros.mavros_msgs import mavros_typedefs
 from fuzzoff.formats.typedefs import bounded
+from fuzzoff.lean_dataclass import dataclass
 
 
 @cache

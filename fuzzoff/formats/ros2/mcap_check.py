@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import io
 import zlib
-from dataclasses import dataclass
 from pathlib import Path
 from typing import BinaryIO
 
@@ -25,6 +24,8 @@ from mcap.data_stream import ReadDataStream
 from mcap.opcode import Opcode
 from mcap.records import Channel, ChunkIndex, Footer
 from mcap.stream_reader import StreamReader
+
+from fuzzoff.lean_dataclass import dataclass
 
 MAGIC = b"\x89MCAP0\r\n"
 FOOTER_RECORD = 1 + 8 + 20

@@ -17,7 +17,6 @@ from __future__ import annotations
 import heapq
 import io
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
 from pathlib import Path
 from typing import BinaryIO
 
@@ -29,6 +28,7 @@ from mcap.records import Chunk, ChunkIndex, Message, MessageIndex
 from mcap.stream_reader import get_chunk_data_stream
 
 from fuzzoff.formats.ros2.mcap_stream import MAX_CHUNK_INFLATION
+from fuzzoff.lean_dataclass import dataclass
 
 SHARE = 0.5
 """The indexes are used when the chosen channels hold less than this share of the messages;

@@ -12,9 +12,9 @@ from __future__ import annotations
 
 from bisect import bisect_right
 from collections.abc import Iterator
-from dataclasses import dataclass
 
 from fuzzoff.events import Event
+from fuzzoff.lean_dataclass import dataclass
 
 MAX_PENDING = 8192
 """Events held at most when the file has no chunks to mark boundaries."""

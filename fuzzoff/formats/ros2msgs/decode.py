@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 import struct
-from dataclasses import dataclass, field
+from dataclasses import field
 from functools import cache
 from typing import Any
 
@@ -26,6 +26,7 @@ from fuzzoff.formats.mavros.ros2 import MavrosTopicDecoder
 from fuzzoff.formats.ros2msgs.convert import BUILDERS, KIND_OF, Builder
 from fuzzoff.formats.ros2msgs.topics import MESSAGE_FOR_NAME, OUTPUT_MESSAGES, TopicRef, parse_topic
 from fuzzoff.formats.typedefs import bounded
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.profiles import PX4_VEHICLE_TYPE
 from fuzzoff.recording import Aside, SourceProblem
 

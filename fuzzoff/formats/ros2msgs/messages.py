@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Iterator
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -20,6 +19,7 @@ from fuzzoff import events as ev
 from fuzzoff.formats import px4_msgs
 from fuzzoff.formats.ros2msgs.topics import topic_for
 from fuzzoff.formats.uorb import ARMING_STATE_ARMED, ARMING_STATE_DISARMED, ESTIMATES
+from fuzzoff.lean_dataclass import dataclass
 
 START_NS = 1_700_000_000_000_000_000
 """Recording start (log time of t = 0) used by the writers unless told otherwise."""

@@ -8,9 +8,9 @@ with no version. A namespace is the vehicle: ``""`` for none.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 
 from fuzzoff.formats.uorb import TOPICS
+from fuzzoff.lean_dataclass import dataclass
 
 _UXRCE = re.compile(r"^(?P<ns>/.+?)?/fmu/(?P<dir>in|out)/(?P<name>[a-z0-9_]+?)(?:_v(?P<ver>\d+))?$")
 _RTPS = re.compile(r"^(?P<ns>/.+?)?/fmu/(?P<name>[a-z0-9_]+?)/(?P<dir>in|out)$")

@@ -14,11 +14,13 @@ from __future__ import annotations
 
 import os
 from collections import Counter
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 from typing import Any, BinaryIO
 
 from rosbags.rosbag1.reader import Header, ReaderError, RecordType, read_uint32
+
+from fuzzoff.lean_dataclass import dataclass
 
 MAGIC = b"#ROSBAG V2.0\n"
 BEFORE_INDEX = frozenset({RecordType.CHUNK, RecordType.IDXDATA, RecordType.CONNECTION})

@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -50,6 +49,7 @@ from fuzzoff.formats.mavros.frames import (
     wrap_pi,
 )
 from fuzzoff.formats.mavros.mavros_msgs import mavros_typedefs
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.modes import mavros_mode_to_nav_state, nav_state_to_mavros_mode
 
 DEFAULT_START_NS = 1_735_689_600 * 1_000_000_000

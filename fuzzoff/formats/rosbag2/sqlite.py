@@ -13,9 +13,10 @@ import sqlite3
 import struct
 import tempfile
 from contextlib import closing, suppress
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+
+from fuzzoff.lean_dataclass import dataclass
 
 ENCODINGS = {"ros2msg": "msg", "ros2idl": "idl"}
 

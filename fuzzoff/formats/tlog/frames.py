@@ -41,8 +41,10 @@ import re
 import struct
 from collections import Counter
 from collections.abc import Callable, Iterator, Mapping
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any, BinaryIO
+
+from fuzzoff.lean_dataclass import dataclass
 
 os.environ.setdefault("MAVLINK20", "1")  # formats.md 7.2: before any pymavlink import
 

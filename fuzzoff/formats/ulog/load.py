@@ -36,7 +36,7 @@ import os
 import re
 import struct
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 from typing import Any, BinaryIO
 
@@ -45,6 +45,7 @@ from pyulog import ULog
 from pyulog.core import ULogException
 
 from fuzzoff.formats.ulog.framing import LIMIT, Framed, RowPlan, frame
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.recording import SourceError, SourceProblem
 
 _unpack_header = struct.Struct("<HB").unpack

@@ -16,7 +16,6 @@ from __future__ import annotations
 import contextlib
 import math
 from collections.abc import Callable, Iterable, Iterator, Mapping
-from dataclasses import dataclass
 from itertools import repeat
 from typing import Any, Literal
 
@@ -25,6 +24,7 @@ import numpy as np
 from fuzzoff import events as ev
 from fuzzoff.formats.uorb import ESTIMATES
 from fuzzoff.formats.uorb import TOPICS as UORB_TOPICS
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.modes import nav_state_name
 
 VEHICLE: Literal["vehicle"] = "vehicle"

@@ -13,13 +13,14 @@ from __future__ import annotations
 
 import threading
 from collections.abc import Iterable
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 
 from rosbags.interfaces import Qos
 from rosbags.rosbag2 import StoragePlugin, Writer
 
 from fuzzoff.formats.rosbag2.writer import Storage, _rihs01
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.sitl.ros2.names import BridgeTopic
 
 PLUGINS = {"sqlite3": StoragePlugin.SQLITE3, "mcap": StoragePlugin.MCAP}

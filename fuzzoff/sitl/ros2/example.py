@@ -17,8 +17,9 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any, Protocol
+
+from fuzzoff.lean_dataclass import dataclass
 
 VEHICLE_CMD_NAV_LAND = 21
 VEHICLE_CMD_DO_SET_MODE = 176
@@ -47,6 +48,10 @@ class Plan:
     at once, PX4's agent some 100 ms later, and PX4 never gets the ARM."""
 
 
+DEFAULT_PLAN = Plan()
+"""The official example's flight: hover at 5 m, never stop."""
+
+
 def now_us() -> int:
     """The node's clock (ROS time is the system clock), in µs as px4_msgs timestamps."""
     return time.time_ns() // 1000
@@ -58,7 +63,7 @@ class OffboardControl:
     def __init__(
         self,
         sinks: dict[str, Sink],
-        plan: Plan = Plan(),
+        plan: Plan = DEFAULT_PLAN,
         new_sink: Callable[[str], Sink] | None = None,
     ) -> None:
         """``new_sink(message)``: a new publisher (``Plan.arm_from_new_publisher``)."""

@@ -16,9 +16,9 @@ without unregistering.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
 from typing import Any
 
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.sitl.ros2.example import Sink, now_us
 
 REQUEST_ID = 4711

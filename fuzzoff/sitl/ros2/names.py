@@ -8,10 +8,9 @@ suffix ``_vN`` (PX4's ``src/modules/uxrce_dds_client/dds_topics.yaml`` of the re
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from fuzzoff.formats import px4_msgs
 from fuzzoff.formats.ros2msgs.topics import topic_for
+from fuzzoff.lean_dataclass import dataclass
 
 SENT = ("OffboardControlMode", "TrajectorySetpoint", "VehicleCommand")
 """What px4_ros_com's offboard_control example publishes."""

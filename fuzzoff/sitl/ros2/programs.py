@@ -7,9 +7,9 @@ codes fuzzoff should give. Times count from the node's arm command.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Literal
 
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.sitl.ros2 import rover as r
 from fuzzoff.sitl.ros2 import vtol as v
 from fuzzoff.sitl.ros2.example import Plan

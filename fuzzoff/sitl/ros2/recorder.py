@@ -9,11 +9,12 @@ from __future__ import annotations
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
 
 from cyclonedds.domain import DomainParticipant
 
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.sitl.ros2.bag import Recording
 from fuzzoff.sitl.ros2.dds import RawReader
 from fuzzoff.sitl.ros2.names import BridgeTopic

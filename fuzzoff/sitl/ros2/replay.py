@@ -11,13 +11,13 @@ from __future__ import annotations
 
 import base64
 import json
-from dataclasses import dataclass
 from pathlib import Path
 
 from rosbags.rosbag2 import Reader
 
 from fuzzoff.formats import px4_msgs
 from fuzzoff.formats.ros2msgs.topics import parse_topic
+from fuzzoff.lean_dataclass import dataclass
 
 
 class ReplayError(Exception):

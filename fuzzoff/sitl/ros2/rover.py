@@ -12,9 +12,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
 
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.sitl.ros2.example import (
     PX4_CUSTOM_MAIN_MODE_OFFBOARD,
     SETPOINTS_BEFORE_SWITCH,

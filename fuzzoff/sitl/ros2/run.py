@@ -11,10 +11,11 @@ from __future__ import annotations
 import importlib.util
 import json
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 from typing import Any
 
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.sitl import airframes, bundle
 from fuzzoff.sitl.ros2 import netns, replay
 from fuzzoff.sitl.ros2.programs import PROGRAMS

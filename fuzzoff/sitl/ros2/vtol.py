@@ -19,8 +19,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
 
+from fuzzoff.lean_dataclass import dataclass
 from fuzzoff.sitl.ros2.example import (
     PX4_CUSTOM_MAIN_MODE_OFFBOARD,
     SETPOINTS_BEFORE_SWITCH,
