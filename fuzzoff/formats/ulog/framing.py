@@ -23,6 +23,11 @@ where under half the records could be left out (``WORTH``), and on a data sectio
 Rows dropped leave no trace pyulog would see, but for the times it dates records by: pyulog
 dates a parameter change and a dropout at the latest data timestamp read before it, and the
 log's ``last_timestamp`` is the latest of all; the row that sets each of those is kept.
+
+The plan's ``first`` topics (the status and the declarations) are decoded whole before the
+rest, to plan the thinning; that decode is the one the load keeps (``Framed.first``), so the
+main pass leaves their rows out but for those that date a record, whose decode ``load``
+replaces by the whole one.
 """
 
 from __future__ import annotations
@@ -32,11 +37,12 @@ import mmap
 import struct
 from array import array
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any, Protocol, TypeAlias
 
 import numpy as np
 from pyulog import ULog
+
+from fuzzoff.lean_dataclass import dataclass
 
 _DATA = ord("D")
 _ADD_LOGGED = ord("A")
@@ -93,6 +99,9 @@ class Framed:
     """Records in the data section."""
     kept: int
     """Records handed to pyulog."""
+    first: list[Any]
+    """pyulog's ``Data`` of the plan's ``first`` topics that were read, every row: they take the
+    place of what the main pass decodes of those topics (only rows that date a record)."""
 
 
 def frame(
@@ -175,6 +184,9 @@ def frame(
     thinned = []
     for msg_id, (numbers, ts) in columns.items():
         sub = subscriptions[msg_id][1]
+        if sub.message_name in plan.first:
+            keep[numbers] = False  # decoded whole by ``_first``
+            continue
         rows = plan.rows(sub.message_name, ts)
         if rows is None or len(rows) == len(ts):
             continue
@@ -186,7 +198,8 @@ def frame(
     partial = {key: (ts, np.flatnonzero(keep[numbers])) for key, numbers, ts in thinned}
     kept = np.flatnonzero(keep)
     data = b"".join(_runs(buf, starts[kept], ends[kept]))
-    return Framed(data, partial, last, len(starts), len(kept))
+    read_first = [d for d in first if d.name in names]
+    return Framed(data, partial, last, len(starts), len(kept), read_first)
 
 
 def _walk(buf: Buffer, pos: int) -> tuple[Any, Any, Any, Any] | None:

@@ -287,6 +287,7 @@ class _TrackedULog(ULog):  # type: ignore[misc]
                 self._file_handle = io.BytesIO(framed.data)
                 super()._read_file_data(message_name_filter_list)
                 self._expand(framed)
+                self._take_first(framed)
                 return
         super()._read_file_data(message_name_filter_list, read_until)
 
@@ -332,6 +333,13 @@ class _TrackedULog(ULog):  # type: ignore[misc]
             self.rows_read[key] = rows
         if found != len(framed.partial) or self._last_timestamp != framed.last_timestamp:
             self.framing_failed = True
+
+    def _take_first(self, framed: Framed) -> None:
+        """The framing pass's whole decode of the status and declarations in place of the main
+        pass's (which read only their rows that date a record), in pyulog's order."""
+        taken = {(d.name, d.multi_id) for d in framed.first}
+        kept = [d for d in self._data_list if (d.name, d.multi_id) not in taken]
+        self._data_list[:] = sorted([*kept, *framed.first], key=lambda d: (d.name, d.multi_id))
 
     @property
     def corruption(self) -> _Corruption | None:
