@@ -9,7 +9,7 @@ from typing import Any
 import pytest
 
 from fuzzoff import releases
-from fuzzoff.config import ConfigError, load_settings
+from fuzzoff.config import ConfigError, find_config, load_settings
 from fuzzoff.findings import Severity
 from tests.helpers import CORPORA, run_cli
 
@@ -133,6 +133,31 @@ def test_a_pyproject_that_cannot_be_read_is_an_error_not_skipped(
     assert result.returncode == 2
     assert f"{project / 'pyproject.toml'}: {complaint}" in result.stderr
     assert "Traceback" not in result.stderr
+
+
+@pytest.mark.parametrize(
+    ("content", "found"),
+    [
+        (b'[tool.fuzzoff]\nselect = ["OFB7"]\n', True),
+        (b'[tool."fuzz\\u006Fff"]\nselect = ["OFB7"]\n', True),  # a quoted key with escapes
+        (b'tool.fuzzoff.select = ["OFB7"]\n', True),
+        (b'[tool.ruff]\nline-length = 100\n', False),
+        (b'[project\nname = "not TOML, and no table of ours"\n', False),
+    ],
+)
+def test_a_pyproject_is_a_configuration_only_with_a_fuzzoff_table(
+    tmp_path: Path, content: bytes, found: bool
+) -> None:
+    """A file that cannot name the table is passed by unparsed (issue 31), even when it is not
+    valid TOML: the folder above decides, as for any pyproject.toml without the table."""
+    (tmp_path / "fuzzoff.toml").write_text('select = ["OFB1"]\n')
+    project = tmp_path / "project"
+    project.mkdir()
+    (project / "pyproject.toml").write_bytes(content)
+    expected = project / "pyproject.toml" if found else tmp_path / "fuzzoff.toml"
+    assert find_config(project) == expected
+    prefixes = {code[:4] for code in load_settings(project).select}
+    assert prefixes == ({"OFB7"} if found else {"OFB1"})
 
 
 def test_select_on_the_command_line_overrides_the_files_ignore(tmp_path: Path) -> None:

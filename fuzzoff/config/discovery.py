@@ -6,30 +6,51 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 from pathlib import Path
 from typing import Any
 
 from fuzzoff.config.errors import ConfigError
 from fuzzoff.config.settings import Settings
 from fuzzoff.config.table import load_toml, read_config_table, settings_from_table
+from fuzzoff.lean_dataclass import dataclass
 
 
 def find_config(start: Path) -> Path | None:
     """The nearest fuzzoff.toml, or pyproject.toml with a ``[tool.fuzzoff]`` table.
 
     A pyproject.toml that cannot be read is an error, not skipped: it may hold the table, and
-    a parent folder's settings would silently take its place."""
+    a parent folder's settings would silently take its place. One whose text cannot name the
+    table (``_may_name_fuzzoff``) is passed by unparsed, as if it had no table."""
     for folder in [start, *start.parents]:
         candidate = folder / "fuzzoff.toml"
         if candidate.is_file():
             return candidate
         candidate = folder / "pyproject.toml"
-        if candidate.is_file():
+        if candidate.is_file() and _may_name_fuzzoff(candidate):
             tool = load_toml(candidate).get("tool", {})
             if isinstance(tool, dict) and "fuzzoff" in tool:
                 return candidate
     return None
+
+
+def _may_name_fuzzoff(path: Path) -> bool:
+    """Whether a pyproject.toml's text could hold a ``[tool.fuzzoff]`` table: the key written
+    out, a quoted key spelled with escapes (``"fuzz\\u006Fff"``), or a file that is not UTF-8
+    (``load_toml`` says so: it may be the table in another encoding). Most projects' files
+    are none of these and are not parsed: tomllib's import and parse were some 25 M
+    instructions of every lint run in such a project (issue 31)."""
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise ConfigError(f"{path}: cannot be read: {exc.strerror or exc}") from None
+    if b"fuzzoff" in data or b"\\u" in data or b"\\U" in data:
+        return True
+    try:
+        data.decode("utf-8")
+    except UnicodeDecodeError:
+        return True
+    return False
 
 
 def load_settings(
