@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import inspect
 import math
 import pickle
 from collections.abc import Callable
@@ -75,7 +76,21 @@ def _child(make: Decorator, options: dict[str, Any]) -> type:
     return Child
 
 
-SHAPES = [_plain, _explicit_eq, _explicit_hash, _child]
+def _derived(make: Decorator, options: dict[str, Any]) -> type:
+    @make(**options)
+    class Derived:
+        a: Any
+        items: list[Any] = dataclasses.field(default_factory=list)
+        text: str = dataclasses.field(init=False, default="")
+        seen: list[str] = dataclasses.field(init=False, default_factory=list)
+
+        def __post_init__(self) -> None:
+            object.__setattr__(self, "text", repr(self.a))
+
+    return Derived
+
+
+SHAPES = [_plain, _explicit_eq, _explicit_hash, _child, _derived]
 CASES = [(shape, options) for shape in SHAPES for options in OPTIONS]
 IDS = [f"{shape.__name__}-{'-'.join(options) or 'defaults'}" for shape, options in CASES]
 
@@ -101,7 +116,9 @@ def _hash(obj: Any) -> int | str:
 
 
 @pytest.mark.parametrize(("shape", "options"), CASES, ids=IDS)
-@given(first=st.lists(VALUES, min_size=5, max_size=5), second=st.lists(VALUES, min_size=5, max_size=5))
+@given(
+    first=st.lists(VALUES, min_size=5, max_size=5), second=st.lists(VALUES, min_size=5, max_size=5)
+)
 def test_repr_equality_and_hash_are_the_standard_ones(
     shape: Callable[[Decorator, dict[str, Any]], type],
     options: dict[str, Any],
@@ -144,6 +161,53 @@ def test_frozen_copy_and_pickle_behave_as_the_standard_ones(
         setattr(obj, first, 1)
         assert getattr(obj, first) == 1
     assert dataclasses.replace(obj).__class__ is lean
+
+
+@pytest.mark.parametrize(("shape", "options"), CASES, ids=IDS)
+def test_init_takes_the_standard_parameters_and_fills_every_field(
+    shape: Callable[[Decorator, dict[str, Any]], type], options: dict[str, Any]
+) -> None:
+    standard = shape(dataclasses.dataclass, options)
+    lean = shape(lean_dataclass.dataclass, options)
+
+    def parameters(cls: type) -> list[tuple[str, Any, str]]:
+        params = inspect.signature(cls.__init__).parameters.values()
+        return [(p.name, p.kind, repr(p.default)) for p in params]
+
+    assert parameters(lean) == parameters(standard)
+    first, second = _build(lean, [1.0]), _build(lean, [1.0])
+    assert repr(first) == repr(_build(standard, [1.0]))
+    for f in dataclasses.fields(lean):
+        if f.default_factory is not dataclasses.MISSING:  # a new object for each instance
+            assert getattr(first, f.name) is not getattr(second, f.name)
+    assert lean.__doc__ == standard.__doc__
+
+
+def test_a_field_without_a_default_after_one_with_is_refused_as_by_the_standard() -> None:
+    with pytest.raises(TypeError):
+
+        @lean_dataclass.dataclass(slots=True)
+        class Wrong:
+            a: int = 0
+            b: int  # type: ignore[misc]
+
+
+def test_a_frozen_subclass_keeps_every_field_frozen() -> None:
+    @lean_dataclass.dataclass(frozen=True, slots=True)
+    class Base:
+        a: int
+
+    @lean_dataclass.dataclass(frozen=True, slots=True)
+    class Child(Base):
+        b: int = 2
+
+    child = Child(1)
+    for name in ("a", "b"):
+        with pytest.raises(dataclasses.FrozenInstanceError):
+            setattr(child, name, 5)
+        with pytest.raises(dataclasses.FrozenInstanceError):
+            delattr(child, name)
+    assert (child.a, child.b) == (1, 2) and copy.copy(child) == child
 
 
 def test_a_pickled_instance_comes_back_equal() -> None:

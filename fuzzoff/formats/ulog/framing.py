@@ -124,7 +124,8 @@ def frame(
         return None
     data_at = np.flatnonzero(is_data)
     data_starts = starts[data_at]
-    ids = u8[data_starts + 3].astype(np.int32) | (u8[data_starts + 4].astype(np.int32) << 8)
+    # 16 bits, as the format has them: numpy's stable sort of them below is a radix sort
+    ids = u8[data_starts + 3].astype(np.uint16) | (u8[data_starts + 4].astype(np.uint16) << 8)
     del data_starts
     subscriptions = _subscriptions(buf, starts, kinds, sizes, formats)
     if subscriptions is None:
@@ -172,8 +173,10 @@ def frame(
     read[numbers] = True
     columns: dict[int, tuple[Any, Any]] = {}  # msg id -> (record numbers, timestamps)
     order = np.argsort(ids, kind="stable")
-    found, first_at = np.unique(ids[order], return_index=True)
-    bounds = [*first_at.tolist(), len(order)]
+    in_order = ids[order]
+    first_at = np.flatnonzero(in_order[1:] != in_order[:-1]) + 1
+    bounds = [0, *first_at.tolist(), len(order)] if len(order) else [0]
+    found = in_order[bounds[:-1]]
     for k, msg_id in enumerate(found.tolist()):
         rows = order[bounds[k] : bounds[k + 1]]
         columns[msg_id] = (numbers[rows], ts[rows])
