@@ -131,13 +131,15 @@ def frame(
     if subscriptions is None:
         return None
     # per message id: where its subscription is, the payload sizes pyulog accepts, where the
-    # timestamp is, and whether the topic is read (tables indexed by the id)
-    where = np.full(1 << 16, len(starts), dtype=np.int64)
-    smallest = np.zeros(1 << 16, dtype=np.int64)
-    largest = np.zeros(1 << 16, dtype=np.int64)
-    offset = np.zeros(1 << 16, dtype=np.int64)
-    wanted = np.zeros(1 << 16, dtype=bool)
-    may_leave = np.ones(1 << 16, dtype=bool)
+    # timestamp is, and whether the topic is read (tables indexed by the id, as long as the
+    # largest id found: PX4 numbers its subscriptions from 0)
+    size = max([int(ids.max()) if len(ids) else 0, *subscriptions]) + 1
+    where = np.full(size, len(starts), dtype=np.int64)
+    smallest = np.zeros(size, dtype=np.int64)
+    largest = np.zeros(size, dtype=np.int64)
+    offset = np.zeros(size, dtype=np.int64)
+    wanted = np.zeros(size, dtype=bool)
+    may_leave = np.ones(size, dtype=bool)
     names = set(topics)
     for msg_id, (at, sub) in subscriptions.items():
         where[msg_id] = at
