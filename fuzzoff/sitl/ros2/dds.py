@@ -132,7 +132,7 @@ def _struct(message: str, dds_type: str, fields: dict[str, Any]) -> Any:
         {"typename": dds_type},
         lambda ns: ns.update({"__annotations__": fields}),
     )
-    return dataclasses.dataclass(cls)
+    return dataclasses.dataclass(cls)  # noqa: TID251 (cyclonedds reads the standard one's fields)
 
 
 @cache
