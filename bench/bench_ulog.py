@@ -247,9 +247,12 @@ def main() -> None:
 def _real_verdict(path: Path) -> None:
     """The issue-31 target on the real-shaped log, from paired rounds (see ``paired``)."""
     bare_run, lint_run, wall, cpu = paired(path)
+    # Issue 31 measures CPU time, whole process, as a user meets it. pyulog's process spends
+    # CPU beside its main thread (numpy's OpenBLAS threads spin at start; a lint keeps them to
+    # one), so its wall time is the other figure to read: shown, not judged.
     print(
-        f"lint / pyulog everything (real, 10 min) <= 1.0x      {wall:7.2f}x ({cpu:5.2f}x)   "
-        f"{wall <= 1.0}"
+        f"lint / pyulog everything (real, 10 min) <= 1.0x CPU  {cpu:7.2f}x CPU ({wall:5.2f}x "
+        f"wall)   {cpu <= 1.0}"
     )
     print(
         f"  (real-10min, medians of {PAIRED_RUNS} paired rounds: pyulog everything "
