@@ -141,7 +141,7 @@ def test_a_pyproject_that_cannot_be_read_is_an_error_not_skipped(
         (b'[tool.fuzzoff]\nselect = ["OFB7"]\n', True),
         (b'[tool."fuzz\\u006Fff"]\nselect = ["OFB7"]\n', True),  # a quoted key with escapes
         (b'tool.fuzzoff.select = ["OFB7"]\n', True),
-        (b'[tool.ruff]\nline-length = 100\n', False),
+        (b"[tool.ruff]\nline-length = 100\n", False),
         (b'[project\nname = "not TOML, and no table of ours"\n', False),
     ],
 )
