@@ -12,7 +12,13 @@ from typing import Any
 
 from fuzzoff.config.errors import ConfigError
 from fuzzoff.config.settings import Settings
-from fuzzoff.config.table import load_toml, read_config_table, settings_from_table
+from fuzzoff.config.table import (
+    load_toml,
+    parse_toml,
+    read_config_table,
+    settings_from_table,
+    toml_text,
+)
 from fuzzoff.lean_dataclass import dataclass
 
 
@@ -27,30 +33,22 @@ def find_config(start: Path) -> Path | None:
         if candidate.is_file():
             return candidate
         candidate = folder / "pyproject.toml"
-        if candidate.is_file() and _may_name_fuzzoff(candidate):
-            tool = load_toml(candidate).get("tool", {})
+        if not candidate.is_file():
+            continue
+        text = toml_text(candidate)
+        if _may_name_fuzzoff(text):
+            tool = parse_toml(text, candidate).get("tool", {})
             if isinstance(tool, dict) and "fuzzoff" in tool:
                 return candidate
     return None
 
 
-def _may_name_fuzzoff(path: Path) -> bool:
+def _may_name_fuzzoff(text: str) -> bool:
     """Whether a pyproject.toml's text could hold a ``[tool.fuzzoff]`` table: the key written
-    out, a quoted key spelled with escapes (``"fuzz\\u006Fff"``), or a file that is not UTF-8
-    (``load_toml`` says so: it may be the table in another encoding). Most projects' files
-    are none of these and are not parsed: tomllib's import and parse were some 25 M
-    instructions of every lint run in such a project (issue 31)."""
-    try:
-        data = path.read_bytes()
-    except OSError as exc:
-        raise ConfigError(f"{path}: cannot be read: {exc.strerror or exc}") from None
-    if b"fuzzoff" in data or b"\\u" in data or b"\\U" in data:
-        return True
-    try:
-        data.decode("utf-8")
-    except UnicodeDecodeError:
-        return True
-    return False
+    out, or a quoted key spelled with escapes (``"fuzz\\u006Fff"``). Most projects' files do
+    neither and are not parsed: tomllib's import and parse were some 25 M instructions of every
+    lint run in such a project (issue 31)."""
+    return "fuzzoff" in text or "\\u" in text or "\\U" in text
 
 
 def load_settings(

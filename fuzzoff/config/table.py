@@ -98,17 +98,27 @@ def user_vehicle_type(text: str) -> str:
 
 
 def load_toml(path: Path) -> dict[str, Any]:
-    import tomllib  # only where a configuration file is found
+    return parse_toml(toml_text(path), path)
 
+
+def toml_text(path: Path) -> str:
+    """A TOML file's text: one that cannot be read or is not UTF-8 is a ``ConfigError``."""
     try:
-        with path.open("rb") as fh:
-            return tomllib.load(fh)
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{path}: not valid TOML: {exc}") from None
+        return path.read_bytes().decode("utf-8")
     except UnicodeDecodeError as exc:
         raise ConfigError(f"{path}: not UTF-8 text (byte {exc.start}), as TOML must be") from None
     except OSError as exc:
         raise ConfigError(f"{path}: cannot be read: {exc.strerror or exc}") from None
+
+
+def parse_toml(text: str, path: Path) -> dict[str, Any]:
+    """``text`` (read from ``path``) as TOML; not valid TOML is a ``ConfigError``."""
+    import tomllib  # only where a configuration file is found
+
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{path}: not valid TOML: {exc}") from None
 
 
 def read_config_table(path: Path) -> dict[str, Any]:
